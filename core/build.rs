@@ -1,0 +1,67 @@
+//! Computes the build identifier that plugins are checked against.
+//!
+//! Rust has no stable ABI: a plugin is only safe to call when it was compiled from the very
+//! same core sources, by the same rustc, for the same target and with the same code-generation
+//! settings as the host. The identifier hashes all of those, so a stale plugin is refused at
+//! load time instead of crashing.
+
+use std::collections::hash_map::DefaultHasher;
+use std::hash::{Hash, Hasher};
+use std::path::Path;
+use std::process::Command;
+
+fn hash_dir(dir: &Path, hasher: &mut DefaultHasher) {
+    let mut entries: Vec<_> = std::fs::read_dir(dir)
+        .expect("core/src is readable")
+        .map(|e| e.expect("directory entry").path())
+        .collect();
+    entries.sort();
+    for path in entries {
+        if path.is_dir() {
+            hash_dir(&path, hasher);
+        } else {
+            path.file_name().hash(hasher);
+            std::fs::read(&path)
+                .expect("source file is readable")
+                .hash(hasher);
+        }
+    }
+}
+
+fn main() {
+    let manifest = std::env::var("CARGO_MANIFEST_DIR").unwrap();
+    let manifest = Path::new(&manifest);
+    let rustc = std::env::var("RUSTC").unwrap_or_else(|_| "rustc".into());
+    let rustc_version = Command::new(&rustc)
+        .arg("--version")
+        .output()
+        .ok()
+        .and_then(|o| String::from_utf8(o.stdout).ok())
+        .map(|s| s.trim().to_string())
+        .unwrap_or_else(|| "unknown rustc".into());
+
+    let mut hasher = DefaultHasher::new();
+    hash_dir(&manifest.join("src"), &mut hasher);
+    std::fs::read(manifest.join("Cargo.toml"))
+        .unwrap()
+        .hash(&mut hasher);
+    rustc_version.hash(&mut hasher);
+    for var in [
+        "TARGET",
+        "PROFILE",
+        "OPT_LEVEL",
+        "DEBUG",
+        "CARGO_CFG_PANIC",
+        "CARGO_CFG_TARGET_FEATURE",
+    ] {
+        std::env::var(var).unwrap_or_default().hash(&mut hasher);
+    }
+    let profile = std::env::var("PROFILE").unwrap_or_default();
+    println!(
+        "cargo:rustc-env=FOTON_BUILD_ID={:016x}-{profile}",
+        hasher.finish()
+    );
+    println!("cargo:rustc-env=FOTON_RUSTC_VERSION={rustc_version}");
+    println!("cargo:rerun-if-changed=src");
+    println!("cargo:rerun-if-changed=Cargo.toml");
+}

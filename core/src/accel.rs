@@ -1,0 +1,83 @@
+//! One BVH over every primitive in the scene (obvhs' compressed wide BVH8).
+
+use crate::geometry::{Hit, Primitive, Ray};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::ray::{Ray as BvhRay, RayHit};
+
+pub struct Accel {
+    bvh: Option<CwBvh>,
+    /// Primitives in BVH leaf order, so a traversal id indexes them directly.
+    prims: Vec<Primitive>,
+}
+
+impl Accel {
+    pub fn build(prims: Vec<Primitive>) -> Accel {
+        if prims.is_empty() {
+            return Accel { bvh: None, prims };
+        }
+        let aabbs: Vec<Aabb> = prims.iter().map(|p| p.shape.aabb()).collect();
+        let bvh = build_cwbvh(
+            &aabbs,
+            BvhBuildParams::medium_build(),
+            &mut std::time::Duration::default(),
+        );
+        let ordered = bvh
+            .primitive_indices
+            .iter()
+            .map(|&i| prims[i as usize])
+            .collect();
+        Accel {
+            bvh: Some(bvh),
+            prims: ordered,
+        }
+    }
+
+    pub fn primitives(&self) -> &[Primitive] {
+        &self.prims
+    }
+
+    /// Closest intersection with t in (0, tmax).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
+        let bvh = self.bvh.as_ref()?;
+        let bray = BvhRay::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+        let mut hit = RayHit::none();
+        let found = bvh.ray_traverse(bray, &mut hit, |r, id| {
+            self.prims[id]
+                .shape
+                .intersect(ray, r.tmax)
+                .unwrap_or(f32::INFINITY)
+        });
+        if !found {
+            return None;
+        }
+        let prim = &self.prims[hit.primitive_id as usize];
+        let p = ray.at(hit.t);
+        Some(Hit {
+            t: hit.t,
+            p,
+            ng: prim.shape.normal(p),
+            prim: hit.primitive_id,
+        })
+    }
+
+    /// Whether any primitive accepted by `blocks` lies on the ray within (0, tmax). Stops at the
+    /// first such hit (shadow rays need no closest hit).
+    #[inline]
+    pub fn occluded(&self, ray: &Ray, tmax: f32, blocks: impl Fn(&Primitive) -> bool) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let bray = BvhRay::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+        !bvh.ray_traverse_miss(bray, |r, id| {
+            let prim = &self.prims[id];
+            if !blocks(prim) {
+                return f32::INFINITY;
+            }
+            prim.shape.intersect(ray, r.tmax).unwrap_or(f32::INFINITY)
+        })
+    }
+}

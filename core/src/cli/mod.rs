@@ -1,0 +1,434 @@
+//! The `foton` command: `render`, `check`, `plugins`, `bench`.
+//!
+//! A thin layer: parse arguments (clap), load the scene, find the plugin, run it, write the
+//! image. Errors are turned into messages here, once.
+
+mod progress;
+
+use crate::error::{Error, Result};
+use crate::film::{Film, check_output};
+use crate::integrator::{Integrator, RenderContext};
+use crate::plugin::{Registry, search_path};
+use crate::scene::Scene;
+use clap::{Args, Parser, Subcommand};
+pub use progress::TermProgress;
+use std::ffi::OsString;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
+
+/// Set by Ctrl-C; a running render stops and writes what it has.
+pub static INTERRUPTED: AtomicBool = AtomicBool::new(false);
+
+/// Makes Ctrl-C stop the render instead of the process (a second Ctrl-C still ends it).
+pub fn install_interrupt_handler() {
+    let _ = ctrlc::set_handler(|| {
+        if INTERRUPTED.swap(true, Ordering::SeqCst) {
+            std::process::exit(130);
+        }
+    });
+}
+
+#[derive(Parser)]
+#[command(
+    name = "foton",
+    version,
+    about = "foton: a physically based renderer whose integrators are plugins",
+    long_about = "foton renders a scene described in one TOML file (see docs/scene-format.md) with \
+                  the integrator plugin the file, or --integrator, names."
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Render a scene to an image (.exr linear float32 or .png sRGB).
+    Render(RenderArgs),
+    /// Parse and validate a scene; list what it uses and any unused field.
+    Check(CheckArgs),
+    /// List the plugins found on the plugin search path.
+    Plugins(PluginArgs),
+    /// Render a scene several times and report samples per second (a benchmark, not a test).
+    Bench(BenchArgs),
+}
+
+#[derive(Args, Clone, Default)]
+struct PluginArgs {
+    /// Look for plugins in DIR first (repeatable); then FOTON_PLUGIN_PATH, then the folder of
+    /// the foton executable and its plugins/ subfolder.
+    #[arg(long = "plugin-dir", value_name = "DIR")]
+    plugin_dirs: Vec<PathBuf>,
+}
+
+#[derive(Args, Clone, Default)]
+struct SceneArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// Use this integrator plugin instead of the scene's render.integrator.
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Samples per pixel (overrides render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Override any scene value by its dotted TOML key path, e.g. --set render.spp=16
+    /// --set integrators.photon.k=100 (repeatable).
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    sets: Vec<String>,
+    /// Treat unknown (unused) scene fields and integrator parameters as errors.
+    #[arg(long)]
+    strict: bool,
+    #[command(flatten)]
+    plugins: PluginArgs,
+}
+
+#[derive(Args)]
+struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image (.exr or .png); default: film.output, relative to the scene file.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Worker threads (default: all cores). The image does not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+}
+
+#[derive(Args)]
+struct CheckArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+}
+
+#[derive(Args)]
+struct BenchArgs {
+    /// The scene to render (default: scenes/cornell-box.toml).
+    #[arg(default_value = "scenes/cornell-box.toml")]
+    scene: PathBuf,
+    #[arg(long)]
+    integrator: Option<String>,
+    #[arg(long)]
+    spp: Option<u32>,
+    #[arg(long)]
+    threads: Option<usize>,
+    /// Number of timed renders (the best is reported).
+    #[arg(long, default_value_t = 3)]
+    repeat: u32,
+    #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
+    sets: Vec<String>,
+    #[command(flatten)]
+    plugins: PluginArgs,
+}
+
+/// Runs the command line `args` (args[0] is the program name); returns the exit code.
+pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 {
+    let cli = match Cli::try_parse_from(args) {
+        Ok(cli) => cli,
+        Err(e) => {
+            let text = e.render().ansi().to_string();
+            if e.use_stderr() {
+                let _ = write!(err, "{text}");
+            } else {
+                let _ = write!(out, "{text}");
+            }
+            return e.exit_code().clamp(0, 255) as u8;
+        }
+    };
+    let result = match cli.command {
+        Command::Render(a) => cmd_render(a, out, err),
+        Command::Check(a) => cmd_check(a, out, err),
+        Command::Plugins(a) => cmd_plugins(a, out),
+        Command::Bench(a) => cmd_bench(a, out, err),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            let _ = writeln!(err, "error: {e}");
+            1
+        }
+    }
+}
+
+/// A scene ready to render: loaded, its integrator found and created.
+pub struct Prepared {
+    pub scene: Scene,
+    pub integrator: Box<dyn Integrator>,
+    pub warnings: Vec<String>,
+}
+
+fn scene_overrides(a: &SceneArgs) -> Vec<String> {
+    let mut sets = a.sets.clone();
+    if let Some(name) = &a.integrator {
+        sets.push(format!("render.integrator={name:?}"));
+    }
+    if let Some(spp) = a.spp {
+        sets.push(format!("render.spp={spp}"));
+    }
+    if let Some(seed) = a.seed {
+        sets.push(format!("render.seed={seed}"));
+    }
+    sets
+}
+
+/// Loads a scene and creates its integrator from the plugin search path.
+pub fn prepare(
+    scene_path: &Path,
+    overrides: &[String],
+    plugin_dirs: &[PathBuf],
+    strict: bool,
+) -> Result<Prepared> {
+    let scene = Scene::load(scene_path, overrides)?;
+    let registry = Registry::discover(&search_path(plugin_dirs));
+    let plugin = registry.integrator(&scene.render.integrator)?;
+    let props = scene.integrator_properties(&scene.render.integrator)?;
+    let integrator = plugin.create(&props, &scene)?;
+    let mut unused = scene.unused.clone();
+    unused.extend(props.unused());
+    drop(props);
+    if strict && let Some((key, loc)) = unused.first() {
+        return Err(Error::Scene {
+            location: loc.clone(),
+            key: key.clone(),
+            message: "unknown field (not used by the scene loader or the integrator)".into(),
+        });
+    }
+    let mut warnings = scene.warnings.clone();
+    warnings.extend(
+        unused
+            .iter()
+            .map(|(key, loc)| format!("{loc}: `{key}`: unknown field, ignored")),
+    );
+    Ok(Prepared {
+        scene,
+        integrator,
+        warnings,
+    })
+}
+
+fn threads(requested: Option<usize>) -> usize {
+    requested.unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
+}
+
+/// Renders a prepared scene on `threads` threads.
+pub fn render_prepared(
+    p: &Prepared,
+    threads: usize,
+    progress: &TermProgress,
+) -> Result<(Film, Duration)> {
+    let ctx = RenderContext {
+        threads,
+        cancel: &INTERRUPTED,
+        progress,
+    };
+    let start = Instant::now();
+    let film = p.integrator.render(&p.scene, &ctx)?;
+    Ok((film, start.elapsed()))
+}
+
+fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let overrides = scene_overrides(&a.scene);
+    let p = prepare(
+        &a.scene.scene,
+        &overrides,
+        &a.scene.plugins.plugin_dirs,
+        a.scene.strict,
+    )?;
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| p.scene.film.output.clone());
+    check_output(&output)?;
+    for w in &p.warnings {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    let progress = TermProgress::new(a.quiet);
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let threads = threads(a.threads);
+    let (film, elapsed) = render_prepared(&p, threads, &progress)?;
+    for w in progress.take_warnings() {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    film.write(&output)?;
+    let samples = film.total_samples();
+    let secs = elapsed.as_secs_f64();
+    let _ = writeln!(
+        out,
+        "{}: {}x{}, {} samples in {:.2} s ({:.2} M samples/s, {} threads) with {} -> {}",
+        p.scene.file.display(),
+        film.width,
+        film.height,
+        samples,
+        secs,
+        samples as f64 / secs.max(1e-9) / 1e6,
+        threads,
+        p.integrator.describe(),
+        output.display()
+    );
+    if INTERRUPTED.load(Ordering::SeqCst) {
+        let full = film.width as u64 * film.height as u64 * p.scene.render.spp as u64;
+        let _ = writeln!(
+            err,
+            "interrupted: wrote the image of the {samples} of {full} samples done so far"
+        );
+        return Ok(130);
+    }
+    Ok(0)
+}
+
+fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let overrides = scene_overrides(&a.scene);
+    let p = prepare(
+        &a.scene.scene,
+        &overrides,
+        &a.scene.plugins.plugin_dirs,
+        a.scene.strict,
+    )?;
+    let s = &p.scene;
+    let _ = writeln!(out, "scene      {}", s.file.display());
+    let _ = writeln!(out, "integrator {}", p.integrator.describe());
+    let _ = writeln!(
+        out,
+        "render     {}x{}, {} spp, seed {}, max_depth {} -> {}",
+        s.film.width,
+        s.film.height,
+        s.render.spp,
+        s.render.seed,
+        s.render.max_depth,
+        s.film.output.display()
+    );
+    let names = |v: Vec<&str>| {
+        if v.is_empty() {
+            "-".to_string()
+        } else {
+            v.join(", ")
+        }
+    };
+    let _ = writeln!(
+        out,
+        "materials  {}",
+        names(s.materials.iter().map(|m| m.name.as_str()).collect())
+    );
+    let _ = writeln!(
+        out,
+        "media      {}",
+        names(s.media.iter().map(|m| m.name.as_str()).collect())
+    );
+    let _ = writeln!(
+        out,
+        "shapes     {} ({} primitives)",
+        s.objects.len(),
+        s.accel.primitives().len()
+    );
+    let points = s.lights.iter().filter(|l| l.is_delta()).count();
+    let power = s.total_power();
+    let _ = writeln!(
+        out,
+        "lights     {} point, {} area; total power [{:.4}, {:.4}, {:.4}] W",
+        points,
+        s.lights.len() - points,
+        power.x,
+        power.y,
+        power.z
+    );
+    for w in &p.warnings {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    let _ = writeln!(out, "ok");
+    Ok(0)
+}
+
+fn cmd_plugins(a: PluginArgs, out: &mut dyn Write) -> Result<u8> {
+    let dirs = search_path(&a.plugin_dirs);
+    let reg = Registry::discover(&dirs);
+    let _ = writeln!(
+        out,
+        "{:<12} {:<11} {:<40} file",
+        "name", "kind", "description"
+    );
+    for p in &reg.integrators {
+        let _ = writeln!(
+            out,
+            "{:<12} {:<11} {:<40} {}",
+            p.name,
+            "integrator",
+            p.description,
+            p.file.display()
+        );
+    }
+    for k in &reg.kernels {
+        let _ = writeln!(
+            out,
+            "{:<12} {:<11} {:<40} {}",
+            k.name,
+            "kernel",
+            "",
+            k.file.display()
+        );
+    }
+    let _ = writeln!(
+        out,
+        "\nfoton-core {}, plugin API {}, {}, build {}",
+        crate::CORE_VERSION,
+        crate::plugin::PLUGIN_API_VERSION,
+        crate::RUSTC_VERSION,
+        crate::BUILD_ID
+    );
+    let shown: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
+    let _ = writeln!(out, "search path: {}", shown.join(":"));
+    for p in &reg.problems {
+        let _ = writeln!(out, "skipped: {}", p.message);
+    }
+    Ok(0)
+}
+
+fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let args = SceneArgs {
+        scene: a.scene.clone(),
+        integrator: a.integrator.clone(),
+        spp: a.spp,
+        sets: a.sets.clone(),
+        plugins: a.plugins.clone(),
+        ..Default::default()
+    };
+    let p = prepare(
+        &a.scene,
+        &scene_overrides(&args),
+        &a.plugins.plugin_dirs,
+        false,
+    )?;
+    for w in &p.warnings {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    let threads = threads(a.threads);
+    let progress = TermProgress::new(true);
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let mut best = f64::INFINITY;
+    let mut samples = 0;
+    for i in 0..a.repeat.max(1) {
+        let (film, t) = render_prepared(&p, threads, &progress)?;
+        samples = film.total_samples();
+        let _ = writeln!(out, "run {}: {:.3} s", i + 1, t.as_secs_f64());
+        best = best.min(t.as_secs_f64());
+    }
+    let _ = writeln!(
+        out,
+        "{} with {}: {}x{} x {} spp, {} threads: best {:.3} s, {:.3} M samples/s",
+        a.scene.display(),
+        p.integrator.describe(),
+        p.scene.film.width,
+        p.scene.film.height,
+        p.scene.render.spp,
+        threads,
+        best,
+        samples as f64 / best / 1e6
+    );
+    Ok(0)
+}

@@ -1,0 +1,273 @@
+//! Rays and the three kinds of primitive: analytic spheres and parallelograms ("quads"), and
+//! triangles from meshes. Each primitive knows its orientation: the geometric normal is the
+//! outward normal for spheres, normalize(u x v) for quads and normalize(e1 x e2) for triangles.
+
+use glam::{Vec2, Vec3};
+use obvhs::aabb::Aabb;
+
+#[derive(Clone, Copy, Debug)]
+pub struct Ray {
+    pub origin: Vec3,
+    /// Unit length.
+    pub dir: Vec3,
+}
+
+impl Ray {
+    pub fn new(origin: Vec3, dir: Vec3) -> Self {
+        Ray { origin, dir }
+    }
+    pub fn at(&self, t: f32) -> Vec3 {
+        self.origin + self.dir * t
+    }
+}
+
+/// Pushes a point off a surface along its normal, to the side `dir` leaves towards, so that a
+/// ray spawned there does not hit the surface it starts on. Scaled with the point's magnitude
+/// because f32 spacing grows with it.
+#[inline]
+pub fn offset_origin(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
+    let eps = 1e-4 * (1.0 + p.abs().max_element());
+    if n.dot(dir) >= 0.0 {
+        p + n * eps
+    } else {
+        p - n * eps
+    }
+}
+
+#[derive(Clone, Copy, Debug)]
+pub enum Shape {
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    /// origin + s u + t v, s, t in [0, 1]. `w` = n / (n . n) with n = u x v (for the
+    /// barycentric-style coordinates of a hit), `normal` = normalize(n).
+    Quad {
+        origin: Vec3,
+        u: Vec3,
+        v: Vec3,
+        w: Vec3,
+        normal: Vec3,
+    },
+    Triangle {
+        p0: Vec3,
+        e1: Vec3,
+        e2: Vec3,
+    },
+}
+
+/// A shape instance in the scene: geometry plus the index of the scene object it belongs to
+/// (material, emission, interior medium).
+#[derive(Clone, Copy, Debug)]
+pub struct Primitive {
+    pub shape: Shape,
+    pub object: u32,
+}
+
+/// A ray-surface intersection.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit {
+    pub t: f32,
+    pub p: Vec3,
+    /// Unit geometric normal with the primitive's own orientation (not flipped towards the ray).
+    pub ng: Vec3,
+    pub prim: u32,
+}
+
+impl Shape {
+    pub fn quad(origin: Vec3, u: Vec3, v: Vec3) -> Shape {
+        let n = u.cross(v);
+        Shape::Quad {
+            origin,
+            u,
+            v,
+            w: n / n.dot(n),
+            normal: n.normalize(),
+        }
+    }
+
+    pub fn aabb(&self) -> Aabb {
+        let (lo, hi) = match *self {
+            Shape::Sphere { center, radius } => {
+                (center - Vec3::splat(radius), center + Vec3::splat(radius))
+            }
+            Shape::Quad { origin, u, v, .. } => {
+                let pts = [origin, origin + u, origin + v, origin + u + v];
+                bounds(&pts)
+            }
+            Shape::Triangle { p0, e1, e2 } => bounds(&[p0, p0 + e1, p0 + e2]),
+        };
+        // Pad flat boxes: an axis-aligned quad has zero thickness.
+        let pad = Vec3::splat(1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element()));
+        Aabb::new((lo - pad).into(), (hi + pad).into())
+    }
+
+    pub fn area(&self) -> f32 {
+        match *self {
+            Shape::Sphere { radius, .. } => 4.0 * std::f32::consts::PI * radius * radius,
+            Shape::Quad { u, v, .. } => u.cross(v).length(),
+            Shape::Triangle { e1, e2, .. } => 0.5 * e1.cross(e2).length(),
+        }
+    }
+
+    /// Distance along the ray to the nearest intersection in (0, tmax), or None.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<f32> {
+        match *self {
+            Shape::Sphere { center, radius } => {
+                // Numerically careful form (Ray Tracing Gems ch. 7): avoids cancellation for
+                // distant or small spheres.
+                let f = ray.origin - center;
+                let b = -f.dot(ray.dir);
+                let l = f + b * ray.dir;
+                let disc = radius * radius - l.dot(l);
+                if disc < 0.0 {
+                    return None;
+                }
+                let c = f.dot(f) - radius * radius;
+                let q = b + b.signum() * disc.sqrt();
+                if q == 0.0 {
+                    return None;
+                }
+                let (mut t0, mut t1) = (c / q, q);
+                if t0 > t1 {
+                    std::mem::swap(&mut t0, &mut t1);
+                }
+                if t0 > 0.0 && t0 < tmax {
+                    Some(t0)
+                } else if t1 > 0.0 && t1 < tmax {
+                    Some(t1)
+                } else {
+                    None
+                }
+            }
+            Shape::Quad {
+                origin,
+                u,
+                v,
+                w,
+                normal,
+            } => {
+                let denom = normal.dot(ray.dir);
+                if denom.abs() < 1e-12 {
+                    return None;
+                }
+                let t = normal.dot(origin - ray.origin) / denom;
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = ray.at(t) - origin;
+                let a = w.dot(q.cross(v));
+                let b = w.dot(u.cross(q));
+                ((0.0..=1.0).contains(&a) && (0.0..=1.0).contains(&b)).then_some(t)
+            }
+            Shape::Triangle { p0, e1, e2 } => {
+                // Moeller-Trumbore.
+                let pvec = ray.dir.cross(e2);
+                let det = e1.dot(pvec);
+                if det.abs() < 1e-12 {
+                    return None;
+                }
+                let inv = 1.0 / det;
+                let tvec = ray.origin - p0;
+                let b1 = tvec.dot(pvec) * inv;
+                if !(0.0..=1.0).contains(&b1) {
+                    return None;
+                }
+                let qvec = tvec.cross(e1);
+                let b2 = ray.dir.dot(qvec) * inv;
+                if b2 < 0.0 || b1 + b2 > 1.0 {
+                    return None;
+                }
+                let t = e2.dot(qvec) * inv;
+                (t > 0.0 && t < tmax).then_some(t)
+            }
+        }
+    }
+
+    /// Unit geometric normal at a point on the surface.
+    #[inline]
+    pub fn normal(&self, p: Vec3) -> Vec3 {
+        match *self {
+            Shape::Sphere { center, .. } => (p - center).normalize(),
+            Shape::Quad { normal, .. } => normal,
+            Shape::Triangle { e1, e2, .. } => e1.cross(e2).normalize(),
+        }
+    }
+
+    /// A point distributed uniformly by area, and the normal there.
+    #[inline]
+    pub fn sample_area(&self, u: Vec2) -> (Vec3, Vec3) {
+        match *self {
+            Shape::Sphere { center, radius } => {
+                let d = crate::sampling::uniform_sphere(u);
+                (center + radius * d, d)
+            }
+            Shape::Quad {
+                origin,
+                u: eu,
+                v: ev,
+                normal,
+                ..
+            } => (origin + u.x * eu + u.y * ev, normal),
+            Shape::Triangle { p0, e1, e2 } => {
+                let (b1, b2) = crate::sampling::uniform_triangle(u);
+                (p0 + b1 * e1 + b2 * e2, e1.cross(e2).normalize())
+            }
+        }
+    }
+}
+
+fn bounds(pts: &[Vec3]) -> (Vec3, Vec3) {
+    pts.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), &p| (lo.min(p), hi.max(p)),
+    )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quad_hit_and_miss() {
+        let q = Shape::quad(
+            Vec3::new(-1.0, 0.0, -1.0),
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 2.0),
+        );
+        let down = Ray::new(Vec3::new(0.2, 1.0, 0.3), Vec3::NEG_Y);
+        assert!((q.intersect(&down, f32::INFINITY).unwrap() - 1.0).abs() < 1e-6);
+        let outside = Ray::new(Vec3::new(1.5, 1.0, 0.0), Vec3::NEG_Y);
+        assert!(q.intersect(&outside, f32::INFINITY).is_none());
+        assert!(q.intersect(&down, 0.5).is_none());
+        // u x v = (2,0,0) x (0,0,2) = (0,-4,0): the normal points down.
+        assert!((q.normal(Vec3::ZERO) - Vec3::NEG_Y).length() < 1e-6);
+    }
+
+    #[test]
+    fn sphere_hits_from_outside_and_inside() {
+        let s = Shape::Sphere {
+            center: Vec3::ZERO,
+            radius: 1.0,
+        };
+        let r = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
+        assert!((s.intersect(&r, f32::INFINITY).unwrap() - 4.0).abs() < 1e-5);
+        let inside = Ray::new(Vec3::ZERO, Vec3::X);
+        assert!((s.intersect(&inside, f32::INFINITY).unwrap() - 1.0).abs() < 1e-5);
+    }
+
+    #[test]
+    fn triangle_hit() {
+        let t = Shape::Triangle {
+            p0: Vec3::ZERO,
+            e1: Vec3::X,
+            e2: Vec3::Y,
+        };
+        let r = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z);
+        assert!((t.intersect(&r, f32::INFINITY).unwrap() - 1.0).abs() < 1e-6);
+        let miss = Ray::new(Vec3::new(0.75, 0.75, 1.0), Vec3::NEG_Z);
+        assert!(t.intersect(&miss, f32::INFINITY).is_none());
+        assert!((t.area() - 0.5).abs() < 1e-6);
+    }
+}

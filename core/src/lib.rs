@@ -1,0 +1,45 @@
+//! foton-core: everything the foton integrators share.
+//!
+//! One module per concept, named as in the literature: [`scene`] loading, [`geometry`] and
+//! [`accel`] (the BVH), [`material`] (BSDFs), [`light`], [`camera`], [`film`], [`sampling`],
+//! [`medium`], [`kernel`] (density-estimation kernels), [`integrator`] (the plugin interface),
+//! [`render`] (the shared parallel image loop), [`plugin`] (loading plugins) and [`cli`] (the
+//! `foton` command, kept in the library so that it can be tested in-process).
+
+pub mod accel;
+pub mod camera;
+pub mod cli;
+pub mod error;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod kernel;
+pub mod light;
+pub mod material;
+pub mod medium;
+pub mod plugin;
+pub mod props;
+pub mod render;
+pub mod sampling;
+pub mod scene;
+pub mod value;
+
+pub use error::{Error, Result};
+pub use glam::Vec3;
+
+/// Linear RGB radiometric quantity (radiance, flux, reflectance...).
+pub type Rgb = glam::Vec3;
+
+/// Average of the three channels: the scalar used for power-proportional choices and
+/// Russian roulette, so that no channel is favoured.
+#[inline]
+pub fn average(c: Rgb) -> f32 {
+    (c.x + c.y + c.z) / 3.0
+}
+
+/// Version of this crate, compared with the one a plugin was built against.
+pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
+/// rustc that compiled this crate (from build.rs).
+pub const RUSTC_VERSION: &str = env!("FOTON_RUSTC_VERSION");
+/// Hash of the core sources, rustc, target and code-generation settings (from build.rs).
+pub const BUILD_ID: &str = env!("FOTON_BUILD_ID");

@@ -1,0 +1,238 @@
+//! Lights: point lights and area lights (any emissive shape). An area light emits radiance
+//! `radiance` on the side its geometric normal points to, and nothing on the other side.
+
+use crate::Rgb;
+use crate::geometry::Shape;
+use crate::sampling::{Distribution1D, to_world, uniform_cone};
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+#[derive(Clone, Debug)]
+pub enum Light {
+    Point {
+        position: Vec3,
+        /// W/sr.
+        intensity: Rgb,
+    },
+    Area {
+        /// The emitting primitives (one for a sphere or quad, the triangles of a mesh).
+        shapes: Vec<Shape>,
+        /// Chooses a shape proportionally to its area.
+        by_area: Distribution1D,
+        area: f32,
+        /// W/(sr m^2).
+        radiance: Rgb,
+        /// The scene object that emits.
+        object: u32,
+    },
+}
+
+/// A light sample seen from a receiving point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction from the receiver towards the light.
+    pub wi: Vec3,
+    pub dist: f32,
+    /// Incident radiance (area light) or intensity / dist^2 (point light), unoccluded.
+    pub li: Rgb,
+    /// Solid-angle pdf of this sample given the light was chosen; 1 for a point light.
+    pub pdf: f32,
+    pub delta: bool,
+    /// The point on the light and its normal (for offsetting the shadow ray's end).
+    pub p: Vec3,
+    pub n: Vec3,
+}
+
+/// A photon leaving a light.
+#[derive(Clone, Copy, Debug)]
+pub struct EmittedRay {
+    pub origin: Vec3,
+    pub dir: Vec3,
+    /// Normal at the origin (zero for a point light).
+    pub n: Vec3,
+    /// Le cos / (pdf_pos pdf_dir): the flux carried by one emitted sample (before dividing by
+    /// the number of samples and the light-selection probability).
+    pub flux: Rgb,
+}
+
+fn sphere_cone(center: Vec3, radius: f32, x: Vec3) -> Option<f32> {
+    let d2 = (center - x).length_squared();
+    let r2 = radius * radius;
+    (d2 > r2 * 1.0001).then(|| (1.0 - r2 / d2).max(0.0).sqrt())
+}
+
+impl Light {
+    /// Total emitted power in W: 4 pi I for a point light, pi A L for a one-sided area light.
+    pub fn power(&self) -> Rgb {
+        match self {
+            Light::Point { intensity, .. } => 4.0 * PI * *intensity,
+            Light::Area { area, radiance, .. } => PI * *area * *radiance,
+        }
+    }
+
+    pub fn is_delta(&self) -> bool {
+        matches!(self, Light::Point { .. })
+    }
+
+    /// Samples a direction from `x` towards the light.
+    pub fn sample_li(&self, x: Vec3, u: Vec2, uc: f32) -> Option<LightSample> {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => {
+                let d = *position - x;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                Some(LightSample {
+                    wi: d / dist,
+                    dist,
+                    li: *intensity / dist2,
+                    pdf: 1.0,
+                    delta: true,
+                    p: *position,
+                    n: Vec3::ZERO,
+                })
+            }
+            Light::Area {
+                shapes,
+                by_area,
+                area,
+                radiance,
+                ..
+            } => {
+                let (i, _) = by_area.sample(uc);
+                let shape = &shapes[i];
+                if let Shape::Sphere { center, radius } = *shape
+                    && shapes.len() == 1
+                    && let Some(cos_max) = sphere_cone(center, radius, x)
+                {
+                    // Sample the cone of directions the sphere subtends (pbrt's
+                    // Sphere::Sample(ctx)): every sample sees the emitting side.
+                    let axis = (center - x).normalize();
+                    let wi = to_world(uniform_cone(u, cos_max), axis);
+                    let t = Shape::Sphere { center, radius }
+                        .intersect(&crate::geometry::Ray::new(x, wi), f32::INFINITY)
+                        .unwrap_or_else(|| (center - x).dot(wi));
+                    let p = x + wi * t;
+                    let n = (p - center).normalize();
+                    return Some(LightSample {
+                        wi,
+                        dist: t,
+                        li: if n.dot(-wi) > 0.0 {
+                            *radiance
+                        } else {
+                            Rgb::ZERO
+                        },
+                        pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                        delta: false,
+                        p,
+                        n,
+                    });
+                }
+                let (p, n) = shape.sample_area(u);
+                let d = p - x;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let cos_l = n.dot(-wi);
+                if cos_l <= 0.0 {
+                    return None;
+                }
+                Some(LightSample {
+                    wi,
+                    dist,
+                    li: *radiance,
+                    pdf: dist2 / (cos_l * *area),
+                    delta: false,
+                    p,
+                    n,
+                })
+            }
+        }
+    }
+
+    /// Solid-angle pdf with which `sample_li` from `x` produces the point `p` (normal `n`) on
+    /// this light. Needed for MIS when a BSDF-sampled ray hits the light.
+    pub fn pdf_li(&self, x: Vec3, p: Vec3, n: Vec3) -> f32 {
+        match self {
+            Light::Point { .. } => 0.0,
+            Light::Area { shapes, area, .. } => {
+                if let Shape::Sphere { center, radius } = shapes[0]
+                    && shapes.len() == 1
+                    && let Some(cos_max) = sphere_cone(center, radius, x)
+                {
+                    return 1.0 / (2.0 * PI * (1.0 - cos_max));
+                }
+                let d = p - x;
+                let cos_l = n.dot(-d.normalize()).abs();
+                if cos_l == 0.0 {
+                    return 0.0;
+                }
+                d.length_squared() / (cos_l * *area)
+            }
+        }
+    }
+
+    /// Radiance leaving the light at a point with normal `n` in direction `w`.
+    #[inline]
+    pub fn emitted(&self, n: Vec3, w: Vec3) -> Rgb {
+        match self {
+            Light::Area { radiance, .. } if n.dot(w) > 0.0 => *radiance,
+            _ => Rgb::ZERO,
+        }
+    }
+
+    /// Samples a photon leaving the light: a point light emits uniformly over the sphere, an
+    /// area light from a uniform point with a cosine-distributed direction on its normal side.
+    pub fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2, uc: f32) -> EmittedRay {
+        match self {
+            Light::Point {
+                position,
+                intensity,
+            } => EmittedRay {
+                origin: *position,
+                dir: crate::sampling::uniform_sphere(u_dir),
+                n: Vec3::ZERO,
+                flux: 4.0 * PI * *intensity,
+            },
+            Light::Area {
+                shapes,
+                by_area,
+                area,
+                radiance,
+                ..
+            } => {
+                let (i, _) = by_area.sample(uc);
+                let (p, n) = shapes[i].sample_area(u_pos);
+                let local = crate::sampling::cosine_hemisphere(u_dir);
+                EmittedRay {
+                    origin: p,
+                    dir: to_world(local, n),
+                    n,
+                    // L cos / (1/A * cos/pi) = pi A L
+                    flux: PI * *area * *radiance,
+                }
+            }
+        }
+    }
+}
+
+/// Builds an area light over the given shapes.
+pub fn area_light(shapes: Vec<Shape>, radiance: Rgb, object: u32) -> Light {
+    let areas: Vec<f32> = shapes.iter().map(|s| s.area()).collect();
+    let area = areas.iter().sum();
+    Light::Area {
+        by_area: Distribution1D::new(&areas),
+        shapes,
+        area,
+        radiance,
+        object,
+    }
+}

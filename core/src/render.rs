@@ -1,0 +1,105 @@
+//! The parallel image loop shared by integrators that estimate radiance per camera sample.
+//!
+//! Samples are taken in passes (1, 1, 2, 4, ... samples per pixel) over 16x16 tiles run in
+//! parallel; each pixel sums its samples in sample order, so the image is bit-identical for a
+//! given seed whatever the thread count. Ctrl-C stops between pixels: every pixel keeps the
+//! samples it has and is divided by its own count.
+
+use crate::Rgb;
+use crate::error::{Error, Result};
+use crate::film::Film;
+use crate::geometry::Ray;
+use crate::integrator::RenderContext;
+use crate::sampling::Sampler;
+use crate::scene::Scene;
+use glam::Vec2;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+
+pub const TILE: u32 = 16;
+
+/// Runs `f` on a pool of `threads` workers. Each plugin links its own rayon, so the pool is
+/// built here, in the caller's copy, from the host's thread count.
+pub fn with_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> Result<R> {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.max(1))
+        .build()
+        .map_err(|e| Error::Render(format!("cannot start {threads} threads: {e}")))?;
+    Ok(pool.install(f))
+}
+
+/// The sampler of camera sample `sample` of pixel (x, y).
+#[inline]
+pub fn pixel_sampler(seed: u64, width: u32, x: u32, y: u32, sample: u32) -> Sampler {
+    Sampler::new(&[seed, (y as u64) * width as u64 + x as u64, sample as u64])
+}
+
+/// Renders `scene.render.spp` samples per pixel; `radiance` estimates the radiance arriving
+/// along a camera ray. The film position is jittered uniformly inside the pixel (box filter).
+pub fn render_pixels<F>(scene: &Scene, ctx: &RenderContext<'_>, radiance: F) -> Result<Film>
+where
+    F: Fn(&Ray, &mut Sampler) -> Rgb + Sync,
+{
+    let (width, height) = (scene.film.width, scene.film.height);
+    let spp = scene.render.spp;
+    let seed = scene.render.seed;
+    let mut film = Film::new(width, height);
+    let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
+        .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
+        .collect();
+    let bad_samples = AtomicU64::new(0);
+    ctx.progress
+        .begin("pixels", width as u64 * height as u64 * spp as u64);
+
+    let mut done = 0u32;
+    while done < spp && !ctx.cancelled() {
+        let batch = done.max(1).min(spp - done);
+        let (s0, s1) = (done, done + batch);
+        let results: Vec<Vec<(usize, [f64; 3], u32)>> = with_pool(ctx.threads, || {
+            tiles
+                .par_iter()
+                .map(|&(x0, y0)| {
+                    let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                    for y in y0..(y0 + TILE).min(height) {
+                        if ctx.cancelled() {
+                            break;
+                        }
+                        for x in x0..(x0 + TILE).min(width) {
+                            let mut sum = [0.0f64; 3];
+                            for s in s0..s1 {
+                                let mut sampler = pixel_sampler(seed, width, x, y, s);
+                                let jitter = sampler.next_2d();
+                                let ray = scene
+                                    .camera
+                                    .generate_ray(Vec2::new(x as f32, y as f32) + jitter);
+                                let mut l = radiance(&ray, &mut sampler);
+                                if !l.is_finite() || l.min_element() < 0.0 {
+                                    bad_samples.fetch_add(1, Ordering::Relaxed);
+                                    l = Rgb::ZERO;
+                                }
+                                sum[0] += l.x as f64;
+                                sum[1] += l.y as f64;
+                                sum[2] += l.z as f64;
+                            }
+                            out.push((film.index(x, y), sum, s1 - s0));
+                        }
+                    }
+                    ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
+                    out
+                })
+                .collect()
+        })?;
+        for (i, sum, n) in results.into_iter().flatten() {
+            film.add_pixel(i, sum, n);
+        }
+        done = s1;
+    }
+    ctx.progress.finish();
+    let bad = bad_samples.load(Ordering::Relaxed);
+    if bad > 0 {
+        ctx.progress.warn(&format!(
+            "{bad} sample(s) were NaN, infinite or negative and were replaced by zero"
+        ));
+    }
+    Ok(film)
+}

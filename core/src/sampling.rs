@@ -1,0 +1,243 @@
+//! Random numbers and the warps that turn them into directions and points.
+//!
+//! Every camera sample owns its own stream, keyed by (seed, pixel, sample index), so an image
+//! is bit-identical whatever the number of threads or the order in which tiles run.
+
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+#[inline]
+pub fn splitmix64(mut x: u64) -> u64 {
+    x = x.wrapping_add(0x9E37_79B9_7F4A_7C15);
+    x = (x ^ (x >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+    x = (x ^ (x >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+    x ^ (x >> 31)
+}
+
+/// PCG32 (O'Neill): small, fast and statistically good.
+#[derive(Clone, Debug)]
+pub struct Rng {
+    state: u64,
+    inc: u64,
+}
+
+impl Rng {
+    /// A stream determined by a tuple of keys, e.g. (seed, pixel, sample).
+    pub fn new(keys: &[u64]) -> Self {
+        let mut h = 0x2545_F491_4F6C_DD1Du64;
+        for &k in keys {
+            h = splitmix64(h ^ k);
+        }
+        let mut rng = Rng {
+            state: 0,
+            inc: (splitmix64(h ^ 0xDA3E_39CB_94B9_5BDB) << 1) | 1,
+        };
+        rng.next_u32();
+        rng.state = rng.state.wrapping_add(h);
+        rng.next_u32();
+        rng
+    }
+
+    #[inline]
+    pub fn next_u32(&mut self) -> u32 {
+        let old = self.state;
+        self.state = old
+            .wrapping_mul(6_364_136_223_846_793_005)
+            .wrapping_add(self.inc);
+        let xorshifted = (((old >> 18) ^ old) >> 27) as u32;
+        let rot = (old >> 59) as u32;
+        xorshifted.rotate_right(rot)
+    }
+
+    /// Uniform in [0, 1).
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        (self.next_u32() >> 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    }
+
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        Vec2::new(self.next_f32(), self.next_f32())
+    }
+}
+
+/// The sampler integrators draw from. Independent uniform samples per dimension.
+pub type Sampler = Rng;
+
+/// Orthonormal basis around `n` (Duff et al. 2017, branchless).
+#[inline]
+pub fn basis(n: Vec3) -> (Vec3, Vec3) {
+    let sign = 1.0f32.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x),
+        Vec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// `local` (z up) expressed in the frame whose z axis is `n`.
+#[inline]
+pub fn to_world(local: Vec3, n: Vec3) -> Vec3 {
+    let (s, t) = basis(n);
+    s * local.x + t * local.y + n * local.z
+}
+
+/// Uniform direction on the unit sphere; pdf 1/(4 pi).
+#[inline]
+pub fn uniform_sphere(u: Vec2) -> Vec3 {
+    let z = 1.0 - 2.0 * u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
+
+/// Concentric map of the square onto the unit disc (Shirley-Chiu).
+#[inline]
+pub fn concentric_disc(u: Vec2) -> Vec2 {
+    let o = 2.0 * u - Vec2::ONE;
+    if o.x == 0.0 && o.y == 0.0 {
+        return Vec2::ZERO;
+    }
+    let (r, theta) = if o.x.abs() > o.y.abs() {
+        (o.x, PI / 4.0 * (o.y / o.x))
+    } else {
+        (o.y, PI / 2.0 - PI / 4.0 * (o.x / o.y))
+    };
+    r * Vec2::new(theta.cos(), theta.sin())
+}
+
+/// Cosine-weighted direction on the hemisphere around +z; pdf cos(theta)/pi.
+#[inline]
+pub fn cosine_hemisphere(u: Vec2) -> Vec3 {
+    let d = concentric_disc(u);
+    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
+    Vec3::new(d.x, d.y, z)
+}
+
+/// Uniform direction in the cone of half-angle acos(cos_max) around +z; pdf 1/(2 pi (1 - cos_max)).
+#[inline]
+pub fn uniform_cone(u: Vec2, cos_max: f32) -> Vec3 {
+    let cos_t = 1.0 - u.x * (1.0 - cos_max);
+    let sin_t = (1.0 - cos_t * cos_t).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(sin_t * phi.cos(), sin_t * phi.sin(), cos_t)
+}
+
+/// Uniform barycentrics (b0, b1) on a triangle (the square-root warp).
+#[inline]
+pub fn uniform_triangle(u: Vec2) -> (f32, f32) {
+    let su = u.x.sqrt();
+    (1.0 - su, u.y * su)
+}
+
+/// Veach's power heuristic with beta = 2 (one sample from each strategy).
+#[inline]
+pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {
+    let f = pdf_f * pdf_f;
+    let g = pdf_g * pdf_g;
+    if f.is_infinite() {
+        return 1.0;
+    }
+    if f + g == 0.0 { 0.0 } else { f / (f + g) }
+}
+
+/// A discrete distribution proportional to non-negative weights, sampled by inverting its CDF.
+#[derive(Clone, Debug, Default)]
+pub struct Distribution1D {
+    cdf: Vec<f32>,
+    pmf: Vec<f32>,
+    total: f32,
+}
+
+impl Distribution1D {
+    pub fn new(weights: &[f32]) -> Self {
+        let total: f64 = weights.iter().map(|&w| w.max(0.0) as f64).sum();
+        let mut cdf = Vec::with_capacity(weights.len());
+        let mut acc = 0.0f64;
+        for &w in weights {
+            acc += w.max(0.0) as f64;
+            cdf.push(if total > 0.0 {
+                (acc / total) as f32
+            } else {
+                0.0
+            });
+        }
+        if let Some(last) = cdf.last_mut() {
+            *last = 1.0;
+        }
+        let pmf = weights
+            .iter()
+            .map(|&w| {
+                if total > 0.0 {
+                    (w.max(0.0) as f64 / total) as f32
+                } else {
+                    0.0
+                }
+            })
+            .collect();
+        Distribution1D {
+            cdf,
+            pmf,
+            total: total as f32,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.pmf.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.pmf.is_empty()
+    }
+    /// Sum of the weights.
+    pub fn total(&self) -> f32 {
+        self.total
+    }
+    pub fn pmf(&self, i: usize) -> f32 {
+        self.pmf[i]
+    }
+
+    /// Index i with probability pmf(i); never returns an index of zero weight.
+    pub fn sample(&self, u: f32) -> (usize, f32) {
+        let mut i = self
+            .cdf
+            .partition_point(|&c| c <= u)
+            .min(self.cdf.len() - 1);
+        while self.pmf[i] == 0.0 && i + 1 < self.pmf.len() {
+            i += 1;
+        }
+        while self.pmf[i] == 0.0 && i > 0 {
+            i -= 1;
+        }
+        (i, self.pmf[i])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn distribution_never_picks_zero_weight() {
+        let d = Distribution1D::new(&[0.0, 1.0, 0.0, 3.0, 0.0]);
+        for k in 0..1000 {
+            let (i, p) = d.sample(k as f32 / 1000.0);
+            assert!(i == 1 || i == 3, "picked {i}");
+            assert!(p > 0.0);
+        }
+        assert_eq!(d.sample(0.9999).0, 3);
+    }
+
+    #[test]
+    fn basis_is_orthonormal() {
+        let mut rng = Rng::new(&[1]);
+        for _ in 0..1000 {
+            let n = uniform_sphere(rng.next_2d());
+            let (s, t) = basis(n);
+            assert!((s.length() - 1.0).abs() < 1e-4 && (t.length() - 1.0).abs() < 1e-4);
+            assert!(s.dot(t).abs() < 1e-4 && s.dot(n).abs() < 1e-4 && t.dot(n).abs() < 1e-4);
+        }
+    }
+}

@@ -1,0 +1,249 @@
+//! A TOML document as an owned tree whose every value remembers its line and column, so that
+//! scene errors can name the place they come from. Built once from toml's spanned parser.
+
+use crate::error::{Error, Location, Result};
+use std::path::{Path, PathBuf};
+use toml::de::{DeTable, DeValue};
+
+#[derive(Clone, Debug, PartialEq)]
+pub enum Value {
+    Bool(bool),
+    Int(i64),
+    Float(f64),
+    Str(String),
+    Datetime(String),
+    Array(Vec<Node>),
+    Table(Table),
+}
+
+/// A value and where it was written (line 0: not from the file, e.g. `--set`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Node {
+    pub value: Value,
+    pub line: u32,
+    pub column: u32,
+}
+
+/// Keys in file order is not what toml gives; sorted order is stable and good enough.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Table(pub Vec<(String, Node)>);
+
+impl Table {
+    pub fn get(&self, key: &str) -> Option<&Node> {
+        self.0.iter().find(|(k, _)| k == key).map(|(_, n)| n)
+    }
+    pub fn get_mut(&mut self, key: &str) -> Option<&mut Node> {
+        self.0.iter_mut().find(|(k, _)| k == key).map(|(_, n)| n)
+    }
+    pub fn keys(&self) -> impl Iterator<Item = &str> {
+        self.0.iter().map(|(k, _)| k.as_str())
+    }
+    pub fn insert(&mut self, key: &str, node: Node) {
+        match self.get_mut(key) {
+            Some(slot) => *slot = node,
+            None => self.0.push((key.to_string(), node)),
+        }
+    }
+}
+
+impl Value {
+    pub fn type_name(&self) -> &'static str {
+        match self {
+            Value::Bool(_) => "a boolean",
+            Value::Int(_) => "an integer",
+            Value::Float(_) => "a float",
+            Value::Str(_) => "a string",
+            Value::Datetime(_) => "a datetime",
+            Value::Array(_) => "an array",
+            Value::Table(_) => "a table",
+        }
+    }
+    pub fn as_f64(&self) -> Option<f64> {
+        match *self {
+            Value::Int(i) => Some(i as f64),
+            Value::Float(f) => Some(f),
+            _ => None,
+        }
+    }
+    /// Short rendering for error messages.
+    pub fn show(&self) -> String {
+        match self {
+            Value::Bool(b) => b.to_string(),
+            Value::Int(i) => i.to_string(),
+            Value::Float(f) => f.to_string(),
+            Value::Str(s) => format!("{s:?}"),
+            Value::Datetime(s) => s.clone(),
+            Value::Array(a) => {
+                let items: Vec<String> = a.iter().map(|n| n.value.show()).collect();
+                format!("[{}]", items.join(", "))
+            }
+            Value::Table(_) => "{...}".into(),
+        }
+    }
+}
+
+/// A parsed scene document: its tree and the file it came from.
+#[derive(Clone, Debug)]
+pub struct Document {
+    pub file: PathBuf,
+    pub root: Table,
+}
+
+fn line_col(src: &str, offset: usize) -> (u32, u32) {
+    let before = &src[..offset.min(src.len())];
+    let line = before.matches('\n').count() as u32 + 1;
+    let col = before.rsplit('\n').next().map_or(0, |l| l.chars().count()) as u32 + 1;
+    (line, col)
+}
+
+fn convert(src: &str, value: &DeValue<'_>, start: usize, file: &Path) -> Result<Node> {
+    let (line, column) = line_col(src, start);
+    let value = match value {
+        DeValue::String(s) => Value::Str(s.to_string()),
+        DeValue::Integer(i) => {
+            let digits = i.as_str().replace('_', "");
+            let digits = digits
+                .trim_start_matches("0x")
+                .trim_start_matches("0o")
+                .trim_start_matches("0b");
+            let parsed = i64::from_str_radix(digits, i.radix()).map_err(|e| Error::Syntax {
+                location: Location {
+                    file: file.to_path_buf(),
+                    line,
+                    column,
+                },
+                message: format!("integer {}: {e}", i.as_str()),
+            })?;
+            Value::Int(parsed)
+        }
+        DeValue::Float(f) => {
+            let text = f.as_str().replace('_', "");
+            let parsed = match text.as_str() {
+                "inf" | "+inf" => f64::INFINITY,
+                "-inf" => f64::NEG_INFINITY,
+                "nan" | "+nan" | "-nan" => f64::NAN,
+                t => t.parse::<f64>().map_err(|e| Error::Syntax {
+                    location: Location {
+                        file: file.to_path_buf(),
+                        line,
+                        column,
+                    },
+                    message: format!("float {t}: {e}"),
+                })?,
+            };
+            Value::Float(parsed)
+        }
+        DeValue::Boolean(b) => Value::Bool(*b),
+        DeValue::Datetime(d) => Value::Datetime(d.to_string()),
+        DeValue::Array(items) => Value::Array(
+            items
+                .iter()
+                .map(|item| convert(src, item.get_ref(), item.span().start, file))
+                .collect::<Result<_>>()?,
+        ),
+        DeValue::Table(t) => Value::Table(convert_table(src, t, file)?),
+    };
+    Ok(Node {
+        value,
+        line,
+        column,
+    })
+}
+
+fn convert_table(src: &str, table: &DeTable<'_>, file: &Path) -> Result<Table> {
+    let mut out = Table::default();
+    for (key, value) in table.iter() {
+        // A table's position is that of its key (its header), which is where a user looks.
+        let start = key.span().start;
+        let mut node = convert(src, value.get_ref(), value.span().start, file)?;
+        if matches!(node.value, Value::Table(_)) {
+            let (line, column) = line_col(src, start);
+            node.line = line;
+            node.column = column;
+        }
+        out.0.push((key.get_ref().to_string(), node));
+    }
+    Ok(out)
+}
+
+impl Document {
+    /// Parses TOML text; `file` is only used in messages and to resolve relative paths.
+    pub fn parse(text: &str, file: &Path) -> Result<Document> {
+        let parsed = DeTable::parse(text).map_err(|e| {
+            let (line, column) = e.span().map_or((0, 0), |s| line_col(text, s.start));
+            Error::Syntax {
+                location: Location {
+                    file: file.to_path_buf(),
+                    line,
+                    column,
+                },
+                message: e.message().trim().to_string(),
+            }
+        })?;
+        Ok(Document {
+            file: file.to_path_buf(),
+            root: convert_table(text, parsed.get_ref(), file)?,
+        })
+    }
+
+    pub fn load(file: &Path) -> Result<Document> {
+        let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
+        Document::parse(&text, file)
+    }
+
+    /// Applies `--set a.b.c=value` (like Mitsuba's -D): the value is parsed as TOML, and taken as
+    /// a string if it does not parse (so `--set film.output=x.png` works unquoted).
+    pub fn set(&mut self, assignment: &str) -> Result<()> {
+        let (path, raw) = assignment.split_once('=').ok_or_else(|| {
+            Error::Usage(format!(
+                "--set {assignment}: expected KEY.PATH=VALUE, e.g. render.spp=16"
+            ))
+        })?;
+        let path = path.trim();
+        let keys: Vec<&str> = path.split('.').collect();
+        if keys.iter().any(|k| k.is_empty()) {
+            return Err(Error::Usage(format!(
+                "--set {assignment}: empty key in `{path}`"
+            )));
+        }
+        let text = format!("v = {}", raw.trim());
+        let value = match DeTable::parse(&text) {
+            Ok(t) => {
+                let node = convert_table(&text, t.get_ref(), &self.file)?;
+                node.get("v").map(|n| n.value.clone()).unwrap()
+            }
+            Err(_) => Value::Str(raw.trim().to_string()),
+        };
+        let mut table = &mut self.root;
+        for key in &keys[..keys.len() - 1] {
+            if table.get(key).is_none() {
+                table.insert(
+                    key,
+                    Node {
+                        value: Value::Table(Table::default()),
+                        line: 0,
+                        column: 0,
+                    },
+                );
+            }
+            table = match &mut table.get_mut(key).unwrap().value {
+                Value::Table(t) => t,
+                other => {
+                    return Err(Error::Usage(format!(
+                        "--set {assignment}: `{key}` is {}, not a table",
+                        other.type_name()
+                    )));
+                }
+            };
+        }
+        table.insert(
+            keys[keys.len() - 1],
+            Node {
+                value,
+                line: 0,
+                column: 0,
+            },
+        );
+        Ok(())
+    }
+}

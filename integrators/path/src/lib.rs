@@ -1,0 +1,161 @@
+//! # `path`: unidirectional path tracer
+//!
+//! | parameter  | type    | meaning                                                  | default |
+//! |------------|---------|----------------------------------------------------------|---------|
+//! | `rr_depth` | integer | scattering events before Russian roulette may end a path | 5       |
+//!
+//! `[render] max_depth` bounds the number of scattering events (0: only emitters seen
+//! directly, 1: direct lighting). `[render] spp` camera samples per pixel.
+//!
+//! Next-event estimation at every non-delta vertex: point lights by shadow rays; area lights
+//! (any emissive shape) by shadow rays combined with BSDF sampling by multiple importance
+//! sampling (power heuristic). Lights are chosen with probability proportional to power.
+//! Delta materials (mirror, glass) are followed by BSDF sampling only; radiance is scaled by
+//! 1/eta^2 on refraction. Null boundaries are crossed without counting as a bounce.
+//!
+//! It is unbiased and converges to the right image for any scene without media, but caustics
+//! seen through or cast by delta surfaces from point lights (L S+ D E paths from a point
+//! light) cannot be sampled: they are missing. That is what photon mapping is for.
+
+use foton_core::geometry::{Ray, offset_origin};
+use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::material::TransportMode;
+use foton_core::props::Properties;
+use foton_core::render::render_pixels;
+use foton_core::sampling::{Sampler, power_heuristic};
+use foton_core::scene::Scene;
+use foton_core::{Error, Result, Rgb, film::Film};
+
+pub struct PathTracer {
+    max_depth: u32,
+    rr_depth: u32,
+}
+
+/// Null boundaries crossed by one ray segment before the path is abandoned (guards against a
+/// ray stuck on coincident boundaries).
+const MAX_NULL_CROSSINGS: u32 = 256;
+
+impl PathTracer {
+    pub fn new(max_depth: u32, rr_depth: u32) -> Self {
+        PathTracer {
+            max_depth,
+            rr_depth,
+        }
+    }
+
+    /// Radiance arriving at the camera along `ray`.
+    pub fn li(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler) -> Rgb {
+        let mut radiance = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        let mut depth = 0u32;
+        // The camera ray counts as specular: emitters seen directly get full weight.
+        let mut specular = true;
+        let mut prev_pdf = 0.0f32;
+        let mut prev_p = ray.origin;
+        let mut crossings = 0u32;
+
+        while let Some(hit) = scene.intersect(&ray, f32::INFINITY) {
+            let material = *scene.material(&hit);
+            if material.is_null() {
+                crossings += 1;
+                if crossings > MAX_NULL_CROSSINGS {
+                    break;
+                }
+                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+                continue;
+            }
+            crossings = 0;
+            let wo = -ray.dir;
+
+            // ---- Emission (weighted against light sampling at the previous vertex) ----
+            if let Some((light_id, light)) = scene.area_light(&hit) {
+                let le = light.emitted(hit.ng, wo);
+                if le != Rgb::ZERO {
+                    if specular {
+                        radiance += beta * le;
+                    } else {
+                        let pdf_light = scene.light_pmf(light_id as usize)
+                            * light.pdf_li(prev_p, hit.p, hit.ng);
+                        radiance += beta * le * power_heuristic(prev_pdf, pdf_light);
+                    }
+                }
+            }
+            if depth >= self.max_depth {
+                break;
+            }
+
+            // ---- Emitter sampling ----
+            if !material.is_delta()
+                && let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32())
+            {
+                let light = &scene.lights[light_id];
+                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                if let Some(ls) = light.sample_li(hit.p, u, uc)
+                    && ls.li != Rgb::ZERO
+                {
+                    let f = material.eval(wo, ls.wi, hit.ng);
+                    if f != Rgb::ZERO && !scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
+                        let cos = ls.wi.dot(hit.ng).abs();
+                        if ls.delta {
+                            radiance += beta * f * cos * ls.li / pmf;
+                        } else {
+                            let pdf_light = pmf * ls.pdf;
+                            let pdf_bsdf = material.pdf(wo, ls.wi, hit.ng);
+                            let w = power_heuristic(pdf_light, pdf_bsdf);
+                            radiance += beta * f * cos * ls.li * w / pdf_light;
+                        }
+                    }
+                }
+            }
+
+            // ---- BSDF sampling ----
+            let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+            let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+                break;
+            };
+            beta *= bs.weight;
+            specular = bs.delta;
+            prev_pdf = bs.pdf;
+            prev_p = hit.p;
+            depth += 1;
+
+            // ---- Russian roulette: keep the throughput's expectation, end dim paths ----
+            if depth >= self.rr_depth {
+                let survive = beta.max_element().min(0.95);
+                if survive <= 0.0 || sampler.next_f32() >= survive {
+                    break;
+                }
+                beta /= survive;
+            }
+            ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+        }
+        radiance
+    }
+}
+
+impl Integrator for PathTracer {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        render_pixels(scene, ctx, |ray, sampler| self.li(scene, *ray, sampler))
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "path(max_depth = {}, rr_depth = {})",
+            self.max_depth, self.rr_depth
+        )
+    }
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let rr_depth = props.u32("rr_depth", 5)?;
+    if scene.has_media() {
+        return Err(Error::Usage(format!(
+            "{}: the scene has participating media, which `path` does not render yet",
+            scene.file.display()
+        )));
+    }
+    Ok(Box::new(PathTracer::new(scene.render.max_depth, rr_depth)))
+}
+
+foton_core::declare_integrator!("path", "unidirectional path tracer (NEE + MIS)", create);
