@@ -1,1 +1,136 @@
-//! Helpers shared by the integration tests.
+//! Helpers shared by the integration tests: finding the plugins cargo built, running the
+//! `foton` command in-process, writing scenes to temporary folders, rendering.
+
+use foton_core::cli::{TermProgress, prepare, render_prepared};
+use foton_core::film::Film;
+use foton_core::plugin::Registry;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// The folder with the plugin cdylibs: cargo puts the dev-dependencies' cdylibs in
+/// target/<profile>/deps, the folder of the test executables.
+pub fn plugin_dir() -> PathBuf {
+    let exe = std::env::current_exe().expect("test executable path");
+    exe.parent().expect("test executable folder").to_path_buf()
+}
+
+pub fn registry() -> Registry {
+    Registry::discover(&[plugin_dir()])
+}
+
+/// Output of one in-process run of the `foton` command.
+pub struct Run {
+    pub code: u8,
+    pub stdout: String,
+    pub stderr: String,
+}
+
+/// Runs `foton ARGS...` in-process (the command's code lives in foton_core::cli).
+pub fn foton(args: &[&str]) -> Run {
+    let mut argv: Vec<std::ffi::OsString> = vec!["foton".into()];
+    argv.extend(args.iter().map(|a| a.into()));
+    let (mut out, mut err) = (Vec::new(), Vec::new());
+    let code = foton_core::cli::run(argv, &mut out, &mut err);
+    Run {
+        code,
+        stdout: String::from_utf8_lossy(&out).into_owned(),
+        stderr: String::from_utf8_lossy(&err).into_owned(),
+    }
+}
+
+/// `foton ARGS... --plugin-dir <the test plugin folder>`.
+pub fn foton_with_plugins(args: &[&str]) -> Run {
+    let dir = plugin_dir();
+    let mut all: Vec<&str> = args.to_vec();
+    all.push("--plugin-dir");
+    all.push(dir.to_str().unwrap());
+    foton(&all)
+}
+
+/// A fresh, empty folder for one test.
+pub fn temp_dir(name: &str) -> PathBuf {
+    static COUNTER: AtomicU32 = AtomicU32::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "foton-test-{}-{}-{name}",
+        std::process::id(),
+        COUNTER.fetch_add(1, Ordering::Relaxed)
+    ));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Writes `text` to `dir/name` and returns the path.
+pub fn write(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let path = dir.join(name);
+    std::fs::write(&path, text).unwrap();
+    path
+}
+
+/// The repository's root folder.
+pub fn repo_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .unwrap()
+        .to_path_buf()
+}
+
+/// Renders a scene file in-process with the test plugins; `overrides` as `--set` values.
+pub fn render_file(scene: &Path, overrides: &[&str], threads: usize) -> Film {
+    let overrides: Vec<String> = overrides.iter().map(|s| s.to_string()).collect();
+    let prepared = prepare(scene, &overrides, &[plugin_dir()], true)
+        .unwrap_or_else(|e| panic!("cannot prepare {}: {e}", scene.display()));
+    let progress = TermProgress::new(true);
+    let (film, _) = render_prepared(&prepared, threads, &progress)
+        .unwrap_or_else(|e| panic!("render of {} failed: {e}", scene.display()));
+    film
+}
+
+/// Renders a scene given as TOML text.
+pub fn render_toml(name: &str, toml: &str, overrides: &[&str], threads: usize) -> Film {
+    let dir = temp_dir(name);
+    let path = write(&dir, "scene.toml", toml);
+    render_film_and_clean(&dir, &path, overrides, threads)
+}
+
+fn render_film_and_clean(dir: &Path, path: &Path, overrides: &[&str], threads: usize) -> Film {
+    let film = render_file(path, overrides, threads);
+    let _ = std::fs::remove_dir_all(dir);
+    film
+}
+
+/// Mean and standard error of the mean of per-pixel values over a pixel rectangle.
+pub fn region_mean(film: &Film, x0: u32, y0: u32, x1: u32, y1: u32) -> (glam::Vec3, glam::Vec3) {
+    let mut sum = glam::DVec3::ZERO;
+    let mut sum2 = glam::DVec3::ZERO;
+    let mut n = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let p = film.pixel(x, y).as_dvec3();
+            sum += p;
+            sum2 += p * p;
+            n += 1.0;
+        }
+    }
+    let mean = sum / n;
+    let var = (sum2 / n - mean * mean).max(glam::DVec3::ZERO);
+    (mean.as_vec3(), (var / n).sqrt().as_vec3())
+}
+
+/// The standard scene header with a camera looking down -z from z = `cam_z`.
+pub fn header(integrator: &str, spp: u32, max_depth: u32, width: u32, height: u32) -> String {
+    format!(
+        r#"
+[render]
+integrator = "{integrator}"
+spp = {spp}
+seed = 7
+max_depth = {max_depth}
+
+[film]
+width = {width}
+height = {height}
+output = "out.exr"
+"#
+    )
+}

@@ -1,0 +1,1 @@
+//! Example integrator plugin (skeleton; see docs/plugins.md).
