@@ -11,6 +11,8 @@ pub struct Film {
     pub height: u32,
     sum: Vec<[f64; 3]>,
     count: Vec<u32>,
+    /// Rays traced to make the image (statistics; 0 if the integrator does not count).
+    pub rays: u64,
 }
 
 impl Film {
@@ -21,6 +23,7 @@ impl Film {
             height,
             sum: vec![[0.0; 3]; n],
             count: vec![0; n],
+            rays: 0,
         }
     }
 

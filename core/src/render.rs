@@ -35,10 +35,11 @@ pub fn pixel_sampler(seed: u64, width: u32, x: u32, y: u32, sample: u32) -> Samp
 }
 
 /// Renders `scene.render.spp` samples per pixel; `radiance` estimates the radiance arriving
-/// along a camera ray. The film position is jittered uniformly inside the pixel (box filter).
+/// along a camera ray and adds the rays it traced to its last argument (for statistics). The
+/// film position is jittered uniformly inside the pixel (box filter).
 pub fn render_pixels<F>(scene: &Scene, ctx: &RenderContext<'_>, radiance: F) -> Result<Film>
 where
-    F: Fn(&Ray, &mut Sampler) -> Rgb + Sync,
+    F: Fn(&Ray, &mut Sampler, &mut u64) -> Rgb + Sync,
 {
     let (width, height) = (scene.film.width, scene.film.height);
     let spp = scene.render.spp;
@@ -48,6 +49,7 @@ where
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     let bad_samples = AtomicU64::new(0);
+    let rays = AtomicU64::new(0);
     ctx.progress
         .begin("pixels", width as u64 * height as u64 * spp as u64);
 
@@ -60,6 +62,7 @@ where
                 .par_iter()
                 .map(|&(x0, y0)| {
                     let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                    let mut tile_rays = 0u64;
                     for y in y0..(y0 + TILE).min(height) {
                         if ctx.cancelled() {
                             break;
@@ -72,7 +75,7 @@ where
                                 let ray = scene
                                     .camera
                                     .generate_ray(Vec2::new(x as f32, y as f32) + jitter);
-                                let mut l = radiance(&ray, &mut sampler);
+                                let mut l = radiance(&ray, &mut sampler, &mut tile_rays);
                                 if !l.is_finite() || l.min_element() < 0.0 {
                                     bad_samples.fetch_add(1, Ordering::Relaxed);
                                     l = Rgb::ZERO;
@@ -84,6 +87,7 @@ where
                             out.push((film.index(x, y), sum, s1 - s0));
                         }
                     }
+                    rays.fetch_add(tile_rays, Ordering::Relaxed);
                     ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
                     out
                 })
@@ -95,6 +99,7 @@ where
         done = s1;
     }
     ctx.progress.finish();
+    film.rays = rays.load(Ordering::Relaxed);
     let bad = bad_samples.load(Ordering::Relaxed);
     if bad > 0 {
         ctx.progress.warn(&format!(

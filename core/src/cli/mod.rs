@@ -133,7 +133,7 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
     let cli = match Cli::try_parse_from(args) {
         Ok(cli) => cli,
         Err(e) => {
-            let text = e.render().ansi().to_string();
+            let text = e.render().to_string();
             if e.use_stderr() {
                 let _ = write!(err, "{text}");
             } else {
@@ -412,15 +412,17 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     INTERRUPTED.store(false, Ordering::SeqCst);
     let mut best = f64::INFINITY;
     let mut samples = 0;
+    let mut rays = 0;
     for i in 0..a.repeat.max(1) {
         let (film, t) = render_prepared(&p, threads, &progress)?;
         samples = film.total_samples();
+        rays = film.rays;
         let _ = writeln!(out, "run {}: {:.3} s", i + 1, t.as_secs_f64());
         best = best.min(t.as_secs_f64());
     }
     let _ = writeln!(
         out,
-        "{} with {}: {}x{} x {} spp, {} threads: best {:.3} s, {:.3} M samples/s",
+        "{} with {}: {}x{} x {} spp, {} threads: best {:.3} s, {:.3} M samples/s, {:.3} M rays/s",
         a.scene.display(),
         p.integrator.describe(),
         p.scene.film.width,
@@ -428,7 +430,8 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
         p.scene.render.spp,
         threads,
         best,
-        samples as f64 / best / 1e6
+        samples as f64 / best / 1e6,
+        rays as f64 / best / 1e6
     );
     Ok(0)
 }

@@ -43,8 +43,8 @@ impl PathTracer {
         }
     }
 
-    /// Radiance arriving at the camera along `ray`.
-    pub fn li(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler) -> Rgb {
+    /// Radiance arriving at the camera along `ray`; adds the rays traced to `rays`.
+    pub fn li(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, rays: &mut u64) -> Rgb {
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
         let mut depth = 0u32;
@@ -54,7 +54,11 @@ impl PathTracer {
         let mut prev_p = ray.origin;
         let mut crossings = 0u32;
 
-        while let Some(hit) = scene.intersect(&ray, f32::INFINITY) {
+        loop {
+            *rays += 1;
+            let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
+                break;
+            };
             let material = *scene.material(&hit);
             if material.is_null() {
                 crossings += 1;
@@ -94,6 +98,7 @@ impl PathTracer {
                     && ls.li != Rgb::ZERO
                 {
                     let f = material.eval(wo, ls.wi, hit.ng);
+                    *rays += (f != Rgb::ZERO) as u64;
                     if f != Rgb::ZERO && !scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
                         let cos = ls.wi.dot(hit.ng).abs();
                         if ls.delta {
@@ -135,7 +140,9 @@ impl PathTracer {
 
 impl Integrator for PathTracer {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        render_pixels(scene, ctx, |ray, sampler| self.li(scene, *ray, sampler))
+        render_pixels(scene, ctx, |ray, sampler, rays| {
+            self.li(scene, *ray, sampler, rays)
+        })
     }
 
     fn describe(&self) -> String {
