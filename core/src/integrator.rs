@@ -17,6 +17,8 @@ pub trait Progress: Send + Sync {
     fn finish(&self);
     /// A non-fatal message for the user.
     fn warn(&self, message: &str);
+    /// `n` more rays were traced (for a rays/s display).
+    fn rays(&self, _n: u64) {}
 }
 
 /// Progress that reports nothing.

@@ -88,6 +88,7 @@ where
                         }
                     }
                     rays.fetch_add(tile_rays, Ordering::Relaxed);
+                    ctx.progress.rays(tile_rays);
                     ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
                     out
                 })

@@ -5,11 +5,15 @@ use crate::integrator::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::sync::Mutex;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
 
 pub struct TermProgress {
     bar: Mutex<Option<ProgressBar>>,
     visible: bool,
     pub warnings: Mutex<Vec<String>>,
+    rays: AtomicU64,
+    start: Mutex<Instant>,
 }
 
 impl TermProgress {
@@ -18,6 +22,8 @@ impl TermProgress {
             bar: Mutex::new(None),
             visible: !quiet && std::io::stderr().is_terminal(),
             warnings: Mutex::new(Vec::new()),
+            rays: AtomicU64::new(0),
+            start: Mutex::new(Instant::now()),
         }
     }
 
@@ -36,11 +42,13 @@ impl Progress for TermProgress {
         let bar = ProgressBar::with_draw_target(Some(total), target);
         bar.set_style(
             ProgressStyle::with_template(
-                "{prefix:>8} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta} {per_sec}",
+                "{prefix:>8} [{elapsed_precise}] {wide_bar} {percent:>3}% ETA {eta} {msg}",
             )
             .expect("valid template"),
         );
         bar.set_prefix(phase.to_string());
+        self.rays.store(0, Ordering::Relaxed);
+        *self.start.lock().unwrap() = Instant::now();
         if let Some(old) = self.bar.lock().unwrap().replace(bar) {
             old.finish_and_clear();
         }
@@ -53,6 +61,13 @@ impl Progress for TermProgress {
     fn finish(&self) {
         if let Some(bar) = self.bar.lock().unwrap().take() {
             bar.finish_and_clear();
+        }
+    }
+    fn rays(&self, n: u64) {
+        let total = self.rays.fetch_add(n, Ordering::Relaxed) + n;
+        if let Some(bar) = &*self.bar.lock().unwrap() {
+            let secs = self.start.lock().unwrap().elapsed().as_secs_f64().max(1e-3);
+            bar.set_message(format!("{:.2} M rays/s", total as f64 / secs / 1e6));
         }
     }
     fn warn(&self, message: &str) {
