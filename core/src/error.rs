@@ -45,6 +45,9 @@ pub enum Error {
     Render(String),
     #[error("interrupted")]
     Interrupted,
+    /// A panic caught at a plugin boundary ("panicked in render: ...").
+    #[error("{0}")]
+    Panic(String),
 }
 
 impl Error {

@@ -140,10 +140,22 @@ pub fn format_of(path: &Path) -> Result<ImageFormat> {
 /// writable folder. Finding out after a long render would lose it.
 pub fn check_output(path: &Path) -> Result<()> {
     format_of(path)?;
+    if path.exists() && !path.is_file() {
+        return Err(Error::io(
+            path,
+            "the output exists and is not a regular file",
+        ));
+    }
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
+    if dir.exists() && !dir.is_dir() {
+        return Err(Error::io(
+            path,
+            format!("{} is not a folder", dir.display()),
+        ));
+    }
     if !dir.is_dir() {
         return Err(Error::io(
             path,

@@ -17,6 +17,7 @@ pub mod kernel;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod photon;
 pub mod plugin;
 pub mod props;
 pub mod render;

@@ -109,8 +109,8 @@ fn panic_message(payload: Box<dyn std::any::Any + Send>) -> String {
 /// raised the panic), since a panic must not unwind across the library boundary.
 pub fn catch<T>(what: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
-        Err(Error::Render(format!(
-            "{what} panicked: {}",
+        Err(Error::Panic(format!(
+            "panicked in {what}: {}",
             panic_message(payload)
         )))
     })
@@ -121,7 +121,7 @@ struct PanicGuard(Box<dyn Integrator>);
 
 impl Integrator for PanicGuard {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        catch(&self.0.describe(), || self.0.render(scene, ctx))
+        catch("render", || self.0.render(scene, ctx))
     }
     fn describe(&self) -> String {
         catch("describe", || Ok(self.0.describe())).unwrap_or_else(|e| e.to_string())
@@ -135,7 +135,7 @@ pub fn guarded_create(
     scene: &Scene,
     create: fn(&Properties<'_>, &Scene) -> Result<Box<dyn Integrator>>,
 ) -> Result<Box<dyn Integrator>> {
-    let inner = catch("integrator creation", || create(props, scene))?;
+    let inner = catch("create", || create(props, scene))?;
     Ok(Box::new(PanicGuard(inner)))
 }
 
@@ -243,8 +243,10 @@ fn load(file: &Path) -> Result<Loaded> {
     };
     // SAFETY: loading runs the library's initialisers; only files on the user's plugin search
     // path are loaded, never one named by a scene.
-    let lib = unsafe { libloading::Library::new(file) }
-        .map_err(|e| err(format!("cannot be loaded: {e}")))?;
+    let lib = unsafe { libloading::Library::new(file) }.map_err(|e| {
+        let why = std::error::Error::source(&e).map_or(String::new(), |s| format!(": {s}"));
+        err(format!("cannot be loaded: {e}{why}"))
+    })?;
     // Never unloaded: code and statics of the plugin may be referenced for the whole run.
     let lib: &'static libloading::Library = Box::leak(Box::new(lib));
 
@@ -355,7 +357,10 @@ impl Registry {
             }
             Err(e) => self.problems.push(Problem {
                 file: file.to_path_buf(),
-                message: e.to_string(),
+                message: match e {
+                    Error::Plugin { message, .. } => message,
+                    other => other.to_string(),
+                },
             }),
         }
     }

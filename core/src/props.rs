@@ -142,8 +142,15 @@ impl<'a> Properties<'a> {
     }
 
     fn finite(&self, name: &str, x: f64) -> Result<f32> {
-        if x.is_finite() {
-            Ok(x as f32)
+        // Checked after the conversion: 1e40 is a finite f64 but an infinite f32.
+        let v = x as f32;
+        if v.is_finite() {
+            Ok(v)
+        } else if x.is_finite() {
+            Err(self.error(
+                name,
+                format!("expected a finite number; {x} is too large for single precision"),
+            ))
         } else {
             Err(self.error(name, format!("expected a finite number, found {x}")))
         }

@@ -226,6 +226,22 @@ impl Scene {
         })
     }
 
+    /// Where a key path was written in the scene file (line 0: it came from `--set`).
+    pub fn location_of(&self, path: &[&str]) -> Option<Location> {
+        let mut node = self.document.root.get(path.first()?)?;
+        for key in &path[1..] {
+            match &node.value {
+                Value::Table(t) => node = t.get(key)?,
+                _ => return None,
+            }
+        }
+        Some(Location {
+            file: self.file.clone(),
+            line: node.line,
+            column: node.column,
+        })
+    }
+
     /// The parameters of integrator `name` (its `[integrators.NAME]` table, or an empty bag).
     pub fn integrator_properties(&self, name: &str) -> Result<Properties<'_>> {
         let path = format!("integrators.{name}");
@@ -325,7 +341,14 @@ fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {
     let mut names: Vec<&str> = known.keys().map(String::as_str).collect();
     names.sort();
     if names.is_empty() {
-        format!("{kind} {name:?} is not defined (no {kind}s are defined)")
+        {
+            let plural = if kind == "medium" {
+                "media"
+            } else {
+                "materials"
+            };
+            format!("{kind} {name:?} is not defined (no {plural} are defined)")
+        }
     } else {
         format!(
             "{kind} {name:?} is not defined; defined: {}",
@@ -616,6 +639,12 @@ fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
 
 /// The mesh's triangles, and whether it is closed.
 fn load_obj(s: &Properties<'_>, path: &Path, transform: Mat4) -> Result<(Vec<Shape>, bool)> {
+    if path.exists() && !path.is_file() {
+        return Err(s.error(
+            "file",
+            format!("mesh {} is not a regular file", path.display()),
+        ));
+    }
     let file = std::fs::File::open(path)
         .map_err(|e| s.error("file", format!("cannot open mesh {}: {e}", path.display())))?;
     let mut reader = std::io::BufReader::new(file);

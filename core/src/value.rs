@@ -82,6 +82,19 @@ impl Value {
     }
 }
 
+fn clear_positions(value: &mut Value) {
+    let nodes: Vec<&mut Node> = match value {
+        Value::Array(items) => items.iter_mut().collect(),
+        Value::Table(t) => t.0.iter_mut().map(|(_, n)| n).collect(),
+        _ => return,
+    };
+    for n in nodes {
+        n.line = 0;
+        n.column = 0;
+        clear_positions(&mut n.value);
+    }
+}
+
 /// A parsed scene document: its tree and the file it came from.
 #[derive(Clone, Debug)]
 pub struct Document {
@@ -187,6 +200,9 @@ impl Document {
     }
 
     pub fn load(file: &Path) -> Result<Document> {
+        if file.is_dir() {
+            return Err(Error::io(file, "is a directory, not a scene file"));
+        }
         let text = std::fs::read_to_string(file).map_err(|e| Error::io(file, e))?;
         Document::parse(&text, file)
     }
@@ -206,14 +222,28 @@ impl Document {
                 "--set {assignment}: empty key in `{path}`"
             )));
         }
+        if keys.iter().any(|k| k.contains('[')) {
+            return Err(Error::Usage(format!(
+                "--set {assignment}: elements of arrays ([[shapes]], [[lights]]) cannot be set from the command line; edit the scene file"
+            )));
+        }
         let text = format!("v = {}", raw.trim());
-        let value = match DeTable::parse(&text) {
+        let mut value = match DeTable::parse(&text) {
             Ok(t) => {
-                let node = convert_table(&text, t.get_ref(), &self.file)?;
+                let node = convert_table(&text, t.get_ref(), &self.file).map_err(|e| {
+                    let why = match e {
+                        Error::Syntax { message, .. } => message,
+                        other => other.to_string(),
+                    };
+                    Error::Usage(format!("--set {assignment}: {why}"))
+                })?;
                 node.get("v").map(|n| n.value.clone()).unwrap()
             }
             Err(_) => Value::Str(raw.trim().to_string()),
         };
+        // Positions inside the `v = ...` text mean nothing to the user: mark the whole value
+        // as coming from the command line.
+        clear_positions(&mut value);
         let mut table = &mut self.root;
         for key in &keys[..keys.len() - 1] {
             if table.get(key).is_none() {

@@ -8,7 +8,7 @@ mod progress;
 use crate::error::{Error, Result};
 use crate::film::{Film, check_output};
 use crate::integrator::{Integrator, RenderContext};
-use crate::plugin::{Registry, search_path};
+use crate::plugin::{IntegratorPlugin, Registry, search_path};
 use crate::scene::Scene;
 use clap::{Args, Parser, Subcommand};
 pub use progress::TermProgress;
@@ -161,6 +161,8 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
 pub struct Prepared {
     pub scene: Scene,
     pub integrator: Box<dyn Integrator>,
+    /// The plugin the integrator comes from (for messages).
+    pub plugin: IntegratorPlugin,
     pub warnings: Vec<String>,
 }
 
@@ -178,6 +180,18 @@ fn scene_overrides(a: &SceneArgs) -> Vec<String> {
     sets
 }
 
+/// Errors from inside a plugin name the plugin and its file; errors in its parameters stay
+/// scene errors (they name the scene file, key and line).
+fn blame_plugin(plugin: &IntegratorPlugin, e: Error) -> Error {
+    match e {
+        Error::Scene { .. } | Error::Syntax { .. } | Error::Io { .. } => e,
+        other => Error::Plugin {
+            file: plugin.file.clone(),
+            message: format!("integrator `{}`: {other}", plugin.name),
+        },
+    }
+}
+
 /// Loads a scene and creates its integrator from the plugin search path.
 pub fn prepare(
     scene_path: &Path,
@@ -187,9 +201,25 @@ pub fn prepare(
 ) -> Result<Prepared> {
     let scene = Scene::load(scene_path, overrides)?;
     let registry = Registry::discover(&search_path(plugin_dirs));
-    let plugin = registry.integrator(&scene.render.integrator)?;
+    let plugin = match registry.integrator(&scene.render.integrator) {
+        Ok(p) => p.clone(),
+        Err(e) => {
+            // Written in the file: say where; given on the command line: say so.
+            let location = scene.location_of(&["render", "integrator"]);
+            return Err(match location {
+                Some(location) if location.line > 0 => Error::Scene {
+                    location,
+                    key: "render.integrator".into(),
+                    message: e.to_string(),
+                },
+                _ => e,
+            });
+        }
+    };
     let props = scene.integrator_properties(&scene.render.integrator)?;
-    let integrator = plugin.create(&props, &scene)?;
+    let integrator = plugin
+        .create(&props, &scene)
+        .map_err(|e| blame_plugin(&plugin, e))?;
     let mut unused = scene.unused.clone();
     unused.extend(props.unused());
     drop(props);
@@ -209,6 +239,7 @@ pub fn prepare(
     Ok(Prepared {
         scene,
         integrator,
+        plugin,
         warnings,
     })
 }
@@ -229,7 +260,10 @@ pub fn render_prepared(
         progress,
     };
     let start = Instant::now();
-    let film = p.integrator.render(&p.scene, &ctx)?;
+    let film = p
+        .integrator
+        .render(&p.scene, &ctx)
+        .map_err(|e| blame_plugin(&p.plugin, e))?;
     Ok((film, start.elapsed()))
 }
 
@@ -384,7 +418,7 @@ fn cmd_plugins(a: PluginArgs, out: &mut dyn Write) -> Result<u8> {
     let shown: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
     let _ = writeln!(out, "search path: {}", shown.join(":"));
     for p in &reg.problems {
-        let _ = writeln!(out, "skipped: {}", p.message);
+        let _ = writeln!(out, "skipped {}: {}", p.file.display(), p.message);
     }
     Ok(0)
 }

@@ -1,0 +1,416 @@
+//! Photons and the photon map: a balanced kd-tree over compact photons with k-nearest and
+//! fixed-radius queries (Jensen, "Realistic Image Synthesis Using Photon Mapping", ch. 6).
+//!
+//! The tree is implicit: photons are reordered so that the median of every range is its node,
+//! the left half its left subtree and the right half its right subtree; a node stores only its
+//! split axis. Positions live in their own array for the query's hot loop. Small ranges are
+//! leaves searched linearly. Built in parallel with rayon; the result does not depend on the
+//! number of threads.
+
+use crate::Rgb;
+use crate::kernel::NormalizedKernel;
+use glam::Vec3;
+
+/// A photon: 32 bytes. Directions are octahedron-encoded in 2 x 16 bits.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(C)]
+pub struct Photon {
+    pub position: Vec3,
+    /// Flux carried (W).
+    pub power: [f32; 3],
+    /// Direction the photon came from (unit, pointing away from the surface).
+    wi: [u16; 2],
+    /// Surface normal on the side the photon arrived at (zero-length encodes "none", used by
+    /// volume photons).
+    normal: [u16; 2],
+}
+
+fn oct_encode(v: Vec3) -> [u16; 2] {
+    let l1 = v.x.abs() + v.y.abs() + v.z.abs();
+    let (mut x, mut y) = (v.x / l1, v.y / l1);
+    if v.z < 0.0 {
+        let (ox, oy) = (x, y);
+        x = (1.0 - oy.abs()) * ox.signum();
+        y = (1.0 - ox.abs()) * oy.signum();
+    }
+    let q = |c: f32| ((c.clamp(-1.0, 1.0) * 0.5 + 0.5) * 65535.0).round() as u16;
+    [q(x), q(y)]
+}
+
+fn oct_decode(e: [u16; 2]) -> Vec3 {
+    let x = e[0] as f32 / 65535.0 * 2.0 - 1.0;
+    let y = e[1] as f32 / 65535.0 * 2.0 - 1.0;
+    let z = 1.0 - x.abs() - y.abs();
+    let t = (-z).max(0.0);
+    let x = x + if x >= 0.0 { -t } else { t };
+    let y = y + if y >= 0.0 { -t } else { t };
+    Vec3::new(x, y, z).normalize()
+}
+
+impl Photon {
+    pub fn new(position: Vec3, power: Rgb, wi: Vec3, normal: Vec3) -> Photon {
+        Photon {
+            position,
+            power: power.to_array(),
+            wi: oct_encode(wi),
+            normal: oct_encode(normal),
+        }
+    }
+
+    #[inline]
+    pub fn power(&self) -> Rgb {
+        Rgb::from_array(self.power)
+    }
+    /// The direction the photon came from, pointing away from where it was stored.
+    #[inline]
+    pub fn wi(&self) -> Vec3 {
+        oct_decode(self.wi)
+    }
+    /// The stored surface normal, on the side the photon arrived at.
+    #[inline]
+    pub fn normal(&self) -> Vec3 {
+        oct_decode(self.normal)
+    }
+}
+
+const LEAF: usize = 8;
+
+pub struct PhotonMap {
+    photons: Vec<Photon>,
+    positions: Vec<[f32; 3]>,
+    /// Split axis of the node at the median of each range (unused for leaf ranges).
+    axis: Vec<u8>,
+}
+
+/// A neighbour found by a query: squared distance and photon index.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Neighbour {
+    pub d2: f32,
+    pub index: u32,
+}
+
+fn build_range(photons: &mut [Photon], axis: &mut [u8]) {
+    let n = photons.len();
+    if n <= LEAF {
+        return;
+    }
+    let (lo, hi) = photons.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(lo, hi), p| (lo.min(p.position), hi.max(p.position)),
+    );
+    let extent = hi - lo;
+    let a = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let mid = n / 2;
+    photons.select_nth_unstable_by(mid, |p, q| {
+        p.position[a].total_cmp(&q.position[a]).then_with(|| {
+            p.position
+                .to_array()
+                .map(f32::to_bits)
+                .cmp(&q.position.to_array().map(f32::to_bits))
+        })
+    });
+    axis[mid] = a as u8;
+    let (left, rest) = photons.split_at_mut(mid);
+    let (left_axis, rest_axis) = axis.split_at_mut(mid);
+    let right = &mut rest[1..];
+    let right_axis = &mut rest_axis[1..];
+    if n > 50_000 {
+        rayon::join(
+            || build_range(left, left_axis),
+            || build_range(right, right_axis),
+        );
+    } else {
+        build_range(left, left_axis);
+        build_range(right, right_axis);
+    }
+}
+
+/// Max-heap of the k best neighbours so far, kept as an array (k is small).
+struct Candidates<'a> {
+    items: &'a mut Vec<Neighbour>,
+    k: usize,
+    /// Current search radius squared.
+    r2: f32,
+}
+
+impl Candidates<'_> {
+    #[inline]
+    fn offer(&mut self, n: Neighbour) {
+        if self.items.len() < self.k {
+            self.items.push(n);
+            sift_up(self.items);
+            if self.items.len() == self.k {
+                self.r2 = self.r2.min(self.items[0].d2);
+            }
+        } else if n.d2 < self.items[0].d2 {
+            self.items[0] = n;
+            sift_down(self.items);
+            self.r2 = self.items[0].d2;
+        }
+    }
+}
+
+fn sift_up(h: &mut [Neighbour]) {
+    let mut i = h.len() - 1;
+    while i > 0 {
+        let parent = (i - 1) / 2;
+        if h[parent].d2 >= h[i].d2 {
+            break;
+        }
+        h.swap(parent, i);
+        i = parent;
+    }
+}
+
+fn sift_down(h: &mut [Neighbour]) {
+    let mut i = 0;
+    loop {
+        let (l, r) = (2 * i + 1, 2 * i + 2);
+        let mut largest = i;
+        if l < h.len() && h[l].d2 > h[largest].d2 {
+            largest = l;
+        }
+        if r < h.len() && h[r].d2 > h[largest].d2 {
+            largest = r;
+        }
+        if largest == i {
+            break;
+        }
+        h.swap(i, largest);
+        i = largest;
+    }
+}
+
+impl PhotonMap {
+    pub fn build(mut photons: Vec<Photon>) -> PhotonMap {
+        let mut axis = vec![0u8; photons.len()];
+        build_range(&mut photons, &mut axis);
+        let positions = photons.iter().map(|p| p.position.to_array()).collect();
+        PhotonMap {
+            photons,
+            positions,
+            axis,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.photons.len()
+    }
+    pub fn is_empty(&self) -> bool {
+        self.photons.is_empty()
+    }
+    pub fn photons(&self) -> &[Photon] {
+        &self.photons
+    }
+    #[inline]
+    pub fn photon(&self, index: u32) -> &Photon {
+        &self.photons[index as usize]
+    }
+
+    /// Calls `visit(index, d2)` for every photon within squared radius `*r2` of `p`, in tree
+    /// order; `visit` may shrink `*r2` to prune the rest of the search.
+    #[inline]
+    fn search(&self, p: Vec3, r2: &mut f32, mut visit: impl FnMut(u32, f32, &mut f32)) {
+        let q = p.to_array();
+        // Explicit stack of ranges [lo, hi) still to visit, with the squared distance to the
+        // splitting plane that separates them from the query (0 if on the query's side).
+        let mut stack: [(u32, u32, f32); 64] = [(0, 0, 0.0); 64];
+        let mut top = 0;
+        let (mut lo, mut hi) = (0usize, self.photons.len());
+        loop {
+            if hi - lo <= LEAF {
+                for i in lo..hi {
+                    let s = self.positions[i];
+                    let d = [s[0] - q[0], s[1] - q[1], s[2] - q[2]];
+                    let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                    if d2 < *r2 {
+                        visit(i as u32, d2, r2);
+                    }
+                }
+            } else {
+                let mid = (lo + hi) / 2;
+                let a = self.axis[mid] as usize;
+                let s = self.positions[mid];
+                let delta = q[a] - s[a];
+                let d = [s[0] - q[0], s[1] - q[1], s[2] - q[2]];
+                let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+                if d2 < *r2 {
+                    visit(mid as u32, d2, r2);
+                }
+                // Near side first; the far side only if the plane is within the radius.
+                let (near, far) = if delta < 0.0 {
+                    ((lo, mid), (mid + 1, hi))
+                } else {
+                    ((mid + 1, hi), (lo, mid))
+                };
+                if far.1 > far.0 {
+                    stack[top] = (far.0 as u32, far.1 as u32, delta * delta);
+                    top += 1;
+                }
+                lo = near.0;
+                hi = near.1;
+                if hi > lo {
+                    continue;
+                }
+            }
+            // Pop the next range whose plane is still within the (possibly shrunk) radius.
+            loop {
+                if top == 0 {
+                    return;
+                }
+                top -= 1;
+                let (l, h, plane2) = stack[top];
+                if plane2 < *r2 {
+                    lo = l as usize;
+                    hi = h as usize;
+                    break;
+                }
+            }
+        }
+    }
+
+    /// The (up to) k nearest photons within `max_radius` of `p` that `accept` takes, into
+    /// `out` (unordered). Returns the squared search radius: the distance to the k-th photon
+    /// if k were found, else `max_radius`^2.
+    pub fn knn(
+        &self,
+        p: Vec3,
+        k: usize,
+        max_radius: f32,
+        accept: impl Fn(&Photon) -> bool,
+        out: &mut Vec<Neighbour>,
+    ) -> f32 {
+        out.clear();
+        if self.photons.is_empty() || k == 0 {
+            return max_radius * max_radius;
+        }
+        let mut cand = Candidates {
+            items: out,
+            k,
+            r2: max_radius * max_radius,
+        };
+        let mut r2 = cand.r2;
+        self.search(p, &mut r2, |i, d2, r2| {
+            if accept(&self.photons[i as usize]) {
+                cand.offer(Neighbour { d2, index: i });
+                *r2 = cand.r2;
+            }
+        });
+        cand.r2
+    }
+
+    /// Calls `f` for every photon within `radius` of `p`.
+    pub fn within(&self, p: Vec3, radius: f32, mut f: impl FnMut(&Photon, f32)) {
+        if self.photons.is_empty() {
+            return;
+        }
+        let mut r2 = radius * radius;
+        self.search(p, &mut r2, |i, d2, _| f(&self.photons[i as usize], d2));
+    }
+
+    /// Irradiance at a surface point: sum of photon power times the surface kernel over the
+    /// k nearest photons (within `max_radius`) stored on the same side of the same surface.
+    ///
+    /// The radius r is the distance to the k-th photon; that photon lies on the boundary of
+    /// the disc, so only the k - 1 inside are summed (for a uniform density the expected
+    /// count inside the disc of the k-th neighbour is k - 1). When fewer than k photons lie
+    /// within `max_radius`, r = `max_radius` and all of them are summed.
+    pub fn irradiance(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        k: usize,
+        max_radius: f32,
+        kernel: &NormalizedKernel,
+        scratch: &mut Vec<Neighbour>,
+    ) -> Rgb {
+        let r2 = self.knn(p, k, max_radius, |ph| ph.normal().dot(n) > 0.9, scratch);
+        if scratch.is_empty() {
+            return Rgb::ZERO;
+        }
+        let r = r2.sqrt();
+        let full = scratch.len() == k;
+        let mut e = Rgb::ZERO;
+        for nb in scratch.iter() {
+            if full && nb.d2 >= r2 {
+                continue; // the k-th photon, on the boundary
+            }
+            let ph = &self.photons[nb.index as usize];
+            e += ph.power() * kernel.weight_2d(nb.d2.sqrt(), r);
+        }
+        e
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::Rng;
+
+    fn random_map(n: usize, seed: u64) -> (Vec<Photon>, PhotonMap) {
+        let mut rng = Rng::new(&[seed]);
+        let photons: Vec<Photon> = (0..n)
+            .map(|_| {
+                let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32() * 0.1);
+                Photon::new(p, Rgb::ONE, Vec3::Z, Vec3::Z)
+            })
+            .collect();
+        (photons.clone(), PhotonMap::build(photons))
+    }
+
+    #[test]
+    fn knn_matches_brute_force() {
+        let (all, map) = random_map(20_000, 1);
+        let mut rng = Rng::new(&[2]);
+        let mut out = Vec::new();
+        for _ in 0..200 {
+            let q = Vec3::new(rng.next_f32(), rng.next_f32(), 0.05);
+            let k = 1 + (rng.next_u32() % 60) as usize;
+            let r2 = map.knn(q, k, 0.2, |_| true, &mut out);
+            let mut d: Vec<f32> = all
+                .iter()
+                .map(|p| p.position.distance_squared(q))
+                .filter(|&d2| d2 < 0.04)
+                .collect();
+            d.sort_by(f32::total_cmp);
+            d.truncate(k);
+            let mut got: Vec<f32> = out.iter().map(|n| n.d2).collect();
+            got.sort_by(f32::total_cmp);
+            assert_eq!(got, d);
+            if d.len() == k {
+                assert_eq!(r2, d[k - 1]);
+            }
+        }
+    }
+
+    #[test]
+    fn within_matches_brute_force() {
+        let (all, map) = random_map(5_000, 3);
+        let q = Vec3::new(0.4, 0.6, 0.0);
+        let mut count = 0;
+        map.within(q, 0.1, |_, _| count += 1);
+        let want = all
+            .iter()
+            .filter(|p| p.position.distance_squared(q) < 0.01)
+            .count();
+        assert_eq!(count, want);
+    }
+
+    #[test]
+    fn directions_survive_encoding() {
+        let mut rng = Rng::new(&[4]);
+        for _ in 0..1000 {
+            let d = crate::sampling::uniform_sphere(rng.next_2d());
+            let p = Photon::new(Vec3::ZERO, Rgb::ONE, d, -d);
+            assert!(p.wi().dot(d) > 0.99999);
+            assert!(p.normal().dot(-d) > 0.99999);
+        }
+        assert_eq!(std::mem::size_of::<Photon>(), 32);
+    }
+}
