@@ -18,6 +18,7 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod photon;
+pub mod photon_trace;
 pub mod plugin;
 pub mod props;
 pub mod render;

@@ -4,6 +4,8 @@
 //! unknown (misspelt) parameters can be reported afterwards.
 
 use crate::error::{Error, Location, Result};
+use crate::kernel::{BUILTIN_KERNELS, NormalizedKernel};
+use crate::plugin::Registry;
 use crate::value::{Node, Table, Value};
 use glam::Vec3;
 use std::cell::RefCell;
@@ -16,6 +18,8 @@ pub struct Properties<'a> {
     line: u32,
     column: u32,
     used: RefCell<Vec<String>>,
+    /// Kernel plugins that `kernel()` may return (handed over by the host).
+    plugins: Option<&'a Registry>,
 }
 
 static EMPTY: Table = Table(Vec::new());
@@ -31,6 +35,7 @@ impl<'a> Properties<'a> {
                 line: node.line,
                 column: node.column,
                 used: RefCell::new(Vec::new()),
+                plugins: None,
             }),
             other => Err(Error::Scene {
                 location: Location {
@@ -53,6 +58,7 @@ impl<'a> Properties<'a> {
             line: 0,
             column: 0,
             used: RefCell::new(Vec::new()),
+            plugins: None,
         }
     }
 
@@ -65,7 +71,42 @@ impl<'a> Properties<'a> {
             line: 0,
             column: 0,
             used: RefCell::new(Vec::new()),
+            plugins: None,
         }
+    }
+
+    /// Makes the kernel plugins of `registry` available to [`Properties::kernel`].
+    pub fn with_plugins(mut self, registry: &'a Registry) -> Self {
+        self.plugins = Some(registry);
+        self
+    }
+
+    /// The density-estimation kernel named by parameter `name` (default `default`): a built-in
+    /// (`box`, `cone` with parameter `cone_c` >= 1, `gaussian`) or a kernel plugin, normalised
+    /// in 2-D and 3-D. The error for an unknown name lists the kernels found.
+    pub fn kernel(&self, name: &str, default: &'a str) -> Result<NormalizedKernel> {
+        let kind = self.string(name, default)?;
+        let cone_c = self.f32("cone_c", 1.0)?;
+        if cone_c < 1.0 {
+            return Err(self.error("cone_c", format!("must be >= 1, found {cone_c}")));
+        }
+        let kernel: Box<dyn crate::kernel::Kernel> = if let Some(k) =
+            crate::kernel::builtin(kind, cone_c as f64)
+        {
+            k
+        } else if let Some(k) = self.plugins.and_then(|r| r.kernel(kind)) {
+            Box::new(k.clone())
+        } else {
+            let mut known: Vec<String> = BUILTIN_KERNELS.iter().map(|s| s.to_string()).collect();
+            if let Some(r) = self.plugins {
+                known.extend(r.kernels.iter().map(|k| format!("{} (plugin)", k.name)));
+            }
+            return Err(self.error(
+                name,
+                format!("unknown kernel {kind:?}; available: {}", known.join(", ")),
+            ));
+        };
+        NormalizedKernel::new(kernel).map_err(|e| self.error(name, e.to_string()))
     }
 
     pub fn file(&self) -> &'a Path {

@@ -216,7 +216,9 @@ pub fn prepare(
             });
         }
     };
-    let props = scene.integrator_properties(&scene.render.integrator)?;
+    let props = scene
+        .integrator_properties(&scene.render.integrator)?
+        .with_plugins(&registry);
     let integrator = plugin
         .create(&props, &scene)
         .map_err(|e| blame_plugin(&plugin, e))?;

@@ -1,0 +1,414 @@
+//! # `photon`: photon mapping (Jensen)
+//!
+//! | parameter         | type    | meaning                                                        | default  |
+//! |-------------------|---------|----------------------------------------------------------------|----------|
+//! | `global_photons`  | integer | photons emitted for the direct and indirect maps               | 200000   |
+//! | `caustic_photons` | integer | photons emitted for the caustic map (0: no caustic map)        | 100000   |
+//! | `k`               | integer | photons per radiance estimate (k nearest)                      | 50       |
+//! | `max_radius`      | float   | largest estimate radius (world units)                          | 1/20 of the scene's diagonal |
+//! | `kernel`          | string  | `box`, `cone`, `gaussian` or a kernel plugin's name            | `box`    |
+//! | `cone_c`          | float   | the cone kernel's c >= 1                                       | 1        |
+//! | `direct`          | string  | `nee` (shadow rays) or `photons` (first-hit photons)           | `nee`    |
+//! | `final_gather`    | bool    | indirect light by gather rays that look the maps up            | false    |
+//! | `gather_rays`     | integer | gather rays per camera sample                                  | 32       |
+//!
+//! `[render] max_depth` bounds a photon's surface hits; `[render] spp` camera samples.
+//!
+//! Two passes. **Photons** leave the lights in proportion to power (core's `photon_trace`),
+//! bounce by BSDF sampling with Russian roulette, and are stored at diffuse surfaces only, by
+//! path: L D (first hit) in the direct map (only when `direct = "photons"` or with final
+//! gathering), L S+ D in the caustic map (from the caustic budget), and every other path in
+//! the indirect map. **Camera rays** follow mirrors and glass to the first diffuse point x,
+//! where radiance = emission + direct + caustic + indirect:
+//!
+//! * direct: shadow rays to the lights, or the direct map's estimate;
+//! * caustic: the caustic map's estimate;
+//! * indirect: the indirect map's estimate, or with `final_gather` the mean over cosine-
+//!   distributed gather rays of the radiance leaving the diffuse point they reach (through
+//!   mirrors and glass), estimated from all three maps there.
+//!
+//! Each light path is counted once (docs/photon-mapping.md). An estimate is
+//! L = f_r sum_p Phi_p K(d_p, r) over the k nearest photons on the same side of the same
+//! surface, r the distance to the k-th (which, on the boundary, is not summed).
+//!
+//! The method is consistent, not unbiased: estimates blur light over the radius r, which
+//! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
+//! come out well.
+
+use foton_core::film::Film;
+use foton_core::geometry::{Hit, Ray, offset_origin};
+use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::kernel::NormalizedKernel;
+use foton_core::material::{Material, TransportMode};
+use foton_core::photon::{Neighbour, PhotonMap};
+use foton_core::photon_trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
+};
+use foton_core::props::Properties;
+use foton_core::render::render_pixels;
+use foton_core::sampling::Sampler;
+use foton_core::scene::Scene;
+use foton_core::{Error, Result, Rgb, Vec3};
+use std::cell::RefCell;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direct {
+    ShadowRays,
+    Photons,
+}
+
+pub struct PhotonMapper {
+    pub global_photons: u64,
+    pub caustic_photons: u64,
+    pub k: usize,
+    pub max_radius: f32,
+    pub kernel: NormalizedKernel,
+    pub direct: Direct,
+    pub final_gather: bool,
+    pub gather_rays: u32,
+    pub max_depth: u32,
+}
+
+/// The photon maps. `direct` exists when direct light or final gathering reads it.
+pub struct Maps {
+    pub direct: Option<PhotonMap>,
+    pub caustic: PhotonMap,
+    pub indirect: PhotonMap,
+}
+
+/// A diffuse point reached by a camera ray: where it is, what it is, where the ray came from.
+#[derive(Clone, Copy)]
+struct Vertex<'a> {
+    hit: &'a Hit,
+    material: &'a Material,
+    wo: Vec3,
+}
+
+/// Specular (delta) bounces a gather ray may follow before giving up.
+const MAX_SPECULAR: u32 = 64;
+/// Null boundaries crossed in a row before a ray is abandoned.
+const MAX_NULL_CROSSINGS: u32 = 256;
+
+thread_local! {
+    /// Per-thread buffer for the k nearest photons of an estimate.
+    static SCRATCH: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
+}
+
+/// The next surface along a ray that is not a null boundary.
+fn next_surface(scene: &Scene, mut ray: Ray, rays: &mut u64) -> Option<(Hit, Ray)> {
+    for _ in 0..MAX_NULL_CROSSINGS {
+        *rays += 1;
+        let hit = scene.intersect(&ray, f32::INFINITY)?;
+        if !scene.material(&hit).is_null() {
+            return Some((hit, ray));
+        }
+        ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+    }
+    None
+}
+
+impl PhotonMapper {
+    /// The photon pass: traces both budgets and builds the maps.
+    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+        let seed = scene.render.seed;
+        let need_direct = self.direct == Direct::Photons || self.final_gather;
+        let global = TraceOptions {
+            photons: self.global_photons,
+            max_depth: self.max_depth,
+            seed,
+            stream: STREAM_GLOBAL,
+            stop_at_diffuse: false,
+        };
+        // L S+ D photons of the global budget are dropped: the caustic budget counts them.
+        let mut lists = trace_photons(scene, &global, ctx, 2, |class| match class {
+            PathClass::Direct if need_direct => Some(0),
+            PathClass::Indirect => Some(1),
+            _ => None,
+        })?;
+        let indirect = lists.pop().unwrap();
+        let direct = lists.pop().unwrap();
+        let caustic = if self.caustic_photons > 0 {
+            let opts = TraceOptions {
+                photons: self.caustic_photons,
+                max_depth: self.max_depth,
+                seed,
+                stream: STREAM_CAUSTIC,
+                stop_at_diffuse: true,
+            };
+            trace_photons(scene, &opts, ctx, 1, |c| {
+                (c == PathClass::Caustic).then_some(0)
+            })?
+            .pop()
+            .unwrap()
+        } else {
+            Vec::new()
+        };
+        for (name, len) in [
+            ("direct", direct.len()),
+            ("caustic", caustic.len()),
+            ("indirect", indirect.len()),
+        ] {
+            if len > 0 && len < self.k {
+                return Err(Error::Usage(format!(
+                    "integrators.photon.k = {} is larger than the {len} photons stored in the {name} map; lower k or emit more photons",
+                    self.k
+                )));
+            }
+        }
+        if indirect.is_empty() && !scene.lights.is_empty() {
+            ctx.progress
+                .warn("no photon reached a second diffuse surface: the indirect map is empty");
+        }
+        Ok(Maps {
+            direct: need_direct.then(|| PhotonMap::build(direct)),
+            caustic: PhotonMap::build(caustic),
+            indirect: PhotonMap::build(indirect),
+        })
+    }
+
+    /// Irradiance at `hit` (on the side `n` faces) from one map.
+    fn irradiance(&self, map: &PhotonMap, hit: &Hit, n: Vec3) -> Rgb {
+        if map.is_empty() {
+            return Rgb::ZERO;
+        }
+        SCRATCH.with_borrow_mut(|scratch| {
+            map.irradiance(hit.p, n, self.k, self.max_radius, &self.kernel, scratch)
+        })
+    }
+
+    /// Radiance reflected at a diffuse point towards `wo` by the photons of `maps` (all of
+    /// them: direct, caustic and indirect), as seen at the end of a gather ray.
+    fn map_radiance(&self, maps: &Maps, material: &Material, hit: &Hit, wo: Vec3) -> Rgb {
+        let n = if hit.ng.dot(wo) > 0.0 {
+            hit.ng
+        } else {
+            -hit.ng
+        };
+        let mut e =
+            self.irradiance(&maps.caustic, hit, n) + self.irradiance(&maps.indirect, hit, n);
+        if let Some(direct) = &maps.direct {
+            e += self.irradiance(direct, hit, n);
+        }
+        material.eval(wo, n, hit.ng) * e
+    }
+
+    /// Direct light at a diffuse point by one shadow ray to a light chosen by power.
+    fn direct_light(
+        &self,
+        scene: &Scene,
+        v: &Vertex<'_>,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        let Vertex { hit, material, wo } = *v;
+        let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) else {
+            return Rgb::ZERO;
+        };
+        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+        let Some(ls) = scene.lights[light_id].sample_li(hit.p, u, uc) else {
+            return Rgb::ZERO;
+        };
+        let f = material.eval(wo, ls.wi, hit.ng);
+        if f == Rgb::ZERO || ls.li == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        if scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
+            return Rgb::ZERO;
+        }
+        f * ls.wi.dot(hit.ng).abs() * ls.li / (pmf * ls.pdf)
+    }
+
+    /// Indirect light at a diffuse point by final gathering: cosine-distributed rays, followed
+    /// through mirrors and glass to a diffuse point whose reflected radiance the maps give.
+    /// Emission found along them is not counted: it is direct light (L D) or a caustic
+    /// (L S+ D), both counted elsewhere.
+    fn final_gather(
+        &self,
+        scene: &Scene,
+        maps: &Maps,
+        v: &Vertex<'_>,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        let Vertex { hit, material, wo } = *v;
+        let mut sum = Rgb::ZERO;
+        for _ in 0..self.gather_rays {
+            let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+            let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+                continue;
+            };
+            let mut beta = bs.weight;
+            let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+            for _ in 0..MAX_SPECULAR {
+                let Some((y, arrived)) = next_surface(scene, ray, rays) else {
+                    break;
+                };
+                let m = *scene.material(&y);
+                let wo_y = -arrived.dir;
+                if !m.is_delta() {
+                    sum += beta * self.map_radiance(maps, &m, &y, wo_y);
+                    break;
+                }
+                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                let Some(bs) = m.sample(wo_y, y.ng, u, uc, TransportMode::Radiance) else {
+                    break;
+                };
+                beta *= bs.weight;
+                ray = Ray::new(offset_origin(y.p, y.ng, bs.wi), bs.wi);
+            }
+        }
+        sum / self.gather_rays as f32
+    }
+
+    /// Radiance arriving at the camera along `ray`: follow mirrors and glass to the first
+    /// diffuse point, then emission + direct + caustic + indirect there.
+    pub fn li(
+        &self,
+        scene: &Scene,
+        maps: &Maps,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        let mut radiance = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        let mut bounces = 0u32;
+        while let Some((hit, arrived)) = next_surface(scene, ray, rays) {
+            let material = *scene.material(&hit);
+            let wo = -arrived.dir;
+            if let Some((_, light)) = scene.area_light(&hit) {
+                radiance += beta * light.emitted(hit.ng, wo);
+            }
+            if bounces >= self.max_depth {
+                break;
+            }
+            if material.is_delta() {
+                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+                    break;
+                };
+                beta *= bs.weight;
+                bounces += 1;
+                ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+                continue;
+            }
+            let n = if hit.ng.dot(wo) > 0.0 {
+                hit.ng
+            } else {
+                -hit.ng
+            };
+            let f = material.eval(wo, n, hit.ng);
+            let vertex = Vertex {
+                hit: &hit,
+                material: &material,
+                wo,
+            };
+            let direct = match self.direct {
+                Direct::ShadowRays => self.direct_light(scene, &vertex, sampler, rays),
+                Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n),
+            };
+            let caustic = f * self.irradiance(&maps.caustic, &hit, n);
+            let indirect = if self.final_gather {
+                self.final_gather(scene, maps, &vertex, sampler, rays)
+            } else {
+                f * self.irradiance(&maps.indirect, &hit, n)
+            };
+            radiance += beta * (direct + caustic + indirect);
+            break;
+        }
+        radiance
+    }
+}
+
+impl Integrator for PhotonMapper {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        let maps = self.build_maps(scene, ctx)?;
+        if ctx.cancelled() {
+            return Ok(Film::new(scene.film.width, scene.film.height));
+        }
+        render_pixels(scene, ctx, |ray, sampler, rays| {
+            self.li(scene, &maps, *ray, sampler, rays)
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "photon(global_photons = {}, caustic_photons = {}, k = {}, max_radius = {}, kernel = {}, direct = {}, final_gather = {}{})",
+            self.global_photons,
+            self.caustic_photons,
+            self.k,
+            self.max_radius,
+            self.kernel.name(),
+            match self.direct {
+                Direct::ShadowRays => "nee",
+                Direct::Photons => "photons",
+            },
+            self.final_gather,
+            if self.final_gather {
+                format!(", gather_rays = {}", self.gather_rays)
+            } else {
+                String::new()
+            }
+        )
+    }
+}
+
+/// Default largest estimate radius: 1/20 of the scene's bounding-box diagonal.
+pub fn default_max_radius(scene: &Scene) -> f32 {
+    let d = (scene.bounds.1 - scene.bounds.0).length();
+    if d > 0.0 { d / 20.0 } else { 1.0 }
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let global_photons = props.u64("global_photons", 200_000)?;
+    if global_photons == 0 {
+        return Err(props.error("global_photons", "must be at least 1"));
+    }
+    let caustic_photons = props.u64("caustic_photons", 100_000)?;
+    let k = props.u32("k", 50)? as usize;
+    if k == 0 {
+        return Err(props.error("k", "must be at least 1"));
+    }
+    let max_radius = props.f32("max_radius", default_max_radius(scene))?;
+    if max_radius <= 0.0 {
+        return Err(props.error(
+            "max_radius",
+            format!("must be positive, found {max_radius}"),
+        ));
+    }
+    let kernel = props.kernel("kernel", "box")?;
+    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
+        "photons" => Direct::Photons,
+        _ => Direct::ShadowRays,
+    };
+    let final_gather = props.bool("final_gather", false)?;
+    let gather_rays = props.u32("gather_rays", 32)?;
+    if gather_rays == 0 {
+        return Err(props.error("gather_rays", "must be at least 1"));
+    }
+    if scene.has_media() {
+        return Err(Error::Usage(format!(
+            "{}: the scene has participating media, which `photon` does not render (use `vpm`)",
+            scene.file.display()
+        )));
+    }
+    Ok(Box::new(PhotonMapper {
+        global_photons,
+        caustic_photons,
+        k,
+        max_radius,
+        kernel,
+        direct,
+        final_gather,
+        gather_rays,
+        max_depth: scene.render.max_depth,
+    }))
+}
+
+foton_core::declare_integrator!(
+    "photon",
+    "photon mapping (Jensen): caustic, direct and indirect maps",
+    create
+);
