@@ -3,7 +3,8 @@
 //! Rust has no stable ABI: a plugin is only safe to call when it was compiled from the very
 //! same core sources, by the same rustc, for the same target and with the same code-generation
 //! settings as the host. The identifier hashes all of those, so a stale plugin is refused at
-//! load time instead of crashing.
+//! load time instead of crashing. (Dependency versions are checked separately, by the layout
+//! fingerprint in plugin.rs.)
 
 use std::collections::hash_map::DefaultHasher;
 use std::hash::{Hash, Hasher};
@@ -46,19 +47,24 @@ fn main() {
         .unwrap()
         .hash(&mut hasher);
     rustc_version.hash(&mut hasher);
+    // What can change the layout or calling convention of types that cross the boundary:
+    // not the optimisation level or debug info, but debug assertions (dependencies may add
+    // fields under them), panic strategy and target features.
     for var in [
         "TARGET",
-        "PROFILE",
-        "OPT_LEVEL",
-        "DEBUG",
+        "CARGO_CFG_DEBUG_ASSERTIONS",
         "CARGO_CFG_PANIC",
         "CARGO_CFG_TARGET_FEATURE",
     ] {
         std::env::var(var).unwrap_or_default().hash(&mut hasher);
     }
-    let profile = std::env::var("PROFILE").unwrap_or_default();
+    let assertions = if std::env::var_os("CARGO_CFG_DEBUG_ASSERTIONS").is_some() {
+        "debug-assertions"
+    } else {
+        "release"
+    };
     println!(
-        "cargo:rustc-env=FOTON_BUILD_ID={:016x}-{profile}",
+        "cargo:rustc-env=FOTON_BUILD_ID={:016x}-{assertions}",
         hasher.finish()
     );
     println!("cargo:rustc-env=FOTON_RUSTC_VERSION={rustc_version}");

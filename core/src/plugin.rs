@@ -40,6 +40,46 @@ pub const CORE_VERSION_C: &CStr = c_str(concat!(env!("CARGO_PKG_VERSION"), "\0")
 pub const RUSTC_VERSION_C: &CStr = c_str(concat!(env!("FOTON_RUSTC_VERSION"), "\0").as_bytes());
 pub const BUILD_ID_C: &CStr = c_str(concat!(env!("FOTON_BUILD_ID"), "\0").as_bytes());
 
+/// Sizes and alignments of the types that cross the plugin boundary, folded into one number at
+/// compile time. A plugin whose copy of core was built against other versions of glam or
+/// obvhs (or other core types) gets another value, even when the sources hash the same.
+pub const LAYOUT_FINGERPRINT: u64 = {
+    use std::mem::{align_of, size_of};
+    const fn mix(h: u64, x: usize) -> u64 {
+        (h ^ x as u64).wrapping_mul(0x0100_0000_01b3)
+    }
+    let sizes = [
+        size_of::<Scene>(),
+        align_of::<Scene>(),
+        size_of::<crate::accel::Accel>(),
+        size_of::<obvhs::cwbvh::CwBvh>(),
+        size_of::<obvhs::cwbvh::node::CwBvhNode>(),
+        size_of::<obvhs::aabb::Aabb>(),
+        size_of::<glam::Vec3>(),
+        size_of::<glam::Vec3A>(),
+        align_of::<glam::Vec3A>(),
+        size_of::<glam::Mat4>(),
+        size_of::<crate::geometry::Primitive>(),
+        size_of::<crate::light::Light>(),
+        size_of::<crate::material::Material>(),
+        size_of::<crate::camera::Camera>(),
+        size_of::<Film>(),
+        size_of::<Properties<'static>>(),
+        size_of::<RenderContext<'static>>(),
+        size_of::<Registry>(),
+        size_of::<Error>(),
+        size_of::<crate::value::Document>(),
+        size_of::<crate::photon::Photon>(),
+    ];
+    let mut h = 0xcbf2_9ce4_8422_2325u64;
+    let mut i = 0;
+    while i < sizes.len() {
+        h = mix(h, sizes[i]);
+        i += 1;
+    }
+    h
+};
+
 /// What an integrator plugin exports. Only `api_version` may be read before it is checked.
 #[repr(C)]
 pub struct IntegratorDeclaration {
@@ -47,6 +87,8 @@ pub struct IntegratorDeclaration {
     pub core_version: *const c_char,
     pub rustc_version: *const c_char,
     pub build_id: *const c_char,
+    /// [`LAYOUT_FINGERPRINT`] as the plugin's copy of core computed it.
+    pub layout: u64,
     pub name: *const c_char,
     pub description: *const c_char,
     /// Rust ABI: called only after every check passed.
@@ -62,7 +104,8 @@ pub struct KernelDeclaration {
     pub api_version: u32,
     pub name: *const c_char,
     /// The radial profile w(t), t in [0, 1]; need not be normalised.
-    pub weight: unsafe extern "C" fn(f64) -> f64,
+    /// Nullable on the C side; a null pointer is refused at load time.
+    pub weight: Option<unsafe extern "C" fn(f64) -> f64>,
 }
 
 // SAFETY: as above.
@@ -88,6 +131,7 @@ macro_rules! declare_integrator {
                 core_version: $crate::plugin::CORE_VERSION_C.as_ptr(),
                 rustc_version: $crate::plugin::RUSTC_VERSION_C.as_ptr(),
                 build_id: $crate::plugin::BUILD_ID_C.as_ptr(),
+                layout: $crate::plugin::LAYOUT_FINGERPRINT,
                 name: concat!($name, "\0").as_ptr() as *const ::std::ffi::c_char,
                 description: concat!($description, "\0").as_ptr() as *const ::std::ffi::c_char,
                 create: __foton_create,
@@ -275,6 +319,12 @@ fn load(file: &Path) -> Result<Loaded> {
                 )));
             }
         }
+        if decl.layout != LAYOUT_FINGERPRINT {
+            return Err(err(format!(
+                "its types have another layout (fingerprint {:016x}, this foton {LAYOUT_FINGERPRINT:016x}): it was built against other versions of foton-core's dependencies (glam, obvhs); rebuild it with this foton's Cargo.lock",
+                decl.layout
+            )));
+        }
         return Ok(Loaded::Integrator(IntegratorPlugin {
             name: read_c_str(decl.name, "name", file)?,
             description: read_c_str(decl.description, "description", file)?,
@@ -297,7 +347,9 @@ fn load(file: &Path) -> Result<Loaded> {
         return Ok(Loaded::Kernel(KernelPlugin {
             name: read_c_str(decl.name, "name", file)?,
             file: file.to_path_buf(),
-            weight: decl.weight,
+            weight: decl
+                .weight
+                .ok_or_else(|| err("its declaration has no weight function".into()))?,
         }));
     }
     Err(err(format!(

@@ -86,7 +86,11 @@ impl<'a> Properties<'a> {
     /// in 2-D and 3-D. The error for an unknown name lists the kernels found.
     pub fn kernel(&self, name: &str, default: &'a str) -> Result<NormalizedKernel> {
         let kind = self.string(name, default)?;
-        let cone_c = self.f32("cone_c", 1.0)?;
+        let cone_c = if kind == "cone" {
+            self.f32("cone_c", 1.0)?
+        } else {
+            1.0
+        };
         if cone_c < 1.0 {
             return Err(self.error("cone_c", format!("must be >= 1, found {cone_c}")));
         }

@@ -158,6 +158,7 @@ impl Scene {
         read_shapes(
             &root,
             &mut ld,
+            &materials,
             &material_index,
             &medium_index,
             &mut objects,
@@ -358,12 +359,9 @@ fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {
 }
 
 fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings> {
-    let Some(t) = root.table("render")? else {
-        return Err(root.error(
-            "render",
-            "missing section [render]; expected at least integrator = \"path\"",
-        ));
-    };
+    let t = root
+        .table("render")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "render"));
     let integrator = t.string("integrator", "path")?.to_string();
     let spp = t.u32("spp", 16)?;
     if spp == 0 {
@@ -380,12 +378,9 @@ fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings>
 }
 
 fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
-    let Some(t) = root.table("film")? else {
-        return Err(root.error(
-            "film",
-            "missing section [film]; expected width, height, output",
-        ));
-    };
+    let t = root
+        .table("film")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "film"));
     let width = t.u32("width", 256)?;
     let height = t.u32("height", 256)?;
     for (k, v) in [("width", width), ("height", height)] {
@@ -658,6 +653,7 @@ fn load_obj(s: &Properties<'_>, path: &Path, transform: Mat4) -> Result<(Vec<Sha
         Err(tobj::LoadError::OpenFileFailed)
     })
     .map_err(|e| s.error("file", format!("{}: malformed OBJ: {e}", path.display())))?;
+    let mirrored = transform.determinant() < 0.0;
     let mut tris = Vec::new();
     let mut corners = Vec::new();
     for model in &models {
@@ -682,6 +678,11 @@ fn load_obj(s: &Properties<'_>, path: &Path, transform: Mat4) -> Result<(Vec<Sha
                     )
                 })?;
             }
+            if mirrored {
+                // A mirroring transform reverses the winding; undo it so that normals keep
+                // their side (outward stays outward).
+                v.swap(1, 2);
+            }
             if !v.iter().all(|p| p.is_finite()) {
                 return Err(s.error("file", format!("{}: non-finite vertex", path.display())));
             }
@@ -701,30 +702,35 @@ fn load_obj(s: &Properties<'_>, path: &Path, transform: Mat4) -> Result<(Vec<Sha
     Ok((tris, is_closed(&corners)))
 }
 
-/// A closed (watertight) triangle set: every edge is shared by exactly two triangles, with
-/// opposite orientation. Needed for `interior`: inside and outside must be well defined.
+/// A closed (watertight), consistently oriented triangle set: every directed edge is used by
+/// exactly one triangle and its reverse by exactly one other. Needed for `interior`: inside
+/// and outside must be well defined. Vertices are matched by position (+0 and -0 alike).
 pub fn is_closed(tris: &[[Vec3; 3]]) -> bool {
     type Vertex = (u32, u32, u32);
-    let key = |p: Vec3| -> Vertex { (p.x.to_bits(), p.y.to_bits(), p.z.to_bits()) };
-    let mut edges: HashMap<(Vertex, Vertex), i32> = HashMap::new();
+    // Adding +0.0 turns -0.0 into +0.0.
+    let key = |p: Vec3| -> Vertex {
+        let p = p + Vec3::ZERO;
+        (p.x.to_bits(), p.y.to_bits(), p.z.to_bits())
+    };
+    let mut directed: HashMap<(Vertex, Vertex), u32> = HashMap::new();
     for v in tris {
         for i in 0..3 {
-            let (a, b) = (key(v[i]), key(v[(i + 1) % 3]));
-            // +1 for a->b, -1 for b->a, stored under the ordered pair.
-            if a < b {
-                *edges.entry((a, b)).or_default() += 1;
-            } else {
-                *edges.entry((b, a)).or_default() -= 1;
-            }
+            *directed
+                .entry((key(v[i]), key(v[(i + 1) % 3])))
+                .or_default() += 1;
         }
     }
-    !edges.is_empty() && edges.values().all(|&c| c == 0)
+    !directed.is_empty()
+        && directed
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
 }
 
 #[allow(clippy::too_many_arguments)]
 fn read_shapes(
     root: &Properties<'_>,
     ld: &mut Loader,
+    material_defs: &[Named<Material>],
     materials: &Index,
     media: &Index,
     objects: &mut Vec<Object>,
@@ -800,6 +806,12 @@ fn read_shapes(
         if let Some(emission) = s.rgb_opt("emission")?
             && emission.max_element() > 0.0
         {
+            if material_defs[material as usize].value.is_null() {
+                return Err(s.error(
+                    "emission",
+                    "a shape with the null material is invisible and cannot emit; give it a real material (e.g. a black diffuse one)",
+                ));
+            }
             light = Some(lights.len() as u32);
             lights.push(area_light(shapes.clone(), emission, object));
         }

@@ -1,1 +1,79 @@
-//! Example integrator plugin (skeleton; see docs/plugins.md).
+//! # `normals`: surface normals as colours
+//!
+//! The minimal example integrator plugin of docs/plugins.md, and a quick look at a scene's
+//! geometry and orientation. Each camera ray is followed to the first surface whose material
+//! is not `null` (null boundaries are crossed); the pixel is the unit geometric normal `n` there
+//! mapped to a colour, `n * 0.5 + 0.5` (x to red, y to green, z to blue), and black when the
+//! ray hits nothing.
+//!
+//! | parameter        | type    | meaning                                                | default |
+//! |------------------|---------|--------------------------------------------------------|---------|
+//! | `flip_to_camera` | boolean | flip each normal to face the camera (the ray's origin) | false   |
+//!
+//! Without the flip, the normal keeps the shape's own orientation (outward for spheres,
+//! normalize(u x v) for quads, normalize(e1 x e2) for mesh triangles), which is also the side
+//! an emissive shape emits on: a surface seen from its back shows the colour of the opposite
+//! direction. `[render] spp` samples are averaged per pixel (silhouettes are anti-aliased);
+//! `max_depth`, materials, lights and media play no part. The values are written as they are:
+//! exactly to an EXR, sRGB-encoded to a PNG like any other linear value.
+
+use foton_core::film::Film;
+use foton_core::geometry::{Ray, offset_origin};
+use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::props::Properties;
+use foton_core::render::render_pixels;
+use foton_core::scene::Scene;
+use foton_core::{Result, Rgb};
+
+pub struct Normals {
+    flip_to_camera: bool,
+}
+
+/// Null boundaries crossed by one camera ray before it is given up (as in `path`).
+const MAX_NULL_CROSSINGS: u32 = 256;
+
+impl Normals {
+    pub fn new(flip_to_camera: bool) -> Self {
+        Normals { flip_to_camera }
+    }
+
+    /// The colour seen along a camera ray; adds the rays traced to `rays` (statistics).
+    pub fn shade(&self, scene: &Scene, mut ray: Ray, rays: &mut u64) -> Rgb {
+        for _ in 0..=MAX_NULL_CROSSINGS {
+            *rays += 1;
+            let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
+                return Rgb::ZERO;
+            };
+            if scene.material(&hit).is_null() {
+                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+                continue;
+            }
+            let mut n = hit.ng;
+            if self.flip_to_camera && n.dot(ray.dir) > 0.0 {
+                n = -n;
+            }
+            return n * 0.5 + Rgb::splat(0.5);
+        }
+        Rgb::ZERO
+    }
+}
+
+impl Integrator for Normals {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        render_pixels(scene, ctx, |ray, _sampler, rays| {
+            self.shade(scene, *ray, rays)
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!("normals(flip_to_camera = {})", self.flip_to_camera)
+    }
+}
+
+/// Reads the parameters (see the table above) from the scene's `[integrators.normals]` table.
+pub fn create(props: &Properties<'_>, _scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let flip_to_camera = props.bool("flip_to_camera", false)?;
+    Ok(Box::new(Normals::new(flip_to_camera)))
+}
+
+foton_core::declare_integrator!("normals", "surface normals as colours (example)", create);

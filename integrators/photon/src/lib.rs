@@ -407,8 +407,4 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!(
-    "photon",
-    "photon mapping (Jensen): caustic, direct and indirect maps",
-    create
-);
+foton_core::declare_integrator!("photon", "photon mapping (Jensen)", create);
