@@ -1,0 +1,73 @@
+//! The integrator plugins built by cargo are found, and the minimal example plugin of
+//! docs/plugins.md (`normals`) loads and renders what it says.
+
+use foton_tests::{header, registry, render_toml};
+use glam::Vec3;
+
+#[test]
+fn built_plugins_are_registered_with_descriptions() {
+    let reg = registry();
+    for name in ["path", "photon", "normals"] {
+        let p = reg
+            .integrators
+            .iter()
+            .find(|p| p.name == name)
+            .unwrap_or_else(|| panic!("{name} not found; problems: {:?}", reg.problems));
+        assert!(!p.description.is_empty());
+        assert!(p.file.is_file());
+    }
+    assert!(
+        reg.problems
+            .iter()
+            .all(|p| !p.file.to_string_lossy().contains("foton_path")),
+        "{:?}",
+        reg.problems
+    );
+}
+
+#[test]
+fn example_plugin_renders_normals() {
+    let scene = format!(
+        r#"{}
+[camera]
+position = [0.0, 0.0, 2.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 30.0
+[materials.m]
+type = "diffuse"
+[[shapes]]
+type = "quad"
+origin = [-1.0, -1.0, 0.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 2.0, 0.0]
+material = "m"
+"#,
+        header("normals", 2, 0, 8, 8)
+    );
+    // u x v = +z faces the camera: colour (0.5, 0.5, 1).
+    let film = render_toml("normals", &scene, &[], 2);
+    for p in film.pixels() {
+        assert!(
+            (p - Vec3::new(0.5, 0.5, 1.0)).abs().max_element() < 1e-6,
+            "{p}"
+        );
+    }
+    // Seen from behind it keeps its own orientation (+z), unless flipped to the camera (-z).
+    let back = ["camera.position=[0.0, 0.0, -2.0]"];
+    let film = render_toml("normals-back", &scene, &back, 2);
+    assert!(
+        (film.pixel(4, 4) - Vec3::new(0.5, 0.5, 1.0))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    let flipped = [back[0], "integrators.normals.flip_to_camera=true"];
+    let film = render_toml("normals-flip", &scene, &flipped, 2);
+    assert!(
+        (film.pixel(4, 4) - Vec3::new(0.5, 0.5, 0.0))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+}
