@@ -1,11 +1,13 @@
 //! Photons and the photon map: a balanced kd-tree over compact photons with k-nearest and
 //! fixed-radius queries (Jensen, "Realistic Image Synthesis Using Photon Mapping", ch. 6).
 //!
-//! The tree is implicit: photons are reordered so that the median of every range is its node,
-//! the left half its left subtree and the right half its right subtree; a node stores only its
-//! split axis. Positions live in their own array for the query's hot loop. Small ranges are
-//! leaves searched linearly. Built in parallel with rayon; the result does not depend on the
-//! number of threads.
+//! The tree is implicit and bucketed: photons are reordered so that each range [lo, hi) is
+//! split at its median index mid = (lo + hi) / 2 into [lo, mid) and [mid, hi) along the axis
+//! of largest extent; the node stores that axis and the median's coordinate at index mid
+//! (unique per node). Ranges of at most `LEAF` photons are buckets, searched linearly over a
+//! separate position array. Queries track the squared distance from the query to each cell
+//! incrementally (Arya and Mount), which prunes more than the distance to the last plane.
+//! Built in parallel with rayon; the result does not depend on the number of threads.
 
 use crate::Rgb;
 use crate::kernel::NormalizedKernel;
@@ -82,13 +84,15 @@ impl Photon {
     }
 }
 
-const LEAF: usize = 4;
+const LEAF: usize = 8;
 
 pub struct PhotonMap {
     photons: Vec<Photon>,
     positions: Vec<[f32; 3]>,
-    /// Split axis of the node at the median of each range (unused for leaf ranges).
+    /// Split axis and coordinate of the node whose range has its median at this index
+    /// (unused for buckets).
     axis: Vec<u8>,
+    split: Vec<f32>,
 }
 
 /// A neighbour found by a query: squared distance and photon index.
@@ -98,7 +102,7 @@ pub struct Neighbour {
     pub index: u32,
 }
 
-fn build_range(photons: &mut [Photon], axis: &mut [u8]) {
+fn build_range(photons: &mut [Photon], axis: &mut [u8], split: &mut [f32]) {
     let n = photons.len();
     if n <= LEAF {
         return;
@@ -116,6 +120,8 @@ fn build_range(photons: &mut [Photon], axis: &mut [u8]) {
         2
     };
     let mid = n / 2;
+    // Ties broken by the full position, so the order (and every query's result) is the same
+    // whatever the thread count.
     photons.select_nth_unstable_by(mid, |p, q| {
         p.position[a].total_cmp(&q.position[a]).then_with(|| {
             p.position
@@ -125,18 +131,18 @@ fn build_range(photons: &mut [Photon], axis: &mut [u8]) {
         })
     });
     axis[mid] = a as u8;
-    let (left, rest) = photons.split_at_mut(mid);
-    let (left_axis, rest_axis) = axis.split_at_mut(mid);
-    let right = &mut rest[1..];
-    let right_axis = &mut rest_axis[1..];
+    split[mid] = photons[mid].position[a];
+    let (left, right) = photons.split_at_mut(mid);
+    let (left_axis, right_axis) = axis.split_at_mut(mid);
+    let (left_split, right_split) = split.split_at_mut(mid);
     if n > 50_000 {
         rayon::join(
-            || build_range(left, left_axis),
-            || build_range(right, right_axis),
+            || build_range(left, left_axis, left_split),
+            || build_range(right, right_axis, right_split),
         );
     } else {
-        build_range(left, left_axis);
-        build_range(right, right_axis);
+        build_range(left, left_axis, left_split);
+        build_range(right, right_axis, right_split);
     }
 }
 
@@ -199,12 +205,14 @@ fn sift_down(h: &mut [Neighbour]) {
 impl PhotonMap {
     pub fn build(mut photons: Vec<Photon>) -> PhotonMap {
         let mut axis = vec![0u8; photons.len()];
-        build_range(&mut photons, &mut axis);
+        let mut split = vec![0f32; photons.len()];
+        build_range(&mut photons, &mut axis, &mut split);
         let positions = photons.iter().map(|p| p.position.to_array()).collect();
         PhotonMap {
             photons,
             positions,
             axis,
+            split,
         }
     }
 
@@ -227,11 +235,25 @@ impl PhotonMap {
     #[inline]
     fn search(&self, p: Vec3, r2: &mut f32, mut visit: impl FnMut(u32, f32, &mut f32)) {
         let q = p.to_array();
-        // Explicit stack of ranges [lo, hi) still to visit, with the squared distance to the
-        // splitting plane that separates them from the query (0 if on the query's side).
-        let mut stack: [(u32, u32, f32); 64] = [(0, 0, 0.0); 64];
+        // Ranges [lo, hi) still to visit, each with the squared distance from the query to its
+        // cell (a lower bound on any of its photons' distances) and the per-axis offsets
+        // that distance is made of (Arya and Mount's incremental distance).
+        struct Pending {
+            lo: u32,
+            hi: u32,
+            dist2: f32,
+            off: [f32; 3],
+        }
+        let mut stack: [Pending; 64] = std::array::from_fn(|_| Pending {
+            lo: 0,
+            hi: 0,
+            dist2: 0.0,
+            off: [0.0; 3],
+        });
         let mut top = 0;
         let (mut lo, mut hi) = (0usize, self.photons.len());
+        let mut off = [0.0f32; 3];
+        let mut dist2 = 0.0f32;
         loop {
             if hi - lo <= LEAF {
                 for i in lo..hi {
@@ -245,39 +267,38 @@ impl PhotonMap {
             } else {
                 let mid = (lo + hi) / 2;
                 let a = self.axis[mid] as usize;
-                let s = self.positions[mid];
-                let delta = q[a] - s[a];
-                let d = [s[0] - q[0], s[1] - q[1], s[2] - q[2]];
-                let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                if d2 < *r2 {
-                    visit(mid as u32, d2, r2);
-                }
-                // Near side first; the far side only if the plane is within the radius.
+                let delta = q[a] - self.split[mid];
+                // Near side first; the far cell is farther by the change of this axis' offset.
                 let (near, far) = if delta < 0.0 {
-                    ((lo, mid), (mid + 1, hi))
+                    ((lo, mid), (mid, hi))
                 } else {
-                    ((mid + 1, hi), (lo, mid))
+                    ((mid, hi), (lo, mid))
                 };
-                if far.1 > far.0 {
-                    stack[top] = (far.0 as u32, far.1 as u32, delta * delta);
+                let far_dist2 = dist2 - off[a] * off[a] + delta * delta;
+                if far_dist2 < *r2 {
+                    let mut far_off = off;
+                    far_off[a] = delta;
+                    stack[top] = Pending {
+                        lo: far.0 as u32,
+                        hi: far.1 as u32,
+                        dist2: far_dist2,
+                        off: far_off,
+                    };
                     top += 1;
                 }
-                lo = near.0;
-                hi = near.1;
-                if hi > lo {
-                    continue;
-                }
+                (lo, hi) = near;
+                continue;
             }
-            // Pop the next range whose plane is still within the (possibly shrunk) radius.
+            // Pop the next range whose cell is still within the (possibly shrunk) radius.
             loop {
                 if top == 0 {
                     return;
                 }
                 top -= 1;
-                let (l, h, plane2) = stack[top];
-                if plane2 < *r2 {
-                    lo = l as usize;
-                    hi = h as usize;
+                let next = &stack[top];
+                if next.dist2 < *r2 {
+                    (lo, hi, dist2, off) =
+                        (next.lo as usize, next.hi as usize, next.dist2, next.off);
                     break;
                 }
             }
