@@ -19,6 +19,12 @@ pub trait Progress: Send + Sync {
     fn warn(&self, message: &str);
     /// `n` more rays were traced (for a rays/s display).
     fn rays(&self, _n: u64) {}
+    /// A short status for the current phase (a progressive integrator's iteration, photons
+    /// so far and radius), shown beside the bar.
+    fn status(&self, _text: &str) {}
+    /// A progressive integrator finished iteration `iteration` (1-based); `image` makes the
+    /// current estimate. The host writes it when the user asked for checkpoints.
+    fn checkpoint(&self, _iteration: u64, _image: &dyn Fn() -> Film) {}
 }
 
 /// Progress that reports nothing.

@@ -8,6 +8,7 @@
 
 pub mod accel;
 pub mod camera;
+pub mod camera_path;
 pub mod cli;
 pub mod error;
 pub mod film;

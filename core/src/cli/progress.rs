@@ -70,6 +70,11 @@ impl Progress for TermProgress {
             bar.set_message(format!("{:.2} M rays/s", total as f64 / secs / 1e6));
         }
     }
+    fn status(&self, text: &str) {
+        if let Some(bar) = &*self.bar.lock().unwrap() {
+            bar.set_message(text.to_string());
+        }
+    }
     fn warn(&self, message: &str) {
         self.warnings.lock().unwrap().push(message.to_string());
     }

@@ -35,6 +35,7 @@
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
 
+use foton_core::camera_path::{VisiblePoint, direct_light, next_surface, trace_to_diffuse};
 use foton_core::film::Film;
 use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Integrator, RenderContext};
@@ -86,25 +87,9 @@ struct Vertex<'a> {
 
 /// Specular (delta) bounces a gather ray may follow before giving up.
 const MAX_SPECULAR: u32 = 64;
-/// Null boundaries crossed in a row before a ray is abandoned.
-const MAX_NULL_CROSSINGS: u32 = 256;
-
 thread_local! {
     /// Per-thread buffer for the k nearest photons of an estimate.
     static SCRATCH: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
-}
-
-/// The next surface along a ray that is not a null boundary.
-fn next_surface(scene: &Scene, mut ray: Ray, rays: &mut u64) -> Option<(Hit, Ray)> {
-    for _ in 0..MAX_NULL_CROSSINGS {
-        *rays += 1;
-        let hit = scene.intersect(&ray, f32::INFINITY)?;
-        if !scene.material(&hit).is_null() {
-            return Some((hit, ray));
-        }
-        ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
-    }
-    None
 }
 
 impl PhotonMapper {
@@ -192,33 +177,6 @@ impl PhotonMapper {
         material.eval(wo, n, hit.ng) * e
     }
 
-    /// Direct light at a diffuse point by one shadow ray to a light chosen by power.
-    fn direct_light(
-        &self,
-        scene: &Scene,
-        v: &Vertex<'_>,
-        sampler: &mut Sampler,
-        rays: &mut u64,
-    ) -> Rgb {
-        let Vertex { hit, material, wo } = *v;
-        let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) else {
-            return Rgb::ZERO;
-        };
-        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-        let Some(ls) = scene.lights[light_id].sample_li(hit.p, u, uc) else {
-            return Rgb::ZERO;
-        };
-        let f = material.eval(wo, ls.wi, hit.ng);
-        if f == Rgb::ZERO || ls.li == Rgb::ZERO {
-            return Rgb::ZERO;
-        }
-        *rays += 1;
-        if scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
-            return Rgb::ZERO;
-        }
-        f * ls.wi.dot(hit.ng).abs() * ls.li / (pmf * ls.pdf)
-    }
-
     /// Indirect light at a diffuse point by final gathering: cosine-distributed rays, followed
     /// through mirrors and glass to a diffuse point whose reflected radiance the maps give.
     /// Emission found along them is not counted: it is direct light (L D) or a caustic
@@ -267,57 +225,39 @@ impl PhotonMapper {
         &self,
         scene: &Scene,
         maps: &Maps,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let mut radiance = Rgb::ZERO;
-        let mut beta = Rgb::ONE;
-        let mut bounces = 0u32;
-        while let Some((hit, arrived)) = next_surface(scene, ray, rays) {
-            let material = *scene.material(&hit);
-            let wo = -arrived.dir;
-            if let Some((_, light)) = scene.area_light(&hit) {
-                radiance += beta * light.emitted(hit.ng, wo);
-            }
-            if bounces >= self.max_depth {
-                break;
-            }
-            if material.is_delta() {
-                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-                let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
-                    break;
-                };
-                beta *= bs.weight;
-                bounces += 1;
-                ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
-                continue;
-            }
-            let n = if hit.ng.dot(wo) > 0.0 {
-                hit.ng
-            } else {
-                -hit.ng
-            };
-            let f = material.eval(wo, n, hit.ng);
-            let vertex = Vertex {
-                hit: &hit,
-                material: &material,
-                wo,
-            };
-            let direct = match self.direct {
-                Direct::ShadowRays => self.direct_light(scene, &vertex, sampler, rays),
-                Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n),
-            };
-            let caustic = f * self.irradiance(&maps.caustic, &hit, n);
-            let indirect = if self.final_gather {
-                self.final_gather(scene, maps, &vertex, sampler, rays)
-            } else {
-                f * self.irradiance(&maps.indirect, &hit, n)
-            };
-            radiance += beta * (direct + caustic + indirect);
-            break;
-        }
-        radiance
+        let path = trace_to_diffuse(scene, ray, self.max_depth, sampler, rays);
+        let Some(vp) = path.visible else {
+            return path.emitted;
+        };
+        let VisiblePoint {
+            hit,
+            material,
+            wo,
+            n,
+            beta,
+            ..
+        } = vp;
+        let f = material.eval(wo, n, hit.ng);
+        let vertex = Vertex {
+            hit: &hit,
+            material: &material,
+            wo,
+        };
+        let direct = match self.direct {
+            Direct::ShadowRays => direct_light(scene, &hit, &material, wo, sampler, rays),
+            Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n),
+        };
+        let caustic = f * self.irradiance(&maps.caustic, &hit, n);
+        let indirect = if self.final_gather {
+            self.final_gather(scene, maps, &vertex, sampler, rays)
+        } else {
+            f * self.irradiance(&maps.indirect, &hit, n)
+        };
+        path.emitted + beta * (direct + caustic + indirect)
     }
 }
 

@@ -1,0 +1,401 @@
+//! # `sppm`: stochastic progressive photon mapping (Hachisuka and Jensen 2009)
+//!
+//! | parameter               | type    | meaning                                                   | default |
+//! |-------------------------|---------|-----------------------------------------------------------|---------|
+//! | `iterations`            | integer | camera + photon passes to run                             | 64 (unlimited with `time`) |
+//! | `time`                  | float   | run until this many seconds have passed                   | none    |
+//! | `photons_per_iteration` | integer | photons emitted in each iteration                         | 100000  |
+//! | `initial_radius`        | float   | every pixel's starting gather radius (world units)        | automatic, below |
+//! | `alpha`                 | float   | fraction of new photons kept, in (0, 1]                   | 0.7     |
+//! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name       | `box`   |
+//! | `cone_c`                | float   | the cone kernel's c >= 1                                  | 1       |
+//! | `direct`                | string  | `nee` (shadow rays) or `photons`                          | `nee`   |
+//!
+//! `[render] max_depth` bounds both the camera path's delta bounces and a photon's surface
+//! hits; `[render] spp` is not used (each iteration takes one new jittered camera sample per
+//! pixel). With `time`, `iterations` (if given) is an upper bound.
+//!
+//! Each iteration traces a new camera path per pixel through mirrors and glass to its first
+//! diffuse point, the *visible point* (so anti-aliasing comes for free), adds the emission met
+//! and, with `direct = "nee"`, direct light by a shadow ray; then traces a batch of photons
+//! (core's photon pass: stored at diffuse surfaces only, never on mirrors or glass), gathers
+//! at each visible point the photons within the pixel's radius R on the same side of the same
+//! surface, and updates the pixel's statistics:
+//!
+//!     N' = N + alpha M,   R' = R sqrt((N + alpha M) / (N + M)),   tau' = (tau + Phi) R'^2 / R^2
+//!
+//! where M is the number of photons gathered and Phi = beta sum_p f_r Phi_p their reflected
+//! flux. The pixel's radiance after n iterations is Ld / n + tau / (n pi R^2) (photon flux
+//! is divided by the photons of one iteration, so n is the number of iterations). R shrinks
+//! to zero while N grows without bound: the estimate is consistent, converging to the image
+//! the path tracer converges to.
+//!
+//! **Kernels.** With a kernel K other than the box, a photon at distance d counts with weight
+//! w = pi R^2 K(d, R) (1 for the box inside the disc): M is the weighted count and Phi the
+//! weighted flux. w averages to one over the disc, so for a locally uniform density the
+//! weighted count has the box count's expectation and the same update keeps tau / (pi R^2)
+//! an estimate of reflected radiance (Knaus and Zwicker 2011 show the update needs only that).
+//!
+//! **Automatic initial radius.** Three times the pixel's footprint at its first visible point
+//! (the angle a pixel subtends at the image centre times the length of the camera path), kept
+//! within [1/1000, 1/50] of the scene's bounding-box diagonal: a few pixels wide, so that early
+//! iterations find photons, and small against the scene.
+//!
+//! **Determinism.** Photons are traced with per-photon random streams and gathered per pixel
+//! from a kd-tree built in a fixed order (core's `PhotonMap`), so images are identical for
+//! any number of threads. Memory is bounded: one iteration's photons at a time.
+
+use foton_core::camera_path::{direct_light, trace_to_diffuse};
+use foton_core::film::Film;
+use foton_core::integrator::{Integrator, NoProgress, RenderContext};
+use foton_core::kernel::NormalizedKernel;
+use foton_core::photon::PhotonMap;
+use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
+use foton_core::props::Properties;
+use foton_core::render::with_pool;
+use foton_core::sampling::{Rng, splitmix64};
+use foton_core::scene::Scene;
+use foton_core::{Error, Result, Rgb};
+use glam::{DVec3, Vec2};
+use rayon::prelude::*;
+use std::f64::consts::PI;
+use std::time::Instant;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direct {
+    ShadowRays,
+    Photons,
+}
+
+pub struct Sppm {
+    /// None: until `time` runs out.
+    pub iterations: Option<u64>,
+    pub time: Option<f64>,
+    pub photons_per_iteration: u64,
+    pub initial_radius: Option<f32>,
+    pub alpha: f64,
+    pub kernel: NormalizedKernel,
+    pub direct: Direct,
+    pub max_depth: u32,
+}
+
+/// A pixel's progressive statistics.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct PixelStats {
+    /// Gather radius R (0 until the pixel's first visible point).
+    pub radius: f64,
+    /// Accumulated (weighted) photon count N.
+    pub n: f64,
+    /// Accumulated reflected flux tau.
+    pub tau: DVec3,
+    /// Sum over iterations of the emission and shadow-ray direct light.
+    pub ld: DVec3,
+}
+
+impl PixelStats {
+    /// Hachisuka and Jensen's update after gathering `m` photons that reflect flux `phi`.
+    pub fn update(&mut self, alpha: f64, m: f64, phi: DVec3) {
+        if m <= 0.0 {
+            return;
+        }
+        let n_new = self.n + alpha * m;
+        let shrink = n_new / (self.n + m); // R'^2 / R^2
+        self.tau = (self.tau + phi) * shrink;
+        self.radius *= shrink.sqrt();
+        self.n = n_new;
+    }
+
+    /// The pixel's radiance estimate after `iterations` iterations.
+    pub fn radiance(&self, iterations: u64) -> DVec3 {
+        if iterations == 0 {
+            return DVec3::ZERO;
+        }
+        let k = iterations as f64;
+        let mut l = self.ld / k;
+        if self.radius > 0.0 {
+            l += self.tau / (k * PI * self.radius * self.radius);
+        }
+        l
+    }
+}
+
+/// Random stream of the camera pass.
+const STREAM_CAMERA: u64 = 0x7370_706d;
+
+/// What an iteration's camera pass found at one pixel.
+struct CameraSample {
+    /// Emission and shadow-ray direct light, weighted by the path throughput.
+    ld: Rgb,
+    visible: Option<foton_core::camera_path::VisiblePoint>,
+}
+
+impl Sppm {
+    fn camera_pass(&self, scene: &Scene, iteration: u64, rays: &mut u64) -> Vec<CameraSample> {
+        let (width, height) = (scene.film.width, scene.film.height);
+        let seed = scene.render.seed;
+        let rows: Vec<(Vec<CameraSample>, u64)> = (0..height)
+            .into_par_iter()
+            .map(|y| {
+                let mut row_rays = 0u64;
+                let row = (0..width)
+                    .map(|x| {
+                        let pixel = y as u64 * width as u64 + x as u64;
+                        let mut sampler = Rng::new(&[seed, STREAM_CAMERA, pixel, iteration]);
+                        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                        let ray = scene.camera.generate_ray(film);
+                        let path = trace_to_diffuse(
+                            scene,
+                            ray,
+                            self.max_depth,
+                            &mut sampler,
+                            &mut row_rays,
+                        );
+                        let mut ld = path.emitted;
+                        if let (Some(vp), Direct::ShadowRays) = (&path.visible, self.direct) {
+                            ld += vp.beta
+                                * direct_light(
+                                    scene,
+                                    &vp.hit,
+                                    &vp.material,
+                                    vp.wo,
+                                    &mut sampler,
+                                    &mut row_rays,
+                                );
+                        }
+                        CameraSample {
+                            ld,
+                            visible: path.visible,
+                        }
+                    })
+                    .collect();
+                (row, row_rays)
+            })
+            .collect();
+        let mut samples = Vec::with_capacity(width as usize * height as usize);
+        for (row, row_rays) in rows {
+            *rays += row_rays;
+            samples.extend(row);
+        }
+        samples
+    }
+
+    /// The starting radius of a pixel whose first visible point lies `distance` along the
+    /// camera path.
+    fn first_radius(&self, scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
+        if let Some(r) = self.initial_radius {
+            return r as f64;
+        }
+        let diagonal = (scene.bounds.1 - scene.bounds.0).length().max(1e-6) as f64;
+        (3.0 * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
+    }
+}
+
+/// The angle one pixel subtends at the centre of the image.
+fn pixel_angle(scene: &Scene) -> f32 {
+    let (w, h) = (scene.film.width as f32, scene.film.height as f32);
+    let a = scene.camera.generate_ray(Vec2::new(w / 2.0, h / 2.0)).dir;
+    let b = scene
+        .camera
+        .generate_ray(Vec2::new(w / 2.0, h / 2.0 + 1.0))
+        .dir;
+    a.dot(b).clamp(-1.0, 1.0).acos()
+}
+
+fn film_of(stats: &[PixelStats], width: u32, height: u32, iterations: u64) -> Film {
+    let mut film = Film::new(width, height);
+    for y in 0..height {
+        for x in 0..width {
+            let l = stats[(y * width + x) as usize].radiance(iterations);
+            film.set_pixel(x, y, l.as_vec3());
+        }
+    }
+    film
+}
+
+impl Integrator for Sppm {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        let (width, height) = (scene.film.width, scene.film.height);
+        let mut stats = vec![PixelStats::default(); width as usize * height as usize];
+        let angle = pixel_angle(scene);
+        let start = Instant::now();
+        let quiet = RenderContext {
+            threads: ctx.threads,
+            cancel: ctx.cancel,
+            progress: &NoProgress,
+        };
+        match (self.iterations, self.time) {
+            (Some(n), None) => ctx.progress.begin("iterations", n),
+            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
+            (None, None) => unreachable!("create() sets one"),
+        }
+        let mut done = 0u64;
+        let mut photons_total = 0u64;
+        let mut rays = 0u64;
+        let mut seconds_reported = 0u64;
+        loop {
+            if self.iterations.is_some_and(|n| done >= n)
+                || self
+                    .time
+                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+                || ctx.cancelled()
+            {
+                break;
+            }
+            let camera = with_pool(ctx.threads, || self.camera_pass(scene, done, &mut rays))?;
+            let options = TraceOptions {
+                photons: self.photons_per_iteration,
+                max_depth: self.max_depth,
+                seed: splitmix64(scene.render.seed ^ splitmix64(done)),
+                stream: STREAM_GLOBAL,
+                stop_at_diffuse: false,
+            };
+            let keep_direct = self.direct == Direct::Photons;
+            let photons = trace_photons(scene, &options, &quiet, 1, |class| {
+                (class != PathClass::Direct || keep_direct).then_some(0)
+            })?
+            .pop()
+            .unwrap_or_default();
+            if ctx.cancelled() {
+                // An iteration with part of its photons would be biased: drop it.
+                break;
+            }
+            let map = PhotonMap::build(photons);
+            let alpha = self.alpha;
+            with_pool(ctx.threads, || {
+                stats
+                    .par_iter_mut()
+                    .zip(camera.par_iter())
+                    .for_each(|(st, cs)| {
+                        st.ld += cs.ld.as_dvec3();
+                        let Some(vp) = &cs.visible else {
+                            return;
+                        };
+                        if st.radius == 0.0 {
+                            st.radius = self.first_radius(scene, angle, vp.distance);
+                        }
+                        let r = st.radius as f32;
+                        let disc = std::f32::consts::PI * r * r;
+                        let (mut m, mut phi) = (0.0f64, DVec3::ZERO);
+                        map.within(vp.hit.p, r, |photon, d2| {
+                            if photon.normal().dot(vp.n) <= 0.9 {
+                                return; // another surface, or the other side of this one
+                            }
+                            let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;
+                            let f = vp.material.eval(vp.wo, photon.wi(), vp.hit.ng);
+                            m += w as f64;
+                            phi += (f * photon.power() * w).as_dvec3();
+                        });
+                        st.update(alpha, m, phi * vp.beta.as_dvec3());
+                    })
+            })?;
+            done += 1;
+            photons_total += self.photons_per_iteration;
+            let (sum_r, lit) = stats
+                .iter()
+                .filter(|s| s.radius > 0.0)
+                .fold((0.0, 0u64), |(s, n), st| (s + st.radius, n + 1));
+            ctx.progress.status(&format!(
+                "iteration {done}, {photons_total} photons, mean radius {:.4}",
+                sum_r / lit.max(1) as f64
+            ));
+            match self.time {
+                None => ctx.progress.advance(1),
+                Some(_) => {
+                    let s = start.elapsed().as_secs();
+                    ctx.progress.advance(s - seconds_reported);
+                    seconds_reported = s;
+                }
+            }
+            ctx.progress
+                .checkpoint(done, &|| film_of(&stats, width, height, done));
+        }
+        ctx.progress.finish();
+        let mut film = film_of(&stats, width, height, done);
+        film.rays = rays;
+        Ok(film)
+    }
+
+    fn describe(&self) -> String {
+        let budget = match (self.iterations, self.time) {
+            (Some(n), None) => format!("iterations = {n}"),
+            (Some(n), Some(t)) => format!("time = {t}, iterations <= {n}"),
+            (None, Some(t)) => format!("time = {t}"),
+            (None, None) => String::new(),
+        };
+        format!(
+            "sppm({budget}, photons_per_iteration = {}, initial_radius = {}, alpha = {}, kernel = {}, direct = {})",
+            self.photons_per_iteration,
+            self.initial_radius
+                .map_or("auto".to_string(), |r| r.to_string()),
+            self.alpha,
+            self.kernel.name(),
+            match self.direct {
+                Direct::ShadowRays => "nee",
+                Direct::Photons => "photons",
+            }
+        )
+    }
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let time = props.f32_opt("time")?;
+    if let Some(t) = time
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(props.error(
+            "time",
+            format!("must be a positive number of seconds, found {t}"),
+        ));
+    }
+    let iterations = if props.has("iterations") || time.is_none() {
+        let n = props.u64("iterations", 64)?;
+        if n == 0 {
+            return Err(props.error("iterations", "must be at least 1"));
+        }
+        Some(n)
+    } else {
+        None
+    };
+    let photons_per_iteration = props.u64("photons_per_iteration", 100_000)?;
+    if photons_per_iteration == 0 {
+        return Err(props.error("photons_per_iteration", "must be at least 1"));
+    }
+    let initial_radius = props.f32_opt("initial_radius")?;
+    if let Some(r) = initial_radius
+        && !(r > 0.0 && r.is_finite())
+    {
+        return Err(props.error("initial_radius", format!("must be positive, found {r}")));
+    }
+    let alpha = props.f32("alpha", 0.7)?;
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(props.error("alpha", format!("must be in (0, 1], found {alpha}")));
+    }
+    let kernel = props.kernel("kernel", "box")?;
+    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
+        "photons" => Direct::Photons,
+        _ => Direct::ShadowRays,
+    };
+    if scene.has_media() {
+        return Err(Error::Usage(format!(
+            "{}: the scene has participating media, which `sppm` does not render (use `vpm` or `path`)",
+            scene.file.display()
+        )));
+    }
+    Ok(Box::new(Sppm {
+        iterations,
+        time: time.map(f64::from),
+        photons_per_iteration,
+        initial_radius,
+        alpha: alpha as f64,
+        kernel,
+        direct,
+        max_depth: scene.render.max_depth,
+    }))
+}
+
+foton_core::declare_integrator!(
+    "sppm",
+    "stochastic progressive photon mapping (Hachisuka and Jensen)",
+    create
+);
