@@ -37,6 +37,9 @@ pub struct VisiblePoint {
     pub n: Vec3,
     /// Throughput of the delta bounces before it.
     pub beta: Rgb,
+    /// Delta bounces before it: photons gathered here may have at most max_depth - bounces
+    /// scattering events.
+    pub bounces: u32,
     /// Length of the path from the camera (for the pixel's footprint).
     pub distance: f32,
 }
@@ -97,6 +100,7 @@ pub fn trace_to_diffuse(
                 wo,
                 n,
                 beta,
+                bounces,
                 distance,
             }),
         };

@@ -15,7 +15,7 @@ use glam::Vec3;
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
 /// surface normal, only ever compared against a threshold, in 3 x 8 bits (cheap to decode in
-/// the estimate's inner loop).
+/// the estimate's inner loop); the number of scattering events of its path in one byte.
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[repr(C)]
 pub struct Photon {
@@ -25,7 +25,9 @@ pub struct Photon {
     /// Direction the photon came from (unit, pointing away from the surface).
     wi: [u16; 2],
     /// Surface normal on the side the photon arrived at, times 127 (zero for volume photons).
-    normal: [i8; 4],
+    normal: [i8; 3],
+    /// Scattering events of the photon's path, this one included (saturates at 255).
+    depth: u8,
 }
 
 fn oct_encode(v: Vec3) -> [u16; 2] {
@@ -58,9 +60,25 @@ impl Photon {
             wi: oct_encode(wi),
             normal: {
                 let q = |c: f32| (c.clamp(-1.0, 1.0) * 127.0).round() as i8;
-                [q(normal.x), q(normal.y), q(normal.z), 0]
+                [q(normal.x), q(normal.y), q(normal.z)]
             },
+            depth: 0,
         }
+    }
+
+    /// The photon with the number of scattering events of its path (this one included).
+    pub fn with_depth(mut self, depth: u32) -> Photon {
+        self.depth = depth.min(255) as u8;
+        self
+    }
+
+    /// Scattering events of the photon's path, the one where it is stored included. An
+    /// estimate for a camera path that already has `a` events takes only photons with depth
+    /// <= max_depth - a, so that no light path is longer than `max_depth`, as in the path
+    /// tracer.
+    #[inline]
+    pub fn depth(&self) -> u32 {
+        self.depth as u32
     }
 
     #[inline]
@@ -345,7 +363,8 @@ impl PhotonMap {
     }
 
     /// Irradiance at a surface point: sum of photon power times the surface kernel over the
-    /// k nearest photons (within `max_radius`) stored on the same side of the same surface.
+    /// k nearest photons (within `max_radius`) stored on the same side of the same surface
+    /// whose paths have at most `max_depth` scattering events.
     ///
     /// The radius r is the distance to the k-th photon; that photon lies on the boundary of
     /// the disc, so only the k - 1 inside are summed (for a uniform density the expected
@@ -355,12 +374,19 @@ impl PhotonMap {
         &self,
         p: Vec3,
         n: Vec3,
+        max_depth: u32,
         k: usize,
         max_radius: f32,
         kernel: &NormalizedKernel,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
-        let r2 = self.knn(p, k, max_radius, |ph| ph.normal().dot(n) > 0.9, scratch);
+        let r2 = self.knn(
+            p,
+            k,
+            max_radius,
+            |ph| ph.depth() <= max_depth && ph.normal().dot(n) > 0.9,
+            scratch,
+        );
         if scratch.is_empty() {
             return Rgb::ZERO;
         }

@@ -103,7 +103,7 @@ pub fn trace_one(
             } else {
                 -hit.ng
             };
-            store(Photon::new(hit.p, flux, wi, n), class);
+            store(Photon::new(hit.p, flux, wi, n).with_depth(hits), class);
             if opts.stop_at_diffuse {
                 return;
             }

@@ -60,7 +60,7 @@ fn main() {
     let mut sum = 0.0f32;
     for p in photons.iter().step_by(photons.len() / queries + 1) {
         sum += map
-            .irradiance(p.position, p.normal(), 50, 0.2, &kernel, &mut scratch)
+            .irradiance(p.position, p.normal(), 16, 50, 0.2, &kernel, &mut scratch)
             .x;
     }
     let done = photons.len().div_ceil(photons.len() / queries + 1);

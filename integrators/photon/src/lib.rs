@@ -12,7 +12,9 @@
 //! | `final_gather`    | bool    | indirect light by gather rays that look the maps up            | false    |
 //! | `gather_rays`     | integer | gather rays per camera sample                                  | 32       |
 //!
-//! `[render] max_depth` bounds a photon's surface hits; `[render] spp` camera samples.
+//! `[render] max_depth` bounds the scattering events of a whole light path, as in the path
+//! tracer: a photon's surface hits plus the camera path's delta bounces (each photon records
+//! its count, and an estimate takes only the photons that fit). `[render] spp` camera samples.
 //!
 //! Two passes. **Photons** leave the lights in proportion to power (core's `photon_trace`),
 //! bounce by BSDF sampling with Russian roulette, and are stored at diffuse surfaces only, by
@@ -83,6 +85,8 @@ struct Vertex<'a> {
     hit: &'a Hit,
     material: &'a Material,
     wo: Vec3,
+    /// Delta bounces of the camera path before this vertex.
+    bounces: u32,
 }
 
 /// Specular (delta) bounces a gather ray may follow before giving up.
@@ -151,28 +155,44 @@ impl PhotonMapper {
         })
     }
 
-    /// Irradiance at `hit` (on the side `n` faces) from one map.
-    fn irradiance(&self, map: &PhotonMap, hit: &Hit, n: Vec3) -> Rgb {
-        if map.is_empty() {
+    /// Irradiance at `hit` (on the side `n` faces) from one map's photons of at most
+    /// `max_depth` scattering events.
+    fn irradiance(&self, map: &PhotonMap, hit: &Hit, n: Vec3, max_depth: u32) -> Rgb {
+        if map.is_empty() || max_depth == 0 {
             return Rgb::ZERO;
         }
         SCRATCH.with_borrow_mut(|scratch| {
-            map.irradiance(hit.p, n, self.k, self.max_radius, &self.kernel, scratch)
+            map.irradiance(
+                hit.p,
+                n,
+                max_depth,
+                self.k,
+                self.max_radius,
+                &self.kernel,
+                scratch,
+            )
         })
     }
 
     /// Radiance reflected at a diffuse point towards `wo` by the photons of `maps` (all of
     /// them: direct, caustic and indirect), as seen at the end of a gather ray.
-    fn map_radiance(&self, maps: &Maps, material: &Material, hit: &Hit, wo: Vec3) -> Rgb {
+    fn map_radiance(
+        &self,
+        maps: &Maps,
+        material: &Material,
+        hit: &Hit,
+        wo: Vec3,
+        max_depth: u32,
+    ) -> Rgb {
         let n = if hit.ng.dot(wo) > 0.0 {
             hit.ng
         } else {
             -hit.ng
         };
-        let mut e =
-            self.irradiance(&maps.caustic, hit, n) + self.irradiance(&maps.indirect, hit, n);
+        let mut e = self.irradiance(&maps.caustic, hit, n, max_depth)
+            + self.irradiance(&maps.indirect, hit, n, max_depth);
         if let Some(direct) = &maps.direct {
-            e += self.irradiance(direct, hit, n);
+            e += self.irradiance(direct, hit, n, max_depth);
         }
         material.eval(wo, n, hit.ng) * e
     }
@@ -189,7 +209,15 @@ impl PhotonMapper {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let Vertex { hit, material, wo } = *v;
+        let Vertex {
+            hit,
+            material,
+            wo,
+            bounces,
+        } = *v;
+        // Scattering events left for the light paths after x: the delta bounces of a gather
+        // ray and the photon's own events (the one at y included).
+        let budget = self.max_depth.saturating_sub(bounces + 1);
         let mut sum = Rgb::ZERO;
         for _ in 0..self.gather_rays {
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
@@ -198,14 +226,14 @@ impl PhotonMapper {
             };
             let mut beta = bs.weight;
             let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
-            for _ in 0..MAX_SPECULAR {
+            for b in 0..MAX_SPECULAR.min(budget) {
                 let Some((y, arrived)) = next_surface(scene, ray, rays) else {
                     break;
                 };
                 let m = *scene.material(&y);
                 let wo_y = -arrived.dir;
                 if !m.is_delta() {
-                    sum += beta * self.map_radiance(maps, &m, &y, wo_y);
+                    sum += beta * self.map_radiance(maps, &m, &y, wo_y, budget - b);
                     break;
                 }
                 let (u, uc) = (sampler.next_2d(), sampler.next_f32());
@@ -239,6 +267,7 @@ impl PhotonMapper {
             wo,
             n,
             beta,
+            bounces,
             ..
         } = vp;
         let f = material.eval(wo, n, hit.ng);
@@ -246,16 +275,19 @@ impl PhotonMapper {
             hit: &hit,
             material: &material,
             wo,
+            bounces,
         };
+        // Photons here may have taken the scattering events the camera path has left.
+        let depth = self.max_depth - bounces;
         let direct = match self.direct {
             Direct::ShadowRays => direct_light(scene, &hit, &material, wo, sampler, rays),
-            Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n),
+            Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n, depth),
         };
-        let caustic = f * self.irradiance(&maps.caustic, &hit, n);
+        let caustic = f * self.irradiance(&maps.caustic, &hit, n, depth);
         let indirect = if self.final_gather {
             self.final_gather(scene, maps, &vertex, sampler, rays)
         } else {
-            f * self.irradiance(&maps.indirect, &hit, n)
+            f * self.irradiance(&maps.indirect, &hit, n, depth)
         };
         path.emitted + beta * (direct + caustic + indirect)
     }

@@ -11,8 +11,8 @@
 //! | `cone_c`                | float   | the cone kernel's c >= 1                                  | 1       |
 //! | `direct`                | string  | `nee` (shadow rays) or `photons`                          | `nee`   |
 //!
-//! `[render] max_depth` bounds both the camera path's delta bounces and a photon's surface
-//! hits; `[render] spp` is not used (each iteration takes one new jittered camera sample per
+//! `[render] max_depth` bounds the scattering events of a whole light path, camera path's
+//! delta bounces and photon's surface hits together, as in the path tracer; `[render] spp` is not used (each iteration takes one new jittered camera sample per
 //! pixel). With `time`, `iterations` (if given) is an upper bound.
 //!
 //! Each iteration traces a new camera path per pixel through mirrors and glass to its first
@@ -276,9 +276,11 @@ impl Integrator for Sppm {
                         let r = st.radius as f32;
                         let disc = std::f32::consts::PI * r * r;
                         let (mut m, mut phi) = (0.0f64, DVec3::ZERO);
+                        // No light path longer than max_depth, as in the path tracer.
+                        let depth = self.max_depth - vp.bounces;
                         map.within(vp.hit.p, r, |photon, d2| {
-                            if photon.normal().dot(vp.n) <= 0.9 {
-                                return; // another surface, or the other side of this one
+                            if photon.depth() > depth || photon.normal().dot(vp.n) <= 0.9 {
+                                return; // too long, another surface, or its other side
                             }
                             let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;
                             let f = vp.material.eval(vp.wo, photon.wi(), vp.hit.ng);
@@ -327,7 +329,7 @@ impl Integrator for Sppm {
             self.photons_per_iteration,
             self.initial_radius
                 .map_or("auto".to_string(), |r| r.to_string()),
-            self.alpha,
+            self.alpha as f32,
             self.kernel.name(),
             match self.direct {
                 Direct::ShadowRays => "nee",
