@@ -104,6 +104,16 @@ impl Photon {
 
 const LEAF: usize = 8;
 
+/// How a k-nearest-neighbour radiance estimate is made.
+#[derive(Clone, Copy)]
+pub struct Estimate<'a> {
+    /// Photons per estimate.
+    pub k: usize,
+    /// Largest radius searched.
+    pub max_radius: f32,
+    pub kernel: &'a NormalizedKernel,
+}
+
 pub struct PhotonMap {
     photons: Vec<Photon>,
     positions: Vec<[f32; 3]>,
@@ -375,11 +385,14 @@ impl PhotonMap {
         p: Vec3,
         n: Vec3,
         max_depth: u32,
-        k: usize,
-        max_radius: f32,
-        kernel: &NormalizedKernel,
+        estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
+        let Estimate {
+            k,
+            max_radius,
+            kernel,
+        } = *estimate;
         let r2 = self.knn(
             p,
             k,

@@ -6,7 +6,7 @@
 use foton_core::cli::{TermProgress, prepare, render_prepared};
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
-use foton_core::photon::PhotonMap;
+use foton_core::photon::{Estimate, PhotonMap};
 use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_core::scene::Scene;
 use foton_tests::{plugin_dir, repo_root};
@@ -54,13 +54,18 @@ fn main() {
 
     // Queries at the photons' own positions (where a render asks), one thread.
     let kernel = NormalizedKernel::new(Box::new(BoxKernel)).unwrap();
+    let estimate = Estimate {
+        k: 50,
+        max_radius: 0.2,
+        kernel: &kernel,
+    };
     let mut scratch = Vec::new();
     let queries = 200_000;
     let t = Instant::now();
     let mut sum = 0.0f32;
     for p in photons.iter().step_by(photons.len() / queries + 1) {
         sum += map
-            .irradiance(p.position, p.normal(), 16, 50, 0.2, &kernel, &mut scratch)
+            .irradiance(p.position, p.normal(), 16, &estimate, &mut scratch)
             .x;
     }
     let done = photons.len().div_ceil(photons.len() / queries + 1);

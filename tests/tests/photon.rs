@@ -4,7 +4,7 @@
 
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
-use foton_core::photon::PhotonMap;
+use foton_core::photon::{Estimate, PhotonMap};
 use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_one, trace_photons};
 use foton_core::scene::Scene;
 use foton_tests::{header, region_mean, render_file, render_toml, repo_root, temp_dir, write};
@@ -192,7 +192,17 @@ intensity = [1.0, 1.0, 1.0]
     for i in 0..points {
         let x = -1.5 + 3.0 * i as f32 / (points - 1) as f32;
         let p = Vec3::new(x, 0.0, 0.3);
-        let e = map.irradiance(p, Vec3::Y, 1, k, 1.0, &kernel, &mut scratch);
+        let e = map.irradiance(
+            p,
+            Vec3::Y,
+            1,
+            &Estimate {
+                k,
+                max_radius: 1.0,
+                kernel: &kernel,
+            },
+            &mut scratch,
+        );
         let d = Vec3::new(0.0, 1.0, 0.0) - p;
         let exact = d.y / d.length() / d.length_squared();
         let rel = (e.x - exact) / exact;

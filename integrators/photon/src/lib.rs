@@ -43,7 +43,7 @@ use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Integrator, RenderContext};
 use foton_core::kernel::NormalizedKernel;
 use foton_core::material::{Material, TransportMode};
-use foton_core::photon::{Neighbour, PhotonMap};
+use foton_core::photon::{Estimate, Neighbour, PhotonMap};
 use foton_core::photon_trace::{
     PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
 };
@@ -162,15 +162,12 @@ impl PhotonMapper {
             return Rgb::ZERO;
         }
         SCRATCH.with_borrow_mut(|scratch| {
-            map.irradiance(
-                hit.p,
-                n,
-                max_depth,
-                self.k,
-                self.max_radius,
-                &self.kernel,
-                scratch,
-            )
+            let estimate = Estimate {
+                k: self.k,
+                max_radius: self.max_radius,
+                kernel: &self.kernel,
+            };
+            map.irradiance(hit.p, n, max_depth, &estimate, scratch)
         })
     }
 
