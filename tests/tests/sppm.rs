@@ -261,3 +261,19 @@ fn bad_parameters_are_clear_errors() {
         assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
     }
 }
+
+#[test]
+fn time_budget_ends_the_render() {
+    // `time` instead of `iterations`: it stops by itself and returns the estimate so far.
+    let scene = repo_root().join("scenes/cornell-box.toml");
+    let set = [
+        "render.integrator=sppm",
+        "film.width=16",
+        "film.height=16",
+        "integrators.sppm.time=0.3",
+        "integrators.sppm.photons_per_iteration=5000",
+    ];
+    let film = render_file(&scene, &set, 2);
+    let m = film.mean();
+    assert!(m.min_element() > 0.0 && m.is_finite(), "{m}");
+}
