@@ -103,4 +103,32 @@ mod tests {
         let expect = (Vec3::new(0.5, 1.2, 0.0) - cam.position).normalize();
         assert!((ray.dir - expect).length() < 1e-4, "{p}");
     }
+
+    #[test]
+    fn a_point_on_a_camera_ray_projects_to_its_pixel() {
+        let cam = Camera::new(
+            Vec3::new(0.3, 1.2, 3.0),
+            Vec3::new(-0.2, 0.8, 0.0),
+            Vec3::Y,
+            50.0,
+            64,
+            48,
+        );
+        for film in [
+            Vec2::new(0.5, 0.5),
+            Vec2::new(13.25, 40.75),
+            Vec2::new(32.0, 24.0),
+            Vec2::new(63.5, 47.5),
+        ] {
+            for t in [0.1, 1.0, 7.5] {
+                let p = cam.generate_ray(film).at(t);
+                let back = cam.project(p).expect("in front and inside the image");
+                assert!((back - film).length() < 1e-3, "{film} -> {back}");
+            }
+        }
+        // Behind the camera and outside the field of view: no pixel.
+        assert_eq!(cam.project(cam.position - cam.forward), None);
+        let outside = cam.generate_ray(Vec2::new(-10.0, 24.0)).at(2.0);
+        assert_eq!(cam.project(outside), None);
+    }
 }

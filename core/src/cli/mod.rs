@@ -1,8 +1,10 @@
-//! The `foton` command: `render`, `check`, `plugins`, `bench`.
+//! The `foton` command: `render`, `check`, `plugins`, `bench`, and `photons`, the first of
+//! the tools for seeing and comparing (one file each).
 //!
 //! A thin layer: parse arguments (clap), load the scene, find the plugin, run it, write the
 //! image. Errors are turned into messages here, once.
 
+pub mod photons;
 mod progress;
 
 use crate::error::{Error, Result};
@@ -53,6 +55,20 @@ enum Command {
     Plugins(PluginArgs),
     /// Render a scene several times and report samples per second (a benchmark, not a test).
     Bench(BenchArgs),
+    /// Draw a photon map as seen from the scene camera, one dot per photon.
+    ///
+    /// The photon pass is core's, with the budgets of the scene's [integrators.photon] table
+    /// (global_photons, default 200000; caustic_photons, default 100000) and the photon
+    /// integrator's classification: the global map holds the direct and indirect photons of
+    /// the global budget, the caustic map the L S+ D photons of the caustic budget. A photon is
+    /// drawn where it projects if the camera sees the side of the surface it lies on (one
+    /// visibility ray per photon); a pixel shows the mean colour of the dots covering it. No
+    /// plugin is loaded (--plugin-dir is accepted so that command lines can be shared).
+    ///
+    /// Exposure: a dot's colour is the photon's flux divided by the 99th percentile of the
+    /// drawn photons' largest channel, so that 99% of the dots are unclipped and photons of
+    /// equal flux on a white surface come out white. Prints the photons stored and drawn.
+    Photons(photons::PhotonsArgs),
 }
 
 #[derive(Args, Clone, Default)]
@@ -147,6 +163,7 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
         Command::Check(a) => cmd_check(a, out, err),
         Command::Plugins(a) => cmd_plugins(a, out),
         Command::Bench(a) => cmd_bench(a, out, err),
+        Command::Photons(a) => photons::run(a, out, err),
     };
     match result {
         Ok(code) => code,
@@ -244,6 +261,14 @@ pub fn prepare(
         plugin,
         warnings,
     })
+}
+
+/// `<scene stem>-<suffix>` in the scene's folder: the default output of the tools.
+fn beside_scene(scene: &Path, suffix: &str) -> PathBuf {
+    let stem = scene
+        .file_stem()
+        .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+    scene.with_file_name(format!("{stem}-{suffix}"))
 }
 
 fn threads(requested: Option<usize>) -> usize {
