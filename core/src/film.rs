@@ -113,6 +113,16 @@ pub fn srgb_encode(linear: f32) -> f32 {
     }
 }
 
+/// Inverse of [`srgb_encode`]: the linear value of an sRGB-encoded one in [0, 1].
+pub fn srgb_decode(encoded: f32) -> f32 {
+    let c = encoded.clamp(0.0, 1.0);
+    if c <= 0.040_45 {
+        c / 12.92
+    } else {
+        ((c + 0.055) / 1.055).powf(2.4)
+    }
+}
+
 /// The format an output path asks for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
@@ -217,18 +227,25 @@ pub fn read_image(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
     let is_png = format_of(path).ok() == Some(ImageFormat::Png);
     let rgb = img.to_rgb32f();
     let (w, h) = rgb.dimensions();
-    let decode = |c: f32| {
-        if !is_png {
-            c
-        } else if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        }
-    };
+    let decode = |c: f32| if is_png { srgb_decode(c) } else { c };
     let px = rgb
         .pixels()
         .map(|p| Rgb::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
         .collect();
     Ok((w, h, px))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn srgb_decode_inverts_encode() {
+        for i in 0..=1000 {
+            let x = i as f32 / 1000.0;
+            assert!((srgb_decode(srgb_encode(x)) - x).abs() < 1e-5, "{x}");
+        }
+        assert_eq!(srgb_decode(0.0), 0.0);
+        assert!((srgb_decode(1.0) - 1.0).abs() < 1e-6);
+    }
 }

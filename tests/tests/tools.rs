@@ -1,7 +1,9 @@
-//! The seeing-and-comparing commands: `foton photons`. Its images are checked by size and
-//! by a few pixels (no snapshots), its numbers through the printed counts; every bad input must end in a message naming
+//! The seeing-and-comparing commands: `foton photons`, `foton compare`. Their
+//! images are checked by size and by a few pixels (no snapshots), their numbers through the
+//! printed counts and the JSON of `compare`; every bad input must end in a message naming
 //! the problem and a non-zero exit. Images are 32x32 with few samples and photons.
 
+use foton_core::cli::montage::BORDER;
 use foton_core::film::read_image;
 use foton_tests::{Run, foton_with_plugins, header, temp_dir, write};
 use std::path::{Path, PathBuf};
@@ -96,6 +98,18 @@ fn count_before(text: &str, word: &str) -> u64 {
         .unwrap_or_else(|_| panic!("no number before `{word}` in {text}"))
 }
 
+/// A numeric field of one integrator's entry in compare's JSON (None for null).
+fn json_number(json: &str, integrator: &str, field: &str) -> Option<f64> {
+    let entry = json
+        .find(&format!("\"name\": \"{integrator}\""))
+        .unwrap_or_else(|| panic!("no entry for {integrator} in {json}"));
+    let rest = &json[entry..];
+    let key = format!("\"{field}\": ");
+    let at = rest.find(&key).unwrap() + key.len();
+    let value = rest[at..].split([',', '\n']).next().unwrap().trim();
+    (value != "null").then(|| value.parse().unwrap())
+}
+
 // ---------------------------------------------------------------------------------------------
 // foton photons
 // ---------------------------------------------------------------------------------------------
@@ -183,15 +197,194 @@ fn photons_are_the_same_for_any_number_of_threads() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// foton compare
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn compare_lays_the_renders_side_by_side_and_lists_them() {
+    let (dir, scene) = setup("compare");
+    let out = dir.join("compare.png");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,photon",
+        "--spp",
+        "2",
+        "-o",
+        s(&out),
+        "-q",
+    ]);
+    ok(&run);
+    let (w, h, _) = read_image(&out).unwrap();
+    assert_eq!(w, 2 * SIZE + 3 * BORDER);
+    assert!(h > SIZE + 2 * BORDER, "a label band above the renders: {h}");
+    for name in ["path", "photon"] {
+        let (rw, rh, _) = read_image(&dir.join(format!("compare-{name}.exr"))).unwrap();
+        assert_eq!((rw, rh), (SIZE, SIZE));
+    }
+    let json = std::fs::read_to_string(dir.join("compare.json")).unwrap();
+    for name in ["path", "photon"] {
+        assert_eq!(json_number(&json, name, "spp"), Some(2.0), "{json}");
+        assert!(json_number(&json, name, "seconds").unwrap() > 0.0, "{json}");
+        assert_eq!(json_number(&json, name, "rel_mse"), None, "{json}");
+    }
+    assert!(json.contains("\"description\": \"photon("), "{json}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn compare_with_its_own_reference_has_zero_error() {
+    let (dir, scene) = setup("compare-ref");
+    let reference = dir.join("ref.exr");
+    let run = foton_with_plugins(&[
+        "render",
+        s(&scene),
+        "--spp",
+        "2",
+        "--seed",
+        "5",
+        "-o",
+        s(&reference),
+        "-q",
+    ]);
+    ok(&run);
+    let compare = |seed: &str, out: &Path| {
+        let run = foton_with_plugins(&[
+            "compare",
+            s(&scene),
+            "--integrators",
+            "path,photon",
+            "--spp",
+            "2",
+            "--seed",
+            seed,
+            "--reference",
+            s(&reference),
+            "-o",
+            s(out),
+            "-q",
+        ]);
+        ok(&run);
+        let json = std::fs::read_to_string(out.with_extension("json")).unwrap();
+        let (w, h, _) = read_image(out).unwrap();
+        assert_eq!(w, 2 * SIZE + 3 * BORDER);
+        assert!(h > 2 * SIZE + 3 * BORDER, "a row of differences: {h}");
+        json
+    };
+
+    let same = compare("5", &dir.join("same.png"));
+    assert_eq!(json_number(&same, "path", "rel_mse"), Some(0.0), "{same}");
+    assert_eq!(json_number(&same, "path", "bias"), Some(0.0), "{same}");
+    assert!(
+        json_number(&same, "photon", "rel_mse").unwrap() > 0.0,
+        "{same}"
+    );
+
+    let other = compare("6", &dir.join("other.png"));
+    assert!(
+        json_number(&other, "path", "rel_mse").unwrap() > 0.0,
+        "{other}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn compare_with_a_time_budget_chooses_the_samples() {
+    let (dir, scene) = setup("compare-time");
+    let out = dir.join("timed.png");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path",
+        "--time",
+        "0.2",
+        "-o",
+        s(&out),
+        "-q",
+    ]);
+    ok(&run);
+    let json = std::fs::read_to_string(dir.join("timed.json")).unwrap();
+    let spp = json_number(&json, "path", "spp").unwrap();
+    assert!(spp >= 1.0, "{json}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------
+
+#[test]
+fn unknown_integrator_in_compare_lists_the_known_ones() {
+    let (dir, scene) = setup("bad-integrator");
+    let out = dir.join("c.png");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,nope",
+        "-o",
+        s(&out),
+    ]);
+    fails_with(
+        &run,
+        &["no integrator plugin named `nope`", "available:", "path"],
+    );
+    assert!(!out.exists());
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,",
+        "-o",
+        s(&out),
+    ]);
+    fails_with(&run, &["empty integrator name"]);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn spp_and_time_together_are_refused() {
+    let (dir, scene) = setup("bad-spp-time");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path",
+        "--spp",
+        "2",
+        "--time",
+        "1",
+    ]);
+    fails_with(&run, &["--spp", "--time", "cannot be used with"]);
+    let run = foton_with_plugins(&["compare", s(&scene), "--integrators", "path", "--time", "0"]);
+    fails_with(&run, &["--time 0", "positive"]);
+    let _ = std::fs::remove_dir_all(dir);
+}
 
 #[test]
 fn set_without_a_value_is_refused() {
     let (dir, scene) = setup("bad-set");
     let out = dir.join("x.png");
-    let run = foton_with_plugins(&["photons", s(&scene), "--set", "render.seed", "-o", s(&out)]);
-    fails_with(&run, &["render.seed", "expected KEY.PATH=VALUE"]);
+    for args in [
+        &[
+            "compare",
+            s(&scene),
+            "--integrators",
+            "path",
+            "--set",
+            "render.spp",
+            "-o",
+            s(&out),
+        ][..],
+        &["photons", s(&scene), "--set", "render.seed", "-o", s(&out)],
+    ] {
+        fails_with(
+            &foton_with_plugins(args),
+            &["render.", "expected KEY.PATH=VALUE"],
+        );
+    }
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -208,8 +401,60 @@ fn unknown_map_is_refused() {
 fn missing_output_folder_is_found_before_rendering() {
     let (dir, scene) = setup("bad-output");
     let out = dir.join("no-such-folder").join("x.png");
-    let run = foton_with_plugins(&["photons", s(&scene), "-o", s(&out)]);
-    fails_with(&run, &["no-such-folder", "does not exist"]);
+    for args in [
+        &["photons", s(&scene), "-o", s(&out)][..],
+        &["compare", s(&scene), "--integrators", "path", "-o", s(&out)],
+    ] {
+        let run = foton_with_plugins(args);
+        fails_with(&run, &["no-such-folder", "does not exist"]);
+        assert!(run.stdout.is_empty(), "nothing rendered: {}", run.stdout);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_reference_is_refused() {
+    let (dir, scene) = setup("bad-reference");
+    let out = dir.join("c.png");
+    let small = dir.join("small.exr");
+    let run = foton_with_plugins(&[
+        "render",
+        s(&scene),
+        "--set",
+        "film.width=16",
+        "--set",
+        "film.height=16",
+        "--spp",
+        "1",
+        "-o",
+        s(&small),
+        "-q",
+    ]);
+    ok(&run);
+    let compare = |reference: &Path| {
+        foton_with_plugins(&[
+            "compare",
+            s(&scene),
+            "--integrators",
+            "path",
+            "--reference",
+            s(reference),
+            "-o",
+            s(&out),
+        ])
+    };
+    let run = compare(&small);
+    fails_with(&run, &["small.exr", "16x16", "32x32"]);
     assert!(run.stdout.is_empty(), "nothing rendered: {}", run.stdout);
+    let garbage = write(&dir, "garbage.exr", "not an image");
+    fails_with(
+        &compare(&garbage),
+        &["garbage.exr", "cannot read the reference image"],
+    );
+    fails_with(
+        &compare(&dir.join("missing.png")),
+        &["missing.png", "cannot read the reference image"],
+    );
+    assert!(!out.exists());
     let _ = std::fs::remove_dir_all(dir);
 }

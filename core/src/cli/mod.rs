@@ -1,9 +1,11 @@
-//! The `foton` command: `render`, `check`, `plugins`, `bench`, and `photons`, the first of
-//! the tools for seeing and comparing (one file each).
+//! The `foton` command: `render`, `check`, `plugins`, `bench`, and the tools for seeing and
+//! comparing, `photons` and `compare` (one file each, their labelled images in `montage`).
 //!
 //! A thin layer: parse arguments (clap), load the scene, find the plugin, run it, write the
 //! image. Errors are turned into messages here, once.
 
+pub mod compare;
+pub mod montage;
 pub mod photons;
 mod progress;
 
@@ -69,6 +71,23 @@ enum Command {
     /// drawn photons' largest channel, so that 99% of the dots are unclipped and photons of
     /// equal flux on a white surface come out white. Prints the photons stored and drawn.
     Photons(photons::PhotonsArgs),
+    /// Render a scene with several integrators and lay the renders side by side, labelled.
+    ///
+    /// Each render is labelled with the integrator's name, samples per pixel, render time and
+    /// parameters, and written beside the output as <output stem>-<integrator>.exr; the numbers
+    /// go to <output stem>.json (name, description, spp, seconds, rel_mse, bias, image).
+    ///
+    /// --time S: each integrator renders at 1 and then 2 spp to measure a fixed cost (a photon
+    /// pass) and a per-sample cost, and then at the spp that fills S seconds (the per-sample
+    /// cost is taken within [t2/20, t2/2] against timer noise). The chosen spp is printed; a
+    /// render with --spp set to it gives the same image.
+    ///
+    /// --reference IMAGE: a second row shows each render's relative difference from the
+    /// reference, per pixel (x - r) / sqrt(r^2 + 0.01) of the channel means, in a diverging
+    /// false colour: blue where the render is darker, light grey where equal, red where
+    /// brighter, saturated at 100%. The labels and the JSON give rel_mse (the mean over pixels
+    /// and channels of (x - r)^2 / (r^2 + 0.01)) and bias ((mean x - mean r) / mean r).
+    Compare(compare::CompareArgs),
 }
 
 #[derive(Args, Clone, Default)]
@@ -164,6 +183,7 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
         Command::Plugins(a) => cmd_plugins(a, out),
         Command::Bench(a) => cmd_bench(a, out, err),
         Command::Photons(a) => photons::run(a, out, err),
+        Command::Compare(a) => compare::run(a, out, err),
     };
     match result {
         Ok(code) => code,
@@ -269,6 +289,21 @@ fn beside_scene(scene: &Path, suffix: &str) -> PathBuf {
         .file_stem()
         .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
     scene.with_file_name(format!("{stem}-{suffix}"))
+}
+
+/// Writes a file atomically: to a temporary name in the same folder, then renamed over `path`.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let name = path
+        .file_name()
+        .ok_or_else(|| Error::io(path, "not a file name"))?
+        .to_string_lossy();
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
+    std::fs::write(&tmp, bytes)
+        .and_then(|()| std::fs::rename(&tmp, path))
+        .map_err(|e| {
+            let _ = std::fs::remove_file(&tmp);
+            Error::io(path, e)
+        })
 }
 
 fn threads(requested: Option<usize>) -> usize {
