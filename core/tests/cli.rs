@@ -145,7 +145,9 @@ fn a_scene_cannot_name_a_plugin_file() {
 #[test]
 fn every_subcommand_has_help() {
     let exe = Path::new(env!("CARGO_BIN_EXE_foton"));
-    for sub in ["render", "check", "plugins", "bench", "photons", "compare"] {
+    for sub in [
+        "render", "check", "plugins", "bench", "photons", "compare", "sweep",
+    ] {
         let (code, out, _) = foton(exe, &[sub, "--help"]);
         assert_eq!(code, 0, "{sub} --help");
         assert!(out.contains("Usage: foton"), "{sub}: {out}");

@@ -1,9 +1,10 @@
-//! The seeing-and-comparing commands: `foton photons`, `foton compare`. Their
+//! The seeing-and-comparing commands: `foton photons`, `foton compare`, `foton sweep`. Their
 //! images are checked by size and by a few pixels (no snapshots), their numbers through the
 //! printed counts and the JSON of `compare`; every bad input must end in a message naming
 //! the problem and a non-zero exit. Images are 32x32 with few samples and photons.
 
 use foton_core::cli::montage::BORDER;
+use foton_core::cli::sweep::{SweepSet, parse_set};
 use foton_core::film::read_image;
 use foton_tests::{Run, foton_with_plugins, header, temp_dir, write};
 use std::path::{Path, PathBuf};
@@ -312,6 +313,65 @@ fn compare_with_a_time_budget_chooses_the_samples() {
 }
 
 // ---------------------------------------------------------------------------------------------
+// foton sweep
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn sweep_renders_one_tile_per_combination() {
+    let (dir, scene) = setup("sweep");
+    let out = dir.join("sweep.png");
+    let run = foton_with_plugins(&[
+        "sweep",
+        s(&scene),
+        "--set",
+        "render.max_depth=1,3",
+        "--set",
+        "render.seed=1,2,3",
+        "--set",
+        "render.spp=1",
+        "-o",
+        s(&out),
+        "-q",
+    ]);
+    ok(&run);
+    assert!(run.stdout.contains("6 cells (2 x 3)"), "{}", run.stdout);
+    assert_eq!(run.stdout.matches("1 spp").count(), 6, "{}", run.stdout);
+    let (w, h, _) = read_image(&out).unwrap();
+    assert_eq!(w, 2 * SIZE + 3 * BORDER);
+    assert!(h > 3 * SIZE + 4 * BORDER, "three rows with labels: {h}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn sweep_keeps_arrays_whole() {
+    assert_eq!(
+        parse_set("a=[1,2],x").unwrap(),
+        SweepSet {
+            key: "a".into(),
+            values: vec!["[1,2]".into(), "x".into()]
+        }
+    );
+    let (dir, scene) = setup("sweep-arrays");
+    let out = dir.join("cameras.png");
+    let run = foton_with_plugins(&[
+        "sweep",
+        s(&scene),
+        "--set",
+        "camera.position=[0,1,3.9],[0.5,1,3.9]",
+        "--spp",
+        "1",
+        "-o",
+        s(&out),
+        "-q",
+    ]);
+    ok(&run);
+    assert!(run.stdout.contains("2 cells (2 x 1)"), "{}", run.stdout);
+    let (w, _, _) = read_image(&out).unwrap();
+    assert_eq!(w, 2 * SIZE + 3 * BORDER);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
 // Bad input
 // ---------------------------------------------------------------------------------------------
 
@@ -368,6 +428,7 @@ fn set_without_a_value_is_refused() {
     let (dir, scene) = setup("bad-set");
     let out = dir.join("x.png");
     for args in [
+        &["sweep", s(&scene), "--set", "render.spp", "-o", s(&out)][..],
         &[
             "compare",
             s(&scene),
@@ -377,7 +438,7 @@ fn set_without_a_value_is_refused() {
             "render.spp",
             "-o",
             s(&out),
-        ][..],
+        ],
         &["photons", s(&scene), "--set", "render.seed", "-o", s(&out)],
     ] {
         fails_with(
@@ -385,6 +446,17 @@ fn set_without_a_value_is_refused() {
             &["render.", "expected KEY.PATH=VALUE"],
         );
     }
+    let run = foton_with_plugins(&["sweep", s(&scene), "--set", "render.spp=", "-o", s(&out)]);
+    fails_with(&run, &["render.spp", "empty value list"]);
+    let run = foton_with_plugins(&[
+        "sweep",
+        s(&scene),
+        "--set",
+        "render.spp=1,,2",
+        "-o",
+        s(&out),
+    ]);
+    fails_with(&run, &["render.spp", "empty value"]);
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -404,6 +476,14 @@ fn missing_output_folder_is_found_before_rendering() {
     for args in [
         &["photons", s(&scene), "-o", s(&out)][..],
         &["compare", s(&scene), "--integrators", "path", "-o", s(&out)],
+        &[
+            "sweep",
+            s(&scene),
+            "--set",
+            "render.seed=1,2",
+            "-o",
+            s(&out),
+        ],
     ] {
         let run = foton_with_plugins(args);
         fails_with(&run, &["no-such-folder", "does not exist"]);

@@ -1,5 +1,6 @@
 //! The `foton` command: `render`, `check`, `plugins`, `bench`, and the tools for seeing and
-//! comparing, `photons` and `compare` (one file each, their labelled images in `montage`).
+//! comparing, `photons`, `compare` and `sweep` (one file each, their labelled images in
+//! `montage`).
 //!
 //! A thin layer: parse arguments (clap), load the scene, find the plugin, run it, write the
 //! image. Errors are turned into messages here, once.
@@ -8,6 +9,7 @@ pub mod compare;
 pub mod montage;
 pub mod photons;
 mod progress;
+pub mod sweep;
 
 use crate::error::{Error, Result};
 use crate::film::{Film, check_output};
@@ -88,6 +90,13 @@ enum Command {
     /// brighter, saturated at 100%. The labels and the JSON give rel_mse (the mean over pixels
     /// and channels of (x - r)^2 / (r^2 + 0.01)) and bias ((mean x - mean r) / mean r).
     Compare(compare::CompareArgs),
+    /// Render a scene over the product of lists of --set values, in a labelled grid.
+    ///
+    /// --set KEY.PATH=V1,V2,... sweeps a scene value; the first --set with several values runs
+    /// along the columns, the second down the rows, any further ones down the rows as well
+    /// (row-major, earlier sets varying faster). A --set with one value applies to every cell.
+    /// Each cell is labelled with its values and its render time.
+    Sweep(sweep::SweepArgs),
 }
 
 #[derive(Args, Clone, Default)]
@@ -184,6 +193,7 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
         Command::Bench(a) => cmd_bench(a, out, err),
         Command::Photons(a) => photons::run(a, out, err),
         Command::Compare(a) => compare::run(a, out, err),
+        Command::Sweep(a) => sweep::run(a, out, err),
     };
     match result {
         Ok(code) => code,

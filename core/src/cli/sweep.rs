@@ -1,0 +1,315 @@
+//! `foton sweep`: one scene rendered over the product of lists of `--set` values, in a
+//! labelled grid. The first `--set` with several values runs along the columns, the second
+//! down the rows, further ones down the rows too (row-major, the earlier varying faster); a
+//! `--set` with one value applies to every cell.
+
+use super::montage::{Image, Tile, grid};
+use super::threads;
+use super::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
+use crate::error::{Error, Result};
+use crate::film::check_output;
+use clap::Args;
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+
+/// More cells than this is almost certainly a typo in a value list.
+pub const MAX_CELLS: usize = 256;
+
+#[derive(Args)]
+pub(super) struct SweepArgs {
+    /// The scene file (TOML).
+    scene: PathBuf,
+    /// KEY.PATH=VALUE[,VALUE...]: the values to sweep a scene value over (repeatable). Commas
+    /// inside brackets, braces or quotes do not split: camera.position=[0,1,3],[0,1,4] is two
+    /// values.
+    #[arg(long = "set", value_name = "KEY.PATH=VALUES")]
+    sets: Vec<String>,
+    /// Use this integrator plugin instead of the scene's render.integrator.
+    #[arg(long)]
+    integrator: Option<String>,
+    /// Samples per pixel (overrides render.spp).
+    #[arg(long)]
+    spp: Option<u32>,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    seed: Option<u64>,
+    /// Output image (.png or .exr); default: <scene stem>-sweep.png beside the scene.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Treat unknown (unused) scene fields and integrator parameters as errors.
+    #[arg(long)]
+    strict: bool,
+    /// Worker threads (default: all cores). The images do not depend on it.
+    #[arg(long)]
+    threads: Option<usize>,
+    /// No progress bar.
+    #[arg(short, long)]
+    quiet: bool,
+    #[command(flatten)]
+    plugins: PluginArgs,
+}
+
+/// A `--set` of `foton sweep`: a key path and the values it takes.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SweepSet {
+    pub key: String,
+    pub values: Vec<String>,
+}
+
+/// Splits a value list on the commas that are outside brackets, braces and quotes, so that
+/// an array or inline table stays one value. Values are trimmed.
+pub fn split_values(list: &str) -> Vec<String> {
+    let mut values = Vec::new();
+    let mut depth = 0i32;
+    let mut quote: Option<char> = None;
+    let mut escaped = false;
+    let mut current = String::new();
+    for c in list.chars() {
+        if let Some(q) = quote {
+            if escaped {
+                escaped = false;
+            } else if c == '\\' && q == '"' {
+                escaped = true;
+            } else if c == q {
+                quote = None;
+            }
+            current.push(c);
+            continue;
+        }
+        match c {
+            '"' | '\'' => quote = Some(c),
+            '[' | '{' => depth += 1,
+            ']' | '}' => depth -= 1,
+            ',' if depth <= 0 => {
+                values.push(current.trim().to_string());
+                current.clear();
+                continue;
+            }
+            _ => {}
+        }
+        current.push(c);
+    }
+    values.push(current.trim().to_string());
+    values
+}
+
+/// Parses `KEY.PATH=VALUE[,VALUE...]`.
+pub fn parse_set(arg: &str) -> Result<SweepSet> {
+    let (key, list) = arg.split_once('=').ok_or_else(|| {
+        Error::Usage(format!(
+            "--set {arg}: expected KEY.PATH=VALUE[,VALUE...], e.g. integrators.photon.k=10,50"
+        ))
+    })?;
+    let key = key.trim();
+    if key.is_empty() {
+        return Err(Error::Usage(format!("--set {arg}: empty key")));
+    }
+    if list.trim().is_empty() {
+        return Err(Error::Usage(format!(
+            "--set {arg}: empty value list for `{key}`"
+        )));
+    }
+    let values = split_values(list);
+    if values.iter().any(String::is_empty) {
+        return Err(Error::Usage(format!(
+            "--set {arg}: empty value in the list for `{key}`"
+        )));
+    }
+    Ok(SweepSet {
+        key: key.to_string(),
+        values,
+    })
+}
+
+/// One cell of the grid: the index of the value each set takes.
+fn cell_choices(sets: &[SweepSet], cell: usize) -> Vec<usize> {
+    let mut rest = cell;
+    sets.iter()
+        .map(|s| {
+            let i = rest % s.values.len();
+            rest /= s.values.len();
+            i
+        })
+        .collect()
+}
+
+/// The names the labels give the swept keys: the last part of the key path, or the whole
+/// path when two swept keys end alike.
+fn short_names(sets: &[&SweepSet]) -> Vec<String> {
+    let last = |k: &str| k.rsplit('.').next().unwrap_or(k).to_string();
+    sets.iter()
+        .map(|s| {
+            let short = last(&s.key);
+            if sets.iter().filter(|o| last(&o.key) == short).count() > 1 {
+                s.key.clone()
+            } else {
+                short
+            }
+        })
+        .collect()
+}
+
+pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let sets = a
+        .sets
+        .iter()
+        .map(|s| parse_set(s))
+        .collect::<Result<Vec<_>>>()?;
+    let cells: usize = sets.iter().map(|s| s.values.len()).product();
+    if cells > MAX_CELLS {
+        return Err(Error::Usage(format!(
+            "the sweep has {cells} cells; at most {MAX_CELLS}"
+        )));
+    }
+    let swept: Vec<&SweepSet> = sets.iter().filter(|s| s.values.len() > 1).collect();
+    let names = short_names(&swept);
+    let columns = swept.first().map_or(1, |s| s.values.len());
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| beside_scene(&a.scene, "sweep.png"));
+    check_output(&output)?;
+
+    let overrides_of = |cell: usize| {
+        let choice = cell_choices(&sets, cell);
+        let mut overrides: Vec<String> = sets
+            .iter()
+            .zip(&choice)
+            .map(|(s, &i)| format!("{}={}", s.key, s.values[i]))
+            .collect();
+        if let Some(name) = &a.integrator {
+            overrides.push(format!("render.integrator={name:?}"));
+        }
+        if let Some(spp) = a.spp {
+            overrides.push(format!("render.spp={spp}"));
+        }
+        if let Some(seed) = a.seed {
+            overrides.push(format!("render.seed={seed}"));
+        }
+        let label: Vec<String> = sets
+            .iter()
+            .zip(&choice)
+            .filter(|(s, _)| s.values.len() > 1)
+            .zip(&names)
+            .map(|((s, &i), name)| format!("{name}={}", s.values[i]))
+            .collect();
+        (overrides, label)
+    };
+
+    // Every cell's scene and integrator are created first, so that a bad value fails before
+    // any render; they are loaded again one at a time to render (a sweep over a large scene
+    // would not fit in memory many times over).
+    let mut warned: Vec<String> = Vec::new();
+    for cell in 0..cells {
+        let p = prepare(
+            &a.scene,
+            &overrides_of(cell).0,
+            &a.plugins.plugin_dirs,
+            a.strict,
+        )?;
+        for w in &p.warnings {
+            if !warned.contains(w) {
+                let _ = writeln!(err, "warning: {w}");
+                warned.push(w.clone());
+            }
+        }
+    }
+
+    let threads = threads(a.threads);
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let mut tiles = Vec::new();
+    for cell in 0..cells {
+        let (overrides, mut label) = overrides_of(cell);
+        let p = prepare(&a.scene, &overrides, &a.plugins.plugin_dirs, a.strict)?;
+        let progress = TermProgress::new(a.quiet);
+        let (film, elapsed) = render_prepared(&p, threads, &progress)?;
+        for w in progress.take_warnings() {
+            let _ = writeln!(err, "warning: {w}");
+        }
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            let _ = writeln!(err, "interrupted: nothing written");
+            return Ok(130);
+        }
+        let secs = elapsed.as_secs_f64();
+        let _ = writeln!(
+            out,
+            "[{}] {}: {} spp in {:.2} s",
+            label.join(", "),
+            p.integrator.describe(),
+            p.scene.render.spp,
+            secs
+        );
+        label.push(format!("{:.2} s", secs));
+        tiles.push(Tile {
+            image: Image::from_film(&film),
+            label,
+        });
+    }
+    let img = grid(&tiles, columns);
+    img.write(&output)?;
+    let _ = writeln!(
+        out,
+        "{} cells ({} x {}) -> {}",
+        cells,
+        columns,
+        cells / columns,
+        output.display()
+    );
+    Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn values_split_on_commas_outside_brackets_and_quotes() {
+        assert_eq!(split_values("[1,2],x"), ["[1,2]", "x"]);
+        assert_eq!(split_values("1, 10 ,100"), ["1", "10", "100"]);
+        assert_eq!(split_values("[[0,1],[2,3]]"), ["[[0,1],[2,3]]"]);
+        assert_eq!(split_values("{a=1,b=2},3"), ["{a=1,b=2}", "3"]);
+        assert_eq!(
+            split_values(r#""a,b",'c,d',"e\",f""#),
+            [r#""a,b""#, "'c,d'", r#""e\",f""#]
+        );
+    }
+
+    #[test]
+    fn sets_parse_and_bad_ones_are_named() {
+        assert_eq!(
+            parse_set("a=[1,2],x").unwrap(),
+            SweepSet {
+                key: "a".into(),
+                values: vec!["[1,2]".into(), "x".into()]
+            }
+        );
+        let message = |s: &str| parse_set(s).unwrap_err().to_string();
+        assert!(message("render.spp").contains("expected KEY.PATH=VALUE"));
+        assert!(message("render.spp=").contains("empty value list"));
+        assert!(message("render.spp=1,,2").contains("empty value"));
+        assert!(message("=1").contains("empty key"));
+    }
+
+    #[test]
+    fn first_set_varies_fastest() {
+        let set = |k: &str, n: usize| SweepSet {
+            key: k.into(),
+            values: (0..n).map(|i| i.to_string()).collect(),
+        };
+        let sets = [set("a", 2), set("b", 1), set("c", 3)];
+        assert_eq!(cell_choices(&sets, 0), [0, 0, 0]);
+        assert_eq!(cell_choices(&sets, 1), [1, 0, 0]);
+        assert_eq!(cell_choices(&sets, 2), [0, 0, 1]);
+        assert_eq!(cell_choices(&sets, 5), [1, 0, 2]);
+        let (x, y) = (
+            set("integrators.photon.k", 2),
+            set("integrators.other.k", 2),
+        );
+        assert_eq!(short_names(&[&x, &sets[0]]), ["k", "a"]);
+        assert_eq!(
+            short_names(&[&x, &y]),
+            ["integrators.photon.k", "integrators.other.k"]
+        );
+    }
+}
