@@ -312,6 +312,45 @@ fn compare_with_a_time_budget_chooses_the_samples() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+#[test]
+fn compare_reports_no_spp_for_an_integrator_with_a_budget_of_its_own() {
+    // sppm runs its iterations whatever render.spp says.
+    let (dir, scene) = setup("compare-own-budget");
+    let out = dir.join("own.png");
+    let run = |budget: &[&str]| {
+        let mut args = vec![
+            "compare",
+            s(&scene),
+            "--integrators",
+            "path,sppm",
+            "--set",
+            "integrators.sppm.iterations=2",
+            "--set",
+            "integrators.sppm.photons_per_iteration=2000",
+            "-o",
+            s(&out),
+            "-q",
+        ];
+        args.extend(budget);
+        let run = foton_with_plugins(&args);
+        ok(&run);
+        (run, std::fs::read_to_string(dir.join("own.json")).unwrap())
+    };
+    let (_, json) = run(&["--spp", "2"]);
+    assert_eq!(json_number(&json, "path", "spp"), Some(2.0), "{json}");
+    assert_eq!(json_number(&json, "sppm", "spp"), None, "{json}");
+    let (timed, json) = run(&["--time", "0.1"]);
+    assert_eq!(json_number(&json, "sppm", "spp"), None, "{json}");
+    assert!(
+        timed
+            .stderr
+            .contains("`sppm` does not take its samples from render.spp"),
+        "{}",
+        timed.stderr
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 // ---------------------------------------------------------------------------------------------
 // foton sweep
 // ---------------------------------------------------------------------------------------------

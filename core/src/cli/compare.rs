@@ -123,11 +123,23 @@ pub fn spp_for_budget(budget: f64, t1: f64, t2: f64) -> u32 {
         .clamp(1.0, u32::MAX as f64) as u32
 }
 
+/// Whether a film has the `spp` samples in every pixel that render.spp asked for. An
+/// integrator with a budget of its own (sppm: iterations or time) writes one estimate per
+/// pixel whatever render.spp says; with `spp` = 1 the two cannot be told apart.
+fn takes_spp(film: &Film, spp: u32) -> bool {
+    film.total_samples() == film.width as u64 * film.height as u64 * spp as u64
+}
+
+fn spp_text(spp: Option<u32>) -> String {
+    spp.map_or_else(|| "own budget".into(), |n| format!("{n} spp"))
+}
+
 /// One integrator's render and its numbers.
 struct Entry {
     name: String,
     description: String,
-    spp: u32,
+    /// None when the integrator does not take its samples from render.spp.
+    spp: Option<u32>,
     seconds: f64,
     film: Film,
     image: PathBuf,
@@ -179,7 +191,10 @@ fn json(scene: &Path, reference: Option<&Path>, entries: &[Entry]) -> String {
         s += "    {\n";
         s += &format!("      \"name\": {},\n", json_string(&e.name));
         s += &format!("      \"description\": {},\n", json_string(&e.description));
-        s += &format!("      \"spp\": {},\n", e.spp);
+        s += &format!(
+            "      \"spp\": {},\n",
+            e.spp.map_or("null".into(), |n| n.to_string())
+        );
         s += &format!("      \"seconds\": {},\n", json_number(e.seconds));
         s += &format!("      \"rel_mse\": {},\n", json_number(rel_mse));
         s += &format!("      \"bias\": {},\n", json_number(bias));
@@ -291,18 +306,34 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     INTERRUPTED.store(false, Ordering::SeqCst);
     let mut entries = Vec::new();
     for (name, mut p) in names.iter().zip(prepared) {
+        let mut rendered = None;
         if let Some(budget) = a.time {
             p.scene.render.spp = 1;
             let (_, t1) = render_timed(&p, threads, true, err)?;
             p.scene.render.spp = 2;
-            let (_, t2) = render_timed(&p, threads, true, err)?;
-            p.scene.render.spp = spp_for_budget(budget, t1.as_secs_f64(), t2.as_secs_f64());
+            let (film, t2) = render_timed(&p, threads, true, err)?;
+            if takes_spp(&film, 2) {
+                p.scene.render.spp = spp_for_budget(budget, t1.as_secs_f64(), t2.as_secs_f64());
+            } else {
+                // Its budget is its own (sppm's iterations or time): more samples per pixel
+                // would not change the image, so the calibration render is the render.
+                let _ = writeln!(
+                    err,
+                    "warning: `{name}` does not take its samples from render.spp, so --time cannot set its budget; give it its own (e.g. --set integrators.{name}.time={budget})"
+                );
+                rendered = Some((film, t2));
+            }
         }
-        let (film, elapsed) = render_timed(&p, threads, a.quiet, err)?;
+        let (film, elapsed) = match rendered {
+            Some(r) => r,
+            None => render_timed(&p, threads, a.quiet, err)?,
+        };
         if INTERRUPTED.load(Ordering::SeqCst) {
             let _ = writeln!(err, "interrupted: nothing written");
             return Ok(130);
         }
+        let spp = p.scene.render.spp;
+        let spp = takes_spp(&film, spp).then_some(spp);
         let image = exr_of(name);
         film.write(&image)?;
         let errors = reference
@@ -311,7 +342,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         let entry = Entry {
             name: name.clone(),
             description: p.integrator.describe(),
-            spp: p.scene.render.spp,
+            spp,
             seconds: elapsed.as_secs_f64(),
             film,
             image,
@@ -319,9 +350,9 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         };
         let _ = write!(
             out,
-            "{}: {} spp in {:.2} s -> {}",
+            "{}: {} in {:.2} s -> {}",
             entry.description,
-            entry.spp,
+            spp_text(entry.spp),
             entry.seconds,
             entry.image.display()
         );
@@ -342,7 +373,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .map(|e| Tile {
             image: Image::from_film(&e.film),
             label: vec![
-                format!("{}: {} spp, {:.2} s", e.name, e.spp, e.seconds),
+                format!("{}: {}, {:.2} s", e.name, spp_text(e.spp), e.seconds),
                 // Narrow tiles: `k=50` wraps better than `k = 50`.
                 e.description.replace(" = ", "="),
             ],

@@ -82,7 +82,9 @@ enum Command {
     /// --time S: each integrator renders at 1 and then 2 spp to measure a fixed cost (a photon
     /// pass) and a per-sample cost, and then at the spp that fills S seconds (the per-sample
     /// cost is taken within [t2/20, t2/2] against timer noise). The chosen spp is printed; a
-    /// render with --spp set to it gives the same image.
+    /// render with --spp set to it gives the same image. An integrator with a budget of its own
+    /// (sppm: iterations or time) ignores render.spp: it renders as configured, with a warning,
+    /// and its spp is reported as null (give it --set integrators.sppm.time=S).
     ///
     /// --reference IMAGE: a second row shows each render's relative difference from the
     /// reference, per pixel (x - r) / sqrt(r^2 + 0.01) of the channel means, in a diverging
