@@ -448,7 +448,11 @@ fn bad_photon_parameters_are_clear_errors() {
         ),
         (
             "integrators.photon.k=0",
-            &["integrators.photon.k", "at least 1"],
+            &["integrators.photon.k", "at least 2"],
+        ),
+        (
+            "integrators.photon.k=1",
+            &["integrators.photon.k", "at least 2"],
         ),
         (
             "integrators.photon.max_radius=0",

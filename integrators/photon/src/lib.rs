@@ -4,7 +4,7 @@
 //! |-------------------|---------|----------------------------------------------------------------|----------|
 //! | `global_photons`  | integer | photons emitted for the direct and indirect maps               | 200000   |
 //! | `caustic_photons` | integer | photons emitted for the caustic map (0: no caustic map)        | 100000   |
-//! | `k`               | integer | photons per radiance estimate (k nearest)                      | 50       |
+//! | `k`               | integer | photons per radiance estimate (k nearest, >= 2)                | 50       |
 //! | `max_radius`      | float   | largest estimate radius (world units)                          | 1/20 of the scene's diagonal |
 //! | `kernel`          | string  | `box`, `cone`, `gaussian` or a kernel plugin's name            | `box`    |
 //! | `cone_c`          | float   | the cone kernel's c >= 1                                       | 1        |
@@ -337,8 +337,13 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }
     let caustic_photons = props.u64("caustic_photons", 100_000)?;
     let k = props.u32("k", 50)? as usize;
-    if k == 0 {
-        return Err(props.error("k", "must be at least 1"));
+    if k < 2 {
+        // The k-th photon lies on the boundary of the estimate's disc and is not summed
+        // (docs/photon-mapping.md): k = 1 would leave nothing to sum.
+        return Err(props.error(
+            "k",
+            format!("must be at least 2, found {k} (the k-th nearest photon only sets the radius: the estimate sums the k - 1 inside it)"),
+        ));
     }
     let max_radius = props.f32("max_radius", default_max_radius(scene))?;
     if max_radius <= 0.0 {

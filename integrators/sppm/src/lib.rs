@@ -22,7 +22,9 @@
 //! at each visible point the photons within the pixel's radius R on the same side of the same
 //! surface, and updates the pixel's statistics:
 //!
-//!     N' = N + alpha M,   R' = R sqrt((N + alpha M) / (N + M)),   tau' = (tau + Phi) R'^2 / R^2
+//! ```text
+//! N' = N + alpha M,   R' = R sqrt((N + alpha M) / (N + M)),   tau' = (tau + Phi) R'^2 / R^2
+//! ```
 //!
 //! where M is the number of photons gathered and Phi = beta sum_p f_r Phi_p their reflected
 //! flux. The pixel's radiance after n iterations is Ld / n + tau / (n pi R^2) (photon flux
