@@ -80,4 +80,18 @@ impl Accel {
             prim.shape.intersect(ray, r.tmax).unwrap_or(f32::INFINITY)
         })
     }
+
+    /// Calls `f(primitive index, t)` for every primitive the ray meets within (0, tmax), in no
+    /// particular order (medium boundaries need every crossing, not only the closest).
+    pub fn for_each_hit(&self, ray: &Ray, tmax: f32, mut f: impl FnMut(u32, f32)) {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return;
+        };
+        let bray = BvhRay::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+        bvh.ray_traverse_anyhit(bray, |_, id| {
+            if let Some(t) = self.prims[id].shape.intersect(ray, tmax) {
+                f(id as u32, t);
+            }
+        });
+    }
 }

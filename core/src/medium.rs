@@ -1,7 +1,20 @@
-//! Participating media. Declared here and parsed from scenes; rendering them is the job of the
-//! integrators that support media.
+//! Participating media: the homogeneous medium, phase functions, transmittance and free-flight
+//! distance sampling. Where media are in a scene (which medium a point or ray is in, and how
+//! it changes at boundaries) is the scene's business: `Scene::medium_at`,
+//! `Scene::medium_after` and `Scene::transmittance`.
+//!
+//! Free-flight sampling in a chromatic medium uses one-sample MIS over the colour channels
+//! (the "spectral MIS" of Wilkie et al. 2014 with the balance heuristic): t is drawn from
+//! sigma_t,c exp(-sigma_t,c t) for a channel c chosen uniformly, and the estimate is divided by
+//! the average over channels of the pdfs, not by the pdf of the channel used; dividing by the
+//! channel's own pdf alone would be biased in the channels whose sigma_t is zero and of
+//! unbounded variance in the others. Per event ([`FreeFlight::weight`], pbrt-v3's homogeneous
+//! medium) the average is over one distance; along a whole path ([`HeroChannel`], pbrt-v4's
+//! `r_u`) the channel is chosen once per path and the average is over the pdfs of the whole
+//! path, which keeps the weight of every channel below 3 however many events the path has.
 
 use crate::Rgb;
+use crate::geometry::Ray;
 use crate::sampling::{to_world, uniform_sphere};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -46,6 +59,93 @@ impl Phase {
     }
 }
 
+/// A free-flight distance sample along a ray segment of length `tmax` (to the next surface, or
+/// infinity).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FreeFlight {
+    /// Distance of the scattering event; `tmax` if the sample passed the whole segment.
+    pub t: f32,
+    /// Whether a real scattering event happened in the medium (otherwise the path goes on at
+    /// the surface at `tmax`, or escapes).
+    pub scattered: bool,
+    /// The integrand's factor: sigma_s Tr(t) at a scattering event, Tr(tmax) otherwise.
+    pub f: Rgb,
+    /// Per channel c, the probability (density, 1/m, at a scattering event) of this outcome
+    /// had channel c been sampled: sigma_t,c Tr_c(t), or Tr_c(tmax) when passing.
+    pub pdf: Rgb,
+}
+
+impl FreeFlight {
+    /// What the throughput is multiplied by with one-sample MIS over the channels of this
+    /// event alone (channel chosen uniformly): f / mean(pdf). Each channel's expectation is
+    /// exactly its transmittance-weighted integrand, and each channel's weight is at most 3
+    /// sigma_s / sigma_t (scattered) or 3 (passed).
+    pub fn weight(&self) -> Rgb {
+        let pdf = crate::average(self.pdf);
+        if pdf > 0.0 { self.f / pdf } else { Rgb::ZERO }
+    }
+}
+
+/// The colour channel chosen by a uniform number in [0, 1).
+#[inline]
+pub fn channel(u: f32) -> usize {
+    ((u * 3.0) as usize).min(2)
+}
+
+/// Spectral MIS over a whole path (the hero channel): every free-flight sample of the path
+/// uses the same channel, and the path's throughput is its integrand divided by the average
+/// over channels of the path's pdf under each channel. `r` holds those per-channel path pdfs,
+/// scaled to mean 1 after every event so that neither it nor the throughput overflows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HeroChannel {
+    pub channel: usize,
+    pub r: Rgb,
+}
+
+impl HeroChannel {
+    /// A path's hero channel, chosen uniformly by `u`.
+    pub fn new(u: f32) -> Self {
+        HeroChannel {
+            channel: channel(u),
+            r: Rgb::ONE,
+        }
+    }
+
+    /// Accounts for a free-flight sample of the path (drawn with `self.channel`); returns the
+    /// factor the throughput is multiplied by.
+    pub fn update(&mut self, flight: &FreeFlight) -> Rgb {
+        let r = self.r * flight.pdf;
+        let mean = crate::average(r);
+        if mean <= 0.0 {
+            return Rgb::ZERO;
+        }
+        self.r = r / mean;
+        flight.f / mean
+    }
+}
+
+/// Transmittance exp(-sigma_t d) per channel. A channel with sigma_t = 0 transmits fully even
+/// over an infinite distance (0 x inf would be NaN).
+#[inline]
+pub fn transmittance_homogeneous(sigma_t: Rgb, d: f32) -> Rgb {
+    let tr = |s: f32| if s == 0.0 { 1.0 } else { (-s * d).exp() };
+    Rgb::new(tr(sigma_t.x), tr(sigma_t.y), tr(sigma_t.z))
+}
+
+/// Density of the free-flight distance t of [`Homogeneous::sample_free_flight`] (spectral MIS,
+/// channels chosen uniformly): the mean over channels of sigma_t,c exp(-sigma_t,c t).
+#[inline]
+pub fn free_flight_pdf(sigma_t: Rgb, t: f32) -> f32 {
+    crate::average(sigma_t * transmittance_homogeneous(sigma_t, t))
+}
+
+/// Probability that a free-flight sample passes a segment of length `tmax`: the mean over
+/// channels of exp(-sigma_t,c tmax).
+#[inline]
+pub fn free_flight_pass_probability(sigma_t: Rgb, tmax: f32) -> f32 {
+    crate::average(transmittance_homogeneous(sigma_t, tmax))
+}
+
 /// A participating medium.
 pub trait Medium: Send + Sync + std::fmt::Debug {
     /// Absorption coefficient (1/m) at `p`.
@@ -55,6 +155,9 @@ pub trait Medium: Send + Sync + std::fmt::Debug {
     fn phase(&self) -> Phase;
     /// Transmittance along the segment from `a` to `b`.
     fn transmittance(&self, a: Vec3, b: Vec3) -> Rgb;
+    /// Samples with channel `channel`'s free-flight density where light travelling back
+    /// along `ray` last scattered within (0, tmax); `u` is uniform in [0, 1).
+    fn sample_free_flight(&self, ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight;
 }
 
 /// A medium with the same coefficients everywhere.
@@ -68,6 +171,48 @@ pub struct Homogeneous {
 impl Homogeneous {
     pub fn sigma_t(&self) -> Rgb {
         self.sigma_a + self.sigma_s
+    }
+
+    /// A medium that neither absorbs nor scatters: integrators skip it entirely, so that an
+    /// empty medium renders exactly (bit for bit) as no medium.
+    pub fn is_vacuum(&self) -> bool {
+        self.sigma_t().max_element() == 0.0
+    }
+
+    /// Transmittance over a distance `d` (which may be infinite).
+    #[inline]
+    pub fn transmittance_over(&self, d: f32) -> Rgb {
+        transmittance_homogeneous(self.sigma_t(), d)
+    }
+
+    /// Samples a free-flight distance with channel `channel`'s density
+    /// sigma_t,c exp(-sigma_t,c t), up to `tmax` (see the module comment for the weights).
+    pub fn sample_free_flight(&self, tmax: f32, channel: usize, u: f32) -> FreeFlight {
+        let sigma_t = self.sigma_t();
+        let s = sigma_t[channel];
+        // 1 - u is in (0, 1]: the logarithm is finite.
+        let t = if s > 0.0 {
+            -(1.0 - u).ln() / s
+        } else {
+            f32::INFINITY
+        };
+        if t < tmax {
+            let tr = transmittance_homogeneous(sigma_t, t);
+            FreeFlight {
+                t,
+                scattered: true,
+                f: self.sigma_s * tr,
+                pdf: sigma_t * tr,
+            }
+        } else {
+            let tr = transmittance_homogeneous(sigma_t, tmax);
+            FreeFlight {
+                t: tmax,
+                scattered: false,
+                f: tr,
+                pdf: tr,
+            }
+        }
     }
 }
 
@@ -83,7 +228,32 @@ impl Medium for Homogeneous {
     }
     /// Beer-Lambert: exp(-sigma_t d) per channel.
     fn transmittance(&self, a: Vec3, b: Vec3) -> Rgb {
-        let d = a.distance(b);
-        (-self.sigma_t() * d).exp()
+        self.transmittance_over(a.distance(b))
+    }
+    fn sample_free_flight(&self, _ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight {
+        Homogeneous::sample_free_flight(self, tmax, channel, u)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vacuum_channels_transmit_over_infinite_distances() {
+        let tr = transmittance_homogeneous(Rgb::new(0.0, 1.0, 2.0), f32::INFINITY);
+        assert_eq!(tr, Rgb::new(1.0, 0.0, 0.0));
+        let m = Homogeneous {
+            sigma_a: Rgb::new(0.0, 1.0, 0.0),
+            sigma_s: Rgb::new(0.0, 0.0, 2.0),
+            phase: Phase::Isotropic,
+        };
+        // Channel 0 (vacuum) chosen: the sample passes with weight Tr / P(pass) = 1 / (1/3).
+        let f = m.sample_free_flight(f32::INFINITY, channel(0.1), 0.5);
+        assert!(!f.scattered);
+        assert_eq!(f.weight(), Rgb::new(3.0, 0.0, 0.0));
+        let mut hero = HeroChannel::new(0.1);
+        assert_eq!(hero.update(&f), Rgb::new(3.0, 0.0, 0.0));
+        assert_eq!(hero.r, Rgb::new(3.0, 0.0, 0.0));
     }
 }

@@ -47,6 +47,24 @@ pub struct Object {
     pub light: Option<u32>,
     /// Medium inside the (closed) shape.
     pub interior: Option<u32>,
+    /// Whether the shape is closed (a sphere, a watertight consistently oriented mesh).
+    pub closed: bool,
+}
+
+/// The media on the two sides of a closed shape that bounds a volume: pbrt's MediumInterface,
+/// except that the outside is not written in the scene but found from how the shapes nest.
+/// A ray crossing the shape against its outward normal enters `inside`, along it leaves to
+/// `outside`, so that every boundary crossing sets the medium afresh and an error made
+/// between two crossings does not propagate along the path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MediumInterface {
+    /// The `interior` medium; None: vacuum (clear glass, a bubble).
+    pub inside: Option<u32>,
+    /// The inside of the innermost boundary enclosing this one, or the scene medium.
+    pub outside: Option<u32>,
+    /// Number of boundaries enclosing this one (0: outermost). Decides between coincident
+    /// boundaries.
+    pub depth: u32,
 }
 
 /// A named material or medium, as referenced from shapes.
@@ -70,6 +88,11 @@ pub struct Scene {
     pub accel: Accel,
     /// The medium filling free space, if any.
     pub medium: Option<u32>,
+    /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
+    /// None in a scene without media.
+    pub interfaces: Vec<Option<MediumInterface>>,
+    /// The medium around the camera (None: vacuum).
+    pub camera_medium: Option<u32>,
     /// Axis-aligned bounds of all geometry and point lights.
     pub bounds: (Vec3, Vec3),
     /// The parsed document (integrators read their `[integrators.NAME]` table from it).
@@ -204,6 +227,27 @@ impl Scene {
             hi = camera.position;
         }
 
+        let accel = Accel::build(prims);
+        let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
+        let interfaces = if uses_media {
+            medium_interfaces(&objects, &materials, &accel, medium)
+        } else {
+            vec![None; objects.len()]
+        };
+        let mut camera_medium = None;
+        if uses_media {
+            camera_medium = locate_medium(&accel, &objects, &interfaces, medium, camera.position)
+                .map_err(|why| {
+                let t = root.table("camera").ok().flatten();
+                let message =
+                    format!("the medium around the camera is undefined: {why}; move the camera");
+                match t {
+                    Some(t) => t.error("position", message),
+                    None => root.error("camera", message),
+                }
+            })?;
+        }
+
         ld.done(&root);
         let mut unused: Vec<(String, Location)> = ld.bags.into_iter().flatten().collect();
         unused.sort_by(|a, b| (a.1.line, &a.0).cmp(&(b.1.line, &b.0)));
@@ -218,8 +262,10 @@ impl Scene {
             objects,
             lights,
             light_distribution,
-            accel: Accel::build(prims),
+            accel,
             medium,
+            interfaces,
+            camera_medium,
             bounds: (lo, hi),
             document: doc,
             unused,
@@ -283,6 +329,117 @@ impl Scene {
         Some((id, &self.lights[id as usize]))
     }
 
+    /// The medium at a point in free space: the inside of the innermost medium boundary that
+    /// contains it, or the scene medium. An error (saying why) if the point lies on a boundary
+    /// or inside boundaries that overlap without one containing the other. Costs a few rays
+    /// per boundary: for starting points (camera, lights), not for every vertex of a path.
+    pub fn medium_at(&self, p: Vec3) -> std::result::Result<Option<u32>, String> {
+        locate_medium(&self.accel, &self.objects, &self.interfaces, self.medium, p)
+    }
+
+    /// The medium on the side of the surface at `hit` that `dir` points into: the medium a
+    /// ray crossing the surface along `dir` enters, or the one a ray leaving the surface
+    /// along `dir` (reflected, or a shadow ray) travels in. `current` is the medium the path
+    /// was in; it is kept unless the surface bounds a volume.
+    ///
+    /// Coincident boundaries (two volumes touching, a volume sharing a face with its
+    /// container) are crossed together: every boundary through the point is found, and the
+    /// innermost one entered wins, or if none is entered, the outermost one left.
+    pub fn medium_after(&self, hit: &Hit, dir: Vec3, current: Option<u32>) -> Option<u32> {
+        let object = self.primitive(hit).object as usize;
+        let Some(own) = self.interfaces[object] else {
+            return current;
+        };
+        let eps = 1e-4 * (1.0 + hit.p.abs().max_element());
+        let probe = Ray::new(hit.p - dir * eps, dir);
+        let mut entered: Option<MediumInterface> = None;
+        let mut left: Option<MediumInterface> = None;
+        let mut consider = |iface: MediumInterface, n: Vec3| {
+            if n.dot(dir) < 0.0 {
+                if entered.is_none_or(|e| iface.depth > e.depth) {
+                    entered = Some(iface);
+                }
+            } else if left.is_none_or(|l| iface.depth < l.depth) {
+                left = Some(iface);
+            }
+        };
+        consider(own, hit.ng);
+        let prims = self.accel.primitives();
+        self.accel.for_each_hit(&probe, 2.0 * eps, |i, t| {
+            let prim = &prims[i as usize];
+            if let Some(iface) = self.interfaces[prim.object as usize] {
+                consider(iface, prim.shape.normal(probe.at(t)));
+            }
+        });
+        match (entered, left) {
+            (Some(e), _) => e.inside,
+            (None, Some(l)) => l.outside,
+            (None, None) => current,
+        }
+    }
+
+    /// Transmittance along the segment between two points, starting in `medium`: zero if
+    /// anything but null boundaries blocks it, otherwise the product of exp(-sigma_t d) over
+    /// the pieces between the null boundaries it crosses, each in its own medium. The ends
+    /// are offset along their normals as in [`Scene::occluded`] (a zero normal, e.g. a point
+    /// in a medium or a point light: no offset). Without media it is exactly 0 or 1.
+    pub fn transmittance(
+        &self,
+        p0: Vec3,
+        n0: Vec3,
+        p1: Vec3,
+        n1: Vec3,
+        medium: Option<u32>,
+    ) -> Rgb {
+        if self.occluded(p0, n0, p1, n1) {
+            return Rgb::ZERO;
+        }
+        let d = p1 - p0;
+        let from = if n0 == Vec3::ZERO {
+            p0
+        } else {
+            offset_origin(p0, n0, d)
+        };
+        let to = if n1 == Vec3::ZERO {
+            p1
+        } else {
+            offset_origin(p1, n1, -d)
+        };
+        // Distances are measured between the crossing points themselves, not the offset
+        // origins, so that the offsets do not shorten the path through the media.
+        let tr_over = |medium: Option<u32>, d: f32| match medium {
+            Some(m) => self.media[m as usize].value.transmittance_over(d),
+            None => Rgb::ONE,
+        };
+        let mut tr = Rgb::ONE;
+        let mut medium = medium;
+        let mut origin = from;
+        let mut last = p0;
+        for _ in 0..MAX_BOUNDARY_CROSSINGS {
+            let seg = to - origin;
+            let dist = seg.length();
+            if dist <= 0.0 || seg.dot(d) <= 0.0 {
+                break;
+            }
+            let ray = Ray::new(origin, seg / dist);
+            let Some(hit) = self.intersect(&ray, dist) else {
+                break;
+            };
+            if !self.material(&hit).is_null() {
+                // Missed by the any-hit test above only through rounding: a blocker is a blocker.
+                return Rgb::ZERO;
+            }
+            tr *= tr_over(medium, hit.p.distance(last));
+            if tr == Rgb::ZERO {
+                return tr;
+            }
+            last = hit.p;
+            medium = self.medium_after(&hit, ray.dir, medium);
+            origin = offset_origin(hit.p, hit.ng, ray.dir);
+        }
+        tr * tr_over(medium, p1.distance(last))
+    }
+
     /// Whether the segment between two surface points is blocked by anything but null
     /// boundaries. The ends are offset along their normals (a zero normal: no offset).
     pub fn occluded(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
@@ -336,6 +493,195 @@ impl Scene {
     pub fn has_media(&self) -> bool {
         self.medium.is_some() || self.objects.iter().any(|o| o.interior.is_some())
     }
+}
+
+/// Null boundaries a shadow ray may cross before it is taken as blocked (guards against rays
+/// stuck on coincident boundaries).
+const MAX_BOUNDARY_CROSSINGS: u32 = 256;
+
+/// Directions of the rays that decide whether a point is inside a closed shape: five, not
+/// aligned with the axes (axis-aligned rays run along the edges and faces of boxes).
+const INSIDE_PROBES: [Vec3; 5] = [
+    Vec3::new(0.267_261_24, 0.534_522_5, 0.801_783_7),
+    Vec3::new(-0.617_213_4, 0.154_303_35, 0.771_516_8),
+    Vec3::new(0.408_248_3, -0.816_496_6, 0.408_248_3),
+    Vec3::new(-0.301_511_35, -0.301_511_35, -0.904_534_04),
+    Vec3::new(0.872_871_6, 0.218_217_9, -0.436_435_8),
+];
+
+/// Whether `p` is inside the closed object `object`: along each probe direction, the nearest
+/// surface of the object is seen from its inside (outward normal along the ray) or not; the
+/// majority decides, so that a probe that slips through an edge between two triangles does
+/// not. Err if `p` is on the surface.
+fn inside_object(accel: &Accel, object: u32, p: Vec3) -> std::result::Result<bool, ()> {
+    let on_surface = 1e-5 * (1.0 + p.abs().max_element());
+    let prims = accel.primitives();
+    // The probes cannot see a surface at distance zero: a point on it is found by distance.
+    if prims
+        .iter()
+        .filter(|q| q.object == object)
+        .any(|q| distance_to(&q.shape, p) < on_surface)
+    {
+        return Err(());
+    }
+    let mut votes = 0;
+    for dir in INSIDE_PROBES {
+        let ray = Ray::new(p, dir);
+        let mut nearest: Option<(f32, u32)> = None;
+        accel.for_each_hit(&ray, f32::INFINITY, |i, t| {
+            if prims[i as usize].object == object && nearest.is_none_or(|(tn, _)| t < tn) {
+                nearest = Some((t, i));
+            }
+        });
+        if let Some((t, i)) = nearest {
+            if t < on_surface {
+                return Err(());
+            }
+            let n = prims[i as usize].shape.normal(ray.at(t));
+            votes += (n.dot(dir) > 0.0) as u32;
+        }
+    }
+    Ok(votes * 2 > INSIDE_PROBES.len() as u32)
+}
+
+/// Distance from `p` to a closed object's primitive (spheres and triangles; quads are never
+/// closed).
+fn distance_to(shape: &Shape, p: Vec3) -> f32 {
+    let segment = |a: Vec3, e: Vec3| {
+        let s = ((p - a).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+        p.distance(a + s * e)
+    };
+    match *shape {
+        Shape::Sphere { center, radius } => (p.distance(center) - radius).abs(),
+        Shape::Triangle { p0, e1, e2 } => {
+            // The nearest point is inside the triangle (the projection) or on an edge.
+            let n = e1.cross(e2);
+            let q = p - p0;
+            let b1 = q.cross(e2).dot(n) / n.length_squared();
+            let b2 = e1.cross(q).dot(n) / n.length_squared();
+            if b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 {
+                q.dot(n).abs() / n.length()
+            } else {
+                segment(p0, e1)
+                    .min(segment(p0, e2))
+                    .min(segment(p0 + e1, e2 - e1))
+            }
+        }
+        Shape::Quad { origin, u, v, .. } => segment(origin, u)
+            .min(segment(origin, v))
+            .min(segment(origin + u, v))
+            .min(segment(origin + v, u)),
+    }
+}
+
+/// A point strictly inside a closed object, near its surface: the centroid of its largest
+/// primitive pushed inwards (the centre, for a sphere). Used to ask which boundaries contain
+/// the object.
+fn point_inside(accel: &Accel, object: u32) -> Vec3 {
+    let mut best: Option<(f32, Shape)> = None;
+    for prim in accel.primitives().iter().filter(|q| q.object == object) {
+        let area = prim.shape.area();
+        if best.is_none_or(|(a, _)| area > a) {
+            best = Some((area, prim.shape));
+        }
+    }
+    match best.map(|(_, s)| s) {
+        Some(Shape::Sphere { center, .. }) => center,
+        Some(Shape::Triangle { p0, e1, e2 }) => {
+            let c = p0 + (e1 + e2) / 3.0;
+            let inward = -e1.cross(e2).normalize();
+            // Far enough from the surface for the probes' on-surface test, well inside any
+            // triangle-sized feature.
+            let step =
+                (1e-3 * (1.0 + c.abs().max_element())).min(0.05 * e1.length().min(e2.length()));
+            c + inward * step
+        }
+        Some(Shape::Quad {
+            origin,
+            u,
+            v,
+            normal,
+            ..
+        }) => origin + 0.5 * (u + v) - normal * 1e-3,
+        None => Vec3::ZERO,
+    }
+}
+
+/// Which objects bound volumes, and their medium interfaces. A closed shape bounds a volume
+/// if it has an `interior` medium, or if light can enter it (a null or dielectric material):
+/// then its inside is vacuum (clear glass in fog). Opaque shapes without an interior leave
+/// the medium as it is (light reflected there stays on its side).
+fn medium_interfaces(
+    objects: &[Object],
+    materials: &[Named<Material>],
+    accel: &Accel,
+    scene_medium: Option<u32>,
+) -> Vec<Option<MediumInterface>> {
+    let bounds: Vec<usize> = (0..objects.len())
+        .filter(|&i| {
+            let o = &objects[i];
+            let m = &materials[o.material as usize].value;
+            o.closed
+                && (o.interior.is_some() || m.is_null() || matches!(m, Material::Dielectric { .. }))
+        })
+        .collect();
+    // containers[k]: the boundaries (indices into `bounds`) that contain boundary k.
+    let containers: Vec<Vec<usize>> = bounds
+        .iter()
+        .map(|&i| {
+            let q = point_inside(accel, i as u32);
+            (0..bounds.len())
+                .filter(|&k| {
+                    bounds[k] != i && inside_object(accel, bounds[k] as u32, q).unwrap_or(false)
+                })
+                .collect()
+        })
+        .collect();
+    let depth: Vec<u32> = containers.iter().map(|c| c.len() as u32).collect();
+    let mut out = vec![None; objects.len()];
+    for (k, &i) in bounds.iter().enumerate() {
+        let parent = containers[k].iter().copied().max_by_key(|&c| depth[c]);
+        out[i] = Some(MediumInterface {
+            inside: objects[i].interior,
+            outside: parent.map_or(scene_medium, |c| objects[bounds[c]].interior),
+            depth: depth[k],
+        });
+    }
+    out
+}
+
+/// See [`Scene::medium_at`].
+fn locate_medium(
+    accel: &Accel,
+    objects: &[Object],
+    interfaces: &[Option<MediumInterface>],
+    scene_medium: Option<u32>,
+    p: Vec3,
+) -> std::result::Result<Option<u32>, String> {
+    let mut innermost: Option<(usize, MediumInterface)> = None;
+    for (i, iface) in interfaces.iter().enumerate() {
+        let Some(iface) = *iface else { continue };
+        match inside_object(accel, i as u32, p) {
+            Err(()) => {
+                return Err(format!(
+                    "it lies on the surface of {}, a medium boundary",
+                    objects[i].name
+                ));
+            }
+            Ok(false) => {}
+            Ok(true) => match innermost {
+                Some((j, other)) if other.depth == iface.depth => {
+                    return Err(format!(
+                        "it is inside both {} and {}, which overlap without one containing the other",
+                        objects[j].name, objects[i].name
+                    ));
+                }
+                Some((_, other)) if other.depth > iface.depth => {}
+                _ => innermost = Some((i, iface)),
+            },
+        }
+    }
+    Ok(innermost.map_or(scene_medium, |(_, iface)| iface.inside))
 }
 
 fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {
@@ -820,6 +1166,7 @@ fn read_shapes(
             material,
             light,
             interior,
+            closed,
         });
         prims.extend(shapes.into_iter().map(|shape| Primitive { shape, object }));
         ld.done(&s);

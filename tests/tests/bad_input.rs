@@ -1586,3 +1586,75 @@ fn bad_plugin_parameter_is_a_scene_error() {
         &["unknown value \"elsewhere\"", "create, render"],
     );
 }
+
+// ---------------------------------------------------------------------------------------------
+// Media: values that are not numbers, and cameras in no well-defined medium
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn medium_non_finite_sigma() {
+    for (i, bad) in ["[nan, 0.5, 0.5]", "[0.5, inf, 0.5]"].iter().enumerate() {
+        let text = edit(
+            &format!("{BASE}{FOG}"),
+            "sigma_s = [0.5, 0.5, 0.5]",
+            &format!("sigma_s = {bad}"),
+        );
+        let scene = SceneFile::new(&format!("medium-sigma-nan-{i}"), &text);
+        scene.check_fails(
+            &format!("sigma_s = {bad}"),
+            "media.fog.sigma_s",
+            &["expected a finite number"],
+        );
+    }
+}
+
+#[test]
+fn camera_on_a_medium_boundary() {
+    // The sphere of BASE (centre [0, 1, 0], radius 0.5) filled with fog, the camera on it.
+    let text = edit(
+        &edit(
+            &format!("{BASE}{FOG}"),
+            SPHERE,
+            &format!("{SPHERE}\ninterior = \"fog\""),
+        ),
+        "position = [0, 1, 3.9]",
+        "position = [0, 1, 0.5]",
+    );
+    let scene = SceneFile::new("camera-on-boundary", &text);
+    scene.check_fails(
+        "position = [0, 1, 0.5]",
+        "camera.position",
+        &[
+            "medium around the camera is undefined",
+            "shapes[0]",
+            "boundary",
+        ],
+    );
+    // The render fails the same way, before rendering.
+    let run = scene.render(&[]);
+    assert_error(&run, &["medium around the camera is undefined"]);
+}
+
+#[test]
+fn camera_inside_overlapping_media() {
+    let second = "\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.6, 1, 0]\nradius = 0.5\nmaterial = \"white\"\ninterior = \"fog\"\n";
+    let text = edit(
+        &edit(
+            &format!("{BASE}{FOG}{second}"),
+            SPHERE,
+            &format!("{SPHERE}\ninterior = \"fog\""),
+        ),
+        "position = [0, 1, 3.9]",
+        "position = [0.3, 1, 0]",
+    );
+    let scene = SceneFile::new("camera-in-overlap", &text);
+    scene.check_fails(
+        "position = [0.3, 1, 0]",
+        "camera.position",
+        &[
+            "medium around the camera is undefined",
+            "shapes[0] and shapes[1]",
+            "overlap",
+        ],
+    );
+}

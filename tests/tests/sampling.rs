@@ -15,7 +15,7 @@ use foton_core::geometry::Shape;
 use foton_core::kernel::{BUILTIN_KERNELS, NormalizedKernel, builtin};
 use foton_core::light::{Light, area_light};
 use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
-use foton_core::medium::Phase;
+use foton_core::medium::{Homogeneous, Phase, channel};
 use foton_core::sampling::{self, Distribution1D, Rng};
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -37,7 +37,8 @@ const NUM_GOF_TESTS: usize = 7 // uniform_sphere, cosine_hemisphere, 3 x uniform
     + DIELECTRIC_CASES.len() // binomial reflect/refract frequencies
     + 3 // sample_li: quad, sphere from outside, triangles
     + 7 // sample_emission: positions and directions of 3 area lights, point light directions
-    + PHASES.len();
+    + PHASES.len()
+    + FREE_FLIGHT_CASES.len();
 
 /// Significance of each single test: 1 - (1 - ALPHA)^(1 / NUM_GOF_TESTS).
 fn alpha_each() -> f64 {
@@ -1728,6 +1729,133 @@ fn normalized_kernels_integrate_to_one_over_disc_and_ball() {
                     "{what}: weight beyond r"
                 );
             }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Free-flight distances in media
+// ---------------------------------------------------------------------------------------------
+
+/// (sigma_a, sigma_s, tmax): a channel that does not interact, a chromatic medium over an
+/// infinite ray, a grey one.
+const FREE_FLIGHT_CASES: [([f32; 3], [f32; 3], f32); 3] = [
+    ([0.0, 0.5, 1.0], [0.0, 0.5, 3.0], 1.5),
+    ([0.1, 0.0, 4.0], [0.1, 1.0, 1.0], f32::INFINITY),
+    ([0.5, 0.5, 0.5], [1.5, 1.5, 1.5], 0.7),
+];
+
+/// Probability that a free-flight distance with the spectral-MIS density (channel chosen
+/// uniformly) falls in [a, b): the mean over channels of exp(-s a) - exp(-s b).
+fn free_flight_mass(sigma_t: [f64; 3], a: f64, b: f64) -> f64 {
+    sigma_t
+        .iter()
+        .map(|&s| {
+            let tr = |t: f64| if s == 0.0 { 1.0 } else { (-s * t).exp() };
+            tr(a) - tr(b)
+        })
+        .sum::<f64>()
+        / 3.0
+}
+
+#[test]
+fn free_flight_sampling_follows_the_spectral_mis_density_and_is_unbiased() {
+    const N: usize = 400_000;
+    const BINS: usize = 60;
+    for (k, &(sigma_a, sigma_s, tmax)) in FREE_FLIGHT_CASES.iter().enumerate() {
+        let medium = Homogeneous {
+            sigma_a: Vec3::from(sigma_a),
+            sigma_s: Vec3::from(sigma_s),
+            phase: Phase::Isotropic,
+        };
+        let sigma_t = medium.sigma_t().as_dvec3().to_array();
+        let name = format!("free flight {sigma_t:?}, tmax {tmax}");
+        // Cells: BINS equal widths over [0, end), then [end, tmax) (if tmax is infinite), then
+        // "passed" (t = tmax).
+        let end = if tmax.is_finite() { tmax as f64 } else { 8.0 };
+        let mut edges: Vec<f64> = (0..=BINS).map(|i| end * i as f64 / BINS as f64).collect();
+        edges.push(tmax as f64);
+        let cells = edges.len(); // BINS + 1 intervals (the last maybe empty) + passed
+        let mut expected: Vec<f64> = edges
+            .windows(2)
+            .map(|w| free_flight_mass(sigma_t, w[0], w[1]))
+            .collect();
+        expected.push(1.0 - free_flight_mass(sigma_t, 0.0, tmax as f64));
+        assert_eq!(expected.len(), cells);
+        assert_close(&format!("{name}: total"), expected.iter().sum(), 1.0, 1e-9);
+
+        let mut observed = vec![0u64; cells];
+        let mut rng = Rng::new(&[60, k as u64]);
+        // Per channel: sum of weights of scattering events, and of passing samples.
+        let (mut scattered, mut passed) = (DVec3::ZERO, DVec3::ZERO);
+        for _ in 0..N {
+            let c = channel(rng.next_f32());
+            let f = medium.sample_free_flight(tmax, c, rng.next_f32());
+            let w = f.weight().as_dvec3();
+            if f.scattered {
+                assert!(f.t >= 0.0 && f.t < tmax, "{name}: t = {}", f.t);
+                let cell = edges.partition_point(|&e| e <= f.t as f64) - 1;
+                observed[cell.min(cells - 2)] += 1;
+                // The reported pdfs are the per-channel densities at t.
+                let t = f.t as f64;
+                for (c, &st) in sigma_t.iter().enumerate() {
+                    let want = st * (-st * t).exp();
+                    // f32 underflows after ~87 mean free paths.
+                    assert_close(
+                        &format!("{name}: pdf[{c}]"),
+                        f.pdf[c] as f64,
+                        want,
+                        1e-4 * want + 1e-30,
+                    );
+                }
+                scattered += w;
+            } else {
+                assert_eq!(f.t, tmax);
+                observed[cells - 1] += 1;
+                passed += w;
+            }
+        }
+        assert_gof(
+            &name,
+            &observed,
+            &expected.iter().map(|p| p * N as f64).collect::<Vec<_>>(),
+        );
+
+        // The expectation of the weights, per channel: sigma_s / sigma_t (1 - Tr(tmax)) for
+        // scattering events, Tr(tmax) for passing.
+        for c in 0..3 {
+            let (st, ss) = (sigma_t[c], sigma_s[c] as f64);
+            let tr = if st == 0.0 {
+                1.0
+            } else {
+                (-st * tmax as f64).exp()
+            };
+            let want_s = if st == 0.0 { 0.0 } else { ss / st * (1.0 - tr) };
+            assert_close(
+                &format!("{name}: E[weight, scattered][{c}]"),
+                scattered[c] / N as f64,
+                want_s,
+                0.01,
+            );
+            assert_close(
+                &format!("{name}: E[weight, passed][{c}]"),
+                passed[c] / N as f64,
+                tr,
+                0.01,
+            );
+        }
+
+        // The test can fail: the same samples against the density of a grey medium of the
+        // mean sigma_t (what sampling one channel and forgetting the others would assume).
+        let mean = (sigma_t[0] + sigma_t[1] + sigma_t[2]) / 3.0;
+        let mut wrong: Vec<f64> = edges
+            .windows(2)
+            .map(|w| free_flight_mass([mean; 3], w[0], w[1]) * N as f64)
+            .collect();
+        wrong.push((1.0 - free_flight_mass([mean; 3], 0.0, tmax as f64)) * N as f64);
+        if sigma_t[0] != sigma_t[1] {
+            let g = chi2_gof(&observed, &wrong).map(|g| g.p).unwrap_or(0.0);
+            assert!(g < alpha_each(), "{name}: a wrong density passed (p = {g})");
         }
     }
 }
