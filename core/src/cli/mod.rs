@@ -146,6 +146,10 @@ struct RenderArgs {
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
+    /// Progressive integrators (sppm): write the image to the output file every N
+    /// iterations (atomically), so that it can be watched as it converges.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    checkpoint: Option<u64>,
 }
 
 #[derive(Args)]
@@ -357,10 +361,20 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");
     }
-    let progress = TermProgress::new(a.quiet);
+    let mut progress = TermProgress::new(a.quiet);
+    if let Some(every) = a.checkpoint {
+        progress = progress.with_checkpoint(every, output.clone());
+    }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
     let (film, elapsed) = render_prepared(&p, threads, &progress)?;
+    if a.checkpoint.is_some() && progress.checkpoints.load(Ordering::Relaxed) == 0 {
+        let _ = writeln!(
+            err,
+            "warning: --checkpoint: {} is not progressive and wrote no intermediate image",
+            p.integrator.describe()
+        );
+    }
     for w in progress.take_warnings() {
         let _ = writeln!(err, "warning: {w}");
     }

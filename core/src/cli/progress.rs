@@ -1,9 +1,11 @@
 //! Terminal progress: a bar with elapsed time, ETA and throughput on a terminal, nothing
 //! otherwise. Warnings from the render are collected and printed after it.
 
+use crate::film::Film;
 use crate::integrator::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
+use std::path::PathBuf;
 use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
@@ -14,6 +16,10 @@ pub struct TermProgress {
     pub warnings: Mutex<Vec<String>>,
     rays: AtomicU64,
     start: Mutex<Instant>,
+    /// Write the image every N iterations of a progressive integrator to this file.
+    checkpoint: Option<(u64, PathBuf)>,
+    /// Checkpoint calls received (0 after a render: the integrator is not progressive).
+    pub checkpoints: AtomicU64,
 }
 
 impl TermProgress {
@@ -24,7 +30,16 @@ impl TermProgress {
             warnings: Mutex::new(Vec::new()),
             rays: AtomicU64::new(0),
             start: Mutex::new(Instant::now()),
+            checkpoint: None,
+            checkpoints: AtomicU64::new(0),
         }
+    }
+
+    /// Writes the current image to `path` (atomically) every `every` iterations of a
+    /// progressive integrator.
+    pub fn with_checkpoint(mut self, every: u64, path: PathBuf) -> Self {
+        self.checkpoint = Some((every.max(1), path));
+        self
     }
 
     pub fn take_warnings(&self) -> Vec<String> {
@@ -73,6 +88,15 @@ impl Progress for TermProgress {
     fn status(&self, text: &str) {
         if let Some(bar) = &*self.bar.lock().unwrap() {
             bar.set_message(text.to_string());
+        }
+    }
+    fn checkpoint(&self, iteration: u64, image: &dyn Fn() -> Film) {
+        self.checkpoints.fetch_add(1, Ordering::Relaxed);
+        if let Some((every, path)) = &self.checkpoint
+            && iteration % every == 0
+            && let Err(e) = image().write(path)
+        {
+            self.warn(&format!("checkpoint at iteration {iteration}: {e}"));
         }
     }
     fn warn(&self, message: &str) {

@@ -1,0 +1,62 @@
+//! Progressive rendering from the host's side: checkpoints written while `sppm` runs, and
+//! Ctrl-C returning the estimate so far. In a test binary of its own, because it raises the
+//! process-wide interrupt flag that every in-process render watches.
+
+use foton_core::cli::{INTERRUPTED, TermProgress, prepare, render_prepared};
+use foton_core::film::read_image;
+use foton_tests::{plugin_dir, repo_root, temp_dir};
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+#[test]
+fn checkpoints_are_written_and_ctrl_c_keeps_the_estimate() {
+    let dir = temp_dir("sppm-interrupt");
+    let out = dir.join("progress.exr");
+    let overrides: Vec<String> = [
+        "render.integrator=\"sppm\"",
+        "film.width=16",
+        "film.height=16",
+        "integrators.sppm.iterations=100000000",
+        "integrators.sppm.photons_per_iteration=2000",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    let prepared = prepare(
+        &repo_root().join("scenes/cornell-box.toml"),
+        &overrides,
+        &[plugin_dir()],
+        true,
+    )
+    .unwrap();
+    let progress = TermProgress::new(true).with_checkpoint(3, out.clone());
+    // Far too many iterations to finish: only the interrupt ends it.
+    let stopper = std::thread::spawn(|| {
+        std::thread::sleep(Duration::from_millis(1500));
+        INTERRUPTED.store(true, Ordering::SeqCst);
+    });
+    let (film, _) = render_prepared(&prepared, 2, &progress).unwrap();
+    stopper.join().unwrap();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+
+    let iterations = progress.checkpoints.load(Ordering::Relaxed);
+    assert!(iterations >= 3, "only {iterations} iterations in 1.5 s");
+    // The estimate so far: every pixel sees the lit box.
+    for p in film.pixels() {
+        assert!(p.is_finite() && p.min_element() > 0.0, "{p}");
+    }
+    // A checkpoint was written (render_prepared itself writes nothing), and it is an image
+    // of the same scene at an earlier iteration: close to the final estimate on average.
+    let (w, h, pixels) = read_image(&out).unwrap();
+    assert_eq!((w, h), (16, 16));
+    let mean =
+        |px: &[glam::Vec3]| px.iter().map(|p| p.element_sum()).sum::<f32>() / px.len() as f32;
+    let (a, b) = (mean(&pixels), mean(&film.pixels()));
+    assert!((a - b).abs() < 0.2 * b, "checkpoint mean {a} vs final {b}");
+    let leftovers: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(leftovers.len(), 1, "temporary files left: {leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
