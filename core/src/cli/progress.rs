@@ -93,7 +93,7 @@ impl Progress for TermProgress {
     fn checkpoint(&self, iteration: u64, image: &dyn Fn() -> Film) {
         self.checkpoints.fetch_add(1, Ordering::Relaxed);
         if let Some((every, path)) = &self.checkpoint
-            && iteration % every == 0
+            && iteration.is_multiple_of(*every)
             && let Err(e) = image().write(path)
         {
             self.warn(&format!("checkpoint at iteration {iteration}: {e}"));
