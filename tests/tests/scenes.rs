@@ -59,16 +59,19 @@ fn fog_box_from_other_tooling_parses_its_media() {
             .count(),
         1
     );
-    // Until participating media are rendered, `path` says so instead of rendering it wrong.
-    let run = foton_tests::foton_with_plugins(&[
-        "render",
-        repo_root().join("scenes/fog_box.toml").to_str().unwrap(),
-        "-o",
-        std::env::temp_dir()
-            .join("fog_box_refused.png")
-            .to_str()
-            .unwrap(),
-    ]);
-    assert_eq!(run.code, 1);
-    assert!(run.stderr.contains("participating media"), "{}", run.stderr);
+    // `path` renders it: the fog in front of the back wall scatters light towards the camera
+    // and dims the wall behind it.
+    let small = ["film.width=32", "film.height=32", "render.spp=16"];
+    let fog = render_file(&repo_root().join("scenes/fog_box.toml"), &small, 2);
+    let clear = render_file(
+        &repo_root().join("scenes/fog_box.toml"),
+        &[
+            &small[..],
+            &["media.fog.sigma_s=[0, 0, 0]", "media.fog.sigma_a=[0, 0, 0]"],
+        ]
+        .concat(),
+        2,
+    );
+    assert!(fog.mean().is_finite() && fog.mean().min_element() > 0.0);
+    assert_ne!(fog.pixels(), clear.pixels());
 }

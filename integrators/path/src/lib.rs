@@ -4,8 +4,9 @@
 //! |------------|---------|----------------------------------------------------------|---------|
 //! | `rr_depth` | integer | scattering events before Russian roulette may end a path | 5       |
 //!
-//! `[render] max_depth` bounds the number of scattering events (0: only emitters seen
-//! directly, 1: direct lighting). `[render] spp` camera samples per pixel.
+//! `[render] max_depth` bounds the number of scattering events, surface bounces and scattering
+//! in media alike (0: only emitters seen directly, 1: direct lighting and single scattering).
+//! `[render] spp` camera samples per pixel.
 //!
 //! Next-event estimation at every non-delta vertex: point lights by shadow rays; area lights
 //! (any emissive shape) by shadow rays combined with BSDF sampling by multiple importance
@@ -13,18 +14,31 @@
 //! Delta materials (mirror, glass) are followed by BSDF sampling only; radiance is scaled by
 //! 1/eta^2 on refraction. Null boundaries are crossed without counting as a bounce.
 //!
-//! It is unbiased and converges to the right image for any scene without media, but caustics
-//! seen through or cast by delta surfaces from point lights (L S+ D E paths from a point
-//! light) cannot be sampled: they are missing. That is what photon mapping is for.
+//! Participating media (volumetric path tracing): the ray's medium is tracked from the camera
+//! through every boundary it crosses (`Scene::medium_after`). In a medium a free-flight
+//! distance is sampled up to the next surface, with spectral MIS over the channels along the
+//! whole path (a hero channel per path, pbrt-v4's scheme), so coloured media are unbiased; a
+//! scattering event is a path vertex (it counts toward `max_depth`) with next-event
+//! estimation (shadow rays carry the transmittance of the media and null boundaries they
+//! cross; area lights are combined with phase-function sampling by MIS) and a
+//! phase-function-sampled continuation. A medium with sigma_t = 0 is skipped, so it renders
+//! exactly as vacuum; a scene without media renders exactly as before media existed.
+//!
+//! It is unbiased and converges to the right image for any scene, but caustics seen through
+//! or cast by delta surfaces from point lights (L S+ D E paths from a point light, L S+ M E
+//! volumetric caustics too) cannot be sampled: they are missing. Volumetric caustics from
+//! area lights are found, slowly. That is what photon mapping is for.
 
+use foton_core::Vec3;
 use foton_core::geometry::{Ray, offset_origin};
 use foton_core::integrator::{Integrator, RenderContext};
 use foton_core::material::TransportMode;
+use foton_core::medium::HeroChannel;
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::{Sampler, power_heuristic};
 use foton_core::scene::Scene;
-use foton_core::{Error, Result, Rgb, film::Film};
+use foton_core::{Result, Rgb, film::Film};
 
 pub struct PathTracer {
     max_depth: u32,
@@ -53,10 +67,77 @@ impl PathTracer {
         let mut prev_pdf = 0.0f32;
         let mut prev_p = ray.origin;
         let mut crossings = 0u32;
+        // The medium the ray travels in (None: vacuum).
+        let mut medium = scene.camera_medium;
+        // Spectral MIS over the whole path, chosen at the first medium the path meets.
+        let mut hero: Option<HeroChannel> = None;
 
         loop {
             *rays += 1;
-            let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
+            let hit = scene.intersect(&ray, f32::INFINITY);
+
+            // ---- Medium: free flight to a scattering event or to the surface ----
+            if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
+                && !m.is_vacuum()
+            {
+                let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+                let hero = hero.get_or_insert_with(|| HeroChannel::new(sampler.next_f32()));
+                let flight = m.sample_free_flight(tmax, hero.channel, sampler.next_f32());
+                beta *= hero.update(&flight);
+                if beta == Rgb::ZERO {
+                    break;
+                }
+                if flight.scattered {
+                    crossings = 0;
+                    if depth >= self.max_depth {
+                        break;
+                    }
+                    let x = ray.at(flight.t);
+                    let phase = m.phase;
+
+                    // ---- Emitter sampling from the medium ----
+                    // The phase function takes the cosine between the directions light
+                    // travels in: from the light (-wi) and on towards the camera (-ray.dir).
+                    if let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) {
+                        let light = &scene.lights[light_id];
+                        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                        if let Some(ls) = light.sample_li(x, u, uc)
+                            && ls.li != Rgb::ZERO
+                        {
+                            *rays += 1;
+                            let tr = scene.transmittance(x, Vec3::ZERO, ls.p, ls.n, medium);
+                            if tr != Rgb::ZERO {
+                                let p = phase.eval(ray.dir.dot(ls.wi));
+                                if ls.delta {
+                                    radiance += beta * tr * p * ls.li / pmf;
+                                } else {
+                                    let pdf_light = pmf * ls.pdf;
+                                    let w = power_heuristic(pdf_light, p);
+                                    radiance += beta * tr * p * ls.li * w / pdf_light;
+                                }
+                            }
+                        }
+                    }
+
+                    // ---- Phase-function sampling: p / pdf = 1, beta is unchanged ----
+                    let (wi, pdf) = phase.sample(ray.dir, sampler.next_2d());
+                    specular = false;
+                    prev_pdf = pdf;
+                    prev_p = x;
+                    depth += 1;
+                    if depth >= self.rr_depth {
+                        let survive = beta.max_element().min(0.95);
+                        if survive <= 0.0 || sampler.next_f32() >= survive {
+                            break;
+                        }
+                        beta /= survive;
+                    }
+                    ray = Ray::new(x, wi);
+                    continue;
+                }
+            }
+
+            let Some(hit) = hit else {
                 break;
             };
             let material = *scene.material(&hit);
@@ -65,6 +146,7 @@ impl PathTracer {
                 if crossings > MAX_NULL_CROSSINGS {
                     break;
                 }
+                medium = scene.medium_after(&hit, ray.dir, medium);
                 ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
                 continue;
             }
@@ -99,15 +181,23 @@ impl PathTracer {
                 {
                     let f = material.eval(wo, ls.wi, hit.ng);
                     *rays += (f != Rgb::ZERO) as u64;
-                    if f != Rgb::ZERO && !scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
+                    let tr = if f != Rgb::ZERO {
+                        let side = scene.medium_after(&hit, ls.wi, medium);
+                        scene.transmittance(hit.p, hit.ng, ls.p, ls.n, side)
+                    } else {
+                        Rgb::ZERO
+                    };
+                    if tr != Rgb::ZERO {
+                        // Without media tr is exactly one: the image is bit for bit the one
+                        // rendered before media existed.
                         let cos = ls.wi.dot(hit.ng).abs();
                         if ls.delta {
-                            radiance += beta * f * cos * ls.li / pmf;
+                            radiance += beta * f * cos * ls.li * tr / pmf;
                         } else {
                             let pdf_light = pmf * ls.pdf;
                             let pdf_bsdf = material.pdf(wo, ls.wi, hit.ng);
                             let w = power_heuristic(pdf_light, pdf_bsdf);
-                            radiance += beta * f * cos * ls.li * w / pdf_light;
+                            radiance += beta * f * cos * ls.li * tr * w / pdf_light;
                         }
                     }
                 }
@@ -123,6 +213,8 @@ impl PathTracer {
             prev_pdf = bs.pdf;
             prev_p = hit.p;
             depth += 1;
+            // Refraction into or out of a volume changes the medium; reflection keeps it.
+            medium = scene.medium_after(&hit, bs.wi, medium);
 
             // ---- Russian roulette: keep the throughput's expectation, end dim paths ----
             if depth >= self.rr_depth {
@@ -156,12 +248,6 @@ impl Integrator for PathTracer {
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
     let rr_depth = props.u32("rr_depth", 5)?;
-    if scene.has_media() {
-        return Err(Error::Usage(format!(
-            "{}: the scene has participating media, which `path` does not render yet",
-            scene.file.display()
-        )));
-    }
     Ok(Box::new(PathTracer::new(scene.render.max_depth, rr_depth)))
 }
 
