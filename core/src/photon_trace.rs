@@ -9,14 +9,16 @@
 //! maps are identical whatever the number of threads.
 
 use crate::Rgb;
-use crate::error::Result;
+use crate::error::{Error, Result};
 use crate::geometry::{Ray, offset_origin};
 use crate::integrator::RenderContext;
 use crate::material::TransportMode;
+use crate::medium::HeroChannel;
 use crate::photon::Photon;
 use crate::render::with_pool;
 use crate::sampling::Rng;
 use crate::scene::Scene;
+use glam::Vec2;
 use rayon::prelude::*;
 
 /// The path a photon took to reach a diffuse surface.
@@ -53,12 +55,54 @@ const CHUNK: u64 = 4096;
 /// Null boundaries crossed in a row before a photon is abandoned.
 const MAX_NULL_CROSSINGS: u32 = 256;
 
-/// Traces one photon, calling `store(photon, class)` at every diffuse hit.
+/// Where a photon is stored.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Site {
+    /// On a diffuse (non-delta) surface.
+    Surface,
+    /// At a scattering event in a participating medium (its normal is zero).
+    Volume,
+}
+
+/// The medium each light sits in (None: vacuum), for photons to start in. An area light is
+/// taken to lie in one medium, the one just off its emitting side.
+pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
+    if !scene.has_media() {
+        return Ok(vec![None; scene.lights.len()]);
+    }
+    let scale = 1.0 + (scene.bounds.1 - scene.bounds.0).length();
+    scene
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, light)| {
+            let e = light.sample_emission(Vec2::splat(0.5), Vec2::splat(0.5), 0.5);
+            let p = e.origin + e.n * (1e-3 * scale);
+            scene.medium_at(p).map_err(|why| {
+                Error::Render(format!(
+                    "{}: cannot tell which medium light {i} is in: {why}",
+                    scene.file.display()
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Traces one photon, calling `store(photon, site, class)` at every diffuse surface hit and
+/// every scattering event in a medium. `light_media` is [`light_media`] of the scene.
+///
+/// In a medium the photon samples a free-flight distance (spectral MIS over the colour
+/// channels along its whole path, as the path tracer); at a scattering event it is stored
+/// with its flux times the event's weight (sigma_s / sigma_t in a grey medium: stored
+/// photons then have the density of scattered light, which the volume estimate needs), then
+/// survives by Russian roulette on that weight (the albedo) and goes on in a phase-function-
+/// sampled direction. Scattering events count toward `max_depth` like surface hits.
 pub fn trace_one(
     scene: &Scene,
     opts: &TraceOptions,
+    light_media: &[Option<u32>],
     index: u64,
-    mut store: impl FnMut(Photon, PathClass),
+    mut store: impl FnMut(Photon, Site, PathClass),
 ) {
     let mut rng = Rng::new(&[opts.seed, opts.stream, index]);
     let Some((light_id, pmf)) = scene.sample_light(rng.next_f32()) else {
@@ -74,16 +118,71 @@ pub fn trace_one(
         offset_origin(emitted.origin, emitted.n, emitted.dir)
     };
     let mut ray = Ray::new(origin, emitted.dir);
+    let mut medium = light_media[light_id];
+    let mut hero: Option<HeroChannel> = None;
     let mut hits = 0u32;
     let mut specular_only = true;
     let mut crossings = 0;
-    while let Some(hit) = scene.intersect(&ray, f32::INFINITY) {
+    let class_of = |hits: u32, specular_only: bool| {
+        if hits == 1 {
+            PathClass::Direct
+        } else if specular_only {
+            PathClass::Caustic
+        } else {
+            PathClass::Indirect
+        }
+    };
+    loop {
+        let hit = scene.intersect(&ray, f32::INFINITY);
+        if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
+            && !m.is_vacuum()
+        {
+            let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+            let hero = hero.get_or_insert_with(|| HeroChannel::new(rng.next_f32()));
+            let flight = m.sample_free_flight(tmax, hero.channel, rng.next_f32());
+            let weight = hero.update(&flight);
+            if flight.scattered {
+                crossings = 0;
+                hits += 1;
+                let x = ray.at(flight.t);
+                let scattered = flux * weight;
+                store(
+                    Photon::new(x, scattered, -ray.dir, glam::Vec3::ZERO).with_depth(hits),
+                    Site::Volume,
+                    class_of(hits, specular_only),
+                );
+                if opts.stop_at_diffuse {
+                    return;
+                }
+                specular_only = false;
+                if hits >= opts.max_depth {
+                    return;
+                }
+                // Russian roulette on the albedo, as on a surface's reflectance.
+                let survive = (scattered.max_element() / flux.max_element().max(1e-30)).min(1.0);
+                if survive <= 0.0 || rng.next_f32() >= survive {
+                    return;
+                }
+                flux = scattered / survive;
+                let (wi, _) = m.phase.sample(ray.dir, rng.next_2d());
+                ray = Ray::new(x, wi);
+                continue;
+            }
+            flux *= weight;
+            if flux == Rgb::ZERO {
+                return;
+            }
+        }
+        let Some(hit) = hit else {
+            return;
+        };
         let material = *scene.material(&hit);
         if material.is_null() {
             crossings += 1;
             if crossings > MAX_NULL_CROSSINGS {
                 return;
             }
+            medium = scene.medium_after(&hit, ray.dir, medium);
             ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
             continue;
         }
@@ -91,19 +190,16 @@ pub fn trace_one(
         hits += 1;
         let wi = -ray.dir;
         if !material.is_delta() {
-            let class = if hits == 1 {
-                PathClass::Direct
-            } else if specular_only {
-                PathClass::Caustic
-            } else {
-                PathClass::Indirect
-            };
             let n = if hit.ng.dot(wi) > 0.0 {
                 hit.ng
             } else {
                 -hit.ng
             };
-            store(Photon::new(hit.p, flux, wi, n).with_depth(hits), class);
+            store(
+                Photon::new(hit.p, flux, wi, n).with_depth(hits),
+                Site::Surface,
+                class_of(hits, specular_only),
+            );
             if opts.stop_at_diffuse {
                 return;
             }
@@ -124,20 +220,23 @@ pub fn trace_one(
             return;
         }
         flux *= bs.weight / survive;
+        // Refraction into or out of a volume changes the medium; reflection keeps it.
+        medium = scene.medium_after(&hit, bs.wi, medium);
         ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
     }
 }
 
 /// Traces `opts.photons` photons in parallel and sorts the stored photons into `lists`
-/// lists: `sort(class)` names the list a photon goes to, or None to drop it. Photons keep
-/// the order they were emitted in (deterministic).
+/// lists: `sort(site, class)` names the list a photon goes to, or None to drop it. Photons
+/// keep the order they were emitted in (deterministic).
 pub fn trace_photons(
     scene: &Scene,
     opts: &TraceOptions,
     ctx: &RenderContext<'_>,
     lists: usize,
-    sort: impl Fn(PathClass) -> Option<usize> + Sync,
+    sort: impl Fn(Site, PathClass) -> Option<usize> + Sync,
 ) -> Result<Vec<Vec<Photon>>> {
+    let media = light_media(scene)?;
     ctx.progress.begin("photons", opts.photons);
     let chunks = opts.photons.div_ceil(CHUNK);
     let parts: Vec<Vec<Vec<Photon>>> = with_pool(ctx.threads, || {
@@ -150,8 +249,8 @@ pub fn trace_photons(
                 }
                 let end = ((c + 1) * CHUNK).min(opts.photons);
                 for i in c * CHUNK..end {
-                    trace_one(scene, opts, i, |p, class| {
-                        if let Some(list) = sort(class) {
+                    trace_one(scene, opts, &media, i, |p, site, class| {
+                        if let Some(list) = sort(site, class) {
                             out[list].push(p);
                         }
                     });

@@ -31,7 +31,7 @@ fn main() {
         stop_at_diffuse: false,
     };
     let t = Instant::now();
-    let photons = trace_photons(&scene, &opts, &ctx, 1, |c| {
+    let photons = trace_photons(&scene, &opts, &ctx, 1, |_, c| {
         (c != PathClass::Caustic).then_some(0)
     })
     .unwrap()

@@ -75,7 +75,7 @@ fn main() {
         stop_at_diffuse: false,
     };
     let t = Instant::now();
-    let photons = trace_photons(&scene, &opts, &ctx, 1, |c| {
+    let photons = trace_photons(&scene, &opts, &ctx, 1, |_, c| {
         (c != PathClass::Direct).then_some(0)
     })
     .unwrap()

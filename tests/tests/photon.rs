@@ -5,7 +5,9 @@
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
 use foton_core::photon::{Estimate, PhotonMap};
-use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_one, trace_photons};
+use foton_core::photon_trace::{
+    PathClass, STREAM_GLOBAL, TraceOptions, light_media, trace_one, trace_photons,
+};
 use foton_core::scene::Scene;
 use foton_tests::{header, region_mean, render_file, render_toml, repo_root, temp_dir, write};
 use glam::{DVec3, Vec3};
@@ -95,10 +97,11 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
     };
+    let media = light_media(&scene).unwrap();
     let mut sum = DVec3::ZERO;
     let mut count = 0;
     for i in 0..opts.photons {
-        trace_one(&scene, &opts, i, |p, class| {
+        trace_one(&scene, &opts, &media, i, |p, _, class| {
             assert_eq!(class, PathClass::Direct);
             sum += p.power().as_dvec3();
             count += 1;
@@ -123,7 +126,7 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
         stop_at_diffuse: false,
         ..opts
     };
-    let lists = trace_photons(&scene, &all, &ctx, 2, |c| match c {
+    let lists = trace_photons(&scene, &all, &ctx, 2, |_, c| match c {
         PathClass::Direct => Some(0),
         PathClass::Indirect => Some(1),
         PathClass::Caustic => None,
@@ -179,7 +182,7 @@ intensity = [1.0, 1.0, 1.0]
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
     };
-    let photons = trace_photons(&scene, &opts, &ctx, 1, |_| Some(0))
+    let photons = trace_photons(&scene, &opts, &ctx, 1, |_, _| Some(0))
         .unwrap()
         .pop()
         .unwrap();

@@ -11,7 +11,9 @@ use crate::error::Result;
 use crate::film::check_output;
 use crate::integrator::RenderContext;
 use crate::photon::Photon;
-use crate::photon_trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons};
+use crate::photon_trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons,
+};
 use crate::props::Properties;
 use crate::render::with_pool;
 use crate::scene::Scene;
@@ -182,9 +184,11 @@ pub(super) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         progress: &progress,
     };
     let keep = pass.keep;
-    let photons = trace_photons(&scene, &pass.opts, &ctx, 1, |c| keep(c).then_some(0))?
-        .pop()
-        .unwrap_or_default();
+    let photons = trace_photons(&scene, &pass.opts, &ctx, 1, |site, c| {
+        (site == Site::Surface && keep(c)).then_some(0)
+    })?
+    .pop()
+    .unwrap_or_default();
     for w in progress.take_warnings() {
         let _ = writeln!(err, "warning: {w}");
     }

@@ -109,7 +109,7 @@ impl PhotonMapper {
             stop_at_diffuse: false,
         };
         // L S+ D photons of the global budget are dropped: the caustic budget counts them.
-        let mut lists = trace_photons(scene, &global, ctx, 2, |class| match class {
+        let mut lists = trace_photons(scene, &global, ctx, 2, |_, class| match class {
             PathClass::Direct if need_direct => Some(0),
             PathClass::Indirect => Some(1),
             _ => None,
@@ -124,7 +124,7 @@ impl PhotonMapper {
                 stream: STREAM_CAUSTIC,
                 stop_at_diffuse: true,
             };
-            trace_photons(scene, &opts, ctx, 1, |c| {
+            trace_photons(scene, &opts, ctx, 1, |_, c| {
                 (c == PathClass::Caustic).then_some(0)
             })?
             .pop()

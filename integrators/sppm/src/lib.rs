@@ -252,7 +252,7 @@ impl Integrator for Sppm {
                 stop_at_diffuse: false,
             };
             let keep_direct = self.direct == Direct::Photons;
-            let photons = trace_photons(scene, &options, &quiet, 1, |class| {
+            let photons = trace_photons(scene, &options, &quiet, 1, |_, class| {
                 (class != PathClass::Direct || keep_direct).then_some(0)
             })?
             .pop()
