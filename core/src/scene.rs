@@ -93,6 +93,8 @@ pub struct Scene {
     pub interfaces: Vec<Option<MediumInterface>>,
     /// The medium around the camera (None: vacuum).
     pub camera_medium: Option<u32>,
+    /// The objects that bound volumes, for [`Scene::medium_at`].
+    volumes: Vec<Volume>,
     /// Axis-aligned bounds of all geometry and point lights.
     pub bounds: (Vec3, Vec3),
     /// The parsed document (integrators read their `[integrators.NAME]` table from it).
@@ -229,15 +231,22 @@ impl Scene {
 
         let accel = Accel::build(prims);
         let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
-        let interfaces = if uses_media {
+        let (interfaces, volumes) = if uses_media {
             medium_interfaces(&objects, &materials, &accel, medium)
         } else {
-            vec![None; objects.len()]
+            (vec![None; objects.len()], Vec::new())
         };
         let mut camera_medium = None;
         if uses_media {
-            camera_medium = locate_medium(&accel, &objects, &interfaces, medium, camera.position)
-                .map_err(|why| {
+            camera_medium = locate_medium(
+                &accel,
+                &objects,
+                &interfaces,
+                &volumes,
+                medium,
+                camera.position,
+            )
+            .map_err(|why| {
                 let t = root.table("camera").ok().flatten();
                 let message =
                     format!("the medium around the camera is undefined: {why}; move the camera");
@@ -265,6 +274,7 @@ impl Scene {
             accel,
             medium,
             interfaces,
+            volumes,
             camera_medium,
             bounds: (lo, hi),
             document: doc,
@@ -334,7 +344,14 @@ impl Scene {
     /// or inside boundaries that overlap without one containing the other. Costs a few rays
     /// per boundary: for starting points (camera, lights), not for every vertex of a path.
     pub fn medium_at(&self, p: Vec3) -> std::result::Result<Option<u32>, String> {
-        locate_medium(&self.accel, &self.objects, &self.interfaces, self.medium, p)
+        locate_medium(
+            &self.accel,
+            &self.objects,
+            &self.interfaces,
+            &self.volumes,
+            self.medium,
+            p,
+        )
     }
 
     /// The medium on the side of the surface at `hit` that `dir` points into: the medium a
@@ -391,8 +408,12 @@ impl Scene {
         n1: Vec3,
         medium: Option<u32>,
     ) -> Rgb {
-        if self.occluded(p0, n0, p1, n1) {
-            return Rgb::ZERO;
+        if !self.has_media() {
+            return if self.occluded(p0, n0, p1, n1) {
+                Rgb::ZERO
+            } else {
+                Rgb::ONE
+            };
         }
         let d = p1 - p0;
         let from = if n0 == Vec3::ZERO {
@@ -426,7 +447,6 @@ impl Scene {
                 break;
             };
             if !self.material(&hit).is_null() {
-                // Missed by the any-hit test above only through rounding: a blocker is a blocker.
                 return Rgb::ZERO;
             }
             tr *= tr_over(medium, hit.p.distance(last));
@@ -495,6 +515,16 @@ impl Scene {
     }
 }
 
+/// An object that bounds a volume, with what point-in-volume tests need.
+struct Volume {
+    object: u32,
+    /// Its primitives (indices into the BVH's primitives).
+    prims: Vec<u32>,
+    /// Its bounding box.
+    lo: Vec3,
+    hi: Vec3,
+}
+
 /// Null boundaries a shadow ray may cross before it is taken as blocked (guards against rays
 /// stuck on coincident boundaries).
 const MAX_BOUNDARY_CROSSINGS: u32 = 256;
@@ -509,18 +539,21 @@ const INSIDE_PROBES: [Vec3; 5] = [
     Vec3::new(0.872_871_6, 0.218_217_9, -0.436_435_8),
 ];
 
-/// Whether `p` is inside the closed object `object`: along each probe direction, the nearest
-/// surface of the object is seen from its inside (outward normal along the ray) or not; the
-/// majority decides, so that a probe that slips through an edge between two triangles does
-/// not. Err if `p` is on the surface.
-fn inside_object(accel: &Accel, object: u32, p: Vec3) -> std::result::Result<bool, ()> {
+/// Whether `p` is inside a volume: along each probe direction, the nearest surface of the
+/// volume is seen from its inside (outward normal along the ray) or not; the majority decides,
+/// so that a probe that slips through an edge between two triangles does not. Err if `p` is
+/// on the surface.
+fn inside_volume(accel: &Accel, volume: &Volume, p: Vec3) -> std::result::Result<bool, ()> {
     let on_surface = 1e-5 * (1.0 + p.abs().max_element());
+    if (p - volume.lo).min_element() < -on_surface || (volume.hi - p).min_element() < -on_surface {
+        return Ok(false);
+    }
     let prims = accel.primitives();
     // The probes cannot see a surface at distance zero: a point on it is found by distance.
-    if prims
+    if volume
+        .prims
         .iter()
-        .filter(|q| q.object == object)
-        .any(|q| distance_to(&q.shape, p) < on_surface)
+        .any(|&i| distance_to(&prims[i as usize].shape, p) < on_surface)
     {
         return Err(());
     }
@@ -529,7 +562,7 @@ fn inside_object(accel: &Accel, object: u32, p: Vec3) -> std::result::Result<boo
         let ray = Ray::new(p, dir);
         let mut nearest: Option<(f32, u32)> = None;
         accel.for_each_hit(&ray, f32::INFINITY, |i, t| {
-            if prims[i as usize].object == object && nearest.is_none_or(|(tn, _)| t < tn) {
+            if prims[i as usize].object == volume.object && nearest.is_none_or(|(tn, _)| t < tn) {
                 nearest = Some((t, i));
             }
         });
@@ -577,9 +610,10 @@ fn distance_to(shape: &Shape, p: Vec3) -> f32 {
 /// A point strictly inside a closed object, near its surface: the centroid of its largest
 /// primitive pushed inwards (the centre, for a sphere). Used to ask which boundaries contain
 /// the object.
-fn point_inside(accel: &Accel, object: u32) -> Vec3 {
+fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
     let mut best: Option<(f32, Shape)> = None;
-    for prim in accel.primitives().iter().filter(|q| q.object == object) {
+    for &i in &volume.prims {
+        let prim = &accel.primitives()[i as usize];
         let area = prim.shape.area();
         if best.is_none_or(|(a, _)| area > a) {
             best = Some((area, prim.shape));
@@ -616,38 +650,57 @@ fn medium_interfaces(
     materials: &[Named<Material>],
     accel: &Accel,
     scene_medium: Option<u32>,
-) -> Vec<Option<MediumInterface>> {
-    let bounds: Vec<usize> = (0..objects.len())
-        .filter(|&i| {
-            let o = &objects[i];
-            let m = &materials[o.material as usize].value;
-            o.closed
-                && (o.interior.is_some() || m.is_null() || matches!(m, Material::Dielectric { .. }))
-        })
-        .collect();
-    // containers[k]: the boundaries (indices into `bounds`) that contain boundary k.
-    let containers: Vec<Vec<usize>> = bounds
+) -> (Vec<Option<MediumInterface>>, Vec<Volume>) {
+    let mut index = vec![None; objects.len()];
+    let mut volumes: Vec<Volume> = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        let m = &materials[o.material as usize].value;
+        if o.closed
+            && (o.interior.is_some() || m.is_null() || matches!(m, Material::Dielectric { .. }))
+        {
+            index[i] = Some(volumes.len());
+            volumes.push(Volume {
+                object: i as u32,
+                prims: Vec::new(),
+                lo: Vec3::splat(f32::INFINITY),
+                hi: Vec3::splat(f32::NEG_INFINITY),
+            });
+        }
+    }
+    for (k, prim) in accel.primitives().iter().enumerate() {
+        if let Some(v) = index[prim.object as usize] {
+            let volume: &mut Volume = &mut volumes[v];
+            volume.prims.push(k as u32);
+            let b = prim.shape.aabb();
+            volume.lo = volume.lo.min(b.min.into());
+            volume.hi = volume.hi.max(b.max.into());
+        }
+    }
+    // containers[k]: the volumes that contain volume k.
+    let containers: Vec<Vec<usize>> = volumes
         .iter()
-        .map(|&i| {
-            let q = point_inside(accel, i as u32);
-            (0..bounds.len())
-                .filter(|&k| {
-                    bounds[k] != i && inside_object(accel, bounds[k] as u32, q).unwrap_or(false)
-                })
+        .enumerate()
+        .map(|(k, volume)| {
+            let q = point_inside(accel, volume);
+            (0..volumes.len())
+                .filter(|&c| c != k && inside_volume(accel, &volumes[c], q).unwrap_or(false))
                 .collect()
         })
         .collect();
     let depth: Vec<u32> = containers.iter().map(|c| c.len() as u32).collect();
     let mut out = vec![None; objects.len()];
-    for (k, &i) in bounds.iter().enumerate() {
+    for (k, volume) in volumes.iter().enumerate() {
         let parent = containers[k].iter().copied().max_by_key(|&c| depth[c]);
+        let i = volume.object as usize;
         out[i] = Some(MediumInterface {
             inside: objects[i].interior,
-            outside: parent.map_or(scene_medium, |c| objects[bounds[c]].interior),
+            outside: parent.map_or(scene_medium, |c| {
+                objects[volumes[c].object as usize].interior
+            }),
             depth: depth[k],
         });
     }
-    out
+    (out, volumes)
 }
 
 /// See [`Scene::medium_at`].
@@ -655,13 +708,15 @@ fn locate_medium(
     accel: &Accel,
     objects: &[Object],
     interfaces: &[Option<MediumInterface>],
+    volumes: &[Volume],
     scene_medium: Option<u32>,
     p: Vec3,
 ) -> std::result::Result<Option<u32>, String> {
     let mut innermost: Option<(usize, MediumInterface)> = None;
-    for (i, iface) in interfaces.iter().enumerate() {
-        let Some(iface) = *iface else { continue };
-        match inside_object(accel, i as u32, p) {
+    for volume in volumes {
+        let i = volume.object as usize;
+        let Some(iface) = interfaces[i] else { continue };
+        match inside_volume(accel, volume, p) {
             Err(()) => {
                 return Err(format!(
                     "it lies on the surface of {}, a medium boundary",
