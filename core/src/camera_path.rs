@@ -122,6 +122,20 @@ pub fn direct_light(
     sampler: &mut Sampler,
     rays: &mut u64,
 ) -> Rgb {
+    direct_light_in(scene, hit, material, wo, None, sampler, rays)
+}
+
+/// [`direct_light`] in a scene with media: `medium` is the one the camera ray arrived in, and
+/// the shadow ray carries the transmittance of the media and null boundaries it crosses.
+pub fn direct_light_in(
+    scene: &Scene,
+    hit: &Hit,
+    material: &Material,
+    wo: Vec3,
+    medium: Option<u32>,
+    sampler: &mut Sampler,
+    rays: &mut u64,
+) -> Rgb {
     let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) else {
         return Rgb::ZERO;
     };
@@ -134,8 +148,13 @@ pub fn direct_light(
         return Rgb::ZERO;
     }
     *rays += 1;
-    if scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
-        return Rgb::ZERO;
-    }
-    f * ls.wi.dot(hit.ng).abs() * ls.li / (pmf * ls.pdf)
+    let tr = if scene.has_media() {
+        let side = scene.medium_after(hit, ls.wi, medium);
+        scene.transmittance(hit.p, hit.ng, ls.p, ls.n, side)
+    } else if scene.occluded(hit.p, hit.ng, ls.p, ls.n) {
+        Rgb::ZERO
+    } else {
+        Rgb::ONE
+    };
+    f * ls.wi.dot(hit.ng).abs() * ls.li * tr / (pmf * ls.pdf)
 }

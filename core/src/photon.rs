@@ -11,6 +11,7 @@
 
 use crate::Rgb;
 use crate::kernel::NormalizedKernel;
+use crate::medium::Phase;
 use glam::Vec3;
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
@@ -414,6 +415,59 @@ impl PhotonMap {
             e += ph.power() * kernel.weight_2d(nb.d2.sqrt(), r);
         }
         e
+    }
+}
+
+impl PhotonMap {
+    /// In-scattered radiance at a point in a medium towards the camera, sigma_s times the
+    /// integral of phase times incident radiance (Jensen and Christensen 1998): the sum over
+    /// the k nearest volume photons (within `max_radius`, of at most `max_depth` scattering
+    /// events) of p(theta) Phi_p K3(d_p, r), with K3 normalised over the ball and, as on
+    /// surfaces, the k-th photon only setting the radius. `dir` is the camera ray's direction
+    /// (light leaves towards -dir). Stored flux already carries sigma_s / sigma_t, so no
+    /// coefficient appears here.
+    pub fn in_scattered(
+        &self,
+        p: Vec3,
+        dir: Vec3,
+        phase: &Phase,
+        max_depth: u32,
+        estimate: &Estimate<'_>,
+        scratch: &mut Vec<Neighbour>,
+    ) -> Rgb {
+        let Estimate {
+            k,
+            max_radius,
+            kernel,
+        } = *estimate;
+        let r2 = self.knn(p, k, max_radius, |ph| ph.depth() <= max_depth, scratch);
+        if scratch.is_empty() {
+            return Rgb::ZERO;
+        }
+        let r = r2.sqrt();
+        let full = scratch.len() == k;
+        let mut l = Rgb::ZERO;
+        for nb in scratch.iter() {
+            if full && nb.d2 >= r2 {
+                continue;
+            }
+            let ph = &self.photons[nb.index as usize];
+            // Light travelled along -wi_p and leaves along -dir.
+            let cos = ph.wi().dot(dir);
+            l += ph.power() * (phase.eval(cos) * kernel.weight_3d(nb.d2.sqrt(), r));
+        }
+        l
+    }
+
+    /// Bounds of the stored photons (empty map: an empty box at the origin).
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        if self.photons.is_empty() {
+            return (Vec3::ZERO, Vec3::ZERO);
+        }
+        self.photons.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(p.position), hi.max(p.position)),
+        )
     }
 }
 

@@ -1,0 +1,461 @@
+//! # `vpm`: volumetric photon mapping (Jensen and Christensen 1998)
+//!
+//! | parameter           | type    | meaning                                                    | default |
+//! |---------------------|---------|------------------------------------------------------------|---------|
+//! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps   | 200000  |
+//! | `caustic_photons`   | integer | photons emitted for the surface caustic map (0: none)      | 100000  |
+//! | `volume_photons`    | integer | photons emitted for the volume map                         | 200000  |
+//! | `k`                 | integer | photons per surface estimate (>= 2)                        | 50      |
+//! | `max_radius`        | float   | largest surface estimate radius                            | 1/20 of the scene diagonal |
+//! | `k_volume`          | integer | photons per volume estimate (>= 2)                         | 50      |
+//! | `max_radius_volume` | float   | largest volume estimate radius                             | 1/20 of the scene diagonal |
+//! | `step`              | float   | ray-marching step (jittered per camera sample)             | 1/100 of the scene diagonal |
+//! | `kernel`, `cone_c`  | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces, 3-D in volumes) | `box` |
+//! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
+//!
+//! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
+//! medium scattering events alike), as in the path tracer. `[render] spp` camera samples.
+//!
+//! **Photons** (core's photon pass through media): three budgets, each with its own random
+//! stream. The global pass stores surface photons in the direct (only if `direct =
+//! "photons"`) and indirect maps; the caustic pass stores L S+ D surface photons; the volume
+//! pass stores photons at scattering events in media, the volume map (with `direct = "nee"`
+//! the first scattering events, L M, are not stored: shadow rays count them).
+//!
+//! **Camera rays** are followed through null boundaries and delta surfaces (murky glass
+//! included), tracking the medium. Along each segment through a medium of length s:
+//!
+//! ```text
+//! L(x, w) = Tr(x, x_s) L_s(x_s, w) + integral_0^s Tr(x, x_t) sigma_s L_i(x_t, w) dt
+//! ```
+//!
+//! The integral is computed by ray marching with `step`, one jittered point per step (the
+//! same offset for every step of a camera sample, so each point stands for its whole step):
+//! at each point the in-scattered radiance sigma_s L_i is the volume estimate
+//! sum_p p(w_p, w) Phi_p K3(d_p, r) over the `k_volume` nearest volume photons, plus, with
+//! `direct = "nee"`, single scattering by one shadow ray to a light (with its transmittance).
+//! Transmittance exp(-sigma_t d) is exact per channel. At the first diffuse surface, L_s is
+//! the photon mapper's: emission + direct (shadow ray with transmittance, or photons) +
+//! caustic + indirect estimates, attenuated by the transmittance in front of it.
+//!
+//! Each light path is counted once: through a march point x_t, L M (x_t) by shadow rays (or
+//! the volume map's first-event photons), everything else by the volume map; at surfaces as in
+//! `photon` (docs/photon-mapping.md).
+
+use foton_core::camera_path::{MAX_NULL_CROSSINGS, direct_light_in};
+use foton_core::film::Film;
+use foton_core::geometry::{Ray, offset_origin};
+use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::kernel::NormalizedKernel;
+use foton_core::material::TransportMode;
+use foton_core::medium::{Homogeneous, transmittance_homogeneous};
+use foton_core::photon::{Estimate, Neighbour, PhotonMap};
+use foton_core::photon_trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons,
+};
+use foton_core::props::Properties;
+use foton_core::render::render_pixels;
+use foton_core::sampling::Sampler;
+use foton_core::scene::Scene;
+use foton_core::{Error, Result, Rgb, Vec3};
+use std::cell::RefCell;
+
+/// Random stream of the volume photon pass.
+pub const STREAM_VOLUME: u64 = 0x766f_6c75;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Direct {
+    ShadowRays,
+    Photons,
+}
+
+pub struct Vpm {
+    pub global_photons: u64,
+    pub caustic_photons: u64,
+    pub volume_photons: u64,
+    pub k: usize,
+    pub max_radius: f32,
+    pub k_volume: usize,
+    pub max_radius_volume: f32,
+    pub step: f32,
+    pub kernel: NormalizedKernel,
+    pub direct: Direct,
+    pub max_depth: u32,
+}
+
+pub struct Maps {
+    pub direct: Option<PhotonMap>,
+    pub caustic: PhotonMap,
+    pub indirect: PhotonMap,
+    pub volume: PhotonMap,
+    /// Where camera rays that leave the scene stop marching: the box around the geometry,
+    /// the lights and the volume photons, grown by the volume radius.
+    pub bounds: (Vec3, Vec3),
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
+}
+
+/// Distance along `ray` to where it leaves the box (0 if it misses it).
+fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
+    let inv = ray.dir.recip();
+    let t0 = (lo - ray.origin) * inv;
+    let t1 = (hi - ray.origin) * inv;
+    let far = t0.max(t1).min_element();
+    let near = t0.min(t1).max_element();
+    if far < near.max(0.0) { 0.0 } else { far }
+}
+
+impl Vpm {
+    fn check_size(&self, name: &str, len: usize, k: usize, key: &str) -> Result<()> {
+        if len > 0 && len < k {
+            return Err(Error::Usage(format!(
+                "integrators.vpm.{key} = {k} is larger than the {len} photons stored in the {name} map; lower it or emit more photons"
+            )));
+        }
+        Ok(())
+    }
+
+    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+        let seed = scene.render.seed;
+        let photons_direct = self.direct == Direct::Photons;
+        let pass = |photons: u64, stream: u64, stop_at_diffuse: bool| TraceOptions {
+            photons,
+            max_depth: self.max_depth,
+            seed,
+            stream,
+            stop_at_diffuse,
+        };
+        let mut lists = trace_photons(
+            scene,
+            &pass(self.global_photons, STREAM_GLOBAL, false),
+            ctx,
+            2,
+            |site, class| match (site, class) {
+                (Site::Surface, PathClass::Direct) if photons_direct => Some(0),
+                (Site::Surface, PathClass::Indirect) => Some(1),
+                _ => None,
+            },
+        )?;
+        let indirect = lists.pop().unwrap();
+        let direct = lists.pop().unwrap();
+        let caustic = if self.caustic_photons > 0 {
+            trace_photons(
+                scene,
+                &pass(self.caustic_photons, STREAM_CAUSTIC, true),
+                ctx,
+                1,
+                |site, class| (site == Site::Surface && class == PathClass::Caustic).then_some(0),
+            )?
+            .pop()
+            .unwrap()
+        } else {
+            Vec::new()
+        };
+        let volume = if self.volume_photons > 0 && scene.has_media() {
+            trace_photons(
+                scene,
+                &pass(self.volume_photons, STREAM_VOLUME, false),
+                ctx,
+                1,
+                |site, class| {
+                    (site == Site::Volume && (class != PathClass::Direct || photons_direct))
+                        .then_some(0)
+                },
+            )?
+            .pop()
+            .unwrap()
+        } else {
+            Vec::new()
+        };
+        self.check_size("direct", direct.len(), self.k, "k")?;
+        self.check_size("caustic", caustic.len(), self.k, "k")?;
+        self.check_size("indirect", indirect.len(), self.k, "k")?;
+        self.check_size("volume", volume.len(), self.k_volume, "k_volume")?;
+        let volume = PhotonMap::build(volume);
+        let (mut lo, mut hi) = scene.bounds;
+        if !volume.is_empty() {
+            let (vlo, vhi) = volume.bounds();
+            lo = lo.min(vlo);
+            hi = hi.max(vhi);
+        }
+        let grow = Vec3::splat(self.max_radius_volume);
+        Ok(Maps {
+            direct: photons_direct.then(|| PhotonMap::build(direct)),
+            caustic: PhotonMap::build(caustic),
+            indirect: PhotonMap::build(indirect),
+            volume,
+            bounds: (lo - grow, hi + grow),
+        })
+    }
+
+    fn surface_estimate(&self) -> Estimate<'_> {
+        Estimate {
+            k: self.k,
+            max_radius: self.max_radius,
+            kernel: &self.kernel,
+        }
+    }
+
+    fn irradiance(&self, map: &PhotonMap, p: Vec3, n: Vec3, max_depth: u32) -> Rgb {
+        if map.is_empty() || max_depth == 0 {
+            return Rgb::ZERO;
+        }
+        SCRATCH.with_borrow_mut(|s| map.irradiance(p, n, max_depth, &self.surface_estimate(), s))
+    }
+
+    /// Single scattering at a point in a medium: one shadow ray to a light chosen by power,
+    /// sigma_s p(theta) Li Tr / pdf.
+    #[allow(clippy::too_many_arguments)]
+    fn single_scattering(
+        &self,
+        scene: &Scene,
+        m: &Homogeneous,
+        medium: Option<u32>,
+        x: Vec3,
+        dir: Vec3,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) else {
+            return Rgb::ZERO;
+        };
+        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+        let Some(ls) = scene.lights[light_id].sample_li(x, u, uc) else {
+            return Rgb::ZERO;
+        };
+        if ls.li == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        let tr = scene.transmittance(x, Vec3::ZERO, ls.p, ls.n, medium);
+        if tr == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        m.sigma_s * m.phase.eval(dir.dot(ls.wi)) * ls.li * tr / (pmf * ls.pdf)
+    }
+
+    /// The in-scattering integral along `ray` from 0 to `t_end` in medium `m`, by ray
+    /// marching; `bounces` delta bounces precede it on the camera path.
+    #[allow(clippy::too_many_arguments)]
+    fn march(
+        &self,
+        scene: &Scene,
+        maps: &Maps,
+        m: &Homogeneous,
+        medium: Option<u32>,
+        ray: &Ray,
+        t_end: f32,
+        bounces: u32,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        // A march point is a scattering event: the light paths through it have one event
+        // more than the camera path before it.
+        if bounces >= self.max_depth || !(t_end > 0.0) {
+            return Rgb::ZERO;
+        }
+        let depth = self.max_depth - bounces;
+        let estimate = Estimate {
+            k: self.k_volume,
+            max_radius: self.max_radius_volume,
+            kernel: &self.kernel,
+        };
+        let sigma_t = m.sigma_t();
+        let u = sampler.next_f32();
+        let mut sum = Rgb::ZERO;
+        let mut t0 = 0.0f32;
+        while t0 < t_end {
+            let dt = self.step.min(t_end - t0);
+            let t = t0 + u * dt;
+            let tr = transmittance_homogeneous(sigma_t, t);
+            // Past this, what is left of the integral is below a millionth of what the
+            // surface behind would get: not worth a photon query.
+            if tr.max_element() < 1e-6 {
+                break;
+            }
+            let x = ray.at(t);
+            let mut inscattered = if maps.volume.is_empty() {
+                Rgb::ZERO
+            } else {
+                SCRATCH.with_borrow_mut(|s| {
+                    maps.volume
+                        .in_scattered(x, ray.dir, &m.phase, depth, &estimate, s)
+                })
+            };
+            if self.direct == Direct::ShadowRays {
+                inscattered += self.single_scattering(scene, m, medium, x, ray.dir, sampler, rays);
+            }
+            sum += tr * inscattered * dt;
+            t0 += dt;
+        }
+        sum
+    }
+
+    /// Radiance arriving at the camera along `ray`.
+    pub fn li(
+        &self,
+        scene: &Scene,
+        maps: &Maps,
+        mut ray: Ray,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> Rgb {
+        let mut radiance = Rgb::ZERO;
+        let mut beta = Rgb::ONE;
+        let mut medium = scene.camera_medium;
+        let mut bounces = 0u32;
+        let mut crossings = 0u32;
+        loop {
+            *rays += 1;
+            let hit = scene.intersect(&ray, f32::INFINITY);
+            if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
+                && !m.is_vacuum()
+            {
+                let t_end = hit.map_or_else(|| exit_distance(&ray, maps.bounds), |h| h.t);
+                radiance +=
+                    beta * self.march(scene, maps, m, medium, &ray, t_end, bounces, sampler, rays);
+                beta *= m.transmittance_over(hit.map_or(f32::INFINITY, |h| h.t));
+                if beta == Rgb::ZERO {
+                    break;
+                }
+            }
+            let Some(hit) = hit else {
+                break;
+            };
+            let material = *scene.material(&hit);
+            if material.is_null() {
+                crossings += 1;
+                if crossings > MAX_NULL_CROSSINGS {
+                    break;
+                }
+                medium = scene.medium_after(&hit, ray.dir, medium);
+                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+                continue;
+            }
+            crossings = 0;
+            let wo = -ray.dir;
+            if let Some((_, light)) = scene.area_light(&hit) {
+                radiance += beta * light.emitted(hit.ng, wo);
+            }
+            if bounces >= self.max_depth {
+                break;
+            }
+            if material.is_delta() {
+                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+                    break;
+                };
+                beta *= bs.weight;
+                bounces += 1;
+                medium = scene.medium_after(&hit, bs.wi, medium);
+                ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+                continue;
+            }
+            let n = if hit.ng.dot(wo) > 0.0 {
+                hit.ng
+            } else {
+                -hit.ng
+            };
+            let f = material.eval(wo, n, hit.ng);
+            let depth = self.max_depth - bounces;
+            let direct = match self.direct {
+                Direct::ShadowRays => {
+                    direct_light_in(scene, &hit, &material, wo, medium, sampler, rays)
+                }
+                Direct::Photons => {
+                    f * self.irradiance(maps.direct.as_ref().unwrap(), hit.p, n, depth)
+                }
+            };
+            let caustic = f * self.irradiance(&maps.caustic, hit.p, n, depth);
+            let indirect = f * self.irradiance(&maps.indirect, hit.p, n, depth);
+            radiance += beta * (direct + caustic + indirect);
+            break;
+        }
+        radiance
+    }
+}
+
+impl Integrator for Vpm {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        let maps = self.build_maps(scene, ctx)?;
+        if ctx.cancelled() {
+            return Ok(Film::new(scene.film.width, scene.film.height));
+        }
+        render_pixels(scene, ctx, |ray, sampler, rays| {
+            self.li(scene, &maps, *ray, sampler, rays)
+        })
+    }
+
+    fn describe(&self) -> String {
+        format!(
+            "vpm(global_photons = {}, caustic_photons = {}, volume_photons = {}, k = {}, k_volume = {}, max_radius = {}, max_radius_volume = {}, step = {}, kernel = {}, direct = {})",
+            self.global_photons,
+            self.caustic_photons,
+            self.volume_photons,
+            self.k,
+            self.k_volume,
+            self.max_radius,
+            self.max_radius_volume,
+            self.step,
+            self.kernel.name(),
+            match self.direct {
+                Direct::ShadowRays => "nee",
+                Direct::Photons => "photons",
+            }
+        )
+    }
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
+    let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
+    let count = |key: &str, default: u64, min: u64| -> Result<u64> {
+        let n = props.u64(key, default)?;
+        if n < min {
+            return Err(props.error(key, format!("must be at least {min}, found {n}")));
+        }
+        Ok(n)
+    };
+    let positive = |key: &str, default: f32| -> Result<f32> {
+        let x = props.f32(key, default)?;
+        if !(x > 0.0 && x.is_finite()) {
+            return Err(props.error(key, format!("must be positive, found {x}")));
+        }
+        Ok(x)
+    };
+    let global_photons = count("global_photons", 200_000, 1)?;
+    let caustic_photons = count("caustic_photons", 100_000, 0)?;
+    let volume_photons = count("volume_photons", 200_000, 0)?;
+    let k = count("k", 50, 2)? as usize;
+    let k_volume = count("k_volume", 50, 2)? as usize;
+    let max_radius = positive("max_radius", diagonal / 20.0)?;
+    let max_radius_volume = positive("max_radius_volume", diagonal / 20.0)?;
+    let step = positive("step", diagonal / 100.0)?;
+    let kernel = props.kernel("kernel", "box")?;
+    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
+        "photons" => Direct::Photons,
+        _ => Direct::ShadowRays,
+    };
+    Ok(Box::new(Vpm {
+        global_photons,
+        caustic_photons,
+        volume_photons,
+        k,
+        max_radius,
+        k_volume,
+        max_radius_volume,
+        step,
+        kernel,
+        direct,
+        max_depth: scene.render.max_depth,
+    }))
+}
+
+foton_core::declare_integrator!(
+    "vpm",
+    "volumetric photon mapping (Jensen and Christensen)",
+    create
+);
