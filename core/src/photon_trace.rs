@@ -146,6 +146,9 @@ pub fn trace_one(
                 hits += 1;
                 let x = ray.at(flight.t);
                 let scattered = flux * weight;
+                if scattered == Rgb::ZERO {
+                    return; // absorbed: a medium that does not scatter stores nothing
+                }
                 store(
                     Photon::new(x, scattered, -ray.dir, glam::Vec3::ZERO).with_depth(hits),
                     Site::Volume,
