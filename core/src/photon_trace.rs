@@ -48,6 +48,7 @@ pub struct TraceOptions {
 /// Stream identifiers, so that passes draw independent random numbers.
 pub const STREAM_GLOBAL: u64 = 0x676c_6f62;
 pub const STREAM_CAUSTIC: u64 = 0x6361_7573;
+pub const STREAM_VOLUME: u64 = 0x766f_6c75;
 
 /// Photons per parallel work unit (also the granularity of progress reports).
 const CHUNK: u64 = 4096;

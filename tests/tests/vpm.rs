@@ -126,3 +126,49 @@ fn bad_parameters_are_clear_errors() {
         assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
     }
 }
+
+/// `foton photons --map volume`: the numbers it reports (stored, emitted, drawn).
+fn volume_map_counts(scene: &str) -> (u64, u64) {
+    let scene = repo_root().join(scene);
+    let dir = foton_tests::temp_dir("volume-map");
+    let out = dir.join("volume.png");
+    let run = foton_with_plugins(&[
+        "photons",
+        scene.to_str().unwrap(),
+        "--map",
+        "volume",
+        "--set",
+        "integrators.vpm.volume_photons=20000",
+        "--set",
+        "film.width=32",
+        "--set",
+        "film.height=32",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let (w, h, _) = foton_core::film::read_image(&out).unwrap();
+    assert_eq!((w, h), (32, 32));
+    let _ = std::fs::remove_dir_all(dir);
+    let number_before = |word: &str| -> u64 {
+        let i = run.stdout.find(word).unwrap();
+        run.stdout[..i]
+            .split_whitespace()
+            .last()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    (number_before(" stored"), number_before(" drawn"))
+}
+
+#[test]
+fn photons_command_shows_the_volume_map() {
+    let (stored, drawn) = volume_map_counts("scenes/fog_box.toml");
+    assert!(
+        stored > 1000 && drawn > 0 && drawn <= stored,
+        "{stored} {drawn}"
+    );
+    // No medium, no volume photon.
+    assert_eq!(volume_map_counts("scenes/cornell-box.toml"), (0, 0));
+}

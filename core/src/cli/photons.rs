@@ -12,7 +12,7 @@ use crate::film::check_output;
 use crate::integrator::RenderContext;
 use crate::photon::Photon;
 use crate::photon_trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons,
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
 };
 use crate::props::Properties;
 use crate::render::with_pool;
@@ -28,6 +28,8 @@ use std::sync::atomic::Ordering;
 /// The photon integrator's default budgets (integrators/photon: keep them equal).
 const GLOBAL_PHOTONS: u64 = 200_000;
 const CAUSTIC_PHOTONS: u64 = 100_000;
+/// `vpm`'s default volume budget.
+const VOLUME_PHOTONS: u64 = 200_000;
 
 /// The fraction of drawn photons whose colour is not clipped: the exposure maps this
 /// quantile of the photons' largest channel to 1.
@@ -42,12 +44,28 @@ pub enum MapKind {
     Global,
     /// Caustic photons (L S+ D) of the caustic budget.
     Caustic,
+    /// Photons at scattering events in participating media, of the volumetric photon
+    /// mapper's volume budget (`[integrators.vpm]`).
+    Volume,
 }
 
 /// How a map is filled: the photon pass to trace and which of its photons to keep.
 struct Pass {
     opts: TraceOptions,
-    keep: fn(PathClass) -> bool,
+    site: Site,
+    /// Which path classes (direct, caustic, indirect) are kept.
+    classes: [bool; 3],
+}
+
+impl Pass {
+    fn keeps(&self, site: Site, class: PathClass) -> bool {
+        site == self.site
+            && self.classes[match class {
+                PathClass::Direct => 0,
+                PathClass::Caustic => 1,
+                PathClass::Indirect => 2,
+            }]
+    }
 }
 
 impl MapKind {
@@ -55,11 +73,20 @@ impl MapKind {
         match self {
             MapKind::Global => "global",
             MapKind::Caustic => "caustic",
+            MapKind::Volume => "volume",
         }
     }
 
-    /// The pass of the photon integrator's `build_maps` that fills this map, with its budget
-    /// read from `props` (the scene's `[integrators.photon]` table).
+    /// The integrator whose `[integrators.NAME]` table holds this map's budget.
+    fn integrator(self) -> &'static str {
+        match self {
+            MapKind::Global | MapKind::Caustic => "photon",
+            MapKind::Volume => "vpm",
+        }
+    }
+
+    /// The pass of the photon integrators' `build_maps` that fills this map, with its budget
+    /// read from `props` (the scene's `[integrators.photon]` or `[integrators.vpm]` table).
     fn pass(self, props: &Properties<'_>, scene: &Scene) -> Result<Pass> {
         let opts = |photons, stream, stop_at_diffuse| TraceOptions {
             photons,
@@ -78,7 +105,8 @@ impl MapKind {
                 // them.
                 Pass {
                     opts: opts(photons, STREAM_GLOBAL, false),
-                    keep: |c| matches!(c, PathClass::Direct | PathClass::Indirect),
+                    site: Site::Surface,
+                    classes: [true, false, true],
                 }
             }
             MapKind::Caustic => Pass {
@@ -87,7 +115,23 @@ impl MapKind {
                     STREAM_CAUSTIC,
                     true,
                 ),
-                keep: |c| c == PathClass::Caustic,
+                site: Site::Surface,
+                classes: [false, true, false],
+            },
+            // As vpm stores them: the first scattering events only when direct light is by
+            // photons (with shadow rays, single scattering is not in the map).
+            MapKind::Volume => Pass {
+                opts: opts(
+                    props.u64("volume_photons", VOLUME_PHOTONS)?,
+                    STREAM_VOLUME,
+                    false,
+                ),
+                site: Site::Volume,
+                classes: [
+                    props.choice("direct", &["nee", "photons"], "nee")? == "photons",
+                    true,
+                    true,
+                ],
             },
         })
     }
@@ -127,12 +171,13 @@ pub(super) struct PhotonsArgs {
 }
 
 /// Where a photon shows on the film, if the camera sees it: in front of the camera, inside
-/// the image, on the side of its surface that faces the camera, and not hidden.
+/// the image, on the side of its surface that faces the camera (a volume photon has no
+/// surface: its normal is zero), and not hidden.
 fn visible_at(scene: &Scene, photon: &Photon) -> Option<Vec2> {
     let camera = &scene.camera;
     let film = camera.project(photon.position)?;
     let n = photon.normal();
-    if n.dot(camera.position - photon.position) <= 0.0 {
+    if n != Vec3::ZERO && n.dot(camera.position - photon.position) <= 0.0 {
         return None;
     }
     (!scene.occluded(camera.position, Vec3::ZERO, photon.position, n)).then_some(film)
@@ -161,7 +206,7 @@ pub(super) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         overrides.push(format!("render.seed={seed}"));
     }
     let scene = Scene::load(&a.scene, &overrides)?;
-    let props = scene.integrator_properties("photon")?;
+    let props = scene.integrator_properties(a.map.integrator())?;
     let pass = a.map.pass(&props, &scene)?;
     let output = a
         .output
@@ -183,9 +228,8 @@ pub(super) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         cancel: &INTERRUPTED,
         progress: &progress,
     };
-    let keep = pass.keep;
     let photons = trace_photons(&scene, &pass.opts, &ctx, 1, |site, c| {
-        (site == Site::Surface && keep(c)).then_some(0)
+        pass.keeps(site, c).then_some(0)
     })?
     .pop()
     .unwrap_or_default();

@@ -51,7 +51,7 @@ use foton_core::material::TransportMode;
 use foton_core::medium::{Homogeneous, transmittance_homogeneous};
 use foton_core::photon::{Estimate, Neighbour, PhotonMap};
 use foton_core::photon_trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons,
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
 };
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
@@ -59,9 +59,6 @@ use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result, Rgb, Vec3};
 use std::cell::RefCell;
-
-/// Random stream of the volume photon pass.
-pub const STREAM_VOLUME: u64 = 0x766f_6c75;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Direct {
