@@ -122,6 +122,8 @@ pub struct PhotonMap {
     /// (unused for buckets).
     axis: Vec<u8>,
     split: Vec<f32>,
+    /// Bounds of the photons' positions (an empty box at the origin for no photon).
+    bounds: (Vec3, Vec3),
 }
 
 /// A neighbour found by a query: squared distance and photon index.
@@ -237,11 +239,20 @@ impl PhotonMap {
         let mut split = vec![0f32; photons.len()];
         build_range(&mut photons, &mut axis, &mut split);
         let positions = photons.iter().map(|p| p.position.to_array()).collect();
+        let bounds = if photons.is_empty() {
+            (Vec3::ZERO, Vec3::ZERO)
+        } else {
+            photons.iter().fold(
+                (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+                |(lo, hi), p| (lo.min(p.position), hi.max(p.position)),
+            )
+        };
         PhotonMap {
             photons,
             positions,
             axis,
             split,
+            bounds,
         }
     }
 
@@ -373,6 +384,63 @@ impl PhotonMap {
         self.search(p, &mut r2, |i, d2, _| f(&self.photons[i as usize], d2));
     }
 
+    /// Calls `visit(index, photon, t, d2)` for every photon whose distance from the segment
+    /// `origin + t dir`, t in [0, `t_max`], is below `radius`, measured perpendicular to it
+    /// (d2 its square, t the photon's projection on the line, inside [0, t_max]). `dir` is
+    /// unit. The beam radiance estimate's query (Jarosz, Zwicker and Jensen 2008): the tree
+    /// is walked with each node's box, grown by `radius`, clipped against the segment.
+    pub fn along_ray(
+        &self,
+        origin: Vec3,
+        dir: Vec3,
+        t_max: f32,
+        radius: f32,
+        mut visit: impl FnMut(u32, &Photon, f32, f32),
+    ) {
+        if self.photons.is_empty() {
+            return;
+        }
+        let inv = dir.recip();
+        let r2 = radius * radius;
+        let hits_box = |lo: Vec3, hi: Vec3| {
+            let t0 = (lo - Vec3::splat(radius) - origin) * inv;
+            let t1 = (hi + Vec3::splat(radius) - origin) * inv;
+            // NaN from 0 * inf (a ray in a box face's plane) is ignored by min/max.
+            let near = t0.min(t1).max_element().max(0.0);
+            let far = t0.max(t1).min_element().min(t_max);
+            near <= far
+        };
+        let (lo, hi) = self.bounds();
+        let mut stack = vec![(0usize, self.photons.len(), lo, hi)];
+        while let Some((lo_i, hi_i, lo, hi)) = stack.pop() {
+            if !hits_box(lo, hi) {
+                continue;
+            }
+            if hi_i - lo_i <= LEAF {
+                for i in lo_i..hi_i {
+                    let v = Vec3::from_array(self.positions[i]) - origin;
+                    let t = v.dot(dir);
+                    if !(0.0..=t_max).contains(&t) {
+                        continue;
+                    }
+                    let d2 = (v - dir * t).length_squared();
+                    if d2 < r2 {
+                        visit(i as u32, &self.photons[i], t, d2);
+                    }
+                }
+                continue;
+            }
+            let mid = (lo_i + hi_i) / 2;
+            let a = self.axis[mid] as usize;
+            let split = self.split[mid];
+            let (mut left_hi, mut right_lo) = (hi, lo);
+            left_hi[a] = split;
+            right_lo[a] = split;
+            stack.push((mid, hi_i, right_lo, hi));
+            stack.push((lo_i, mid, lo, left_hi));
+        }
+    }
+
     /// Irradiance at a surface point: sum of photon power times the surface kernel over the
     /// k nearest photons (within `max_radius`) stored on the same side of the same surface
     /// whose paths have at most `max_depth` scattering events.
@@ -461,13 +529,7 @@ impl PhotonMap {
 
     /// Bounds of the stored photons (empty map: an empty box at the origin).
     pub fn bounds(&self) -> (Vec3, Vec3) {
-        if self.photons.is_empty() {
-            return (Vec3::ZERO, Vec3::ZERO);
-        }
-        self.photons.iter().fold(
-            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-            |(lo, hi), p| (lo.min(p.position), hi.max(p.position)),
-        )
+        self.bounds
     }
 }
 
@@ -485,6 +547,37 @@ mod tests {
             })
             .collect();
         (photons.clone(), PhotonMap::build(photons))
+    }
+
+    #[test]
+    fn along_ray_matches_brute_force() {
+        let (all, map) = random_map(20_000, 3);
+        let mut rng = Rng::new(&[4]);
+        for _ in 0..100 {
+            let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 1.4 - 0.2;
+            let dir = crate::sampling::uniform_sphere(rng.next_2d());
+            let (t_max, radius) = (0.2 + rng.next_f32(), 0.01 + 0.05 * rng.next_f32());
+            let mut got = Vec::new();
+            map.along_ray(origin, dir, t_max, radius, |_, p, t, d2| {
+                got.push((p.position.to_array().map(f32::to_bits), t.to_bits(), d2.to_bits()))
+            });
+            let mut want: Vec<_> = all
+                .iter()
+                .filter_map(|p| {
+                    let v = p.position - origin;
+                    let t = v.dot(dir);
+                    let d2 = (v - dir * t).length_squared();
+                    ((0.0..=t_max).contains(&t) && d2 < radius * radius).then_some((
+                        p.position.to_array().map(f32::to_bits),
+                        t.to_bits(),
+                        d2.to_bits(),
+                    ))
+                })
+                .collect();
+            got.sort();
+            want.sort();
+            assert_eq!(got, want);
+        }
     }
 
     #[test]

@@ -64,6 +64,13 @@ fn agrees_with_path_on_the_fog_cube_and_converges() {
     let photons = ["integrators.vpm.direct=\"photons\""];
     let [coarse, fine] = vpm_errors("scenes/fog_box.toml", path, &photons);
     assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    // The beam radiance estimate instead of marching, all scattering by photons.
+    let beam = [
+        "integrators.vpm.estimate=\"beam\"",
+        "integrators.vpm.direct=\"photons\"",
+    ];
+    let [coarse, fine] = vpm_errors("scenes/fog_box.toml", path, &beam);
+    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
 }
 
 #[test]

@@ -12,6 +12,7 @@
 //! | `step`              | float   | ray-marching step (jittered per camera sample)             | 1/100 of the scene diagonal |
 //! | `kernel`, `cone_c`  | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces, 3-D in volumes) | `box` |
 //! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
+//! | `estimate`          | string  | `march` (ray marching) or `beam` (beam radiance estimate)  | `march` |
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
 //! medium scattering events alike), as in the path tracer. `[render] spp` camera samples.
@@ -38,6 +39,14 @@
 //! the photon mapper's: emission + direct (shadow ray with transmittance, or photons) +
 //! caustic + indirect estimates, attenuated by the transmittance in front of it.
 //!
+//! **Beam radiance estimate** (`estimate = "beam"`, Jarosz, Zwicker and Jensen 2008): instead
+//! of a k-nearest query at every step, each volume photon gets its own radius at build time
+//! (the distance to its `k_volume`-th neighbour, at most `max_radius_volume`), and a camera
+//! segment gathers every photon whose disc, perpendicular to the ray, it crosses:
+//! sum_p Tr(x, x_p) p(w_p, w) Phi_p K2(d_p, r_p), with d_p the photon's distance from the ray
+//! and K2 the kernel normalised over the disc. One tree walk per segment replaces the steps'
+//! queries; single scattering by shadow rays (`direct = "nee"`) is still marched.
+//!
 //! Each light path is counted once: through a march point x_t, L M (x_t) by shadow rays (or
 //! the volume map's first-event photons), everything else by the volume map; at surfaces as in
 //! `photon` (docs/photon-mapping.md).
@@ -54,11 +63,20 @@ use foton_core::photon_trace::{
     PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
 };
 use foton_core::props::Properties;
-use foton_core::render::render_pixels;
+use foton_core::render::{render_pixels, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result, Rgb, Vec3};
+use rayon::prelude::*;
 use std::cell::RefCell;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum VolumeEstimate {
+    /// A k-nearest volume estimate at every marching step.
+    March,
+    /// The beam radiance estimate along each camera segment.
+    Beam,
+}
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Direct {
@@ -77,6 +95,7 @@ pub struct Vpm {
     pub step: f32,
     pub kernel: NormalizedKernel,
     pub direct: Direct,
+    pub estimate: VolumeEstimate,
     pub max_depth: u32,
 }
 
@@ -85,6 +104,10 @@ pub struct Maps {
     pub caustic: PhotonMap,
     pub indirect: PhotonMap,
     pub volume: PhotonMap,
+    /// For the beam estimate: each volume photon's radius (in the map's order) and the
+    /// largest.
+    pub volume_radius: Vec<f32>,
+    pub volume_radius_max: f32,
     /// Where camera rays that leave the scene stop marching: the box around the geometry,
     /// the lights and the volume photons, grown by the volume radius.
     pub bounds: (Vec3, Vec3),
@@ -171,6 +194,28 @@ impl Vpm {
         self.check_size("indirect", indirect.len(), self.k, "k")?;
         self.check_size("volume", volume.len(), self.k_volume, "k_volume")?;
         let volume = PhotonMap::build(volume);
+        let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
+            with_pool(ctx.threads, || {
+                volume
+                    .photons()
+                    .par_iter()
+                    .map_init(Vec::new, |scratch, p| {
+                        volume
+                            .knn(
+                                p.position,
+                                self.k_volume,
+                                self.max_radius_volume,
+                                |_| true,
+                                scratch,
+                            )
+                            .sqrt()
+                    })
+                    .collect()
+            })?
+        } else {
+            Vec::new()
+        };
+        let volume_radius_max = volume_radius.iter().copied().fold(0.0, f32::max);
         let (mut lo, mut hi) = scene.bounds;
         if !volume.is_empty() {
             let (vlo, vhi) = volume.bounds();
@@ -183,6 +228,8 @@ impl Vpm {
             caustic: PhotonMap::build(caustic),
             indirect: PhotonMap::build(indirect),
             volume,
+            volume_radius,
+            volume_radius_max,
             bounds: (lo - grow, hi + grow),
         })
     }
@@ -273,7 +320,8 @@ impl Vpm {
                 break;
             }
             let x = ray.at(t);
-            let mut inscattered = if maps.volume.is_empty() {
+            let mut inscattered = if maps.volume.is_empty() || self.estimate == VolumeEstimate::Beam
+            {
                 Rgb::ZERO
             } else {
                 SCRATCH.with_borrow_mut(|s| {
@@ -287,6 +335,33 @@ impl Vpm {
             sum += tr * inscattered * dt;
             t0 += dt;
         }
+        sum
+    }
+
+    /// The beam radiance estimate of the in-scattering integral along `ray` from 0 to
+    /// `t_end` in medium `m`.
+    fn beam(&self, maps: &Maps, m: &Homogeneous, ray: &Ray, t_end: f32, bounces: u32) -> Rgb {
+        if bounces >= self.max_depth || !(t_end > 0.0) || maps.volume.is_empty() {
+            return Rgb::ZERO;
+        }
+        let depth = self.max_depth - bounces;
+        let sigma_t = m.sigma_t();
+        let mut sum = Rgb::ZERO;
+        maps.volume.along_ray(
+            ray.origin,
+            ray.dir,
+            t_end,
+            maps.volume_radius_max,
+            |i, photon, t, d2| {
+                let r = maps.volume_radius[i as usize];
+                if d2 >= r * r || photon.depth() > depth {
+                    return;
+                }
+                let w =
+                    self.kernel.weight_2d(d2.sqrt(), r) * m.phase.eval(photon.wi().dot(ray.dir));
+                sum += transmittance_homogeneous(sigma_t, t) * photon.power() * w;
+            },
+        );
         sum
     }
 
@@ -311,8 +386,15 @@ impl Vpm {
                 && !m.is_vacuum()
             {
                 let t_end = hit.map_or_else(|| exit_distance(&ray, maps.bounds), |h| h.t);
-                radiance +=
-                    beta * self.march(scene, maps, m, medium, &ray, t_end, bounces, sampler, rays);
+                let mut inscattered = Rgb::ZERO;
+                if self.estimate == VolumeEstimate::Beam {
+                    inscattered += self.beam(maps, m, &ray, t_end, bounces);
+                }
+                if self.estimate == VolumeEstimate::March || self.direct == Direct::ShadowRays {
+                    inscattered +=
+                        self.march(scene, maps, m, medium, &ray, t_end, bounces, sampler, rays);
+                }
+                radiance += beta * inscattered;
                 beta *= m.transmittance_over(hit.map_or(f32::INFINITY, |h| h.t));
                 if beta == Rgb::ZERO {
                     break;
@@ -387,7 +469,7 @@ impl Integrator for Vpm {
 
     fn describe(&self) -> String {
         format!(
-            "vpm(global_photons = {}, caustic_photons = {}, volume_photons = {}, k = {}, k_volume = {}, max_radius = {}, max_radius_volume = {}, step = {}, kernel = {}, direct = {})",
+            "vpm(global_photons = {}, caustic_photons = {}, volume_photons = {}, k = {}, k_volume = {}, max_radius = {}, max_radius_volume = {}, step = {}, kernel = {}, direct = {}, estimate = {})",
             self.global_photons,
             self.caustic_photons,
             self.volume_photons,
@@ -400,6 +482,10 @@ impl Integrator for Vpm {
             match self.direct {
                 Direct::ShadowRays => "nee",
                 Direct::Photons => "photons",
+            },
+            match self.estimate {
+                VolumeEstimate::March => "march",
+                VolumeEstimate::Beam => "beam",
             }
         )
     }
@@ -436,6 +522,10 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         "photons" => Direct::Photons,
         _ => Direct::ShadowRays,
     };
+    let estimate = match props.choice("estimate", &["march", "beam"], "march")? {
+        "beam" => VolumeEstimate::Beam,
+        _ => VolumeEstimate::March,
+    };
     Ok(Box::new(Vpm {
         global_photons,
         caustic_photons,
@@ -447,6 +537,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         step,
         kernel,
         direct,
+        estimate,
         max_depth: scene.render.max_depth,
     }))
 }
