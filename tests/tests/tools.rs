@@ -577,3 +577,166 @@ fn bad_reference_is_refused() {
     assert!(!out.exists());
     let _ = std::fs::remove_dir_all(dir);
 }
+
+// ---------------------------------------------------------------------------------------------
+// foton compare --curve
+// ---------------------------------------------------------------------------------------------
+
+/// One point of an error curve in compare's JSON.
+struct CurvePoint {
+    seconds: f64,
+    rel_mse: f64,
+    /// The number of the first `--set` chosen (spp, or sppm's iterations).
+    units: u64,
+}
+
+/// The points of one integrator's error curve in compare's JSON.
+fn curve_points(json: &str, integrator: &str) -> Vec<CurvePoint> {
+    let entry = json
+        .find(&format!("\"name\": \"{integrator}\""))
+        .unwrap_or_else(|| panic!("no entry for {integrator} in {json}"));
+    let rest = &json[entry..];
+    let start = rest
+        .find("\"curve\": [")
+        .unwrap_or_else(|| panic!("no curve for {integrator} in {json}"));
+    // The curve's closing bracket is on a line of its own.
+    let end = start + rest[start..].find("\n      ]").unwrap();
+    let field = |line: &str, key: &str| -> f64 {
+        let key = format!("\"{key}\": ");
+        let at = line.find(&key).unwrap() + key.len();
+        line[at..]
+            .split([',', '}'])
+            .next()
+            .unwrap()
+            .trim()
+            .parse()
+            .unwrap()
+    };
+    let units = |line: &str| -> u64 {
+        let at = line.find("\"set\": [\"").unwrap() + 9;
+        let set = line[at..].split('"').next().unwrap();
+        set.split_once('=').unwrap().1.parse().unwrap()
+    };
+    rest[start..end]
+        .lines()
+        .filter(|l| l.contains("\"budget\""))
+        .map(|l| CurvePoint {
+            seconds: field(l, "seconds"),
+            rel_mse: field(l, "rel_mse"),
+            units: units(l),
+        })
+        .collect()
+}
+
+#[test]
+fn compare_curve_plots_the_error_against_time() {
+    use foton_core::cli::montage::{PLOT_HEIGHT, PLOT_WIDTH};
+    let (dir, scene) = setup("compare-curve");
+    let small = ["--set", "film.width=20", "--set", "film.height=20"];
+    let reference = dir.join("ref.exr");
+    // Far more samples than the curve's renders take, so that the reference's own noise does
+    // not hide theirs; and another seed than theirs (they would share its first samples).
+    let mut args = vec![
+        "render",
+        s(&scene),
+        "--spp",
+        "8192",
+        "--seed",
+        "99",
+        "-o",
+        s(&reference),
+        "-q",
+    ];
+    args.extend(small);
+    ok(&foton_with_plugins(&args));
+
+    let out = dir.join("curve.png");
+    let mut args = vec![
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,photon,sppm",
+        "--time",
+        "0.4",
+        "--threads",
+        "1",
+        "--curve",
+        "3",
+        "--reference",
+        s(&reference),
+        "--set",
+        "integrators.sppm.photons_per_iteration=10000",
+        "-o",
+        s(&out),
+        "-q",
+    ];
+    args.extend(small);
+    let run = foton_with_plugins(&args);
+    ok(&run);
+    let (w, h, _) = read_image(&dir.join("curve-curve.png")).unwrap();
+    assert_eq!((w, h), (PLOT_WIDTH, PLOT_HEIGHT));
+    let json = std::fs::read_to_string(dir.join("curve.json")).unwrap();
+    for name in ["path", "photon", "sppm"] {
+        let points = curve_points(&json, name);
+        assert_eq!(points.len(), 3, "{name}: {json}");
+        // Each budget twice the one before: more samples (iterations for sppm) each time,
+        // and more seconds. Times on a shared machine are noisy, and a render of a tenth of
+        // a second can take longer than one of twice its budget, so the seconds are compared
+        // over the whole curve, a factor of four in budget.
+        for pair in points.windows(2) {
+            assert!(pair[0].units < pair[1].units, "{name}: {json}");
+        }
+        assert!(
+            points[0].seconds < points[2].seconds,
+            "{name}: seconds must grow: {json}"
+        );
+        // The last point is the render shown.
+        assert_eq!(
+            Some(points[2].rel_mse),
+            json_number(&json, name, "rel_mse"),
+            "{json}"
+        );
+    }
+    // Four times the samples: about a quarter of the path tracer's error.
+    let path = curve_points(&json, "path");
+    assert!(path[2].rel_mse < path[0].rel_mse, "{json}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn curve_without_a_reference_or_a_time_is_refused() {
+    let (dir, scene) = setup("bad-curve");
+    let out = dir.join("c.png");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path",
+        "--time",
+        "1",
+        "--curve",
+        "3",
+        "-o",
+        s(&out),
+    ]);
+    fails_with(&run, &["--curve 3 needs --reference"]);
+    assert!(run.stdout.is_empty(), "nothing rendered: {}", run.stdout);
+    let reference = write(&dir, "ref.exr", "never read");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path",
+        "--spp",
+        "1",
+        "--curve",
+        "3",
+        "--reference",
+        s(&reference),
+        "-o",
+        s(&out),
+    ]);
+    fails_with(&run, &["--curve 3 needs --time"]);
+    assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(dir);
+}

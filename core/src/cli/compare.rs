@@ -2,17 +2,18 @@
 //! image; against a reference, with a false-colour difference image and error numbers per
 //! render. Each render is also written as EXR, and the numbers as JSON.
 
-use super::montage::{Image, Tile, diverging, grid};
+use super::montage::{Image, Series, Tile, diverging, grid, log_log_plot};
 use super::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare, threads};
-use super::{render_prepared, write_atomic};
+use super::{blame_plugin, render_prepared, write_atomic};
 use crate::Rgb;
 use crate::error::{Error, Result};
 use crate::film::{Film, check_output, read_image};
+use crate::integrator::{Progress, RenderContext};
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::Ordering;
-use std::time::Duration;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
+use std::time::{Duration, Instant};
 
 /// Added to the squared reference value in the relative error, so that black pixels of the
 /// reference do not dominate it.
@@ -33,14 +34,20 @@ pub(super) struct CompareArgs {
     /// Samples per pixel for every integrator (overrides render.spp).
     #[arg(long, conflicts_with = "time")]
     spp: Option<u32>,
-    /// About S seconds of rendering per integrator: samples per pixel are chosen from two
-    /// short calibration renders (1 and 2 spp) and printed.
+    /// About S seconds of rendering per integrator: samples per pixel (a progressive
+    /// integrator's iterations; a photon mapper's photon budgets and spp, half the time each)
+    /// are chosen from short calibration renders and printed (docs/tools.md).
     #[arg(long, value_name = "S")]
     time: Option<f64>,
     /// A reference image (.exr linear, or .png sRGB) of the scene's size: adds a row of
     /// relative-difference images and the error numbers.
     #[arg(long, value_name = "IMAGE")]
     reference: Option<PathBuf>,
+    /// With --time S and --reference: also render each integrator at N budgets S/2^(N-1),
+    /// ..., S/2, S and plot the relative MSE against the seconds taken, log-log, as <output
+    /// stem>-curve.png (the points go to the JSON).
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=12))]
+    curve: Option<u32>,
     /// Output image (.png or .exr); default: <scene stem>-compare.png beside the scene. The
     /// renders go beside it as <output stem>-<integrator>.exr, the numbers as <output
     /// stem>.json.
@@ -111,16 +118,140 @@ pub fn difference_image(width: u32, height: u32, x: &[Rgb], reference: &[Rgb]) -
     }
 }
 
-/// Samples per pixel that fill `budget` seconds, from the times of renders at 1 and 2 spp:
-/// t(spp) = fixed + spp x per_sample. The per-sample cost is bounded to [t2/20, t2/2], so that
-/// timer noise on a fast render cannot ask for an enormous number of samples.
+/// The cost of a render as a function of its budget n (samples per pixel, or iterations of a
+/// progressive integrator), t(n) = fixed + n x per_unit, from the times t1 and t2 of renders
+/// at n and 2n.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct CostModel {
+    /// Seconds that do not grow with n (a photon mapper's photon pass).
+    pub fixed: f64,
+    pub per_unit: f64,
+    /// The time of the longer calibration render (t2).
+    pub longest: f64,
+}
+
+impl CostModel {
+    /// per_unit = (t2 - t1) / n, bounded to [t2/20, t2/2] / n so that timer noise on a fast
+    /// render cannot ask for an enormous budget; fixed = t2 - 2n per_unit.
+    pub fn from_times(n: u32, t1: f64, t2: f64) -> CostModel {
+        let n = n.max(1) as f64;
+        let t2 = t2.max(1e-6);
+        let per_unit = ((t2 - t1) / n).clamp(t2 / 20.0 / n, t2 / 2.0 / n);
+        CostModel {
+            fixed: (t2 - 2.0 * n * per_unit).max(0.0),
+            per_unit,
+            longest: t2,
+        }
+    }
+
+    /// The budget n that fills `seconds`, at least 1.
+    pub fn units_for(&self, seconds: f64) -> u32 {
+        ((seconds - self.fixed) / self.per_unit)
+            .floor()
+            .clamp(1.0, u32::MAX as f64) as u32
+    }
+}
+
+/// Calibration renders take at least this long (or a tenth of the budget, if that is less),
+/// so that their times are not timer and scheduler noise.
+pub const CALIBRATION_SECONDS: f64 = 0.05;
+
+/// The cost model from renders at n and 2n units, n = 1 and then larger until the render at
+/// 2n takes `min_seconds` (n at most 2^16). `seconds_of(n)` renders at n and returns its time.
+fn calibrate_cost(
+    min_seconds: f64,
+    mut seconds_of: impl FnMut(u32) -> Result<f64>,
+) -> Result<CostModel> {
+    const MAX_UNITS: u32 = 1 << 16;
+    let mut n = 1u32;
+    loop {
+        let t1 = seconds_of(n)?;
+        let t2 = seconds_of(2 * n)?;
+        if t2 >= min_seconds || n >= MAX_UNITS || INTERRUPTED.load(Ordering::SeqCst) {
+            return Ok(CostModel::from_times(n, t1, t2));
+        }
+        let factor = (min_seconds / t2.max(1e-6)).ceil().clamp(2.0, 1024.0) as u32;
+        n = n.saturating_mul(factor).min(MAX_UNITS);
+    }
+}
+
+/// Samples per pixel that fill `budget` seconds, from the times of renders at 1 and 2 spp
+/// (see `CostModel`).
 pub fn spp_for_budget(budget: f64, t1: f64, t2: f64) -> u32 {
-    let t2 = t2.max(1e-6);
-    let per_sample = (t2 - t1).clamp(t2 / 20.0, t2 / 2.0);
-    let fixed = (t2 - 2.0 * per_sample).max(0.0);
-    ((budget - fixed) / per_sample)
-        .floor()
-        .clamp(1.0, u32::MAX as f64) as u32
+    CostModel::from_times(1, t1, t2).units_for(budget)
+}
+
+/// The photon budgets of an integrator, from its description (`describe()`): its parameters
+/// named `*_photons` with an integer value, e.g. `photon`'s global_photons and caustic_photons.
+pub fn photon_budgets(description: &str) -> Vec<(String, u64)> {
+    let params = description
+        .split_once('(')
+        .map_or("", |(_, rest)| rest.trim_end_matches(')'));
+    params
+        .split(',')
+        .filter_map(|item| {
+            let (key, value) = item.split_once('=')?;
+            let key = key.trim();
+            if !key.ends_with("_photons") {
+                return None;
+            }
+            Some((key.to_string(), value.trim().parse().ok()?))
+        })
+        .collect()
+}
+
+/// How `--time` gives an integrator a budget of S seconds, from its calibration renders.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Plan {
+    /// Samples per pixel (render.spp) fill the time.
+    Samples(CostModel),
+    /// A progressive integrator (one that reports iterations, sppm): its `iterations`
+    /// parameter fills the time; render.spp is not used.
+    Iterations(CostModel),
+    /// A photon mapper (an integrator with photon budgets, `photon`): about half of the time
+    /// goes to the photon pass, half to camera samples. The scene's photon budgets are taken
+    /// to belong to the time 2 x `photon_pass` (the measured cost of their pass) and are
+    /// scaled in proportion to the budget; spp = (S / 2) / `per_sample`.
+    PhotonsAndSamples {
+        per_sample: f64,
+        photon_pass: f64,
+        photons: Vec<(String, u64)>,
+    },
+    /// A budget that --time cannot set: the calibration render is the render.
+    Fixed,
+}
+
+impl Plan {
+    /// The scene values (`--set` overrides) that make integrator `name` take about `seconds`.
+    pub fn settings(&self, name: &str, seconds: f64) -> Vec<String> {
+        match self {
+            Plan::Samples(cost) => vec![format!("render.spp={}", cost.units_for(seconds))],
+            Plan::Iterations(cost) => vec![format!(
+                "integrators.{name}.iterations={}",
+                cost.units_for(seconds)
+            )],
+            Plan::PhotonsAndSamples {
+                per_sample,
+                photon_pass,
+                photons,
+            } => {
+                let half = seconds / 2.0;
+                let spp = (half / per_sample).floor().clamp(1.0, u32::MAX as f64) as u32;
+                let scale = half / photon_pass;
+                let mut sets = vec![format!("render.spp={spp}")];
+                for (key, n) in photons {
+                    let scaled = if *n == 0 {
+                        0
+                    } else {
+                        (*n as f64 * scale).round().clamp(1.0, 1e15) as u64
+                    };
+                    sets.push(format!("integrators.{name}.{key}={scaled}"));
+                }
+                sets
+            }
+            Plan::Fixed => Vec::new(),
+        }
+    }
 }
 
 /// Whether a film has the `spp` samples in every pixel that render.spp asked for. An
@@ -130,8 +261,20 @@ fn takes_spp(film: &Film, spp: u32) -> bool {
     film.total_samples() == film.width as u64 * film.height as u64 * spp as u64
 }
 
-fn spp_text(spp: Option<u32>) -> String {
-    spp.map_or_else(|| "own budget".into(), |n| format!("{n} spp"))
+/// "16 spp"; for an integrator with a budget of its own, "23 iterations" when --time set its
+/// iterations, else "own budget".
+fn budget_text(spp: Option<u32>, settings: &[String]) -> String {
+    if let Some(n) = spp {
+        return format!("{n} spp");
+    }
+    settings
+        .iter()
+        .find_map(|s| {
+            let (key, n) = s.split_once('=')?;
+            key.ends_with(".iterations")
+                .then(|| format!("{n} iterations"))
+        })
+        .unwrap_or_else(|| "own budget".into())
 }
 
 /// One integrator's render and its numbers.
@@ -141,9 +284,21 @@ struct Entry {
     /// None when the integrator does not take its samples from render.spp.
     spp: Option<u32>,
     seconds: f64,
+    /// The scene values --time chose (`--set` overrides), empty without --time.
+    settings: Vec<String>,
     film: Film,
     image: PathBuf,
     errors: Option<Errors>,
+    /// With --curve: the renders at the smaller budgets, then this one.
+    curve: Vec<Point>,
+}
+
+/// One point of the error curve: a render at a budget of `budget` seconds.
+struct Point {
+    budget: f64,
+    seconds: f64,
+    errors: Errors,
+    settings: Vec<String>,
 }
 
 fn json_string(s: &str) -> String {
@@ -169,7 +324,12 @@ fn json_number(x: f64) -> String {
     }
 }
 
-fn json(scene: &Path, reference: Option<&Path>, entries: &[Entry]) -> String {
+fn json_settings(settings: &[String]) -> String {
+    let items: Vec<String> = settings.iter().map(|x| json_string(x)).collect();
+    format!("[{}]", items.join(", "))
+}
+
+fn json(scene: &Path, reference: Option<&Path>, time: Option<f64>, entries: &[Entry]) -> String {
     let file_name = |p: &Path| {
         p.file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
@@ -183,6 +343,7 @@ fn json(scene: &Path, reference: Option<&Path>, entries: &[Entry]) -> String {
         "  \"reference\": {},\n",
         reference.map_or("null".into(), |r| json_string(&r.display().to_string()))
     );
+    s += &format!("  \"time\": {},\n", time.map_or("null".into(), json_number));
     s += "  \"integrators\": [\n";
     for (i, e) in entries.iter().enumerate() {
         let (rel_mse, bias) = e
@@ -198,6 +359,22 @@ fn json(scene: &Path, reference: Option<&Path>, entries: &[Entry]) -> String {
         s += &format!("      \"seconds\": {},\n", json_number(e.seconds));
         s += &format!("      \"rel_mse\": {},\n", json_number(rel_mse));
         s += &format!("      \"bias\": {},\n", json_number(bias));
+        s += &format!("      \"set\": {},\n", json_settings(&e.settings));
+        if !e.curve.is_empty() {
+            s += "      \"curve\": [\n";
+            for (j, p) in e.curve.iter().enumerate() {
+                s += &format!(
+                    "        {{\"budget\": {}, \"seconds\": {}, \"rel_mse\": {}, \"bias\": {}, \"set\": {}}}{}\n",
+                    json_number(p.budget),
+                    json_number(p.seconds),
+                    json_number(p.errors.rel_mse),
+                    json_number(p.errors.bias),
+                    json_settings(&p.settings),
+                    if j + 1 < e.curve.len() { "," } else { "" }
+                );
+            }
+            s += "      ],\n";
+        }
         s += &format!("      \"image\": {}\n", json_string(&file_name(&e.image)));
         s += if i + 1 < entries.len() {
             "    },\n"
@@ -223,6 +400,152 @@ fn render_timed(
     result
 }
 
+/// The progress of the first calibration render: stops a progressive integrator after its
+/// first iteration (the integrator reports it as a checkpoint) and counts the iterations, so
+/// that finding out that sppm does not take render.spp costs one iteration, not its whole
+/// budget. Ctrl-C is passed on to the render at each progress report.
+struct Probe<'a> {
+    inner: &'a TermProgress,
+    stop: &'a AtomicBool,
+    iterations: AtomicU64,
+}
+
+impl Probe<'_> {
+    fn pass_interrupt(&self) {
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            self.stop.store(true, Ordering::SeqCst);
+        }
+    }
+}
+
+impl Progress for Probe<'_> {
+    fn begin(&self, phase: &str, total: u64) {
+        self.pass_interrupt();
+        self.inner.begin(phase, total);
+    }
+    fn advance(&self, units: u64) {
+        self.pass_interrupt();
+        self.inner.advance(units);
+    }
+    fn finish(&self) {
+        self.inner.finish();
+    }
+    fn warn(&self, message: &str) {
+        self.inner.warn(message);
+    }
+    fn rays(&self, n: u64) {
+        self.pass_interrupt();
+        self.inner.rays(n);
+    }
+    fn status(&self, text: &str) {
+        self.pass_interrupt();
+        self.inner.status(text);
+    }
+    fn checkpoint(&self, _iteration: u64, _image: &dyn Fn() -> Film) {
+        self.iterations.fetch_add(1, Ordering::SeqCst);
+        self.stop.store(true, Ordering::SeqCst);
+    }
+}
+
+/// Renders with a `Probe`: returns the time and the iterations the integrator reported (0 for
+/// an integrator that is not progressive).
+fn render_probe(p: &Prepared, threads: usize, err: &mut dyn Write) -> Result<(Duration, u64)> {
+    let inner = TermProgress::new(true);
+    let stop = AtomicBool::new(false);
+    let probe = Probe {
+        inner: &inner,
+        stop: &stop,
+        iterations: AtomicU64::new(0),
+    };
+    let ctx = RenderContext {
+        threads,
+        cancel: &stop,
+        progress: &probe,
+    };
+    let start = Instant::now();
+    p.integrator
+        .render(&p.scene, &ctx)
+        .map_err(|e| blame_plugin(&p.plugin, e))?;
+    let elapsed = start.elapsed();
+    for w in inner.take_warnings() {
+        let _ = writeln!(err, "warning: {}: {w}", p.plugin.name);
+    }
+    Ok((elapsed, probe.iterations.load(Ordering::SeqCst)))
+}
+
+/// Calibrates how `--time` sets integrator `name`'s budget (see `Plan`): a first render at
+/// 1 spp finds out whether the integrator is progressive (and is stopped after one
+/// iteration if it is); then renders at n and 2n samples per pixel, or iterations of a
+/// progressive integrator (`calibrate_cost`). With `Plan::Fixed`, also returns the
+/// calibration render, which is then the render shown.
+fn calibrate(
+    name: &str,
+    p: &mut Prepared,
+    prep: &dyn Fn(&[String]) -> Result<Prepared>,
+    budget: f64,
+    threads: usize,
+    err: &mut dyn Write,
+) -> Result<(Plan, Option<(Film, Duration)>)> {
+    p.scene.render.spp = 1;
+    let (_, iterations) = render_probe(p, threads, err)?;
+    if INTERRUPTED.load(Ordering::SeqCst) {
+        return Ok((Plan::Fixed, None));
+    }
+    let min_seconds = CALIBRATION_SECONDS.min(budget / 10.0);
+    if iterations > 0 {
+        let key = format!("integrators.{name}.iterations");
+        let cost = calibrate_cost(min_seconds, |n| {
+            let q = prep(&[format!("{key}={n}")])?;
+            Ok(render_timed(&q, threads, true, err)?.1.as_secs_f64())
+        })?;
+        let _ = writeln!(
+            err,
+            "note: `{name}` does not take its samples from render.spp: --time sets its iterations instead ({key})"
+        );
+        return Ok((Plan::Iterations(cost), None));
+    }
+    p.scene.render.spp = 2;
+    let (film, t2) = render_timed(p, threads, true, err)?;
+    if !takes_spp(&film, 2) {
+        // Its budget is its own and not iterations: more samples per pixel would not change
+        // the image, so the calibration render is the render.
+        let _ = writeln!(
+            err,
+            "warning: `{name}` does not take its samples from render.spp, so --time cannot set its budget; give it its own (e.g. --set integrators.{name}.time={budget})"
+        );
+        return Ok((Plan::Fixed, Some((film, t2))));
+    }
+    let cost = calibrate_cost(min_seconds, |n| {
+        p.scene.render.spp = n;
+        Ok(render_timed(p, threads, true, err)?.1.as_secs_f64())
+    })?;
+    let photons = photon_budgets(&p.integrator.describe());
+    let plan = if photons.is_empty() {
+        Plan::Samples(cost)
+    } else {
+        Plan::PhotonsAndSamples {
+            per_sample: cost.per_unit,
+            // Not below the bound of the per-sample cost: noise on a fast photon pass would
+            // otherwise ask for an enormous number of photons.
+            photon_pass: cost.fixed.max(cost.longest / 20.0),
+            photons,
+        }
+    };
+    Ok((plan, None))
+}
+
+/// The budgets of the error curve: `points` times from `budget` / 2^(points - 1) to `budget`,
+/// each twice the one before.
+pub fn curve_budgets(budget: f64, points: u32) -> Vec<f64> {
+    (0..points)
+        .map(|j| budget / 2f64.powi((points - 1 - j) as i32))
+        .collect()
+}
+
+fn errors_text(e: Errors) -> String {
+    format!("rel. MSE {:.4e}, bias {:+.3}%", e.rel_mse, e.bias * 100.0)
+}
+
 pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let mut names: Vec<String> = Vec::new();
     for name in a.integrators.iter().map(|n| n.trim()) {
@@ -246,6 +569,19 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             "--time {t}: expected a positive number of seconds"
         )));
     }
+    if let Some(n) = a.curve {
+        if a.time.is_none() {
+            return Err(Error::Usage(format!(
+                "--curve {n} needs --time S: the curve's budgets are S/2^{}, ..., S/2, S",
+                n - 1
+            )));
+        }
+        if a.reference.is_none() {
+            return Err(Error::Usage(format!(
+                "--curve {n} needs --reference REF: the curve is the error against a reference image (e.g. a long path-traced render of the scene)"
+            )));
+        }
+    }
     let output = a
         .output
         .clone()
@@ -256,8 +592,12 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .map_or_else(|| "compare".into(), |s| s.to_string_lossy().into_owned());
     let exr_of = |name: &str| output.with_file_name(format!("{stem}-{name}.exr"));
     let json_path = output.with_file_name(format!("{stem}.json"));
+    let curve_path = output.with_file_name(format!("{stem}-curve.png"));
     for name in &names {
         check_output(&exr_of(name))?;
+    }
+    if a.curve.is_some() {
+        check_output(&curve_path)?;
     }
     let reference = match &a.reference {
         Some(path) => Some(read_image(path).map_err(|e| match e {
@@ -270,11 +610,8 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         None => None,
     };
 
-    // Every integrator is created before anything renders: a misspelt name or a bad
-    // parameter is reported at once, not after the first render.
-    let mut prepared = Vec::new();
-    let mut warned: Vec<String> = Vec::new();
-    for name in &names {
+    // The scene as the command line sets it for integrator `name`, plus `extra` overrides.
+    let overrides = |name: &str, extra: &[String]| {
         let mut overrides = a.sets.clone();
         overrides.push(format!("render.integrator={name:?}"));
         if let Some(spp) = a.spp {
@@ -283,7 +620,21 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         if let Some(seed) = a.seed {
             overrides.push(format!("render.seed={seed}"));
         }
-        let p = prepare(&a.scene, &overrides, &a.plugins.plugin_dirs, a.strict)?;
+        overrides.extend_from_slice(extra);
+        overrides
+    };
+
+    // Every integrator is created before anything renders: a misspelt name or a bad
+    // parameter is reported at once, not after the first render.
+    let mut prepared = Vec::new();
+    let mut warned: Vec<String> = Vec::new();
+    for name in &names {
+        let p = prepare(
+            &a.scene,
+            &overrides(name, &[]),
+            &a.plugins.plugin_dirs,
+            a.strict,
+        )?;
         for w in &p.warnings {
             if !warned.contains(w) {
                 let _ = writeln!(err, "warning: {w}");
@@ -304,32 +655,89 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
 
     let threads = threads(a.threads);
     INTERRUPTED.store(false, Ordering::SeqCst);
+    let interrupted = |err: &mut dyn Write| {
+        let stop = INTERRUPTED.load(Ordering::SeqCst);
+        if stop {
+            let _ = writeln!(err, "interrupted: nothing written");
+        }
+        stop
+    };
     let mut entries = Vec::new();
     for (name, mut p) in names.iter().zip(prepared) {
-        let mut rendered = None;
-        if let Some(budget) = a.time {
-            p.scene.render.spp = 1;
-            let (_, t1) = render_timed(&p, threads, true, err)?;
-            p.scene.render.spp = 2;
-            let (film, t2) = render_timed(&p, threads, true, err)?;
-            if takes_spp(&film, 2) {
-                p.scene.render.spp = spp_for_budget(budget, t1.as_secs_f64(), t2.as_secs_f64());
-            } else {
-                // Its budget is its own (sppm's iterations or time): more samples per pixel
-                // would not change the image, so the calibration render is the render.
-                let _ = writeln!(
-                    err,
-                    "warning: `{name}` does not take its samples from render.spp, so --time cannot set its budget; give it its own (e.g. --set integrators.{name}.time={budget})"
-                );
-                rendered = Some((film, t2));
-            }
-        }
-        let (film, elapsed) = match rendered {
-            Some(r) => r,
-            None => render_timed(&p, threads, a.quiet, err)?,
+        // The scene with --time's choices for this integrator (warnings were printed above).
+        let prep = |extra: &[String]| {
+            prepare(
+                &a.scene,
+                &overrides(name, extra),
+                &a.plugins.plugin_dirs,
+                a.strict,
+            )
         };
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            let _ = writeln!(err, "interrupted: nothing written");
+        let mut curve = Vec::new();
+        let (p, film, elapsed, settings) = match a.time {
+            None => {
+                let (film, elapsed) = render_timed(&p, threads, a.quiet, err)?;
+                (p, film, elapsed, Vec::new())
+            }
+            Some(budget) => {
+                let (plan, shown) = calibrate(name, &mut p, &prep, budget, threads, err)?;
+                if interrupted(err) {
+                    return Ok(130);
+                }
+                let budgets = match (a.curve, &shown) {
+                    (Some(points), None) => curve_budgets(budget, points),
+                    (Some(_), Some(_)) => {
+                        let _ = writeln!(
+                            err,
+                            "warning: `{name}`: no error curve, --time cannot set its budget"
+                        );
+                        vec![budget]
+                    }
+                    (None, _) => vec![budget],
+                };
+                let mut last = None;
+                for (j, &b) in budgets.iter().enumerate() {
+                    let settings = plan.settings(name, b);
+                    let is_last = j + 1 == budgets.len();
+                    let (q, film, elapsed) = match shown {
+                        Some((ref film, t)) if is_last => (prep(&[])?, film.clone(), t),
+                        _ => {
+                            let q = prep(&settings)?;
+                            let (film, t) = render_timed(&q, threads, a.quiet || !is_last, err)?;
+                            (q, film, t)
+                        }
+                    };
+                    if interrupted(err) {
+                        return Ok(130);
+                    }
+                    if let (Some((_, _, r)), Some(_)) = (&reference, a.curve)
+                        && shown.is_none()
+                    {
+                        let point = Point {
+                            budget: b,
+                            seconds: elapsed.as_secs_f64(),
+                            errors: errors(&film.pixels(), r),
+                            settings: settings.clone(),
+                        };
+                        let _ = writeln!(
+                            out,
+                            "{name}, curve point {} of {} ({b:.3} s budget; {}): {:.2} s, {}",
+                            j + 1,
+                            budgets.len(),
+                            settings.join(" "),
+                            point.seconds,
+                            errors_text(point.errors)
+                        );
+                        curve.push(point);
+                    }
+                    if is_last {
+                        last = Some((q, film, elapsed, settings));
+                    }
+                }
+                last.expect("at least one budget")
+            }
+        };
+        if interrupted(err) {
             return Ok(130);
         }
         let spp = p.scene.render.spp;
@@ -344,25 +752,25 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             description: p.integrator.describe(),
             spp,
             seconds: elapsed.as_secs_f64(),
+            settings,
             film,
             image,
             errors,
+            curve,
         };
         let _ = write!(
             out,
             "{}: {} in {:.2} s -> {}",
             entry.description,
-            spp_text(entry.spp),
+            budget_text(entry.spp, &entry.settings),
             entry.seconds,
             entry.image.display()
         );
+        if !entry.settings.is_empty() {
+            let _ = write!(out, " (--time chose {})", entry.settings.join(" "));
+        }
         if let Some(e) = entry.errors {
-            let _ = write!(
-                out,
-                "; rel. MSE {:.4e}, bias {:+.3}%",
-                e.rel_mse,
-                e.bias * 100.0
-            );
+            let _ = write!(out, "; {}", errors_text(e));
         }
         let _ = writeln!(out);
         entries.push(entry);
@@ -373,7 +781,12 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .map(|e| Tile {
             image: Image::from_film(&e.film),
             label: vec![
-                format!("{}: {}, {:.2} s", e.name, spp_text(e.spp), e.seconds),
+                format!(
+                    "{}: {}, {:.2} s",
+                    e.name,
+                    budget_text(e.spp, &e.settings),
+                    e.seconds
+                ),
                 // Narrow tiles: `k=50` wraps better than `k = 50`.
                 e.description.replace(" = ", "="),
             ],
@@ -400,9 +813,37 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     grid(&tiles, entries.len()).write(&output)?;
     write_atomic(
         &json_path,
-        json(&a.scene, a.reference.as_deref(), &entries).as_bytes(),
+        json(&a.scene, a.reference.as_deref(), a.time, &entries).as_bytes(),
     )?;
-    let _ = writeln!(out, "-> {} and {}", output.display(), json_path.display());
+    if a.curve.is_some() {
+        let series: Vec<Series> = entries
+            .iter()
+            .map(|e| Series {
+                name: e.name.clone(),
+                points: e
+                    .curve
+                    .iter()
+                    .map(|p| (p.seconds, p.errors.rel_mse))
+                    .collect(),
+            })
+            .collect();
+        let scene_name = a
+            .scene
+            .file_name()
+            .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+        let title = format!("{scene_name} {width}x{height}: error against render time");
+        log_log_plot(&title, "render time (seconds)", "relative MSE", &series)
+            .write(&curve_path)?;
+        let _ = writeln!(
+            out,
+            "-> {}, {} and {}",
+            output.display(),
+            curve_path.display(),
+            json_path.display()
+        );
+    } else {
+        let _ = writeln!(out, "-> {} and {}", output.display(), json_path.display());
+    }
     Ok(0)
 }
 
@@ -445,5 +886,61 @@ mod tests {
         assert_eq!(json_number(f64::NAN), "null");
         assert_eq!(json_number(0.0), "0");
         assert_eq!(json_number(0.25), "0.25");
+    }
+
+    #[test]
+    fn photon_budgets_are_read_from_the_description() {
+        assert_eq!(
+            photon_budgets(
+                "photon(global_photons = 200000, caustic_photons = 500000, k = 50, max_radius = 0.17)"
+            ),
+            [
+                ("global_photons".to_string(), 200000),
+                ("caustic_photons".to_string(), 500000)
+            ]
+        );
+        assert!(photon_budgets("path(max_depth = 16, rr_depth = 5)").is_empty());
+        assert!(photon_budgets("sppm(iterations = 64, photons_per_iteration = 100000)").is_empty());
+    }
+
+    #[test]
+    fn photon_budgets_and_samples_grow_with_the_time() {
+        // A photon pass of 0.5 s at the scene's budgets, 0.05 s per sample per pixel: the
+        // scene's budgets belong to 1 s; 10 s gets ten times the photons and 100 spp.
+        let plan = Plan::PhotonsAndSamples {
+            per_sample: 0.05,
+            photon_pass: 0.5,
+            photons: vec![
+                ("global_photons".into(), 200_000),
+                ("caustic_photons".into(), 0),
+            ],
+        };
+        assert_eq!(
+            plan.settings("photon", 10.0),
+            [
+                "render.spp=100",
+                "integrators.photon.global_photons=2000000",
+                "integrators.photon.caustic_photons=0"
+            ]
+        );
+        assert_eq!(
+            plan.settings("photon", 0.01)[..2],
+            ["render.spp=1", "integrators.photon.global_photons=2000"]
+        );
+        let cost = CostModel::from_times(1, 1.125, 1.25);
+        assert_eq!(
+            Plan::Iterations(cost).settings("sppm", 10.0),
+            ["integrators.sppm.iterations=72"]
+        );
+        assert_eq!(
+            Plan::Samples(cost).settings("path", 10.0),
+            ["render.spp=72"]
+        );
+    }
+
+    #[test]
+    fn curve_budgets_double_up_to_the_time() {
+        assert_eq!(curve_budgets(20.0, 5), [1.25, 2.5, 5.0, 10.0, 20.0]);
+        assert_eq!(curve_budgets(1.0, 2), [0.5, 1.0]);
     }
 }

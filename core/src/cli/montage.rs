@@ -242,6 +242,275 @@ pub fn diverging(d: f32) -> Rgb {
     Rgb::new(c(0), c(1), c(2))
 }
 
+// ---------------------------------------------------------------------------------------------
+// A log-log plot of a few series of points (compare's error curve)
+// ---------------------------------------------------------------------------------------------
+
+/// Size of the image `log_log_plot` draws.
+pub const PLOT_WIDTH: u32 = 640;
+pub const PLOT_HEIGHT: u32 = 480;
+/// The plot area inside it: left, top, right, bottom edges (the legend goes right of it).
+const PLOT_AREA: (u32, u32, u32, u32) = (72, 40, 496, 432);
+
+/// The plot area's background (linear; black), its grid lines and its frame.
+const GRID: Rgb = Rgb::splat(0.06);
+const FRAME: Rgb = Rgb::splat(0.35);
+
+/// One named series of (x, y) points, drawn as a polyline with a marker at each point.
+#[derive(Clone, Debug)]
+pub struct Series {
+    pub name: String,
+    pub points: Vec<(f64, f64)>,
+}
+
+/// Okabe and Ito's colour-blind-safe palette (sRGB bytes), in series order: orange, sky blue,
+/// bluish green, yellow, blue, vermillion, reddish purple.
+const PALETTE: [[u8; 3]; 7] = [
+    [230, 159, 0],
+    [86, 180, 233],
+    [0, 158, 115],
+    [240, 228, 66],
+    [0, 114, 178],
+    [213, 94, 0],
+    [204, 121, 167],
+];
+
+/// The colour of series `i` (linear, for the display transform of `Image::write`).
+pub fn series_colour(i: usize) -> Rgb {
+    let c = PALETTE[i % PALETTE.len()];
+    let d = |b: u8| srgb_decode(b as f32 / 255.0);
+    Rgb::new(d(c[0]), d(c[1]), d(c[2]))
+}
+
+/// The k-th value of the 1-2-5 sequence: ..., 0.5, 1, 2, 5, 10, 20, ... (k = 0 is 1).
+fn one_two_five(k: i32) -> f64 {
+    [1.0, 2.0, 5.0][k.rem_euclid(3) as usize] * 10f64.powi(k.div_euclid(3))
+}
+
+/// The index of the largest 1-2-5 value not above `x` (> 0), up to rounding.
+fn one_two_five_below(x: f64) -> i32 {
+    let x = x * (1.0 + 1e-9);
+    let e = x.log10().floor() as i32;
+    let m = x / 10f64.powi(e);
+    3 * e + if m >= 5.0 { 2 } else { i32::from(m >= 2.0) }
+}
+
+/// The ticks of a logarithmic axis covering [lo, hi] (0 < lo <= hi): the axis runs from the
+/// 1-2-5 value at or below `lo` to the one at or above `hi` (one step either side if they
+/// meet), ticked at every 1-2-5 value; over more than 10 ticks, at the powers of ten only (and
+/// every other one, and so on, until at most 10 are left). Returns (axis lo, axis hi, ticks).
+pub fn log_ticks(lo: f64, hi: f64) -> (f64, f64, Vec<f64>) {
+    let mut a = one_two_five_below(lo);
+    let mut b = one_two_five_below(hi);
+    if one_two_five(b) < hi * (1.0 - 1e-9) {
+        b += 1;
+    }
+    if a == b {
+        a -= 1;
+        b += 1;
+    }
+    if b - a < 10 {
+        return (
+            one_two_five(a),
+            one_two_five(b),
+            (a..=b).map(one_two_five).collect(),
+        );
+    }
+    let (lo_e, hi_e) = (a.div_euclid(3), (b + 2).div_euclid(3));
+    let stride = ((hi_e - lo_e) as usize).div_ceil(9).max(1);
+    let ticks = (lo_e..=hi_e)
+        .step_by(stride)
+        .map(|e| 10f64.powi(e))
+        .collect();
+    (10f64.powi(lo_e), 10f64.powi(hi_e), ticks)
+}
+
+/// A tick label: plain decimals from 0.01 to 9999 ("0.05", "2", "500"), else "2e-3", "1e5".
+pub fn tick_label(v: f64) -> String {
+    let e = (v * (1.0 + 1e-9)).log10().floor() as i32;
+    if (-2..4).contains(&e) {
+        format!("{:.*}", (-e).max(0) as usize, v)
+    } else {
+        format!("{}e{e}", (v / 10f64.powi(e)).round())
+    }
+}
+
+impl Image {
+    /// A line from (x0, y0) to (x1, y1), `width` pixels thick, kept inside `clip` (left, top,
+    /// right, bottom).
+    fn line(
+        &mut self,
+        from: (f64, f64),
+        to: (f64, f64),
+        width: u32,
+        c: Rgb,
+        clip: (u32, u32, u32, u32),
+    ) {
+        let steps = ((to.0 - from.0).abs().max((to.1 - from.1).abs()) * 2.0)
+            .ceil()
+            .max(1.0) as u32;
+        let half = (width as f64 - 1.0) / 2.0;
+        for i in 0..=steps {
+            let t = i as f64 / steps as f64;
+            let x = from.0 + (to.0 - from.0) * t - half;
+            let y = from.1 + (to.1 - from.1) * t - half;
+            for dy in 0..width {
+                for dx in 0..width {
+                    let (px, py) = (
+                        (x + dx as f64).round() as i64,
+                        (y + dy as f64).round() as i64,
+                    );
+                    if px >= clip.0 as i64
+                        && py >= clip.1 as i64
+                        && px <= clip.2 as i64
+                        && py <= clip.3 as i64
+                    {
+                        self.put(px, py, c);
+                    }
+                }
+            }
+        }
+    }
+
+    /// A filled marker 9 pixels across centred on (x, y): square, disc, diamond or triangle
+    /// for shapes 0, 1, 2, 3 (and so on, cyclically).
+    fn marker(&mut self, x: f64, y: f64, shape: usize, c: Rgb) {
+        let (cx, cy) = (x.round() as i64, y.round() as i64);
+        for dy in -4i64..=4 {
+            for dx in -4i64..=4 {
+                let inside = match shape % 4 {
+                    0 => dx.abs() <= 3 && dy.abs() <= 3,
+                    1 => dx * dx + dy * dy <= 17,
+                    2 => dx.abs() + dy.abs() <= 4,
+                    // Apex at the top: the half-width grows by one every two rows.
+                    _ => (-4..=3).contains(&dy) && 2 * dx.abs() <= dy + 4,
+                };
+                if inside {
+                    self.put(cx + dx, cy + dy, c);
+                }
+            }
+        }
+    }
+}
+
+/// A log-log plot, `PLOT_WIDTH` x `PLOT_HEIGHT`: each series a polyline in its colour
+/// (`series_colour`) with a marker at each point (`marker` shapes in turn), over a grid at the
+/// ticks of `log_ticks` on both axes, labelled with `tick_label`; `title` above, `x_label`
+/// under the x axis, `y_label` above the y axis, and a legend (marker, line and name of each
+/// series) right of the plot. Points with a coordinate that is not a positive number are left
+/// out (a series' line joins the points that are left). White text on dark grey, the plot area
+/// black, as the labels of `grid`.
+pub fn log_log_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Image {
+    let mut img = Image::new(PLOT_WIDTH, PLOT_HEIGHT, BAND);
+    let (left, top, right, bottom) = PLOT_AREA;
+    img.fill_rect(left, top, right - left + 1, bottom - top + 1, BACKGROUND);
+
+    let plotted: Vec<Vec<(f64, f64)>> = series
+        .iter()
+        .map(|s| {
+            s.points
+                .iter()
+                .copied()
+                .filter(|&(x, y)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite())
+                .collect()
+        })
+        .collect();
+    let all = || plotted.iter().flatten();
+    let range = |coord: fn(&(f64, f64)) -> f64| {
+        let lo = all().map(coord).fold(f64::INFINITY, f64::min);
+        let hi = all().map(coord).fold(0.0, f64::max);
+        if lo.is_finite() {
+            (lo, hi)
+        } else {
+            (1.0, 10.0)
+        }
+    };
+    let (x_lo, x_hi, x_ticks) = {
+        let (lo, hi) = range(|p| p.0);
+        log_ticks(lo, hi)
+    };
+    let (y_lo, y_hi, y_ticks) = {
+        let (lo, hi) = range(|p| p.1);
+        log_ticks(lo, hi)
+    };
+    let to_px = |x: f64, y: f64| {
+        let tx = (x / x_lo).ln() / (x_hi / x_lo).ln();
+        let ty = (y / y_lo).ln() / (y_hi / y_lo).ln();
+        (
+            left as f64 + tx * (right - left) as f64,
+            bottom as f64 - ty * (bottom - top) as f64,
+        )
+    };
+
+    // Grid and tick labels.
+    let all_area = (0, 0, PLOT_WIDTH - 1, PLOT_HEIGHT - 1);
+    for &t in &x_ticks {
+        let (x, _) = to_px(t, y_lo);
+        img.line((x, top as f64), (x, bottom as f64), 1, GRID, all_area);
+        let label = tick_label(t);
+        let w = label.len() as f64 * GLYPH as f64;
+        let lx = (x - w / 2.0).clamp(0.0, (PLOT_WIDTH as f64 - w).max(0.0)) as u32;
+        draw_text(&mut img, lx, bottom + 6, PLOT_WIDTH, &label, 1);
+    }
+    for &t in &y_ticks {
+        let (_, y) = to_px(x_lo, t);
+        img.line((left as f64, y), (right as f64, y), 1, GRID, all_area);
+        let label = tick_label(t);
+        let lx = left.saturating_sub(6 + label.len() as u32 * GLYPH);
+        draw_text(&mut img, lx, (y - 4.0).max(0.0) as u32, left, &label, 1);
+    }
+    for (from, to) in [
+        ((left, top), (right, top)),
+        ((right, top), (right, bottom)),
+        ((right, bottom), (left, bottom)),
+        ((left, bottom), (left, top)),
+    ] {
+        let f = |p: (u32, u32)| (p.0 as f64, p.1 as f64);
+        img.line(f(from), f(to), 1, FRAME, all_area);
+    }
+
+    // Titles.
+    draw_text(&mut img, PAD * 2, 10, PLOT_WIDTH, title, 1);
+    draw_text(&mut img, PAD * 2, top - 14, PLOT_WIDTH, y_label, 1);
+    let w = x_label.len() as u32 * GLYPH;
+    let x = (left + right).saturating_sub(w) / 2;
+    draw_text(&mut img, x, bottom + 24, PLOT_WIDTH, x_label, 1);
+
+    // The series, then the legend.
+    let area = (left, top, right, bottom);
+    for (i, points) in plotted.iter().enumerate() {
+        let c = series_colour(i);
+        for pair in points.windows(2) {
+            img.line(
+                to_px(pair[0].0, pair[0].1),
+                to_px(pair[1].0, pair[1].1),
+                2,
+                c,
+                area,
+            );
+        }
+        for &(x, y) in points {
+            let (px, py) = to_px(x, y);
+            img.marker(px, py, i, c);
+        }
+    }
+    for (i, s) in series.iter().enumerate() {
+        let c = series_colour(i);
+        let y = top + 8 + i as u32 * 20;
+        let x = right + 16;
+        img.line(
+            (x as f64, y as f64),
+            ((x + 24) as f64, y as f64),
+            2,
+            c,
+            all_area,
+        );
+        img.marker((x + 12) as f64, y as f64, i, c);
+        draw_text(&mut img, x + 32, y - 4, PLOT_WIDTH, &s.name, 1);
+    }
+    img
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -298,5 +567,48 @@ mod tests {
         assert!(above.x > above.z);
         assert_eq!(diverging(3.0), diverging(1.0));
         assert_eq!(diverging(f32::NAN), Rgb::ZERO);
+    }
+
+    #[test]
+    fn log_ticks_follow_one_two_five_and_cover_the_range() {
+        let (lo, hi, ticks) = log_ticks(0.3, 7.0);
+        assert_eq!((lo, hi), (0.2, 10.0));
+        assert_eq!(ticks, [0.2, 0.5, 1.0, 2.0, 5.0, 10.0]);
+        // Values on the sequence are their own ends; a single value gets a step either side.
+        assert_eq!(log_ticks(1.0, 20.0).2, [1.0, 2.0, 5.0, 10.0, 20.0]);
+        assert_eq!(log_ticks(2.0, 2.0).2, [1.0, 2.0, 5.0]);
+        // Six decades: powers of ten only.
+        let (lo, hi, ticks) = log_ticks(3e-5, 0.4);
+        assert_eq!((lo, hi), (1e-5, 1.0));
+        assert_eq!(ticks.len(), 6);
+        let labels: Vec<String> = [1e-5, 2e-3, 0.01, 0.05, 1.0, 20.0, 500.0, 1e4]
+            .iter()
+            .map(|&v| tick_label(v))
+            .collect();
+        assert_eq!(
+            labels,
+            ["1e-5", "2e-3", "0.01", "0.05", "1", "20", "500", "1e4"]
+        );
+    }
+
+    #[test]
+    fn plot_has_its_size_and_draws_each_series_in_its_colour() {
+        let series = [
+            Series {
+                name: "path".into(),
+                points: vec![(0.5, 0.2), (1.0, 0.1), (2.0, 0.05)],
+            },
+            Series {
+                name: "photon".into(),
+                // A point at zero error cannot be drawn on a log axis: left out.
+                points: vec![(0.6, 0.03), (1.1, 0.0), (2.1, 0.02)],
+            },
+        ];
+        let img = log_log_plot("title", "seconds", "rel. MSE", &series);
+        assert_eq!((img.width, img.height), (PLOT_WIDTH, PLOT_HEIGHT));
+        let count = |c: Rgb| img.pixels.iter().filter(|&&p| p == c).count();
+        assert!(count(series_colour(0)) > 100 && count(series_colour(1)) > 100);
+        assert!(count(INK) > 100, "text");
+        assert_ne!(series_colour(0), series_colour(1));
     }
 }
