@@ -503,8 +503,11 @@ fn set_without_a_value_is_refused() {
 #[test]
 fn unknown_map_is_refused() {
     let (dir, scene) = setup("bad-map");
-    let run = foton_with_plugins(&["photons", s(&scene), "--map", "volume"]);
-    fails_with(&run, &["invalid value 'volume'", "global", "caustic"]);
+    let run = foton_with_plugins(&["photons", s(&scene), "--map", "direct"]);
+    fails_with(
+        &run,
+        &["invalid value 'direct'", "global", "caustic", "volume"],
+    );
     let _ = std::fs::remove_dir_all(dir);
 }
 
