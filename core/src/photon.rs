@@ -559,7 +559,11 @@ mod tests {
             let (t_max, radius) = (0.2 + rng.next_f32(), 0.01 + 0.05 * rng.next_f32());
             let mut got = Vec::new();
             map.along_ray(origin, dir, t_max, radius, |_, p, t, d2| {
-                got.push((p.position.to_array().map(f32::to_bits), t.to_bits(), d2.to_bits()))
+                got.push((
+                    p.position.to_array().map(f32::to_bits),
+                    t.to_bits(),
+                    d2.to_bits(),
+                ))
             });
             let mut want: Vec<_> = all
                 .iter()
