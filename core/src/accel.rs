@@ -94,4 +94,26 @@ impl Accel {
             }
         });
     }
+
+    /// Offers `visit` every primitive whose box the ray crosses within (0, tmax), in no
+    /// particular order, until it returns true; returns whether it did. (A shadow ray that
+    /// must both find blockers and collect what it passes.)
+    pub fn visit(
+        &self,
+        ray: &Ray,
+        tmax: f32,
+        mut visit: impl FnMut(u32, &Primitive) -> bool,
+    ) -> bool {
+        let Some(bvh) = self.bvh.as_ref() else {
+            return false;
+        };
+        let bray = BvhRay::new(ray.origin.into(), ray.dir.into(), 0.0, tmax);
+        !bvh.ray_traverse_miss(bray, |_, id| {
+            if visit(id as u32, &self.prims[id]) {
+                0.0
+            } else {
+                f32::INFINITY
+            }
+        })
+    }
 }

@@ -95,6 +95,9 @@ pub struct Scene {
     pub camera_medium: Option<u32>,
     /// The objects that bound volumes, for [`Scene::medium_at`].
     volumes: Vec<Volume>,
+    /// Per object: a volume whose bounding box meets no other volume's, so that no other
+    /// boundary can coincide with it and crossing it needs no search for coincident ones.
+    alone: Vec<bool>,
     /// Axis-aligned bounds of all geometry and point lights.
     pub bounds: (Vec3, Vec3),
     /// The parsed document (integrators read their `[integrators.NAME]` table from it).
@@ -231,10 +234,14 @@ impl Scene {
 
         let accel = Accel::build(prims);
         let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
-        let (interfaces, volumes) = if uses_media {
+        let (interfaces, volumes, alone) = if uses_media {
             medium_interfaces(&objects, &materials, &accel, medium)
         } else {
-            (vec![None; objects.len()], Vec::new())
+            (
+                vec![None; objects.len()],
+                Vec::new(),
+                vec![false; objects.len()],
+            )
         };
         let mut camera_medium = None;
         if uses_media {
@@ -275,6 +282,7 @@ impl Scene {
             medium,
             interfaces,
             volumes,
+            alone,
             camera_medium,
             bounds: (lo, hi),
             document: doc,
@@ -367,6 +375,13 @@ impl Scene {
         let Some(own) = self.interfaces[object] else {
             return current;
         };
+        if self.alone[object] {
+            return if hit.ng.dot(dir) < 0.0 {
+                own.inside
+            } else {
+                own.outside
+            };
+        }
         let eps = 1e-4 * (1.0 + hit.p.abs().max_element());
         let probe = Ray::new(hit.p - dir * eps, dir);
         let mut entered: Option<MediumInterface> = None;
@@ -426,12 +441,83 @@ impl Scene {
         } else {
             offset_origin(p1, n1, -d)
         };
-        // Distances are measured between the crossing points themselves, not the offset
-        // origins, so that the offsets do not shorten the path through the media.
-        let tr_over = |medium: Option<u32>, d: f32| match medium {
+        let seg = to - from;
+        let dist = seg.length();
+        if dist <= 0.0 || seg.dot(d) <= 0.0 {
+            return self.transmittance_over(medium, p0.distance(p1));
+        }
+        // One traversal of the segment: it stops at the first blocker, and collects the null
+        // boundaries crossed (a sphere may be crossed twice); they are then walked in order.
+        let ray = Ray::new(from, seg / dist);
+        let mut crossings = [(0.0f32, 0u32); MAX_COLLECTED_CROSSINGS];
+        let mut n = 0;
+        let mut overflow = false;
+        let blocked = self.accel.visit(&ray, dist, |i, prim| {
+            let material = &self.materials[self.objects[prim.object as usize].material as usize];
+            if !material.value.is_null() {
+                return prim.shape.intersect(&ray, dist).is_some();
+            }
+            for t in segment_crossings(&prim.shape, &ray, dist)
+                .into_iter()
+                .flatten()
+            {
+                if n < crossings.len() {
+                    crossings[n] = (t, i);
+                    n += 1;
+                } else {
+                    overflow = true;
+                }
+            }
+            false
+        });
+        if blocked {
+            return Rgb::ZERO;
+        }
+        if overflow {
+            return self.transmittance_walk(p0, p1, from, to, medium);
+        }
+        let crossings = &mut crossings[..n];
+        crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let prims = self.accel.primitives();
+        let mut tr = Rgb::ONE;
+        let mut medium = medium;
+        // Distances are measured from the end points themselves, not the offset origins.
+        let mut last = p0;
+        for &(t, i) in crossings.iter() {
+            let p = ray.at(t);
+            tr *= self.transmittance_over(medium, p.distance(last));
+            last = p;
+            let hit = Hit {
+                t,
+                p,
+                ng: prims[i as usize].shape.normal(p),
+                prim: i,
+            };
+            medium = self.medium_after(&hit, ray.dir, medium);
+        }
+        tr * self.transmittance_over(medium, p1.distance(last))
+    }
+
+    /// exp(-sigma_t d) in `medium` (one in vacuum).
+    fn transmittance_over(&self, medium: Option<u32>, d: f32) -> Rgb {
+        match medium {
             Some(m) => self.media[m as usize].value.transmittance_over(d),
             None => Rgb::ONE,
-        };
+        }
+    }
+
+    /// [`Scene::transmittance`] by closest hits, one boundary after another: for segments
+    /// that cross more boundaries than one traversal collects.
+    fn transmittance_walk(
+        &self,
+        p0: Vec3,
+        p1: Vec3,
+        from: Vec3,
+        to: Vec3,
+        medium: Option<u32>,
+    ) -> Rgb {
+        let d = p1 - p0;
+        let tr_over = |medium: Option<u32>, d: f32| self.transmittance_over(medium, d);
         let mut tr = Rgb::ONE;
         let mut medium = medium;
         let mut origin = from;
@@ -528,6 +614,35 @@ struct Volume {
 /// Null boundaries a shadow ray may cross before it is taken as blocked (guards against rays
 /// stuck on coincident boundaries).
 const MAX_BOUNDARY_CROSSINGS: u32 = 256;
+
+/// Null-boundary crossings one traversal of a shadow ray collects; more, and it walks them
+/// one closest hit at a time.
+const MAX_COLLECTED_CROSSINGS: usize = 16;
+
+/// Where a ray crosses a shape within (0, tmax): both roots of a sphere, the one point of a
+/// quad or triangle.
+fn segment_crossings(shape: &Shape, ray: &Ray, tmax: f32) -> [Option<f32>; 2] {
+    match *shape {
+        Shape::Sphere { center, radius } => {
+            // As Shape::intersect (Ray Tracing Gems ch. 7), keeping both roots.
+            let f = ray.origin - center;
+            let b = -f.dot(ray.dir);
+            let l = f + b * ray.dir;
+            let disc = radius * radius - l.dot(l);
+            if disc < 0.0 {
+                return [None, None];
+            }
+            let c = f.dot(f) - radius * radius;
+            let q = b + b.signum() * disc.sqrt();
+            if q == 0.0 {
+                return [None, None];
+            }
+            let inside = |t: f32| (t > 0.0 && t < tmax).then_some(t);
+            [inside(c / q), inside(q)]
+        }
+        _ => [shape.intersect(ray, tmax), None],
+    }
+}
 
 /// Directions of the rays that decide whether a point is inside a closed shape: five, not
 /// aligned with the axes (axis-aligned rays run along the edges and faces of boxes).
@@ -650,7 +765,7 @@ fn medium_interfaces(
     materials: &[Named<Material>],
     accel: &Accel,
     scene_medium: Option<u32>,
-) -> (Vec<Option<MediumInterface>>, Vec<Volume>) {
+) -> (Vec<Option<MediumInterface>>, Vec<Volume>, Vec<bool>) {
     let mut index = vec![None; objects.len()];
     let mut volumes: Vec<Volume> = Vec::new();
     for (i, o) in objects.iter().enumerate() {
@@ -700,7 +815,15 @@ fn medium_interfaces(
             depth: depth[k],
         });
     }
-    (out, volumes)
+    let mut alone = vec![false; objects.len()];
+    let pad = |v: &Volume| 1e-3 * (1.0 + v.lo.abs().max(v.hi.abs()).max_element());
+    for (k, v) in volumes.iter().enumerate() {
+        alone[v.object as usize] = volumes.iter().enumerate().all(|(c, w)| {
+            let e = pad(v).max(pad(w));
+            c == k || (v.lo - e).cmpgt(w.hi).any() || (w.lo - e).cmpgt(v.hi).any()
+        });
+    }
+    (out, volumes, alone)
 }
 
 /// See [`Scene::medium_at`].
