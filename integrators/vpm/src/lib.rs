@@ -297,7 +297,7 @@ impl Vpm {
     ) -> Rgb {
         // A march point is a scattering event: the light paths through it have one event
         // more than the camera path before it.
-        if bounces >= self.max_depth || !(t_end > 0.0) {
+        if bounces >= self.max_depth || t_end.is_nan() || t_end <= 0.0 {
             return Rgb::ZERO;
         }
         let depth = self.max_depth - bounces;
@@ -341,7 +341,7 @@ impl Vpm {
     /// The beam radiance estimate of the in-scattering integral along `ray` from 0 to
     /// `t_end` in medium `m`.
     fn beam(&self, maps: &Maps, m: &Homogeneous, ray: &Ray, t_end: f32, bounces: u32) -> Rgb {
-        if bounces >= self.max_depth || !(t_end > 0.0) || maps.volume.is_empty() {
+        if bounces >= self.max_depth || t_end.is_nan() || t_end <= 0.0 || maps.volume.is_empty() {
             return Rgb::ZERO;
         }
         let depth = self.max_depth - bounces;
