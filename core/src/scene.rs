@@ -595,9 +595,11 @@ impl Scene {
         self.lights.iter().map(|l| l.power()).sum()
     }
 
-    /// Whether any participating medium is used.
+    /// Whether any participating medium is used. Cheap (every shadow ray asks): a shape with
+    /// an `interior` is closed, so it is among the volumes, which exist only when media do.
+    #[inline]
     pub fn has_media(&self) -> bool {
-        self.medium.is_some() || self.objects.iter().any(|o| o.interior.is_some())
+        self.medium.is_some() || !self.volumes.is_empty()
     }
 }
 
