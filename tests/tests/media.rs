@@ -253,12 +253,11 @@ fn camera_inside_a_nested_medium_starts_there() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
-/// A 4x4 image of a Lambertian emitter (radiance `le`) at z = -1 seen through a slab of an
-/// absorbing medium z in [-0.25, 0.25] from z = 5, `max_depth` 0 (emission only).
-#[test]
-fn rendered_transmittance_through_an_absorbing_slab() {
-    let sigma_a = Vec3::new(0.5, 2.0, 4.0);
-    let toml = format!(
+/// A 4x4 image, `max_depth` 0 (emission only), of an emitter of radiance [1, 2, 3] at z = -1
+/// seen from z = 5 through slabs of absorbing media ((sigma_a, z0, z1), each a closed box
+/// behind a null boundary); asserts that the image is Le exp(-sum sigma_a d) per channel.
+fn assert_rendered_transmittance(name: &str, slabs: &[(Vec3, f32, f32)]) {
+    let mut toml = format!(
         r#"{}
 [camera]
 position = [0.0, 0.0, 5.0]
@@ -272,16 +271,6 @@ type = "null"
 type = "diffuse"
 reflectance = [0.0, 0.0, 0.0]
 
-[media.ink]
-type = "homogeneous"
-sigma_a = [{}, {}, {}]
-
-[[shapes]]
-type = "mesh"
-file = "slab.obj"
-material = "boundary"
-interior = "ink"
-
 [[shapes]]
 type = "quad"
 origin = [-10.0, -10.0, -1.0]
@@ -290,33 +279,65 @@ v = [0.0, 20.0, 0.0]
 material = "black"
 emission = [1.0, 2.0, 3.0]
 "#,
-        header("path", 256, 0, 4, 4),
-        sigma_a.x,
-        sigma_a.y,
-        sigma_a.z
+        header("path", 256, 0, 4, 4)
     );
-    let slab = [(
-        "slab.obj",
-        Vec3::new(-5.0, -5.0, -0.25),
-        Vec3::new(5.0, 5.0, 0.25),
-    )];
-    let (dir, path) = scene_dir("media-slab-render", &toml, &slab);
+    let mut boxes = Vec::new();
+    let mut files = Vec::new();
+    let mut optical_depth = Vec3::ZERO;
+    for (k, &(sigma_a, z0, z1)) in slabs.iter().enumerate() {
+        toml += &format!(
+            "[media.m{k}]\ntype = \"homogeneous\"\nsigma_a = [{}, {}, {}]\n[[shapes]]\ntype = \"mesh\"\nfile = \"slab{k}.obj\"\nmaterial = \"boundary\"\ninterior = \"m{k}\"\n",
+            sigma_a.x, sigma_a.y, sigma_a.z
+        );
+        files.push(format!("slab{k}.obj"));
+        boxes.push((Vec3::new(-5.0, -5.0, z0), Vec3::new(5.0, 5.0, z1)));
+        optical_depth += sigma_a * (z1 - z0);
+    }
+    let boxes: Vec<(&str, Vec3, Vec3)> = files
+        .iter()
+        .zip(&boxes)
+        .map(|(f, &(lo, hi))| (f.as_str(), lo, hi))
+        .collect();
+    let (dir, path) = scene_dir(name, &toml, &boxes);
     let film = render_file(&path, &[], 2);
-    let want = Rgb::new(1.0, 2.0, 3.0) * exp_rgb(-0.5 * sigma_a);
-    // A sample passes with probability P = P(pass) and then carries Le Tr / P, else nothing
-    // (the medium does not scatter): the standard error of the mean of n samples is
-    // Le Tr / P sqrt(P (1 - P) / n). 4 standard errors.
+    let want = Rgb::new(1.0, 2.0, 3.0) * exp_rgb(-optical_depth);
+    // A sample passes with probability P (the mean over the hero channels of their
+    // transmittance) and then carries Le Tr / P, else nothing (the media do not scatter): the
+    // standard error of the mean of n samples is Le Tr / P sqrt(P (1 - P) / n).
     let mean = film.mean();
-    let p = foton_core::medium::free_flight_pass_probability(sigma_a, 0.5);
+    let p = foton_core::medium::free_flight_pass_probability(optical_depth, 1.0);
     let n = 16.0 * 256.0;
     let err = want / p * (p * (1.0 - p) / n).sqrt();
     for c in 0..3 {
         assert!(
             (mean[c] - want[c]).abs() < 4.0 * err[c] + 1e-6,
-            "channel {c}: {mean} +- {err}, expected {want}"
+            "{name}: channel {c}: {mean} +- {err}, expected {want}"
         );
     }
     let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn rendered_transmittance_through_an_absorbing_slab() {
+    assert_rendered_transmittance(
+        "media-slab-render",
+        &[(Vec3::new(0.5, 2.0, 4.0), -0.25, 0.25)],
+    );
+}
+
+#[test]
+fn rendered_transmittance_through_touching_volumes() {
+    // Three slabs touching at z = 0 and z = 0.3: the camera ray crosses their shared faces,
+    // where whichever of the two coincident boundaries it hits first, it must enter the next
+    // slab, not vacuum.
+    assert_rendered_transmittance(
+        "media-touching-render",
+        &[
+            (Vec3::new(0.5, 2.0, 4.0), -0.25, 0.0),
+            (Vec3::new(3.0, 0.2, 0.0), 0.0, 0.3),
+            (Vec3::new(1.0, 1.0, 1.0), 0.3, 0.5),
+        ],
+    );
 }
 
 /// The HG phase function (or isotropic for g = 0) in f64, independently of the core's.
