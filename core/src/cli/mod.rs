@@ -79,12 +79,13 @@ enum Command {
     /// parameters, and written beside the output as <output stem>-<integrator>.exr; the numbers
     /// go to <output stem>.json (name, description, spp, seconds, rel_mse, bias, image).
     ///
-    /// --time S: each integrator renders at 1 and then 2 spp to measure a fixed cost (a photon
-    /// pass) and a per-sample cost, and then at the spp that fills S seconds (the per-sample
-    /// cost is taken within [t2/20, t2/2] against timer noise). The chosen spp is printed; a
-    /// render with --spp set to it gives the same image. An integrator with a budget of its own
-    /// (sppm: iterations or time) ignores render.spp: it renders as configured, with a warning,
-    /// and its spp is reported as null (give it --set integrators.sppm.time=S).
+    /// --time S: each integrator gets about S seconds, found by short calibration renders that
+    /// measure a fixed cost (a photon pass) and a per-step cost: path-like integrators get the
+    /// spp that fills S; progressive ones (sppm) the number of iterations (their spp is
+    /// reported as null); photon mappers (photon, vpm) their photon budgets scaled with S and
+    /// the spp that fills the rest. The chosen values are printed and written to the JSON as
+    /// --set overrides, so `foton render` with them gives the same image. --curve N also
+    /// renders at S/2^(N-1), ..., S/2 and plots the error against the time (docs/tools.md).
     ///
     /// --reference IMAGE: a second row shows each render's relative difference from the
     /// reference, per pixel (x - r) / sqrt(r^2 + 0.01) of the channel means, in a diverging
