@@ -71,16 +71,20 @@ impl PathTracer {
         let mut medium = scene.camera_medium;
         // Spectral MIS over the whole path, chosen at the first medium the path meets.
         let mut hero: Option<HeroChannel> = None;
+        // How far the ray's origin lies past the null boundary it just crossed, along the ray:
+        // that piece of the medium is sampled too (as if the ray started on the boundary).
+        let mut next_gap = 0.0f32;
 
         loop {
             *rays += 1;
             let hit = scene.intersect(&ray, f32::INFINITY);
+            let gap = std::mem::take(&mut next_gap);
 
             // ---- Medium: free flight to a scattering event or to the surface ----
             if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
                 && !m.is_vacuum()
             {
-                let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+                let tmax = hit.map_or(f32::INFINITY, |h| h.t + gap);
                 let hero = hero.get_or_insert_with(|| HeroChannel::new(sampler.next_f32()));
                 let flight = m.sample_free_flight(tmax, hero.channel, sampler.next_f32());
                 beta *= hero.update(&flight);
@@ -92,7 +96,7 @@ impl PathTracer {
                     if depth >= self.max_depth {
                         break;
                     }
-                    let x = ray.at(flight.t);
+                    let x = ray.at(flight.t - gap);
                     let phase = m.phase;
 
                     // ---- Emitter sampling from the medium ----
@@ -147,7 +151,12 @@ impl PathTracer {
                     break;
                 }
                 medium = scene.medium_after(&hit, ray.dir, medium);
-                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
+                let origin = offset_origin(hit.p, hit.ng, ray.dir);
+                // The origin is offset along the normal; back along the ray to the boundary's
+                // plane is offset / |cos| (bounded, for grazing rays, by 10 offsets).
+                let offset = (origin - hit.p).length();
+                next_gap = offset / hit.ng.dot(ray.dir).abs().max(0.1);
+                ray = Ray::new(origin, ray.dir);
                 continue;
             }
             crossings = 0;
