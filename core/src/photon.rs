@@ -441,14 +441,42 @@ impl PhotonMap {
         }
     }
 
-    /// Irradiance at a surface point: sum of photon power times the surface kernel over the
-    /// k nearest photons (within `max_radius`) stored on the same side of the same surface
-    /// whose paths have at most `max_depth` scattering events.
+    /// The k-nearest density estimate shared by surfaces and volumes: the sum of
+    /// `contribution(photon, d, r)` over the k nearest photons (within `max_radius`) that
+    /// `accept` takes, r the distance to the k-th.
     ///
-    /// The radius r is the distance to the k-th photon; that photon lies on the boundary of
-    /// the disc, so only the k - 1 inside are summed (for a uniform density the expected
-    /// count inside the disc of the k-th neighbour is k - 1). When fewer than k photons lie
-    /// within `max_radius`, r = `max_radius` and all of them are summed.
+    /// That photon lies on the boundary of the disc (ball) of radius r, so only the k - 1
+    /// inside are summed (for a uniform density the expected count inside the k-th
+    /// neighbour's radius is k - 1). When fewer than k photons lie within `max_radius`,
+    /// r = `max_radius` and all of them are summed.
+    fn knn_estimate(
+        &self,
+        p: Vec3,
+        estimate: &Estimate<'_>,
+        accept: impl Fn(&Photon) -> bool,
+        scratch: &mut Vec<Neighbour>,
+        contribution: impl Fn(&Photon, f32, f32) -> Rgb,
+    ) -> Rgb {
+        let k = estimate.k;
+        let r2 = self.knn(p, k, estimate.max_radius, accept, scratch);
+        if scratch.is_empty() {
+            return Rgb::ZERO;
+        }
+        let r = r2.sqrt();
+        let full = scratch.len() == k;
+        let mut sum = Rgb::ZERO;
+        for nb in scratch.iter() {
+            if full && nb.d2 >= r2 {
+                continue; // the k-th photon, on the boundary
+            }
+            sum += contribution(&self.photons[nb.index as usize], nb.d2.sqrt(), r);
+        }
+        sum
+    }
+
+    /// Irradiance at a surface point: sum of photon power times the surface kernel K2 over
+    /// the k nearest photons (see `knn_estimate`) stored on the same side of the same surface
+    /// whose paths have at most `max_depth` scattering events.
     pub fn irradiance(
         &self,
         p: Vec3,
@@ -457,43 +485,21 @@ impl PhotonMap {
         estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
-        let Estimate {
-            k,
-            max_radius,
-            kernel,
-        } = *estimate;
-        let r2 = self.knn(
+        self.knn_estimate(
             p,
-            k,
-            max_radius,
+            estimate,
             |ph| ph.depth() <= max_depth && ph.normal().dot(n) > 0.9,
             scratch,
-        );
-        if scratch.is_empty() {
-            return Rgb::ZERO;
-        }
-        let r = r2.sqrt();
-        let full = scratch.len() == k;
-        let mut e = Rgb::ZERO;
-        for nb in scratch.iter() {
-            if full && nb.d2 >= r2 {
-                continue; // the k-th photon, on the boundary
-            }
-            let ph = &self.photons[nb.index as usize];
-            e += ph.power() * kernel.weight_2d(nb.d2.sqrt(), r);
-        }
-        e
+            |ph, d, r| ph.power() * estimate.kernel.weight_2d(d, r),
+        )
     }
-}
 
-impl PhotonMap {
     /// In-scattered radiance at a point in a medium towards the camera, sigma_s times the
     /// integral of phase times incident radiance (Jensen and Christensen 1998): the sum over
-    /// the k nearest volume photons (within `max_radius`, of at most `max_depth` scattering
-    /// events) of p(theta) Phi_p K3(d_p, r), with K3 normalised over the ball and, as on
-    /// surfaces, the k-th photon only setting the radius. `dir` is the camera ray's direction
-    /// (light leaves towards -dir). Stored flux already carries sigma_s / sigma_t, so no
-    /// coefficient appears here.
+    /// the k nearest volume photons (see `knn_estimate`; of at most `max_depth` scattering
+    /// events) of p(theta) Phi_p K3(d_p, r), K3 normalised over the ball. `dir` is the camera
+    /// ray's direction (light leaves towards -dir). Stored flux already carries
+    /// sigma_s / sigma_t, so no coefficient appears here.
     pub fn in_scattered(
         &self,
         p: Vec3,
@@ -503,28 +509,16 @@ impl PhotonMap {
         estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
-        let Estimate {
-            k,
-            max_radius,
-            kernel,
-        } = *estimate;
-        let r2 = self.knn(p, k, max_radius, |ph| ph.depth() <= max_depth, scratch);
-        if scratch.is_empty() {
-            return Rgb::ZERO;
-        }
-        let r = r2.sqrt();
-        let full = scratch.len() == k;
-        let mut l = Rgb::ZERO;
-        for nb in scratch.iter() {
-            if full && nb.d2 >= r2 {
-                continue;
-            }
-            let ph = &self.photons[nb.index as usize];
+        self.knn_estimate(
+            p,
+            estimate,
+            |ph| ph.depth() <= max_depth,
+            scratch,
             // Light travelled along -wi_p and leaves along -dir.
-            let cos = ph.wi().dot(dir);
-            l += ph.power() * (phase.eval(cos) * kernel.weight_3d(nb.d2.sqrt(), r));
-        }
-        l
+            |ph, d, r| {
+                ph.power() * (phase.eval(ph.wi().dot(dir)) * estimate.kernel.weight_3d(d, r))
+            },
+        )
     }
 
     /// Bounds of the stored photons (empty map: an empty box at the origin).

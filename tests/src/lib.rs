@@ -134,3 +134,51 @@ output = "out.exr"
 "#
     )
 }
+
+/// A course scene (`scenes/NAME`) with its point light replaced by a small area light (0.5 x
+/// 0.5, radiance 20, just below the ceiling), written to a temporary folder, so that the path
+/// tracer can render its caustics too (through BSDF-sampled rays that reach the light through
+/// glass).
+pub fn with_area_light(scene: &str) -> PathBuf {
+    let text = std::fs::read_to_string(repo_root().join("scenes").join(scene)).unwrap();
+    let (before, _) = text.split_once("[[lights]]").unwrap();
+    let text = before.to_string()
+        + r#"
+[materials.black]
+type = "diffuse"
+reflectance = [0.0, 0.0, 0.0]
+
+[[shapes]]
+type = "quad"
+origin = [-0.25, 1.98, -0.25]
+u = [0.5, 0.0, 0.0]
+v = [0.0, 0.0, 0.5]
+material = "black"
+emission = [20.0, 20.0, 20.0]
+"#;
+    let dir = temp_dir("area-light");
+    write(&dir, "scene.toml", &text)
+}
+
+/// Renders `scene` (a path from the repository root) with `integrator` and each `--set` of
+/// `cases` after `extra`, and checks that each is refused: a non-zero exit, no panic, and an
+/// error that contains the case's text (the parameter's name, or what was wrong).
+pub fn assert_refused(scene: &str, integrator: &str, extra: &[&str], cases: &[(&str, &str)]) {
+    let scene = repo_root().join(scene);
+    for &(set, expect) in cases {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--integrator",
+            integrator,
+        ];
+        for e in extra.iter().chain([&set]) {
+            args.extend(["--set", e]);
+        }
+        args.extend(["-o", "/tmp/foton-never-written.png"]);
+        let run = foton_with_plugins(&args);
+        assert_ne!(run.code, 0, "{set} was accepted");
+        assert!(run.stderr.contains(expect), "{set}: {}", run.stderr);
+        assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
+    }
+}

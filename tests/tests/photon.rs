@@ -9,7 +9,9 @@ use foton_core::photon_trace::{
     PathClass, STREAM_GLOBAL, TraceOptions, light_media, trace_one, trace_photons,
 };
 use foton_core::scene::Scene;
-use foton_tests::{header, region_mean, render_file, render_toml, repo_root, temp_dir, write};
+use foton_tests::{
+    header, region_mean, render_file, render_toml, repo_root, temp_dir, with_area_light, write,
+};
 use glam::{DVec3, Vec3};
 use std::f32::consts::PI;
 use std::sync::atomic::AtomicBool;
@@ -301,29 +303,6 @@ fn scenes_load() {
         let scene = load(s);
         assert!(!scene.lights.is_empty());
     }
-}
-
-/// A course scene with the point light replaced by a small area light, so that the path tracer
-/// can render caustics too (through BSDF-sampled rays that reach the light through glass).
-fn with_area_light(scene: &str) -> std::path::PathBuf {
-    let text = std::fs::read_to_string(repo_root().join("scenes").join(scene)).unwrap();
-    let (before, _) = text.split_once("[[lights]]").unwrap();
-    let text = before.to_string()
-        + r#"
-[materials.black]
-type = "diffuse"
-reflectance = [0.0, 0.0, 0.0]
-
-[[shapes]]
-type = "quad"
-origin = [-0.25, 1.98, -0.25]
-u = [0.5, 0.0, 0.0]
-v = [0.0, 0.0, 0.5]
-material = "black"
-emission = [20.0, 20.0, 20.0]
-"#;
-    let dir = temp_dir("area-light");
-    write(&dir, "scene.toml", &text)
 }
 
 #[test]

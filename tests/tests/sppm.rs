@@ -3,10 +3,10 @@
 
 use foton_core::film::Film;
 use foton_sppm::PixelStats;
-use foton_tests::{foton_with_plugins, header, region_mean, render_file, render_toml, repo_root};
-use foton_tests::{temp_dir, write};
+use foton_tests::{
+    assert_refused, header, region_mean, render_file, render_toml, repo_root, with_area_light,
+};
 use glam::DVec3;
-use std::path::PathBuf;
 
 #[test]
 fn statistics_update_follows_hachisuka_and_jensen() {
@@ -128,31 +128,9 @@ fn converges_to_the_path_tracer_on_the_cornell_box() {
     assert_mean_close(&last, &reference, 0.02);
 }
 
-/// Scene 1 with the point light replaced by a small area light, so that the path tracer can
-/// render its caustics too.
-fn caustics_with_area_light() -> PathBuf {
-    let text = std::fs::read_to_string(repo_root().join("scenes/caustics.toml")).unwrap();
-    let (before, _) = text.split_once("[[lights]]").unwrap();
-    let text = before.to_string()
-        + r#"
-[materials.black]
-type = "diffuse"
-reflectance = [0.0, 0.0, 0.0]
-
-[[shapes]]
-type = "quad"
-origin = [-0.25, 1.98, -0.25]
-u = [0.5, 0.0, 0.0]
-v = [0.0, 0.0, 0.5]
-material = "black"
-emission = [20.0, 20.0, 20.0]
-"#;
-    write(&temp_dir("sppm-caustics"), "scene.toml", &text)
-}
-
 #[test]
 fn converges_to_the_path_tracer_on_the_glass_sphere_caustic() {
-    let scene = caustics_with_area_light();
+    let scene = with_area_light("caustics.toml");
     // Looking down through the glass sphere at the caustic under it.
     let view = [
         "camera.position=[0.5, 0.35, 1.6]",
@@ -231,35 +209,24 @@ fn identical_for_one_and_many_threads() {
 
 #[test]
 fn bad_parameters_are_clear_errors() {
-    let scene = repo_root().join("scenes/cornell-box.toml");
-    let scene = scene.to_str().unwrap();
-    for (set, expect) in [
-        ("integrators.sppm.iterations=0", "iterations"),
-        (
-            "integrators.sppm.photons_per_iteration=0",
-            "photons_per_iteration",
-        ),
-        ("integrators.sppm.alpha=0", "alpha"),
-        ("integrators.sppm.alpha=1.5", "alpha"),
-        ("integrators.sppm.initial_radius=-1", "initial_radius"),
-        ("integrators.sppm.time=0", "time"),
-        ("integrators.sppm.direct=\"sometimes\"", "direct"),
-        ("integrators.sppm.kernel=\"nope\"", "kernel"),
-    ] {
-        let run = foton_with_plugins(&[
-            "render",
-            scene,
-            "--integrator",
-            "sppm",
-            "--set",
-            set,
-            "-o",
-            "/tmp/foton-sppm-never-written.png",
-        ]);
-        assert_ne!(run.code, 0, "{set} was accepted");
-        assert!(run.stderr.contains(expect), "{set}: {}", run.stderr);
-        assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
-    }
+    assert_refused(
+        "scenes/cornell-box.toml",
+        "sppm",
+        &[],
+        &[
+            ("integrators.sppm.iterations=0", "iterations"),
+            (
+                "integrators.sppm.photons_per_iteration=0",
+                "photons_per_iteration",
+            ),
+            ("integrators.sppm.alpha=0", "alpha"),
+            ("integrators.sppm.alpha=1.5", "alpha"),
+            ("integrators.sppm.initial_radius=-1", "initial_radius"),
+            ("integrators.sppm.time=0", "time"),
+            ("integrators.sppm.direct=\"sometimes\"", "direct"),
+            ("integrators.sppm.kernel=\"nope\"", "kernel"),
+        ],
+    );
 }
 
 #[test]
