@@ -411,8 +411,14 @@ impl PhotonMap {
             near <= far
         };
         let (lo, hi) = self.bounds();
-        let mut stack = vec![(0usize, self.photons.len(), lo, hi)];
-        while let Some((lo_i, hi_i, lo, hi)) = stack.pop() {
+        // Depth-first: at most one pending range per level of the tree (under 64 levels for
+        // any photon count), so no allocation per ray.
+        let mut stack = [(0usize, 0usize, Vec3::ZERO, Vec3::ZERO); 64];
+        stack[0] = (0, self.photons.len(), lo, hi);
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (lo_i, hi_i, lo, hi) = stack[top];
             if !hits_box(lo, hi) {
                 continue;
             }
@@ -436,8 +442,9 @@ impl PhotonMap {
             let (mut left_hi, mut right_lo) = (hi, lo);
             left_hi[a] = split;
             right_lo[a] = split;
-            stack.push((mid, hi_i, right_lo, hi));
-            stack.push((lo_i, mid, lo, left_hi));
+            stack[top] = (mid, hi_i, right_lo, hi);
+            stack[top + 1] = (lo_i, mid, lo, left_hi);
+            top += 2;
         }
     }
 

@@ -182,3 +182,31 @@ pub fn assert_refused(scene: &str, integrator: &str, extra: &[&str], cases: &[(&
         assert!(!run.stderr.contains("panicked"), "{}", run.stderr);
     }
 }
+
+/// A white-furnace box: six inward-facing diffuse quads around [-1, 1]^3 of albedo `rho`,
+/// each emitting `emission` inside (0: none), a camera in the box, `integrator` at `size` x
+/// `size` pixels and 16 spp, then `extra` (lights, integrator tables).
+pub fn closed_box(integrator: &str, size: u32, rho: f32, emission: f32, extra: &str) -> String {
+    let c = |x: f32, y: f32, z: f32| format!("[{x}, {y}, {z}]");
+    // (origin, u, v) with u x v pointing into the box.
+    let faces = [
+        (c(-1., -1., -1.), c(0., 0., 2.), c(2., 0., 0.)),
+        (c(-1., 1., -1.), c(2., 0., 0.), c(0., 0., 2.)),
+        (c(-1., -1., -1.), c(2., 0., 0.), c(0., 2., 0.)),
+        (c(-1., -1., 1.), c(0., 2., 0.), c(2., 0., 0.)),
+        (c(-1., -1., -1.), c(0., 2., 0.), c(0., 0., 2.)),
+        (c(1., -1., -1.), c(0., 0., 2.), c(0., 2., 0.)),
+    ];
+    let mut s = header(integrator, 16, 1000, size, size);
+    s += "[camera]\nposition = [0.0, 0.0, 0.9]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov = 90.0\n";
+    s += &format!("[materials.wall]\ntype = \"diffuse\"\nreflectance = [{rho}, {rho}, {rho}]\n");
+    for (o, u, v) in faces {
+        s += &format!(
+            "[[shapes]]\ntype = \"quad\"\norigin = {o}\nu = {u}\nv = {v}\nmaterial = \"wall\"\n"
+        );
+        if emission > 0.0 {
+            s += &format!("emission = [{emission}, {emission}, {emission}]\n");
+        }
+    }
+    s + extra
+}

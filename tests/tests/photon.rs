@@ -30,27 +30,7 @@ fn scene_from(name: &str, toml: &str) -> Scene {
 
 /// Six inward-facing diffuse quads around [-1, 1]^3 and `lights`.
 fn closed_box(rho: f32, emission: f32, lights: &str) -> String {
-    let c = |x: f32, y: f32, z: f32| format!("[{x}, {y}, {z}]");
-    let faces = [
-        (c(-1., -1., -1.), c(0., 0., 2.), c(2., 0., 0.)),
-        (c(-1., 1., -1.), c(2., 0., 0.), c(0., 0., 2.)),
-        (c(-1., -1., -1.), c(2., 0., 0.), c(0., 2., 0.)),
-        (c(-1., -1., 1.), c(0., 2., 0.), c(2., 0., 0.)),
-        (c(-1., -1., -1.), c(0., 2., 0.), c(0., 0., 2.)),
-        (c(1., -1., -1.), c(0., 0., 2.), c(0., 2., 0.)),
-    ];
-    let mut s = header("photon", 16, 1000, 24, 24);
-    s += "[camera]\nposition = [0.0, 0.0, 0.9]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov = 90.0\n";
-    s += &format!("[materials.wall]\ntype = \"diffuse\"\nreflectance = [{rho}, {rho}, {rho}]\n");
-    for (o, u, v) in faces {
-        s += &format!(
-            "[[shapes]]\ntype = \"quad\"\norigin = {o}\nu = {u}\nv = {v}\nmaterial = \"wall\"\n"
-        );
-        if emission > 0.0 {
-            s += &format!("emission = [{emission}, {emission}, {emission}]\n");
-        }
-    }
-    s + lights
+    foton_tests::closed_box("photon", 24, rho, emission, lights)
 }
 
 const TWO_LIGHTS: &str = r#"

@@ -4,7 +4,7 @@
 use foton_core::film::Film;
 use foton_sppm::PixelStats;
 use foton_tests::{
-    assert_refused, header, region_mean, render_file, render_toml, repo_root, with_area_light,
+    assert_refused, closed_box, region_mean, render_file, render_toml, repo_root, with_area_light,
 };
 use glam::DVec3;
 
@@ -161,24 +161,13 @@ fn converges_to_the_path_tracer_on_the_glass_sphere_caustic() {
 fn white_furnace_gives_le_over_one_minus_rho() {
     // A closed box of albedo rho emitting Le everywhere inside: L = Le / (1 - rho) everywhere.
     let rho = 0.5;
-    let c = |x: f32, y: f32, z: f32| format!("[{x}, {y}, {z}]");
-    let faces = [
-        (c(-1., -1., -1.), c(0., 0., 2.), c(2., 0., 0.)),
-        (c(-1., 1., -1.), c(2., 0., 0.), c(0., 0., 2.)),
-        (c(-1., -1., -1.), c(2., 0., 0.), c(0., 2., 0.)),
-        (c(-1., -1., 1.), c(0., 2., 0.), c(2., 0., 0.)),
-        (c(-1., -1., -1.), c(0., 2., 0.), c(0., 0., 2.)),
-        (c(1., -1., -1.), c(0., 0., 2.), c(0., 2., 0.)),
-    ];
-    let mut toml = header("sppm", 1, 1000, 16, 16);
-    toml += "[camera]\nposition = [0.0, 0.0, 0.9]\nlook_at = [0.0, 0.0, 0.0]\nup = [0.0, 1.0, 0.0]\nfov = 90.0\n";
-    toml += &format!("[materials.wall]\ntype = \"diffuse\"\nreflectance = [{rho}, {rho}, {rho}]\n");
-    for (o, u, v) in faces {
-        toml += &format!(
-            "[[shapes]]\ntype = \"quad\"\norigin = {o}\nu = {u}\nv = {v}\nmaterial = \"wall\"\nemission = [1.0, 1.0, 1.0]\n"
-        );
-    }
-    toml += "[integrators.sppm]\niterations = 64\nphotons_per_iteration = 20000\n";
+    let toml = closed_box(
+        "sppm",
+        16,
+        rho,
+        1.0,
+        "[integrators.sppm]\niterations = 64\nphotons_per_iteration = 20000\n",
+    );
     let film = render_toml("sppm-furnace", &toml, &[], 2);
     let (mean, err) = region_mean(&film, 0, 0, film.width, film.height);
     let expected = 1.0 / (1.0 - rho);
