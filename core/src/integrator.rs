@@ -1,9 +1,17 @@
-//! The interface every integrator plugin implements.
+//! The interface every integrator plugin implements, and what the host hands a render.
+//!
+//! Besides rendering, an integrator answers the tools' questions through typed methods, never
+//! through its description text: its parameters ([`Integrator::parameters`], from which
+//! [`Integrator::describe`] is built), how a time budget scales its work
+//! ([`Integrator::budget`]) and the photon maps it would build ([`Integrator::photon_maps`]).
+//! Any change to this file is a change of the plugin API (docs/plugins.md, "Versions").
 
+use crate::Rgb;
 use crate::error::Result;
 use crate::film::Film;
 use crate::props::Properties;
 use crate::scene::Scene;
+use glam::Vec3;
 use std::sync::atomic::{AtomicBool, Ordering};
 
 /// Progress and messages from a render, implemented by the host (a terminal progress bar, or
@@ -40,7 +48,8 @@ impl Progress for NoProgress {
 pub struct RenderContext<'a> {
     /// Worker threads (a plugin builds its own pool of this size: its rayon is its own copy).
     pub threads: usize,
-    /// Set by the host on Ctrl-C: stop soon and return what has been done.
+    /// Set by the host (on Ctrl-C, or when a tool has seen enough): stop soon and return what
+    /// has been done.
     pub cancel: &'a AtomicBool,
     pub progress: &'a dyn Progress,
 }
@@ -51,14 +60,155 @@ impl RenderContext<'_> {
     }
 }
 
+/// A parameter's value, as a scene file would write it.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ParamValue {
+    Int(i64),
+    Float(f64),
+    Bool(bool),
+    Str(String),
+}
+
+impl std::fmt::Display for ParamValue {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            ParamValue::Int(n) => write!(f, "{n}"),
+            // A value that came from an f32 prints as that f32 (0.1, not 0.10000000149).
+            ParamValue::Float(x) if (*x as f32) as f64 == *x => write!(f, "{}", *x as f32),
+            ParamValue::Float(x) => write!(f, "{x}"),
+            ParamValue::Bool(b) => write!(f, "{b}"),
+            ParamValue::Str(s) => write!(f, "{s}"),
+        }
+    }
+}
+
+/// One configured parameter of an integrator: its key in `[integrators.NAME]` and the value
+/// in force (the default where the scene gives none).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Parameter {
+    pub name: String,
+    pub value: ParamValue,
+}
+
+impl Parameter {
+    pub fn int(name: &str, value: impl TryInto<i64>) -> Parameter {
+        let value = value.try_into().unwrap_or(i64::MAX);
+        Parameter {
+            name: name.into(),
+            value: ParamValue::Int(value),
+        }
+    }
+    pub fn float(name: &str, value: impl Into<f64>) -> Parameter {
+        Parameter {
+            name: name.into(),
+            value: ParamValue::Float(value.into()),
+        }
+    }
+    pub fn bool(name: &str, value: bool) -> Parameter {
+        Parameter {
+            name: name.into(),
+            value: ParamValue::Bool(value),
+        }
+    }
+    pub fn str(name: &str, value: impl Into<String>) -> Parameter {
+        Parameter {
+            name: name.into(),
+            value: ParamValue::Str(value.into()),
+        }
+    }
+}
+
+/// "name(a = 1, b = box)": the form of [`Integrator::describe`].
+pub fn describe(name: &str, parameters: &[Parameter]) -> String {
+    let items: Vec<String> = parameters
+        .iter()
+        .map(|p| format!("{} = {}", p.name, p.value))
+        .collect();
+    format!("{name}({})", items.join(", "))
+}
+
+/// What the work of a render is counted in.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum Work {
+    /// Camera samples per pixel, `render.spp`.
+    Samples,
+    /// Iterations of a progressive integrator, set by the scene value at this dotted key
+    /// (`integrators.sppm.iterations`); `render.spp` is not used.
+    Iterations { key: String },
+    /// A budget the tools cannot set (the integrator decides how much work it does).
+    Own,
+}
+
+/// How a time budget scales an integrator: the render's time grows with its [`Work`] (from a
+/// fixed cost, such as a photon pass), and each of `scaled` (photon budgets) is a cost that a
+/// longer budget grows in proportion.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Budget {
+    pub work: Work,
+    /// Dotted scene keys and their values in force, e.g.
+    /// ("integrators.photon.global_photons", 200000).
+    pub scaled: Vec<(String, u64)>,
+}
+
+impl Budget {
+    /// A budget counted in camera samples and nothing else.
+    pub fn samples() -> Budget {
+        Budget {
+            work: Work::Samples,
+            scaled: Vec::new(),
+        }
+    }
+}
+
+/// A stored photon as the tools see it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MapPhoton {
+    pub position: Vec3,
+    /// Flux carried (W).
+    pub power: Rgb,
+    /// Surface normal on the side the photon arrived at; zero for a photon in a medium.
+    pub normal: Vec3,
+}
+
+/// One photon map an integrator builds, for `foton photons`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhotonMapView {
+    /// The map's name (`global`, `caustic`, `volume`...), as `foton photons --map` takes it.
+    pub name: String,
+    /// What the map holds, in a few words ("L S+ D photons of the caustic budget").
+    pub description: String,
+    /// Photons emitted by the pass that filled it (stored ones are in `photons`).
+    pub emitted: u64,
+    pub photons: Vec<MapPhoton>,
+}
+
 /// An integrator: computes an image of a scene.
 pub trait Integrator: Send + Sync {
+    /// The name it is registered under (`photon`).
+    fn name(&self) -> &str;
+
+    /// Every parameter in force, with the key of `[integrators.NAME]` it is read from.
+    fn parameters(&self) -> Vec<Parameter>;
+
     /// Renders the scene's camera view. On cancellation, returns the film as it is (each pixel
     /// holds its own sample count), not an error.
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film>;
 
+    /// How a time budget scales the work (`foton compare --time`).
+    fn budget(&self) -> Budget {
+        Budget::samples()
+    }
+
+    /// The photon maps the integrator builds for `scene`, in the order it names them; empty
+    /// for an integrator without photon maps. The same photons a render would store.
+    fn photon_maps(&self, _scene: &Scene, _ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        Ok(Vec::new())
+    }
+
     /// The configured integrator, for logs and labels (Mitsuba's `to_string`).
-    fn describe(&self) -> String;
+    fn describe(&self) -> String {
+        describe(self.name(), &self.parameters())
+    }
 }
 
 /// Creates an integrator from its `[integrators.NAME]` parameters.

@@ -1,15 +1,17 @@
-//! foton-core: everything the foton integrators share.
+//! foton-core: what an integrator plugin links, and what the host hands it.
 //!
-//! One module per concept, named as in the literature: [`scene`] loading, [`geometry`] and
-//! [`accel`] (the BVH), [`material`] (BSDFs), [`light`], [`camera`], [`film`], [`sampling`],
-//! [`medium`], [`kernel`] (density-estimation kernels), [`integrator`] (the plugin interface),
-//! [`render`] (the shared parallel image loop), [`plugin`] (loading plugins) and [`cli`] (the
-//! `foton` command, kept in the library so that it can be tested in-process).
+//! One module per concept, named as in the literature: [`scene`] (the scene and its queries,
+//! loading, meshes, volumes, visibility), [`geometry`] and [`accel`] (the BVH), [`material`]
+//! (BSDFs), [`light`], [`camera`], [`film`], [`sampling`], [`medium`], [`kernel`]
+//! (density-estimation kernels), [`integrator`] (the plugin interface), [`render`] (the shared
+//! parallel image loop) and [`plugin`] (declaring and loading plugins). Nothing host-only lives
+//! here: the `foton` program and its tools are the crate in `cli/`, the photon machinery of
+//! the photon-mapping plugins is `integrators/photonmap`.
 
 pub mod accel;
 pub mod camera;
 pub mod camera_path;
-pub mod cli;
+pub mod direct;
 pub mod error;
 pub mod film;
 pub mod geometry;
@@ -18,8 +20,6 @@ pub mod kernel;
 pub mod light;
 pub mod material;
 pub mod medium;
-pub mod photon;
-pub mod photon_trace;
 pub mod plugin;
 pub mod props;
 pub mod render;

@@ -14,7 +14,9 @@
 
 use crate::error::{Error, Result};
 use crate::film::Film;
-use crate::integrator::{CreateIntegrator, Integrator, RenderContext};
+use crate::integrator::{
+    Budget, CreateIntegrator, Integrator, Parameter, PhotonMapView, RenderContext, Work,
+};
 use crate::kernel::Kernel;
 use crate::props::Properties;
 use crate::scene::Scene;
@@ -23,7 +25,7 @@ use std::path::{Path, PathBuf};
 
 /// Version of the integrator plugin interface (bumped on any change of the declaration or of
 /// the traits that cross the boundary).
-pub const PLUGIN_API_VERSION: u32 = 1;
+pub const PLUGIN_API_VERSION: u32 = 2;
 /// Version of the C kernel interface.
 pub const KERNEL_API_VERSION: u32 = 1;
 
@@ -69,7 +71,6 @@ pub const LAYOUT_FINGERPRINT: u64 = {
         size_of::<Registry>(),
         size_of::<Error>(),
         size_of::<crate::value::Document>(),
-        size_of::<crate::photon::Photon>(),
     ];
     let mut h = 0xcbf2_9ce4_8422_2325u64;
     let mut i = 0;
@@ -164,8 +165,23 @@ pub fn catch<T>(what: &str, f: impl FnOnce() -> Result<T>) -> Result<T> {
 struct PanicGuard(Box<dyn Integrator>);
 
 impl Integrator for PanicGuard {
+    fn name(&self) -> &str {
+        catch("name", || Ok(self.0.name())).unwrap_or("(panicked)")
+    }
+    fn parameters(&self) -> Vec<Parameter> {
+        catch("parameters", || Ok(self.0.parameters())).unwrap_or_default()
+    }
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
         catch("render", || self.0.render(scene, ctx))
+    }
+    fn budget(&self) -> Budget {
+        catch("budget", || Ok(self.0.budget())).unwrap_or(Budget {
+            work: Work::Own,
+            scaled: Vec::new(),
+        })
+    }
+    fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        catch("photon_maps", || self.0.photon_maps(scene, ctx))
     }
     fn describe(&self) -> String {
         catch("describe", || Ok(self.0.describe())).unwrap_or_else(|e| e.to_string())

@@ -4,8 +4,8 @@
 //!
 //!   cargo bench -p foton-tests --features kiddo --bench photon_map
 
-use foton_core::photon::{Photon, PhotonMap};
 use foton_core::sampling::{Rng, uniform_sphere};
+use foton_photonmap::map::{Photon, PhotonMap};
 use glam::Vec3;
 use kiddo::{ImmutableKdTree, SquaredEuclidean};
 use std::num::NonZeroUsize;

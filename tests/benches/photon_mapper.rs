@@ -3,12 +3,12 @@
 //!
 //!   cargo bench -p foton-tests --bench photon_mapper
 
-use foton_core::cli::{TermProgress, prepare, render_prepared};
+use foton_cli::{TermProgress, prepare, render_prepared};
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
-use foton_core::photon::{Estimate, PhotonMap};
-use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_core::scene::Scene;
+use foton_photonmap::map::{Estimate, PhotonMap};
+use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::{plugin_dir, repo_root};
 use std::sync::atomic::AtomicBool;
 use std::time::Instant;

@@ -13,10 +13,10 @@
 
 use foton_core::camera_path::trace_to_diffuse;
 use foton_core::integrator::{NoProgress, RenderContext};
-use foton_core::photon::PhotonMap;
-use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
+use foton_photonmap::map::PhotonMap;
+use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::repo_root;
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
@@ -168,7 +168,7 @@ fn main() {
             grid_build * 1e3
         );
     }
-    let photon_bytes = photons.len() * std::mem::size_of::<foton_core::photon::Photon>();
+    let photon_bytes = photons.len() * std::mem::size_of::<foton_photonmap::map::Photon>();
     println!(
         "memory per iteration: photons {:.1} MB (+ positions and splits {:.1} MB in the tree)",
         photon_bytes as f64 / 1e6,

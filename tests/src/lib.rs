@@ -1,7 +1,7 @@
 //! Helpers shared by the integration tests: finding the plugins cargo built, running the
 //! `foton` command in-process, writing scenes to temporary folders, rendering.
 
-use foton_core::cli::{TermProgress, prepare, render_prepared};
+use foton_cli::{TermProgress, prepare, render_prepared};
 use foton_core::film::Film;
 use foton_core::plugin::Registry;
 use std::path::{Path, PathBuf};
@@ -18,6 +18,28 @@ pub fn registry() -> Registry {
     Registry::discover(&[plugin_dir()])
 }
 
+/// A folder holding the `panicky` fixture plugin as `libfoton_panicky.so`. Cargo builds it as
+/// `libpanicky_fixture.so`, a name the plugin search skips, so that it never lies beside the
+/// real plugins under a plugin's name; the tests that want it add this folder.
+pub fn fixture_plugin_dir() -> PathBuf {
+    static DIR: std::sync::OnceLock<PathBuf> = std::sync::OnceLock::new();
+    DIR.get_or_init(|| {
+        let file = |stem: &str| {
+            format!(
+                "{}{stem}{}",
+                std::env::consts::DLL_PREFIX,
+                std::env::consts::DLL_SUFFIX
+            )
+        };
+        let built = plugin_dir().join(file("panicky_fixture"));
+        assert!(built.is_file(), "{} was not built", built.display());
+        let dir = temp_dir("fixture-plugins");
+        std::fs::copy(&built, dir.join(file("foton_panicky"))).unwrap();
+        dir
+    })
+    .clone()
+}
+
 /// Output of one in-process run of the `foton` command.
 pub struct Run {
     pub code: u8,
@@ -25,12 +47,12 @@ pub struct Run {
     pub stderr: String,
 }
 
-/// Runs `foton ARGS...` in-process (the command's code lives in foton_core::cli).
+/// Runs `foton ARGS...` in-process (the command's code lives in the foton crate's library).
 pub fn foton(args: &[&str]) -> Run {
     let mut argv: Vec<std::ffi::OsString> = vec!["foton".into()];
     argv.extend(args.iter().map(|a| a.into()));
     let (mut out, mut err) = (Vec::new(), Vec::new());
-    let code = foton_core::cli::run(argv, &mut out, &mut err);
+    let code = foton_cli::run(argv, &mut out, &mut err);
     Run {
         code,
         stdout: String::from_utf8_lossy(&out).into_owned(),
@@ -38,12 +60,12 @@ pub fn foton(args: &[&str]) -> Run {
     }
 }
 
-/// `foton ARGS... --plugin-dir <the test plugin folder>`.
+/// `foton ARGS... --plugin-dir <the test plugin folder> --plugin-dir <the fixture folder>`.
 pub fn foton_with_plugins(args: &[&str]) -> Run {
-    let dir = plugin_dir();
+    let (dir, fixtures) = (plugin_dir(), fixture_plugin_dir());
     let mut all: Vec<&str> = args.to_vec();
-    all.push("--plugin-dir");
-    all.push(dir.to_str().unwrap());
+    all.extend(["--plugin-dir", dir.to_str().unwrap()]);
+    all.extend(["--plugin-dir", fixtures.to_str().unwrap()]);
     foton(&all)
 }
 

@@ -3,7 +3,7 @@
 //! never a panic or a hang. Warnings (reflectance above one, unknown fields without
 //! `--strict`) leave the exit code at 0.
 //!
-//! The `foton` command runs in-process (foton_core::cli::run) on a helper thread, so that a
+//! The `foton` command runs in-process (foton_cli::run) on a helper thread, so that a
 //! panic is reported as a bug of the command and a hang as a timeout instead of stalling the
 //! suite. Renders are 8x8 pixels at 1 sample per pixel.
 //!
@@ -1436,7 +1436,7 @@ fn plugin_built_against_another_core_is_refused() {
         (
             "othercore",
             FakeDeclaration {
-                api_version: 1,
+                api_version: foton_core::plugin::PLUGIN_API_VERSION,
                 core_version: Some("0.0.0-other"),
                 rustc_version: Some(rustc),
                 build_id: Some(build),
@@ -1449,7 +1449,7 @@ fn plugin_built_against_another_core_is_refused() {
         (
             "otherrustc",
             FakeDeclaration {
-                api_version: 1,
+                api_version: foton_core::plugin::PLUGIN_API_VERSION,
                 core_version: Some(core),
                 rustc_version: Some("rustc 0.0.0-other"),
                 build_id: Some(build),
@@ -1462,7 +1462,7 @@ fn plugin_built_against_another_core_is_refused() {
         (
             "otherbuild",
             FakeDeclaration {
-                api_version: 1,
+                api_version: foton_core::plugin::PLUGIN_API_VERSION,
                 core_version: Some(core),
                 rustc_version: Some(rustc),
                 build_id: Some("0000000000000000-other"),
@@ -1512,7 +1512,7 @@ fn plugin_with_another_api_version_is_refused() {
 fn plugin_declaration_with_a_null_version_is_refused() {
     let dir = temp_dir("null-version");
     let decl = FakeDeclaration {
-        api_version: 1,
+        api_version: foton_core::plugin::PLUGIN_API_VERSION,
         core_version: None,
         rustc_version: Some(foton_core::RUSTC_VERSION),
         build_id: Some(foton_core::BUILD_ID),

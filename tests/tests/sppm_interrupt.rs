@@ -2,7 +2,7 @@
 //! Ctrl-C returning the estimate so far. In a test binary of its own, because it raises the
 //! process-wide interrupt flag that every in-process render watches.
 
-use foton_core::cli::{INTERRUPTED, TermProgress, prepare, render_prepared};
+use foton_cli::{INTERRUPTED, TermProgress, prepare, render_prepared};
 use foton_core::film::read_image;
 use foton_tests::{plugin_dir, repo_root, temp_dir};
 use std::sync::atomic::Ordering;

@@ -3,8 +3,8 @@
 //! printed counts and the JSON of `compare`; every bad input must end in a message naming
 //! the problem and a non-zero exit. Images are 32x32 with few samples and photons.
 
-use foton_core::cli::montage::BORDER;
-use foton_core::cli::sweep::{SweepSet, parse_set};
+use foton_cli::montage::BORDER;
+use foton_cli::sweep::{SweepSet, parse_set};
 use foton_core::film::read_image;
 use foton_tests::{Run, foton_with_plugins, header, temp_dir, write};
 use std::path::{Path, PathBuf};
@@ -115,10 +115,39 @@ fn json_number(json: &str, integrator: &str, field: &str) -> Option<f64> {
 // foton photons
 // ---------------------------------------------------------------------------------------------
 
+/// The tool draws whatever maps the integrator returns: `sppm`'s one iteration of photons too
+/// (no budget or classification of any integrator is written in the tool).
+#[test]
+fn photons_draws_the_maps_any_integrator_returns() {
+    let (dir, scene) = setup("photons-sppm");
+    let out = dir.join("sppm.png");
+    let args = [
+        "photons",
+        s(&scene),
+        "--integrator",
+        "sppm",
+        "--set",
+        "integrators.sppm.photons_per_iteration=5000",
+        "-o",
+        s(&out),
+        "-q",
+    ];
+    let run = foton_with_plugins(&args);
+    ok(&run);
+    assert!(run.stdout.contains("sppm iteration map"), "{}", run.stdout);
+    assert!(
+        run.stdout.contains("of 5000 photons emitted"),
+        "{}",
+        run.stdout
+    );
+    assert!(count_before(&run.stdout, "drawn") > 0, "{}", run.stdout);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 #[test]
 fn photons_shows_the_floor_and_leaves_the_background_black() {
     let (dir, scene) = setup("photons");
-    let run = foton_with_plugins(&["photons", s(&scene), "-q"]);
+    let run = foton_with_plugins(&["photons", s(&scene), "--integrator", "photon", "-q"]);
     ok(&run);
     // The default output lies beside the scene.
     let (w, h, px) = read_image(&dir.join("box-global-photons.png")).unwrap();
@@ -160,6 +189,8 @@ fn caustic_map_of_a_diffuse_scene_is_empty() {
     let run = foton_with_plugins(&[
         "photons",
         s(&scene),
+        "--integrator",
+        "photon",
         "--map",
         "caustic",
         "-o",
@@ -182,6 +213,8 @@ fn photons_are_the_same_for_any_number_of_threads() {
         let run = foton_with_plugins(&[
             "photons",
             s(&scene),
+            "--integrator",
+            "photon",
             "-o",
             s(&out),
             "--threads",
@@ -503,11 +536,18 @@ fn set_without_a_value_is_refused() {
 #[test]
 fn unknown_map_is_refused() {
     let (dir, scene) = setup("bad-map");
-    let run = foton_with_plugins(&["photons", s(&scene), "--map", "direct"]);
-    fails_with(
-        &run,
-        &["invalid value 'direct'", "global", "caustic", "volume"],
-    );
+    let run = foton_with_plugins(&[
+        "photons",
+        s(&scene),
+        "--integrator",
+        "photon",
+        "--map",
+        "direct",
+    ]);
+    fails_with(&run, &["--map direct", "`photon`", "global, caustic"]);
+    // An integrator without photon maps says so.
+    let run = foton_with_plugins(&["photons", s(&scene)]);
+    fails_with(&run, &["`path` builds no photon maps", "--integrator"]);
     let _ = std::fs::remove_dir_all(dir);
 }
 
@@ -516,7 +556,14 @@ fn missing_output_folder_is_found_before_rendering() {
     let (dir, scene) = setup("bad-output");
     let out = dir.join("no-such-folder").join("x.png");
     for args in [
-        &["photons", s(&scene), "-o", s(&out)][..],
+        &[
+            "photons",
+            s(&scene),
+            "--integrator",
+            "photon",
+            "-o",
+            s(&out),
+        ][..],
         &["compare", s(&scene), "--integrators", "path", "-o", s(&out)],
         &[
             "sweep",
@@ -633,7 +680,7 @@ fn curve_points(json: &str, integrator: &str) -> Vec<CurvePoint> {
 
 #[test]
 fn compare_curve_plots_the_error_against_time() {
-    use foton_core::cli::montage::{PLOT_HEIGHT, PLOT_WIDTH};
+    use foton_cli::montage::{PLOT_HEIGHT, PLOT_WIDTH};
     let (dir, scene) = setup("compare-curve");
     let small = ["--set", "film.width=20", "--set", "film.height=20"];
     let reference = dir.join("ref.exr");

@@ -1,10 +1,10 @@
 //! The photon pass through participating media: energy is conserved, every photon ends
 //! absorbed or escaped in the right proportion.
 
-use foton_core::photon_trace::{
+use foton_core::scene::Scene;
+use foton_photonmap::trace::{
     PathClass, STREAM_GLOBAL, Site, TraceOptions, light_media, trace_one,
 };
-use foton_core::scene::Scene;
 use foton_tests::{header, temp_dir, write};
 use glam::DVec3;
 

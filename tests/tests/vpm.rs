@@ -131,6 +131,8 @@ fn volume_map_counts(scene: &str) -> (u64, u64) {
     let run = foton_with_plugins(&[
         "photons",
         scene.to_str().unwrap(),
+        "--integrator",
+        "vpm",
         "--map",
         "volume",
         "--set",

@@ -19,7 +19,7 @@
 
 use foton_core::film::Film;
 use foton_core::geometry::{Ray, offset_origin};
-use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::integrator::{Integrator, Parameter, RenderContext};
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::scene::Scene;
@@ -65,8 +65,12 @@ impl Integrator for Normals {
         })
     }
 
-    fn describe(&self) -> String {
-        format!("normals(flip_to_camera = {})", self.flip_to_camera)
+    fn name(&self) -> &str {
+        "normals"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        vec![Parameter::bool("flip_to_camera", self.flip_to_camera)]
     }
 }
 

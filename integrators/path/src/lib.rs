@@ -31,7 +31,7 @@
 
 use foton_core::Vec3;
 use foton_core::geometry::{Ray, offset_origin};
-use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::integrator::{Integrator, Parameter, RenderContext};
 use foton_core::material::TransportMode;
 use foton_core::medium::HeroChannel;
 use foton_core::props::Properties;
@@ -246,11 +246,12 @@ impl Integrator for PathTracer {
         })
     }
 
-    fn describe(&self) -> String {
-        format!(
-            "path(max_depth = {}, rr_depth = {})",
-            self.max_depth, self.rr_depth
-        )
+    fn name(&self) -> &str {
+        "path"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        vec![Parameter::int("rr_depth", self.rr_depth)]
     }
 }
 

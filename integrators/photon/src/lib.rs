@@ -38,27 +38,22 @@
 //! come out well.
 
 use foton_core::camera_path::{VisiblePoint, direct_light, next_surface, trace_to_diffuse};
+use foton_core::direct::Direct;
 use foton_core::film::Film;
 use foton_core::geometry::{Hit, Ray, offset_origin};
-use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
 use foton_core::kernel::NormalizedKernel;
 use foton_core::material::{Material, TransportMode};
-use foton_core::photon::{Estimate, Neighbour, PhotonMap};
-use foton_core::photon_trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
-};
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result, Rgb, Vec3};
+use foton_photonmap::map::{Estimate, Neighbour, Photon, PhotonMap};
+use foton_photonmap::trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
+};
 use std::cell::RefCell;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Direct {
-    ShadowRays,
-    Photons,
-}
 
 pub struct PhotonMapper {
     pub global_photons: u64,
@@ -97,10 +92,17 @@ thread_local! {
 }
 
 impl PhotonMapper {
-    /// The photon pass: traces both budgets and builds the maps.
-    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+    /// The photon pass: traces both budgets and sorts the stored photons into the direct
+    /// (only if `keep_direct`), caustic and indirect lists. Without a caustic budget the
+    /// global pass keeps its L S+ D photons in the indirect list: caustics then come from the
+    /// global map instead of vanishing.
+    fn trace_lists(
+        &self,
+        scene: &Scene,
+        ctx: &RenderContext<'_>,
+        keep_direct: bool,
+    ) -> Result<[Vec<Photon>; 3]> {
         let seed = scene.render.seed;
-        let need_direct = self.direct == Direct::Photons || self.final_gather;
         let global = TraceOptions {
             photons: self.global_photons,
             max_depth: self.max_depth,
@@ -108,15 +110,17 @@ impl PhotonMapper {
             stream: STREAM_GLOBAL,
             stop_at_diffuse: false,
         };
-        // L S+ D photons of the global budget are dropped: the caustic budget counts them.
+        let caustic_map = self.caustic_photons > 0;
+        // With a caustic map, L S+ D photons of the global budget are dropped: the caustic
+        // budget counts them.
         let mut lists = trace_photons(scene, &global, ctx, 2, |_, class| match class {
-            PathClass::Direct if need_direct => Some(0),
+            PathClass::Direct => keep_direct.then_some(0),
+            PathClass::Caustic => (!caustic_map).then_some(1),
             PathClass::Indirect => Some(1),
-            _ => None,
         })?;
         let indirect = lists.pop().unwrap();
         let direct = lists.pop().unwrap();
-        let caustic = if self.caustic_photons > 0 {
+        let caustic = if caustic_map {
             let opts = TraceOptions {
                 photons: self.caustic_photons,
                 max_depth: self.max_depth,
@@ -132,6 +136,13 @@ impl PhotonMapper {
         } else {
             Vec::new()
         };
+        Ok([direct, caustic, indirect])
+    }
+
+    /// The photon pass: traces both budgets and builds the maps.
+    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+        let need_direct = self.direct == Direct::Photons || self.final_gather;
+        let [direct, caustic, indirect] = self.trace_lists(scene, ctx, need_direct)?;
         for (name, len) in [
             ("direct", direct.len()),
             ("caustic", caustic.len()),
@@ -301,25 +312,66 @@ impl Integrator for PhotonMapper {
         })
     }
 
-    fn describe(&self) -> String {
-        format!(
-            "photon(global_photons = {}, caustic_photons = {}, k = {}, max_radius = {}, kernel = {}, direct = {}, final_gather = {}{})",
-            self.global_photons,
-            self.caustic_photons,
-            self.k,
-            self.max_radius,
-            self.kernel.name(),
-            match self.direct {
-                Direct::ShadowRays => "nee",
-                Direct::Photons => "photons",
-            },
-            self.final_gather,
-            if self.final_gather {
-                format!(", gather_rays = {}", self.gather_rays)
-            } else {
-                String::new()
-            }
-        )
+    fn name(&self) -> &str {
+        "photon"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        let mut p = vec![
+            Parameter::int("global_photons", self.global_photons),
+            Parameter::int("caustic_photons", self.caustic_photons),
+            Parameter::int("k", self.k),
+            Parameter::float("max_radius", self.max_radius),
+            Parameter::str("kernel", self.kernel.name()),
+            Parameter::str("direct", self.direct.name()),
+            Parameter::bool("final_gather", self.final_gather),
+        ];
+        if self.final_gather {
+            p.push(Parameter::int("gather_rays", self.gather_rays));
+        }
+        p
+    }
+
+    fn budget(&self) -> Budget {
+        Budget {
+            work: Work::Samples,
+            scaled: vec![
+                (
+                    "integrators.photon.global_photons".into(),
+                    self.global_photons,
+                ),
+                (
+                    "integrators.photon.caustic_photons".into(),
+                    self.caustic_photons,
+                ),
+            ],
+        }
+    }
+
+    /// `global`: the direct and indirect photons of the global budget (Jensen's global map;
+    /// a render keeps the direct ones only for `direct = "photons"` or final gathering), and
+    /// `caustic`: the L S+ D photons of the caustic budget.
+    fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        let [mut global, caustic, indirect] = self.trace_lists(scene, ctx, true)?;
+        global.extend(indirect);
+        Ok(vec![
+            foton_photonmap::view(
+                "global",
+                if self.caustic_photons > 0 {
+                    "L D and paths with a diffuse bounce, of the global budget"
+                } else {
+                    "every path of the global budget (no caustic map)"
+                },
+                self.global_photons,
+                &global,
+            ),
+            foton_photonmap::view(
+                "caustic",
+                "L S+ D photons of the caustic budget",
+                self.caustic_photons,
+                &caustic,
+            ),
+        ])
     }
 }
 
@@ -353,10 +405,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         ));
     }
     let kernel = props.kernel("kernel", "box")?;
-    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
-        "photons" => Direct::Photons,
-        _ => Direct::ShadowRays,
-    };
+    let direct = Direct::read(props)?;
     let final_gather = props.bool("final_gather", false)?;
     let gather_rays = props.u32("gather_rays", 32)?;
     if gather_rays == 0 {

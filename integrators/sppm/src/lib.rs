@@ -48,26 +48,23 @@
 //! any number of threads. Memory is bounded: one iteration's photons at a time.
 
 use foton_core::camera_path::{direct_light, trace_to_diffuse};
+use foton_core::direct::Direct;
 use foton_core::film::Film;
-use foton_core::integrator::{Integrator, NoProgress, RenderContext};
+use foton_core::integrator::{
+    Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
+};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::photon::PhotonMap;
-use foton_core::photon_trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_core::props::Properties;
 use foton_core::render::with_pool;
 use foton_core::sampling::{Rng, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::{Error, Result, Rgb};
+use foton_photonmap::map::PhotonMap;
+use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use glam::{DVec3, Vec2};
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::time::Instant;
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Direct {
-    ShadowRays,
-    Photons,
-}
 
 pub struct Sppm {
     /// None: until `time` runs out.
@@ -181,6 +178,29 @@ impl Sppm {
         samples
     }
 
+    /// The photons iteration `iteration` (0-based) stores: every one but the L D ones with
+    /// shadow rays for direct light.
+    fn iteration_photons(
+        &self,
+        scene: &Scene,
+        iteration: u64,
+        ctx: &RenderContext<'_>,
+    ) -> Result<Vec<foton_photonmap::Photon>> {
+        let options = TraceOptions {
+            photons: self.photons_per_iteration,
+            max_depth: self.max_depth,
+            seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
+            stream: STREAM_GLOBAL,
+            stop_at_diffuse: false,
+        };
+        let keep_direct = self.direct == Direct::Photons;
+        Ok(trace_photons(scene, &options, ctx, 1, |_, class| {
+            (class != PathClass::Direct || keep_direct).then_some(0)
+        })?
+        .pop()
+        .unwrap_or_default())
+    }
+
     /// The starting radius of a pixel whose first visible point lies `distance` along the
     /// camera path.
     fn first_radius(&self, scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
@@ -244,19 +264,7 @@ impl Integrator for Sppm {
                 break;
             }
             let camera = with_pool(ctx.threads, || self.camera_pass(scene, done, &mut rays))?;
-            let options = TraceOptions {
-                photons: self.photons_per_iteration,
-                max_depth: self.max_depth,
-                seed: splitmix64(scene.render.seed ^ splitmix64(done)),
-                stream: STREAM_GLOBAL,
-                stop_at_diffuse: false,
-            };
-            let keep_direct = self.direct == Direct::Photons;
-            let photons = trace_photons(scene, &options, &quiet, 1, |_, class| {
-                (class != PathClass::Direct || keep_direct).then_some(0)
-            })?
-            .pop()
-            .unwrap_or_default();
+            let photons = self.iteration_photons(scene, done, &quiet)?;
             if ctx.cancelled() {
                 // An iteration with part of its photons would be biased: drop it.
                 break;
@@ -319,25 +327,57 @@ impl Integrator for Sppm {
         Ok(film)
     }
 
-    fn describe(&self) -> String {
-        let budget = match (self.iterations, self.time) {
-            (Some(n), None) => format!("iterations = {n}"),
-            (Some(n), Some(t)) => format!("time = {t}, iterations <= {n}"),
-            (None, Some(t)) => format!("time = {t}"),
-            (None, None) => String::new(),
-        };
-        format!(
-            "sppm({budget}, photons_per_iteration = {}, initial_radius = {}, alpha = {}, kernel = {}, direct = {})",
+    fn name(&self) -> &str {
+        "sppm"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        let mut p = Vec::new();
+        if let Some(n) = self.iterations {
+            p.push(Parameter::int("iterations", n));
+        }
+        if let Some(t) = self.time {
+            p.push(Parameter::float("time", t));
+        }
+        p.push(Parameter::int(
+            "photons_per_iteration",
             self.photons_per_iteration,
-            self.initial_radius
-                .map_or("auto".to_string(), |r| r.to_string()),
-            self.alpha as f32,
-            self.kernel.name(),
-            match self.direct {
-                Direct::ShadowRays => "nee",
-                Direct::Photons => "photons",
-            }
-        )
+        ));
+        p.push(match self.initial_radius {
+            Some(r) => Parameter::float("initial_radius", r),
+            None => Parameter::str("initial_radius", "auto"),
+        });
+        p.extend([
+            Parameter::float("alpha", self.alpha as f32),
+            Parameter::str("kernel", self.kernel.name()),
+            Parameter::str("direct", self.direct.name()),
+        ]);
+        p
+    }
+
+    fn budget(&self) -> Budget {
+        Budget {
+            work: Work::Iterations {
+                key: "integrators.sppm.iterations".into(),
+            },
+            scaled: Vec::new(),
+        }
+    }
+
+    /// `iteration`: the photons the first iteration stores (those of every iteration are
+    /// alike, from their own random streams).
+    fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        let photons = self.iteration_photons(scene, 0, ctx)?;
+        Ok(vec![foton_photonmap::view(
+            "iteration",
+            if self.direct == Direct::Photons {
+                "every photon of one iteration"
+            } else {
+                "one iteration's photons but L D (shadow rays count those)"
+            },
+            self.photons_per_iteration,
+            &photons,
+        )])
     }
 }
 
@@ -376,10 +416,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         return Err(props.error("alpha", format!("must be in (0, 1], found {alpha}")));
     }
     let kernel = props.kernel("kernel", "box")?;
-    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
-        "photons" => Direct::Photons,
-        _ => Direct::ShadowRays,
-    };
+    let direct = Direct::read(props)?;
     if scene.has_media() {
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `sppm` does not render (use `vpm` or `path`)",

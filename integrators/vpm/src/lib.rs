@@ -52,21 +52,22 @@
 //! `photon` (docs/photon-mapping.md).
 
 use foton_core::camera_path::{MAX_NULL_CROSSINGS, direct_light_in};
+use foton_core::direct::Direct;
 use foton_core::film::Film;
 use foton_core::geometry::{Ray, offset_origin};
-use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
 use foton_core::kernel::NormalizedKernel;
 use foton_core::material::TransportMode;
 use foton_core::medium::{Homogeneous, transmittance_homogeneous};
-use foton_core::photon::{Estimate, Neighbour, PhotonMap};
-use foton_core::photon_trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
-};
 use foton_core::props::Properties;
 use foton_core::render::{render_pixels, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result, Rgb, Vec3};
+use foton_photonmap::map::{Estimate, Neighbour, Photon, PhotonMap};
+use foton_photonmap::trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
+};
 use rayon::prelude::*;
 use std::cell::RefCell;
 
@@ -76,12 +77,6 @@ pub enum VolumeEstimate {
     March,
     /// The beam radiance estimate along each camera segment.
     Beam,
-}
-
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Direct {
-    ShadowRays,
-    Photons,
 }
 
 pub struct Vpm {
@@ -137,9 +132,20 @@ impl Vpm {
         Ok(())
     }
 
-    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+    /// The three photon passes, sorted into the direct (only if `keep_direct`), caustic,
+    /// indirect and volume lists. Without a caustic budget the global pass keeps its L S+ D
+    /// surface photons in the indirect list (caustics then come from the global map). The
+    /// volume list holds L M photons (first scattering events) only with `direct = "photons"`:
+    /// otherwise shadow rays count them.
+    fn trace_lists(
+        &self,
+        scene: &Scene,
+        ctx: &RenderContext<'_>,
+        keep_direct: bool,
+    ) -> Result<[Vec<Photon>; 4]> {
         let seed = scene.render.seed;
         let photons_direct = self.direct == Direct::Photons;
+        let caustic_map = self.caustic_photons > 0;
         let pass = |photons: u64, stream: u64, stop_at_diffuse: bool| TraceOptions {
             photons,
             max_depth: self.max_depth,
@@ -153,14 +159,15 @@ impl Vpm {
             ctx,
             2,
             |site, class| match (site, class) {
-                (Site::Surface, PathClass::Direct) if photons_direct => Some(0),
+                (Site::Surface, PathClass::Direct) if keep_direct => Some(0),
+                (Site::Surface, PathClass::Caustic) if !caustic_map => Some(1),
                 (Site::Surface, PathClass::Indirect) => Some(1),
                 _ => None,
             },
         )?;
         let indirect = lists.pop().unwrap();
         let direct = lists.pop().unwrap();
-        let caustic = if self.caustic_photons > 0 {
+        let caustic = if caustic_map {
             trace_photons(
                 scene,
                 &pass(self.caustic_photons, STREAM_CAUSTIC, true),
@@ -189,6 +196,12 @@ impl Vpm {
         } else {
             Vec::new()
         };
+        Ok([direct, caustic, indirect, volume])
+    }
+
+    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
+        let photons_direct = self.direct == Direct::Photons;
+        let [direct, caustic, indirect, volume] = self.trace_lists(scene, ctx, photons_direct)?;
         self.check_size("direct", direct.len(), self.k, "k")?;
         self.check_size("caustic", caustic.len(), self.k, "k")?;
         self.check_size("indirect", indirect.len(), self.k, "k")?;
@@ -467,27 +480,72 @@ impl Integrator for Vpm {
         })
     }
 
-    fn describe(&self) -> String {
-        format!(
-            "vpm(global_photons = {}, caustic_photons = {}, volume_photons = {}, k = {}, k_volume = {}, max_radius = {}, max_radius_volume = {}, step = {}, kernel = {}, direct = {}, estimate = {})",
-            self.global_photons,
-            self.caustic_photons,
-            self.volume_photons,
-            self.k,
-            self.k_volume,
-            self.max_radius,
-            self.max_radius_volume,
-            self.step,
-            self.kernel.name(),
-            match self.direct {
-                Direct::ShadowRays => "nee",
-                Direct::Photons => "photons",
-            },
-            match self.estimate {
-                VolumeEstimate::March => "march",
-                VolumeEstimate::Beam => "beam",
-            }
-        )
+    fn name(&self) -> &str {
+        "vpm"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        vec![
+            Parameter::int("global_photons", self.global_photons),
+            Parameter::int("caustic_photons", self.caustic_photons),
+            Parameter::int("volume_photons", self.volume_photons),
+            Parameter::int("k", self.k),
+            Parameter::int("k_volume", self.k_volume),
+            Parameter::float("max_radius", self.max_radius),
+            Parameter::float("max_radius_volume", self.max_radius_volume),
+            Parameter::float("step", self.step),
+            Parameter::str("kernel", self.kernel.name()),
+            Parameter::str("direct", self.direct.name()),
+            Parameter::str(
+                "estimate",
+                match self.estimate {
+                    VolumeEstimate::March => "march",
+                    VolumeEstimate::Beam => "beam",
+                },
+            ),
+        ]
+    }
+
+    fn budget(&self) -> Budget {
+        Budget {
+            work: Work::Samples,
+            scaled: ["global_photons", "caustic_photons", "volume_photons"]
+                .into_iter()
+                .zip([
+                    self.global_photons,
+                    self.caustic_photons,
+                    self.volume_photons,
+                ])
+                .map(|(key, n)| (format!("integrators.vpm.{key}"), n))
+                .collect(),
+        }
+    }
+
+    /// `global` (direct and indirect surface photons of the global budget), `caustic` (L S+ D
+    /// surface photons of the caustic budget) and `volume` (the volume map as rendered).
+    fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        let [mut global, caustic, indirect, volume] = self.trace_lists(scene, ctx, true)?;
+        global.extend(indirect);
+        Ok(vec![
+            foton_photonmap::view(
+                "global",
+                "surface photons of the global budget",
+                self.global_photons,
+                &global,
+            ),
+            foton_photonmap::view(
+                "caustic",
+                "L S+ D surface photons of the caustic budget",
+                self.caustic_photons,
+                &caustic,
+            ),
+            foton_photonmap::view(
+                "volume",
+                "photons at scattering events in media, of the volume budget",
+                self.volume_photons,
+                &volume,
+            ),
+        ])
     }
 }
 
@@ -518,10 +576,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let max_radius_volume = positive("max_radius_volume", diagonal / 20.0)?;
     let step = positive("step", diagonal / 100.0)?;
     let kernel = props.kernel("kernel", "box")?;
-    let direct = match props.choice("direct", &["nee", "photons"], "nee")? {
-        "photons" => Direct::Photons,
-        _ => Direct::ShadowRays,
-    };
+    let direct = Direct::read(props)?;
     let estimate = match props.choice("estimate", &["march", "beam"], "march")? {
         "beam" => VolumeEstimate::Beam,
         _ => VolumeEstimate::March,

@@ -9,9 +9,9 @@
 //! incrementally (Arya and Mount), which prunes more than the distance to the last plane.
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
-use crate::Rgb;
-use crate::kernel::NormalizedKernel;
-use crate::medium::Phase;
+use foton_core::Rgb;
+use foton_core::kernel::NormalizedKernel;
+use foton_core::medium::Phase;
 use glam::Vec3;
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
@@ -537,7 +537,7 @@ impl PhotonMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::sampling::Rng;
+    use foton_core::sampling::Rng;
 
     fn random_map(n: usize, seed: u64) -> (Vec<Photon>, PhotonMap) {
         let mut rng = Rng::new(&[seed]);
@@ -556,7 +556,7 @@ mod tests {
         let mut rng = Rng::new(&[4]);
         for _ in 0..100 {
             let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 1.4 - 0.2;
-            let dir = crate::sampling::uniform_sphere(rng.next_2d());
+            let dir = foton_core::sampling::uniform_sphere(rng.next_2d());
             let (t_max, radius) = (0.2 + rng.next_f32(), 0.01 + 0.05 * rng.next_f32());
             let mut got = Vec::new();
             map.along_ray(origin, dir, t_max, radius, |_, p, t, d2| {
@@ -627,7 +627,7 @@ mod tests {
     fn directions_survive_encoding() {
         let mut rng = Rng::new(&[4]);
         for _ in 0..1000 {
-            let d = crate::sampling::uniform_sphere(rng.next_2d());
+            let d = foton_core::sampling::uniform_sphere(rng.next_2d());
             let p = Photon::new(Vec3::ZERO, Rgb::ONE, d, -d);
             assert!(p.wi().dot(d) > 0.99999);
             assert!(p.normal().dot(-d) > 0.99 && p.normal().length() < 1.01);

@@ -9,9 +9,9 @@
 //! Layout: cells as large as the largest tile, `BORDER` pixels around and between them; the
 //! label bands of a row have the height of the row's longest label, so the images line up.
 
-use crate::Rgb;
-use crate::error::Result;
-use crate::film::{Film, srgb_decode, write_image};
+use foton_core::Rgb;
+use foton_core::error::Result;
+use foton_core::film::{Film, srgb_decode, write_image};
 use std::path::Path;
 
 /// Pixels around and between the cells of a grid.

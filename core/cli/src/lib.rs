@@ -1,9 +1,11 @@
-//! The `foton` command: `render`, `check`, `plugins`, `bench`, and the tools for seeing and
+//! The `foton` program: `render`, `check`, `plugins`, `bench`, and the tools for seeing and
 //! comparing, `photons`, `compare` and `sweep` (one file each, their labelled images in
-//! `montage`).
+//! `montage`, the terminal progress in `progress`).
 //!
-//! A thin layer: parse arguments (clap), load the scene, find the plugin, run it, write the
-//! image. Errors are turned into messages here, once.
+//! A thin layer over foton-core: parse arguments (clap), load the scene, find the plugin, run
+//! it, write the image. Errors are turned into messages here, once. Everything host-only lives
+//! here and not in core (clap, indicatif, the Ctrl-C handler and its flag, the label font), so
+//! that editing a tool never changes what plugins are checked against.
 
 pub mod compare;
 pub mod montage;
@@ -11,12 +13,12 @@ pub mod photons;
 mod progress;
 pub mod sweep;
 
-use crate::error::{Error, Result};
-use crate::film::{Film, check_output};
-use crate::integrator::{Integrator, RenderContext};
-use crate::plugin::{IntegratorPlugin, Registry, search_path};
-use crate::scene::Scene;
 use clap::{Args, Parser, Subcommand};
+use foton_core::error::{Error, Result};
+use foton_core::film::{Film, check_output};
+use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::plugin::{IntegratorPlugin, Registry, search_path};
+use foton_core::scene::Scene;
 pub use progress::TermProgress;
 use std::ffi::OsString;
 use std::io::Write;
@@ -61,13 +63,10 @@ enum Command {
     Bench(BenchArgs),
     /// Draw a photon map as seen from the scene camera, one dot per photon.
     ///
-    /// The photon pass is core's, with the budgets of the scene's [integrators.photon] table
-    /// (global_photons, default 200000; caustic_photons, default 100000) and the photon
-    /// integrator's classification: the global map holds the direct and indirect photons of
-    /// the global budget, the caustic map the L S+ D photons of the caustic budget. A photon is
+    /// The photons are those the integrator (the scene's, or --integrator) would store: the
+    /// tool asks the plugin for its photon maps and draws the one --map names. A photon is
     /// drawn where it projects if the camera sees the side of the surface it lies on (one
-    /// visibility ray per photon); a pixel shows the mean colour of the dots covering it. No
-    /// plugin is loaded (--plugin-dir is accepted so that command lines can be shared).
+    /// visibility ray per photon); a pixel shows the mean colour of the dots covering it.
     ///
     /// Exposure: a dot's colour is the photon's flux divided by the 99th percentile of the
     /// drawn photons' largest channel, so that 99% of the dots are unclipped and photons of
@@ -103,7 +102,7 @@ enum Command {
 }
 
 #[derive(Args, Clone, Default)]
-struct PluginArgs {
+pub(crate) struct PluginArgs {
     /// Look for plugins in DIR first (repeatable); then FOTON_PLUGIN_PATH, then the folder of
     /// the foton executable and its plugins/ subfolder.
     #[arg(long = "plugin-dir", value_name = "DIR")]
@@ -111,7 +110,7 @@ struct PluginArgs {
 }
 
 #[derive(Args, Clone, Default)]
-struct SceneArgs {
+pub(crate) struct SceneArgs {
     /// The scene file (TOML).
     scene: PathBuf,
     /// Use this integrator plugin instead of the scene's render.integrator.
@@ -220,7 +219,7 @@ pub struct Prepared {
     pub warnings: Vec<String>,
 }
 
-fn scene_overrides(a: &SceneArgs) -> Vec<String> {
+pub(crate) fn scene_overrides(a: &SceneArgs) -> Vec<String> {
     let mut sets = a.sets.clone();
     if let Some(name) = &a.integrator {
         sets.push(format!("render.integrator={name:?}"));
@@ -236,7 +235,7 @@ fn scene_overrides(a: &SceneArgs) -> Vec<String> {
 
 /// Errors from inside a plugin name the plugin and its file; errors in its parameters stay
 /// scene errors (they name the scene file, key and line).
-fn blame_plugin(plugin: &IntegratorPlugin, e: Error) -> Error {
+pub(crate) fn blame_plugin(plugin: &IntegratorPlugin, e: Error) -> Error {
     match e {
         Error::Scene { .. } | Error::Syntax { .. } | Error::Io { .. } => e,
         other => Error::Plugin {
@@ -499,10 +498,10 @@ fn cmd_plugins(a: PluginArgs, out: &mut dyn Write) -> Result<u8> {
     let _ = writeln!(
         out,
         "\nfoton-core {}, plugin API {}, {}, build {}",
-        crate::CORE_VERSION,
-        crate::plugin::PLUGIN_API_VERSION,
-        crate::RUSTC_VERSION,
-        crate::BUILD_ID
+        foton_core::CORE_VERSION,
+        foton_core::plugin::PLUGIN_API_VERSION,
+        foton_core::RUSTC_VERSION,
+        foton_core::BUILD_ID
     );
     let shown: Vec<String> = dirs.iter().map(|d| d.display().to_string()).collect();
     let _ = writeln!(out, "search path: {}", shown.join(":"));

@@ -55,7 +55,7 @@ fn foton(exe: &Path, args: &[&str]) -> (i32, String, String) {
 }
 
 fn scene(dir: &Path, spp: u32, size: u32) -> PathBuf {
-    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell-box.toml");
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell-box.toml");
     let text = std::fs::read_to_string(src)
         .unwrap()
         .replace("spp = 64", &format!("spp = {spp}"))

@@ -1,8 +1,8 @@
 //! Terminal progress: a bar with elapsed time, ETA and throughput on a terminal, nothing
 //! otherwise. Warnings from the render are collected and printed after it.
 
-use crate::film::Film;
-use crate::integrator::Progress;
+use foton_core::film::Film;
+use foton_core::integrator::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;

@@ -8,16 +8,16 @@
 //! counting the photons that hit nothing. Photon i draws from its own random stream, so the
 //! maps are identical whatever the number of threads.
 
-use crate::Rgb;
-use crate::error::{Error, Result};
-use crate::geometry::{Ray, offset_origin};
-use crate::integrator::RenderContext;
-use crate::material::TransportMode;
-use crate::medium::HeroChannel;
-use crate::photon::Photon;
-use crate::render::with_pool;
-use crate::sampling::Rng;
-use crate::scene::Scene;
+use crate::map::Photon;
+use foton_core::Rgb;
+use foton_core::error::{Error, Result};
+use foton_core::geometry::{Ray, offset_origin};
+use foton_core::integrator::RenderContext;
+use foton_core::material::TransportMode;
+use foton_core::medium::HeroChannel;
+use foton_core::render::with_pool;
+use foton_core::sampling::Rng;
+use foton_core::scene::Scene;
 use glam::Vec2;
 use rayon::prelude::*;
 

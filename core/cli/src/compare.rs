@@ -2,18 +2,18 @@
 //! image; against a reference, with a false-colour difference image and error numbers per
 //! render. Each render is also written as EXR, and the numbers as JSON.
 
-use super::montage::{Image, Series, Tile, diverging, grid, log_log_plot};
-use super::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare, threads};
-use super::{blame_plugin, render_prepared, write_atomic};
-use crate::Rgb;
-use crate::error::{Error, Result};
-use crate::film::{Film, check_output, read_image};
-use crate::integrator::{Progress, RenderContext};
+use crate::montage::{Image, Series, Tile, diverging, grid, log_log_plot};
+use crate::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare, threads};
+use crate::{render_prepared, write_atomic};
 use clap::Args;
+use foton_core::Rgb;
+use foton_core::error::{Error, Result};
+use foton_core::film::{Film, check_output, read_image};
+use foton_core::integrator::{Budget, Work};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::time::{Duration, Instant};
+use std::sync::atomic::Ordering;
+use std::time::Duration;
 
 /// Added to the squared reference value in the relative error, so that black pixels of the
 /// reference do not dominate it.
@@ -107,7 +107,10 @@ pub fn difference_image(width: u32, height: u32, x: &[Rgb], reference: &[Rgb]) -
         .iter()
         .zip(reference)
         .map(|(p, r)| {
-            let (p, r) = (crate::average(*p) as f64, crate::average(*r) as f64);
+            let (p, r) = (
+                foton_core::average(*p) as f64,
+                foton_core::average(*r) as f64,
+            );
             diverging(((p - r) / (r * r + REL_EPSILON).sqrt()) as f32)
         })
         .collect();
@@ -181,37 +184,19 @@ pub fn spp_for_budget(budget: f64, t1: f64, t2: f64) -> u32 {
     CostModel::from_times(1, t1, t2).units_for(budget)
 }
 
-/// The photon budgets of an integrator, from its description (`describe()`): its parameters
-/// named `*_photons` with an integer value, e.g. `photon`'s global_photons and caustic_photons.
-pub fn photon_budgets(description: &str) -> Vec<(String, u64)> {
-    let params = description
-        .split_once('(')
-        .map_or("", |(_, rest)| rest.trim_end_matches(')'));
-    params
-        .split(',')
-        .filter_map(|item| {
-            let (key, value) = item.split_once('=')?;
-            let key = key.trim();
-            if !key.ends_with("_photons") {
-                return None;
-            }
-            Some((key.to_string(), value.trim().parse().ok()?))
-        })
-        .collect()
-}
-
 /// How `--time` gives an integrator a budget of S seconds, from its calibration renders.
 #[derive(Clone, Debug, PartialEq)]
 pub enum Plan {
     /// Samples per pixel (render.spp) fill the time.
     Samples(CostModel),
-    /// A progressive integrator (one that reports iterations, sppm): its `iterations`
-    /// parameter fills the time; render.spp is not used.
-    Iterations(CostModel),
-    /// A photon mapper (an integrator with photon budgets, `photon`): about half of the time
-    /// goes to the photon pass, half to camera samples. The scene's photon budgets are taken
-    /// to belong to the time 2 x `photon_pass` (the measured cost of their pass) and are
-    /// scaled in proportion to the budget; spp = (S / 2) / `per_sample`.
+    /// A progressive integrator (its `Integrator::budget` counts iterations, sppm): the scene
+    /// value at `key` fills the time; render.spp is not used.
+    Iterations { cost: CostModel, key: String },
+    /// An integrator with budgets that scale beside its samples (`Integrator::budget`'s
+    /// `scaled`: a photon mapper's photon budgets): about half of the time goes to their fixed
+    /// cost, half to camera samples. The scene's budgets are taken to belong to the time 2 x
+    /// `photon_pass` (the measured fixed cost) and are scaled in proportion to the budget;
+    /// spp = (S / 2) / `per_sample`.
     PhotonsAndSamples {
         per_sample: f64,
         photon_pass: f64,
@@ -222,14 +207,11 @@ pub enum Plan {
 }
 
 impl Plan {
-    /// The scene values (`--set` overrides) that make integrator `name` take about `seconds`.
-    pub fn settings(&self, name: &str, seconds: f64) -> Vec<String> {
+    /// The scene values (`--set` overrides) that make the integrator take about `seconds`.
+    pub fn settings(&self, seconds: f64) -> Vec<String> {
         match self {
             Plan::Samples(cost) => vec![format!("render.spp={}", cost.units_for(seconds))],
-            Plan::Iterations(cost) => vec![format!(
-                "integrators.{name}.iterations={}",
-                cost.units_for(seconds)
-            )],
+            Plan::Iterations { cost, key } => vec![format!("{key}={}", cost.units_for(seconds))],
             Plan::PhotonsAndSamples {
                 per_sample,
                 photon_pass,
@@ -245,7 +227,7 @@ impl Plan {
                     } else {
                         (*n as f64 * scale).round().clamp(1.0, 1e15) as u64
                     };
-                    sets.push(format!("integrators.{name}.{key}={scaled}"));
+                    sets.push(format!("{key}={scaled}"));
                 }
                 sets
             }
@@ -254,27 +236,30 @@ impl Plan {
     }
 }
 
-/// Whether a film has the `spp` samples in every pixel that render.spp asked for. An
-/// integrator with a budget of its own (sppm: iterations or time) writes one estimate per
-/// pixel whatever render.spp says; with `spp` = 1 the two cannot be told apart.
-fn takes_spp(film: &Film, spp: u32) -> bool {
-    film.total_samples() == film.width as u64 * film.height as u64 * spp as u64
-}
-
-/// "16 spp"; for an integrator with a budget of its own, "23 iterations" when --time set its
-/// iterations, else "own budget".
-fn budget_text(spp: Option<u32>, settings: &[String]) -> String {
-    if let Some(n) = spp {
-        return format!("{n} spp");
+/// "16 spp", "23 iterations" (a progressive integrator's iterations, as --time set them or
+/// as its parameters say), or "own budget".
+fn budget_text(p: &Prepared, settings: &[String]) -> String {
+    match p.integrator.budget().work {
+        Work::Samples => format!("{} spp", p.scene.render.spp),
+        Work::Iterations { key } => {
+            let set = settings
+                .iter()
+                .find_map(|s| s.strip_prefix(&format!("{key}=")).map(str::to_string));
+            let name = key.rsplit('.').next().unwrap_or(&key);
+            let given = || {
+                p.integrator
+                    .parameters()
+                    .into_iter()
+                    .find(|q| q.name == name)
+                    .map(|q| q.value.to_string())
+            };
+            match set.or_else(given) {
+                Some(n) => format!("{n} iterations"),
+                None => "own budget".into(),
+            }
+        }
+        Work::Own => "own budget".into(),
     }
-    settings
-        .iter()
-        .find_map(|s| {
-            let (key, n) = s.split_once('=')?;
-            key.ends_with(".iterations")
-                .then(|| format!("{n} iterations"))
-        })
-        .unwrap_or_else(|| "own budget".into())
 }
 
 /// One integrator's render and its numbers.
@@ -283,6 +268,8 @@ struct Entry {
     description: String,
     /// None when the integrator does not take its samples from render.spp.
     spp: Option<u32>,
+    /// "16 spp", "23 iterations", "own budget".
+    budget: String,
     seconds: f64,
     /// The scene values --time chose (`--set` overrides), empty without --time.
     settings: Vec<String>,
@@ -400,84 +387,10 @@ fn render_timed(
     result
 }
 
-/// The progress of the first calibration render: stops a progressive integrator after its
-/// first iteration (the integrator reports it as a checkpoint) and counts the iterations, so
-/// that finding out that sppm does not take render.spp costs one iteration, not its whole
-/// budget. Ctrl-C is passed on to the render at each progress report.
-struct Probe<'a> {
-    inner: &'a TermProgress,
-    stop: &'a AtomicBool,
-    iterations: AtomicU64,
-}
-
-impl Probe<'_> {
-    fn pass_interrupt(&self) {
-        if INTERRUPTED.load(Ordering::SeqCst) {
-            self.stop.store(true, Ordering::SeqCst);
-        }
-    }
-}
-
-impl Progress for Probe<'_> {
-    fn begin(&self, phase: &str, total: u64) {
-        self.pass_interrupt();
-        self.inner.begin(phase, total);
-    }
-    fn advance(&self, units: u64) {
-        self.pass_interrupt();
-        self.inner.advance(units);
-    }
-    fn finish(&self) {
-        self.inner.finish();
-    }
-    fn warn(&self, message: &str) {
-        self.inner.warn(message);
-    }
-    fn rays(&self, n: u64) {
-        self.pass_interrupt();
-        self.inner.rays(n);
-    }
-    fn status(&self, text: &str) {
-        self.pass_interrupt();
-        self.inner.status(text);
-    }
-    fn checkpoint(&self, _iteration: u64, _image: &dyn Fn() -> Film) {
-        self.iterations.fetch_add(1, Ordering::SeqCst);
-        self.stop.store(true, Ordering::SeqCst);
-    }
-}
-
-/// Renders with a `Probe`: returns the time and the iterations the integrator reported (0 for
-/// an integrator that is not progressive).
-fn render_probe(p: &Prepared, threads: usize, err: &mut dyn Write) -> Result<(Duration, u64)> {
-    let inner = TermProgress::new(true);
-    let stop = AtomicBool::new(false);
-    let probe = Probe {
-        inner: &inner,
-        stop: &stop,
-        iterations: AtomicU64::new(0),
-    };
-    let ctx = RenderContext {
-        threads,
-        cancel: &stop,
-        progress: &probe,
-    };
-    let start = Instant::now();
-    p.integrator
-        .render(&p.scene, &ctx)
-        .map_err(|e| blame_plugin(&p.plugin, e))?;
-    let elapsed = start.elapsed();
-    for w in inner.take_warnings() {
-        let _ = writeln!(err, "warning: {}: {w}", p.plugin.name);
-    }
-    Ok((elapsed, probe.iterations.load(Ordering::SeqCst)))
-}
-
-/// Calibrates how `--time` sets integrator `name`'s budget (see `Plan`): a first render at
-/// 1 spp finds out whether the integrator is progressive (and is stopped after one
-/// iteration if it is); then renders at n and 2n samples per pixel, or iterations of a
-/// progressive integrator (`calibrate_cost`). With `Plan::Fixed`, also returns the
-/// calibration render, which is then the render shown.
+/// Calibrates how `--time` sets integrator `name`'s budget (see `Plan`), from what the
+/// integrator says of its work (`Integrator::budget`): renders at n and 2n samples per pixel,
+/// or iterations of a progressive integrator (`calibrate_cost`). With `Plan::Fixed` (a budget
+/// of its own), also returns the one render made, which is then the render shown.
 fn calibrate(
     name: &str,
     p: &mut Prepared,
@@ -486,52 +399,47 @@ fn calibrate(
     threads: usize,
     err: &mut dyn Write,
 ) -> Result<(Plan, Option<(Film, Duration)>)> {
-    p.scene.render.spp = 1;
-    let (_, iterations) = render_probe(p, threads, err)?;
-    if INTERRUPTED.load(Ordering::SeqCst) {
-        return Ok((Plan::Fixed, None));
-    }
     let min_seconds = CALIBRATION_SECONDS.min(budget / 10.0);
-    if iterations > 0 {
-        let key = format!("integrators.{name}.iterations");
-        let cost = calibrate_cost(min_seconds, |n| {
-            let q = prep(&[format!("{key}={n}")])?;
-            Ok(render_timed(&q, threads, true, err)?.1.as_secs_f64())
-        })?;
-        let _ = writeln!(
-            err,
-            "note: `{name}` does not take its samples from render.spp: --time sets its iterations instead ({key})"
-        );
-        return Ok((Plan::Iterations(cost), None));
-    }
-    p.scene.render.spp = 2;
-    let (film, t2) = render_timed(p, threads, true, err)?;
-    if !takes_spp(&film, 2) {
-        // Its budget is its own and not iterations: more samples per pixel would not change
-        // the image, so the calibration render is the render.
-        let _ = writeln!(
-            err,
-            "warning: `{name}` does not take its samples from render.spp, so --time cannot set its budget; give it its own (e.g. --set integrators.{name}.time={budget})"
-        );
-        return Ok((Plan::Fixed, Some((film, t2))));
-    }
-    let cost = calibrate_cost(min_seconds, |n| {
-        p.scene.render.spp = n;
-        Ok(render_timed(p, threads, true, err)?.1.as_secs_f64())
-    })?;
-    let photons = photon_budgets(&p.integrator.describe());
-    let plan = if photons.is_empty() {
-        Plan::Samples(cost)
-    } else {
-        Plan::PhotonsAndSamples {
-            per_sample: cost.per_unit,
-            // Not below the bound of the per-sample cost: noise on a fast photon pass would
-            // otherwise ask for an enormous number of photons.
-            photon_pass: cost.fixed.max(cost.longest / 20.0),
-            photons,
+    let Budget { work, scaled } = p.integrator.budget();
+    match work {
+        Work::Iterations { key } => {
+            let cost = calibrate_cost(min_seconds, |n| {
+                let q = prep(&[format!("{key}={n}")])?;
+                Ok(render_timed(&q, threads, true, err)?.1.as_secs_f64())
+            })?;
+            let _ = writeln!(
+                err,
+                "note: `{name}` does not take its samples from render.spp: --time sets its iterations instead ({key})"
+            );
+            Ok((Plan::Iterations { cost, key }, None))
         }
-    };
-    Ok((plan, None))
+        Work::Own => {
+            let _ = writeln!(
+                err,
+                "warning: `{name}` sets its own budget, so --time cannot set it; it renders as the scene says"
+            );
+            let shown = render_timed(p, threads, true, err)?;
+            Ok((Plan::Fixed, Some(shown)))
+        }
+        Work::Samples => {
+            let cost = calibrate_cost(min_seconds, |n| {
+                p.scene.render.spp = n;
+                Ok(render_timed(p, threads, true, err)?.1.as_secs_f64())
+            })?;
+            let plan = if scaled.is_empty() {
+                Plan::Samples(cost)
+            } else {
+                Plan::PhotonsAndSamples {
+                    per_sample: cost.per_unit,
+                    // Not below the bound of the per-sample cost: noise on a fast photon pass
+                    // would otherwise ask for an enormous number of photons.
+                    photon_pass: cost.fixed.max(cost.longest / 20.0),
+                    photons: scaled,
+                }
+            };
+            Ok((plan, None))
+        }
+    }
 }
 
 /// The budgets of the error curve: `points` times from `budget` / 2^(points - 1) to `budget`,
@@ -697,7 +605,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
                 };
                 let mut last = None;
                 for (j, &b) in budgets.iter().enumerate() {
-                    let settings = plan.settings(name, b);
+                    let settings = plan.settings(b);
                     let is_last = j + 1 == budgets.len();
                     let (q, film, elapsed) = match shown {
                         Some((ref film, t)) if is_last => (prep(&[])?, film.clone(), t),
@@ -740,8 +648,8 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         if interrupted(err) {
             return Ok(130);
         }
-        let spp = p.scene.render.spp;
-        let spp = takes_spp(&film, spp).then_some(spp);
+        let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render.spp);
+        let budget = budget_text(&p, &settings);
         let image = exr_of(name);
         film.write(&image)?;
         let errors = reference
@@ -751,6 +659,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             name: name.clone(),
             description: p.integrator.describe(),
             spp,
+            budget,
             seconds: elapsed.as_secs_f64(),
             settings,
             film,
@@ -762,7 +671,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             out,
             "{}: {} in {:.2} s -> {}",
             entry.description,
-            budget_text(entry.spp, &entry.settings),
+            entry.budget,
             entry.seconds,
             entry.image.display()
         );
@@ -781,12 +690,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .map(|e| Tile {
             image: Image::from_film(&e.film),
             label: vec![
-                format!(
-                    "{}: {}, {:.2} s",
-                    e.name,
-                    budget_text(e.spp, &e.settings),
-                    e.seconds
-                ),
+                format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
                 // Narrow tiles: `k=50` wraps better than `k = 50`.
                 e.description.replace(" = ", "="),
             ],
@@ -889,21 +793,6 @@ mod tests {
     }
 
     #[test]
-    fn photon_budgets_are_read_from_the_description() {
-        assert_eq!(
-            photon_budgets(
-                "photon(global_photons = 200000, caustic_photons = 500000, k = 50, max_radius = 0.17)"
-            ),
-            [
-                ("global_photons".to_string(), 200000),
-                ("caustic_photons".to_string(), 500000)
-            ]
-        );
-        assert!(photon_budgets("path(max_depth = 16, rr_depth = 5)").is_empty());
-        assert!(photon_budgets("sppm(iterations = 64, photons_per_iteration = 100000)").is_empty());
-    }
-
-    #[test]
     fn photon_budgets_and_samples_grow_with_the_time() {
         // A photon pass of 0.5 s at the scene's budgets, 0.05 s per sample per pixel: the
         // scene's budgets belong to 1 s; 10 s gets ten times the photons and 100 spp.
@@ -911,12 +800,12 @@ mod tests {
             per_sample: 0.05,
             photon_pass: 0.5,
             photons: vec![
-                ("global_photons".into(), 200_000),
-                ("caustic_photons".into(), 0),
+                ("integrators.photon.global_photons".into(), 200_000),
+                ("integrators.photon.caustic_photons".into(), 0),
             ],
         };
         assert_eq!(
-            plan.settings("photon", 10.0),
+            plan.settings(10.0),
             [
                 "render.spp=100",
                 "integrators.photon.global_photons=2000000",
@@ -924,18 +813,19 @@ mod tests {
             ]
         );
         assert_eq!(
-            plan.settings("photon", 0.01)[..2],
+            plan.settings(0.01)[..2],
             ["render.spp=1", "integrators.photon.global_photons=2000"]
         );
         let cost = CostModel::from_times(1, 1.125, 1.25);
         assert_eq!(
-            Plan::Iterations(cost).settings("sppm", 10.0),
+            Plan::Iterations {
+                cost,
+                key: "integrators.sppm.iterations".into()
+            }
+            .settings(10.0),
             ["integrators.sppm.iterations=72"]
         );
-        assert_eq!(
-            Plan::Samples(cost).settings("path", 10.0),
-            ["render.spp=72"]
-        );
+        assert_eq!(Plan::Samples(cost).settings(10.0), ["render.spp=72"]);
     }
 
     #[test]

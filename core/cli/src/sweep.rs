@@ -3,12 +3,12 @@
 //! down the rows, further ones down the rows too (row-major, the earlier varying faster); a
 //! `--set` with one value applies to every cell.
 
-use super::montage::{Image, Tile, grid};
-use super::threads;
-use super::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
-use crate::error::{Error, Result};
-use crate::film::check_output;
+use crate::montage::{Image, Tile, grid};
+use crate::threads;
+use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
 use clap::Args;
+use foton_core::error::{Error, Result};
+use foton_core::film::check_output;
 use std::io::Write;
 use std::path::PathBuf;
 use std::sync::atomic::Ordering;
