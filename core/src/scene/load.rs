@@ -1,0 +1,649 @@
+//! Loading a scene file (TOML, see docs/scene-format.md) into a [`Scene`].
+//!
+//! Every table is read through a [`Properties`] bag, so every error names file, line, key path
+//! and what was expected, and every key that was never read is reported as unused.
+
+use super::mesh::load_obj;
+use super::volumes::{locate_medium, medium_interfaces};
+use super::{FilmSettings, Named, Object, RenderSettings, Scene};
+use crate::Rgb;
+use crate::accel::Accel;
+use crate::camera::Camera;
+use crate::error::{Location, Result};
+use crate::geometry::{Primitive, Shape};
+use crate::light::{Light, area_light};
+use crate::material::Material;
+use crate::medium::{Homogeneous, Phase};
+use crate::props::Properties;
+use crate::sampling::Distribution1D;
+use crate::value::{Document, Value};
+use glam::{Mat4, Vec3};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+
+const SECTIONS: &[&str] = &[
+    "render",
+    "film",
+    "camera",
+    "integrators",
+    "materials",
+    "media",
+    "shapes",
+    "lights",
+    "scene",
+];
+const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "null"];
+const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
+const LIGHT_TYPES: &[&str] = &["point"];
+const MEDIUM_TYPES: &[&str] = &["homogeneous"];
+
+/// Collects the bags of a load so that unused keys can be listed at the end.
+struct Loader {
+    dir: PathBuf,
+    bags: Vec<Vec<(String, Location)>>,
+    warnings: Vec<String>,
+}
+
+impl Loader {
+    fn done(&mut self, bag: &Properties<'_>) {
+        self.bags.push(bag.unused());
+    }
+
+    fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String) {
+        self.warnings.push(format!(
+            "{}: `{}`: {message}",
+            bag.location(key),
+            bag.key_path(key)
+        ));
+    }
+}
+
+impl Scene {
+    /// Loads a scene file, applying `--set` style overrides first.
+    pub fn load(path: &Path, overrides: &[String]) -> Result<Scene> {
+        let mut doc = Document::load(path)?;
+        for o in overrides {
+            doc.set(o)?;
+        }
+        Scene::from_document(doc)
+    }
+
+    pub fn from_document(doc: Document) -> Result<Scene> {
+        let file = doc.file.clone();
+        let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
+        let mut ld = Loader {
+            dir,
+            bags: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let root = Properties::root(&file, &doc.root);
+        for key in root.keys() {
+            if !SECTIONS.contains(&key) {
+                return Err(root.error(
+                    key,
+                    format!("unknown section; expected one of: {}", SECTIONS.join(", ")),
+                ));
+            }
+        }
+        root.node("integrators");
+
+        let render = read_render(&root, &mut ld)?;
+        let film = read_film(&root, &mut ld)?;
+        let camera = read_camera(&root, &film, &mut ld)?;
+        let (materials, material_index) = read_materials(&root, &mut ld)?;
+        let (media, medium_index) = read_media(&root, &mut ld)?;
+
+        let mut objects = Vec::new();
+        let mut prims = Vec::new();
+        let mut lights = Vec::new();
+        read_shapes(
+            &root,
+            &mut ld,
+            &materials,
+            &material_index,
+            &medium_index,
+            &mut objects,
+            &mut prims,
+            &mut lights,
+        )?;
+        read_point_lights(&root, &mut ld, &mut lights)?;
+
+        let mut medium = None;
+        if let Some(scene) = root.table("scene")? {
+            if let Some(name) = scene.string_opt("medium")? {
+                medium = Some(*medium_index.get(name).ok_or_else(|| {
+                    scene.error("medium", undefined("medium", name, &medium_index))
+                })?);
+            }
+            ld.done(&scene);
+        }
+
+        if lights.is_empty() {
+            ld.warnings.push(format!(
+                "{}: the scene has no lights: the image will be black",
+                file.display()
+            ));
+        }
+        let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
+        let light_distribution = Distribution1D::new(&powers);
+
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in &prims {
+            let b = p.shape.aabb();
+            lo = lo.min(b.min.into());
+            hi = hi.max(b.max.into());
+        }
+        for l in &lights {
+            if let Light::Point { position, .. } = l {
+                lo = lo.min(*position);
+                hi = hi.max(*position);
+            }
+        }
+        if !lo.is_finite() {
+            lo = camera.position;
+            hi = camera.position;
+        }
+
+        let accel = Accel::build(prims);
+        let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
+        let (interfaces, volumes, alone) = if uses_media {
+            medium_interfaces(&objects, &materials, &accel, medium)
+        } else {
+            (
+                vec![None; objects.len()],
+                Vec::new(),
+                vec![false; objects.len()],
+            )
+        };
+        let mut camera_medium = None;
+        if uses_media {
+            camera_medium = locate_medium(
+                &accel,
+                &objects,
+                &interfaces,
+                &volumes,
+                medium,
+                camera.position,
+            )
+            .map_err(|why| {
+                let t = root.table("camera").ok().flatten();
+                let message =
+                    format!("the medium around the camera is undefined: {why}; move the camera");
+                match t {
+                    Some(t) => t.error("position", message),
+                    None => root.error("camera", message),
+                }
+            })?;
+        }
+
+        ld.done(&root);
+        let mut unused: Vec<(String, Location)> = ld.bags.into_iter().flatten().collect();
+        unused.sort_by(|a, b| (a.1.line, &a.0).cmp(&(b.1.line, &b.0)));
+        let warnings = ld.warnings;
+        Ok(Scene {
+            file,
+            render,
+            film,
+            camera,
+            materials,
+            media,
+            objects,
+            lights,
+            light_distribution,
+            accel,
+            medium,
+            interfaces,
+            volumes,
+            alone,
+            camera_medium,
+            bounds: (lo, hi),
+            document: doc,
+            unused,
+            warnings,
+        })
+    }
+}
+
+fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {
+    let mut names: Vec<&str> = known.keys().map(String::as_str).collect();
+    names.sort();
+    if names.is_empty() {
+        {
+            let plural = if kind == "medium" {
+                "media"
+            } else {
+                "materials"
+            };
+            format!("{kind} {name:?} is not defined (no {plural} are defined)")
+        }
+    } else {
+        format!(
+            "{kind} {name:?} is not defined; defined: {}",
+            names.join(", ")
+        )
+    }
+}
+
+fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings> {
+    let t = root
+        .table("render")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "render"));
+    let integrator = t.string("integrator", "path")?.to_string();
+    let spp = t.u32("spp", 16)?;
+    if spp == 0 {
+        return Err(t.error("spp", "must be at least 1"));
+    }
+    let settings = RenderSettings {
+        integrator,
+        spp,
+        seed: t.u64("seed", 0)?,
+        max_depth: t.u32("max_depth", 16)?,
+    };
+    ld.done(&t);
+    Ok(settings)
+}
+
+fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
+    let t = root
+        .table("film")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "film"));
+    let width = t.u32("width", 256)?;
+    let height = t.u32("height", 256)?;
+    for (k, v) in [("width", width), ("height", height)] {
+        if v == 0 || v > 1 << 15 {
+            return Err(t.error(k, format!("must be between 1 and 32768, found {v}")));
+        }
+    }
+    let output = t.string("output", "out.exr")?;
+    let out = PathBuf::from(output);
+    crate::film::format_of(&out).map_err(|_| {
+        t.error(
+            "output",
+            format!("{output:?}: unsupported format; expected a .exr or .png file name"),
+        )
+    })?;
+    let film = FilmSettings {
+        width,
+        height,
+        output: ld.dir.join(out),
+    };
+    ld.done(&t);
+    Ok(film)
+}
+
+fn read_camera(root: &Properties<'_>, film: &FilmSettings, ld: &mut Loader) -> Result<Camera> {
+    let Some(t) = root.table("camera")? else {
+        return Err(root.error(
+            "camera",
+            "missing section [camera]; expected position, look_at, up, fov",
+        ));
+    };
+    let position = t.vec3_required("position")?;
+    let look_at = t.vec3_required("look_at")?;
+    let up = t.vec3("up", Vec3::Y)?;
+    let fov = t.f32("fov", 39.3)?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(t.error("fov", format!("must be in (0, 180) degrees, found {fov}")));
+    }
+    let forward = look_at - position;
+    if forward.length_squared() == 0.0 {
+        return Err(t.error("look_at", "is the same point as position"));
+    }
+    if forward.normalize().cross(up).length_squared() < 1e-12 {
+        return Err(t.error("up", "is zero or parallel to the viewing direction"));
+    }
+    ld.done(&t);
+    Ok(Camera::new(
+        position,
+        look_at,
+        up,
+        fov,
+        film.width,
+        film.height,
+    ))
+}
+
+type Index = HashMap<String, u32>;
+
+fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<Material>>, Index)> {
+    let mut out = Vec::new();
+    let mut index = HashMap::new();
+    let Some(all) = root.table("materials")? else {
+        return Ok((out, index));
+    };
+    let names: Vec<&str> = all.keys().collect();
+    for name in names {
+        let m = all.table(name)?.unwrap();
+        let ty = m.string_opt("type")?.ok_or_else(|| {
+            m.error(
+                "type",
+                format!("missing; expected one of: {}", MATERIAL_TYPES.join(", ")),
+            )
+        })?;
+        let material = match ty {
+            "diffuse" => {
+                let reflectance = m.rgb("reflectance", Rgb::splat(0.5))?;
+                if reflectance.max_element() > 1.0 {
+                    ld.warn(
+                        &m,
+                        "reflectance",
+                        "is above 1: the material creates energy".into(),
+                    );
+                }
+                Material::Diffuse { reflectance }
+            }
+            "mirror" => {
+                let reflectance = m.rgb("reflectance", Rgb::ONE)?;
+                if reflectance.max_element() > 1.0 {
+                    ld.warn(
+                        &m,
+                        "reflectance",
+                        "is above 1: the material creates energy".into(),
+                    );
+                }
+                Material::Mirror { reflectance }
+            }
+            "dielectric" => {
+                let ior = m.f32("ior", 1.5)?;
+                if ior <= 0.0 {
+                    return Err(m.error("ior", format!("must be positive, found {ior}")));
+                }
+                Material::Dielectric { ior }
+            }
+            "null" => Material::Null,
+            other => {
+                return Err(m.error(
+                    "type",
+                    format!(
+                        "unknown material type {other:?}; expected one of: {}",
+                        MATERIAL_TYPES.join(", ")
+                    ),
+                ));
+            }
+        };
+        index.insert(name.to_string(), out.len() as u32);
+        out.push(Named {
+            name: name.to_string(),
+            value: material,
+        });
+        ld.done(&m);
+    }
+    ld.done(&all);
+    Ok((out, index))
+}
+
+fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<Homogeneous>>, Index)> {
+    let mut out = Vec::new();
+    let mut index = HashMap::new();
+    let Some(all) = root.table("media")? else {
+        return Ok((out, index));
+    };
+    let names: Vec<&str> = all.keys().collect();
+    for name in names {
+        let m = all.table(name)?.unwrap();
+        let ty = m.string_opt("type")?.ok_or_else(|| {
+            m.error(
+                "type",
+                format!("missing; expected one of: {}", MEDIUM_TYPES.join(", ")),
+            )
+        })?;
+        if ty != "homogeneous" {
+            return Err(m.error(
+                "type",
+                format!(
+                    "unknown medium type {ty:?}; expected one of: {}",
+                    MEDIUM_TYPES.join(", ")
+                ),
+            ));
+        }
+        let sigma_a = m.rgb("sigma_a", Rgb::ZERO)?;
+        let sigma_s = m.rgb("sigma_s", Rgb::ZERO)?;
+        let phase = match m.node("phase").map(|n| &n.value) {
+            None => Phase::Isotropic,
+            Some(Value::Str(s)) if s == "isotropic" => Phase::Isotropic,
+            Some(Value::Str(s)) => {
+                return Err(m.error(
+                    "phase",
+                    format!("unknown phase function {s:?}; expected \"isotropic\" or {{ type = \"hg\", g = ... }}"),
+                ));
+            }
+            Some(Value::Table(_)) => {
+                let p = m.table("phase")?.unwrap();
+                let ty = p.choice("type", &["hg", "isotropic"], "hg")?;
+                let phase = if ty == "isotropic" {
+                    Phase::Isotropic
+                } else {
+                    let g = p.f32("g", 0.0)?;
+                    if g.abs() >= 1.0 {
+                        return Err(p.error("g", format!("must satisfy |g| < 1, found {g}")));
+                    }
+                    Phase::HenyeyGreenstein { g }
+                };
+                ld.done(&p);
+                phase
+            }
+            Some(other) => {
+                return Err(m.error(
+                    "phase",
+                    format!(
+                        "expected \"isotropic\" or {{ type = \"hg\", g = ... }}, found {} `{}`",
+                        other.type_name(),
+                        other.show()
+                    ),
+                ));
+            }
+        };
+        index.insert(name.to_string(), out.len() as u32);
+        out.push(Named {
+            name: name.to_string(),
+            value: Homogeneous {
+                sigma_a,
+                sigma_s,
+                phase,
+            },
+        });
+        ld.done(&m);
+    }
+    ld.done(&all);
+    Ok((out, index))
+}
+
+/// The `[[shapes]]` or `[[lights]]` array: (key path, bag) per element.
+fn array_of_tables<'a>(root: &Properties<'a>, key: &str) -> Result<Vec<Properties<'a>>> {
+    let Some(node) = root.node(key) else {
+        return Ok(Vec::new());
+    };
+    let Value::Array(items) = &node.value else {
+        return Err(root.error(
+            key,
+            format!(
+                "expected an array of tables ([[{key}]]), found {}",
+                node.value.type_name()
+            ),
+        ));
+    };
+    items
+        .iter()
+        .enumerate()
+        .map(|(i, item)| Properties::new(root.file(), &format!("{key}[{i}]"), item))
+        .collect()
+}
+
+fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
+    let Some(t) = s.table("transform")? else {
+        return Ok(Mat4::IDENTITY);
+    };
+    let translate = t.vec3("translate", Vec3::ZERO)?;
+    let scale = match t.node("scale").map(|n| &n.value) {
+        None => Vec3::ONE,
+        Some(Value::Array(_)) => t.vec3_required("scale")?,
+        Some(_) => Vec3::splat(t.f32_required("scale")?),
+    };
+    if scale.x * scale.y * scale.z == 0.0 {
+        return Err(t.error("scale", "must not be zero"));
+    }
+    let rotate = match t.table("rotate")? {
+        None => Mat4::IDENTITY,
+        Some(r) => {
+            let axis = r.vec3_required("axis")?;
+            if axis.length_squared() == 0.0 {
+                return Err(r.error("axis", "must not be the zero vector"));
+            }
+            let degrees = r.f32_required("degrees")?;
+            ld.done(&r);
+            Mat4::from_axis_angle(axis.normalize(), degrees.to_radians())
+        }
+    };
+    ld.done(&t);
+    Ok(Mat4::from_translation(translate) * rotate * Mat4::from_scale(scale))
+}
+
+#[allow(clippy::too_many_arguments)]
+fn read_shapes(
+    root: &Properties<'_>,
+    ld: &mut Loader,
+    material_defs: &[Named<Material>],
+    materials: &Index,
+    media: &Index,
+    objects: &mut Vec<Object>,
+    prims: &mut Vec<Primitive>,
+    lights: &mut Vec<Light>,
+) -> Result<()> {
+    for s in array_of_tables(root, "shapes")? {
+        let ty = s.string_opt("type")?.ok_or_else(|| {
+            s.error(
+                "type",
+                format!("missing; expected one of: {}", SHAPE_TYPES.join(", ")),
+            )
+        })?;
+        let mut closed = ty == "sphere";
+        let shapes = match ty {
+            "sphere" => {
+                let center = s.vec3_required("center")?;
+                let radius = s.f32_required("radius")?;
+                if radius <= 0.0 {
+                    return Err(s.error("radius", format!("must be positive, found {radius}")));
+                }
+                vec![Shape::Sphere { center, radius }]
+            }
+            "quad" => {
+                let origin = s.vec3_required("origin")?;
+                let u = s.vec3_required("u")?;
+                let v = s.vec3_required("v")?;
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(
+                        s.error("v", "u and v are parallel or zero: the quad has zero area")
+                    );
+                }
+                vec![Shape::quad(origin, u, v)]
+            }
+            "mesh" => {
+                let file = s.string_required("file")?;
+                let transform = read_transform(&s, ld)?;
+                let (tris, is_closed) = load_obj(&s, &ld.dir.join(file), transform)?;
+                closed = is_closed;
+                tris
+            }
+            other => {
+                return Err(s.error(
+                    "type",
+                    format!(
+                        "unknown shape type {other:?}; expected one of: {}",
+                        SHAPE_TYPES.join(", ")
+                    ),
+                ));
+            }
+        };
+        let material_name = s.string_required("material")?;
+        let material = *materials
+            .get(material_name)
+            .ok_or_else(|| s.error("material", undefined("material", material_name, materials)))?;
+        let interior = match s.string_opt("interior")? {
+            None => None,
+            Some(name) => {
+                let id = *media
+                    .get(name)
+                    .ok_or_else(|| s.error("interior", undefined("medium", name, media)))?;
+                if !closed {
+                    return Err(s.error(
+                        "interior",
+                        format!("a {ty} that is not closed cannot have an interior medium (a mesh needs every edge shared by exactly two consistently oriented triangles)"),
+                    ));
+                }
+                Some(id)
+            }
+        };
+        let object = objects.len() as u32;
+        let mut light = None;
+        if let Some(emission) = s.rgb_opt("emission")?
+            && emission.max_element() > 0.0
+        {
+            if material_defs[material as usize].value.is_null() {
+                return Err(s.error(
+                    "emission",
+                    "a shape with the null material is invisible and cannot emit; give it a real material (e.g. a black diffuse one)",
+                ));
+            }
+            light = Some(lights.len() as u32);
+            lights.push(area_light(shapes.clone(), emission, object));
+        }
+        objects.push(Object {
+            name: s.path().to_string(),
+            material,
+            light,
+            interior,
+            closed,
+        });
+        prims.extend(shapes.into_iter().map(|shape| Primitive { shape, object }));
+        ld.done(&s);
+    }
+    Ok(())
+}
+
+fn read_point_lights(
+    root: &Properties<'_>,
+    ld: &mut Loader,
+    lights: &mut Vec<Light>,
+) -> Result<()> {
+    for l in array_of_tables(root, "lights")? {
+        let ty = l.string_opt("type")?.ok_or_else(|| {
+            l.error(
+                "type",
+                format!("missing; expected one of: {}", LIGHT_TYPES.join(", ")),
+            )
+        })?;
+        if ty != "point" {
+            return Err(l.error(
+                "type",
+                format!(
+                    "unknown light type {ty:?}; expected one of: {}",
+                    LIGHT_TYPES.join(", ")
+                ),
+            ));
+        }
+        let position = l.vec3_required("position")?;
+        let intensity = match (l.rgb_opt("intensity")?, l.rgb_opt("power")?) {
+            (Some(i), None) => i,
+            (None, Some(p)) => p / (4.0 * std::f32::consts::PI),
+            (Some(_), Some(_)) => {
+                return Err(l.error(
+                    "power",
+                    "give either intensity (W/sr) or power (W), not both",
+                ));
+            }
+            (None, None) => {
+                return Err(l.error(
+                    "intensity",
+                    "missing; expected intensity = [r, g, b] (W/sr) or power = [r, g, b] (W)",
+                ));
+            }
+        };
+        lights.push(Light::Point {
+            position,
+            intensity,
+        });
+        ld.done(&l);
+    }
+    Ok(())
+}

@@ -1,0 +1,185 @@
+//! The scene: what a scene file describes, as the integrators use it, and the queries they
+//! make of it (closest hits, materials, lights). The rest of it, one concept per file:
+//! [`load`]ing a TOML file, [`mesh`]es (OBJ), [`volumes`] (which medium is where, from how
+//! closed shapes nest) and [`visibility`] (shadow rays, through null boundaries and media).
+
+mod load;
+pub mod mesh;
+mod visibility;
+mod volumes;
+
+pub use volumes::MediumInterface;
+use volumes::Volume;
+
+use crate::Rgb;
+use crate::accel::Accel;
+use crate::camera::Camera;
+use crate::error::{Location, Result};
+use crate::geometry::{Hit, Primitive, Ray};
+use crate::light::Light;
+use crate::material::Material;
+use crate::medium::Homogeneous;
+use crate::props::Properties;
+use crate::sampling::Distribution1D;
+use crate::value::{Document, Value};
+use glam::Vec3;
+use std::path::PathBuf;
+
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    /// Name of the integrator plugin.
+    pub integrator: String,
+    /// Camera samples per pixel.
+    pub spp: u32,
+    pub seed: u64,
+    /// Scattering events, pbrt style: 0 = emitters seen directly, 1 = direct lighting.
+    pub max_depth: u32,
+}
+
+#[derive(Clone, Debug)]
+pub struct FilmSettings {
+    pub width: u32,
+    pub height: u32,
+    /// Resolved against the scene file's folder.
+    pub output: PathBuf,
+}
+
+/// What a primitive belongs to: a `[[shapes]]` entry.
+#[derive(Clone, Debug)]
+pub struct Object {
+    /// "shapes[3]" (its key path) for messages.
+    pub name: String,
+    pub material: u32,
+    /// The area light this object is, if it emits.
+    pub light: Option<u32>,
+    /// Medium inside the (closed) shape.
+    pub interior: Option<u32>,
+    /// Whether the shape is closed (a sphere, a watertight consistently oriented mesh).
+    pub closed: bool,
+}
+
+/// A named material or medium, as referenced from shapes.
+#[derive(Clone, Debug)]
+pub struct Named<T> {
+    pub name: String,
+    pub value: T,
+}
+
+pub struct Scene {
+    pub file: PathBuf,
+    pub render: RenderSettings,
+    pub film: FilmSettings,
+    pub camera: Camera,
+    pub materials: Vec<Named<Material>>,
+    pub media: Vec<Named<Homogeneous>>,
+    pub objects: Vec<Object>,
+    pub lights: Vec<Light>,
+    /// Chooses a light proportionally to its power.
+    pub light_distribution: Distribution1D,
+    pub accel: Accel,
+    /// The medium filling free space, if any.
+    pub medium: Option<u32>,
+    /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
+    /// None in a scene without media.
+    pub interfaces: Vec<Option<MediumInterface>>,
+    /// The medium around the camera (None: vacuum).
+    pub camera_medium: Option<u32>,
+    /// The objects that bound volumes, for [`Scene::medium_at`].
+    volumes: Vec<Volume>,
+    /// Per object: a volume whose bounding box meets no other volume's, so that no other
+    /// boundary can coincide with it and crossing it needs no search for coincident ones.
+    alone: Vec<bool>,
+    /// Axis-aligned bounds of all geometry and point lights.
+    pub bounds: (Vec3, Vec3),
+    /// The parsed document (integrators read their `[integrators.NAME]` table from it).
+    pub document: Document,
+    /// Keys that were present but never read by the loader (not counting `[integrators]`).
+    pub unused: Vec<(String, Location)>,
+    /// Non-fatal problems (reflectance above one, no lights...).
+    pub warnings: Vec<String>,
+}
+
+impl Scene {
+    /// Where a key path was written in the scene file (line 0: it came from `--set`).
+    pub fn location_of(&self, path: &[&str]) -> Option<Location> {
+        let mut node = self.document.root.get(path.first()?)?;
+        for key in &path[1..] {
+            match &node.value {
+                Value::Table(t) => node = t.get(key)?,
+                _ => return None,
+            }
+        }
+        Some(Location {
+            file: self.file.clone(),
+            line: node.line,
+            column: node.column,
+        })
+    }
+
+    /// The parameters of integrator `name` (its `[integrators.NAME]` table, or an empty bag).
+    pub fn integrator_properties(&self, name: &str) -> Result<Properties<'_>> {
+        let path = format!("integrators.{name}");
+        let Some(node) = self.document.root.get("integrators") else {
+            return Ok(Properties::empty(&self.file, &path));
+        };
+        let integrators = Properties::new(&self.file, "integrators", node)?;
+        Ok(integrators
+            .table(name)?
+            .unwrap_or_else(|| Properties::empty(&self.file, &path)))
+    }
+
+    /// Closest surface hit (null boundaries included) with t in (0, tmax).
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
+        self.accel.intersect(ray, tmax)
+    }
+
+    #[inline]
+    pub fn primitive(&self, hit: &Hit) -> &Primitive {
+        &self.accel.primitives()[hit.prim as usize]
+    }
+
+    #[inline]
+    pub fn object(&self, hit: &Hit) -> &Object {
+        &self.objects[self.primitive(hit).object as usize]
+    }
+
+    #[inline]
+    pub fn material(&self, hit: &Hit) -> &Material {
+        &self.materials[self.object(hit).material as usize].value
+    }
+
+    /// The area light a hit lies on, if its object emits.
+    #[inline]
+    pub fn area_light(&self, hit: &Hit) -> Option<(u32, &Light)> {
+        let id = self.object(hit).light?;
+        Some((id, &self.lights[id as usize]))
+    }
+
+    /// Samples a light proportionally to power: (index, probability).
+    #[inline]
+    pub fn sample_light(&self, u: f32) -> Option<(usize, f32)> {
+        if self.lights.is_empty() || self.light_distribution.total() <= 0.0 {
+            return None;
+        }
+        Some(self.light_distribution.sample(u))
+    }
+
+    /// Probability of choosing light `i`.
+    #[inline]
+    pub fn light_pmf(&self, i: usize) -> f32 {
+        self.light_distribution.pmf(i)
+    }
+
+    /// Total emitted power of all lights (W).
+    pub fn total_power(&self) -> Rgb {
+        self.lights.iter().map(|l| l.power()).sum()
+    }
+
+    /// Whether any participating medium is used. Cheap (every shadow ray asks): a shape with
+    /// an `interior` is closed, so it is among the volumes, which exist only when media do.
+    #[inline]
+    pub fn has_media(&self) -> bool {
+        self.medium.is_some() || !self.volumes.is_empty()
+    }
+}

@@ -1,0 +1,207 @@
+//! Visibility between two points: shadow rays, which pass null boundaries and carry the
+//! transmittance of the media they cross.
+
+use super::Scene;
+use crate::Rgb;
+use crate::geometry::{Hit, Ray, Shape, offset_origin};
+use glam::Vec3;
+
+impl Scene {
+    /// Transmittance along the segment between two points, starting in `medium`: zero if
+    /// anything but null boundaries blocks it, otherwise the product of exp(-sigma_t d) over
+    /// the pieces between the null boundaries it crosses, each in its own medium. The ends
+    /// are offset along their normals as in [`Scene::occluded`] (a zero normal, e.g. a point
+    /// in a medium or a point light: no offset). Without media it is exactly 0 or 1.
+    pub fn transmittance(
+        &self,
+        p0: Vec3,
+        n0: Vec3,
+        p1: Vec3,
+        n1: Vec3,
+        medium: Option<u32>,
+    ) -> Rgb {
+        if !self.has_media() {
+            return if self.occluded(p0, n0, p1, n1) {
+                Rgb::ZERO
+            } else {
+                Rgb::ONE
+            };
+        }
+        let d = p1 - p0;
+        let from = if n0 == Vec3::ZERO {
+            p0
+        } else {
+            offset_origin(p0, n0, d)
+        };
+        let to = if n1 == Vec3::ZERO {
+            p1
+        } else {
+            offset_origin(p1, n1, -d)
+        };
+        let seg = to - from;
+        let dist = seg.length();
+        if dist <= 0.0 || seg.dot(d) <= 0.0 {
+            return self.transmittance_over(medium, p0.distance(p1));
+        }
+        // One traversal of the segment: it stops at the first blocker, and collects the null
+        // boundaries crossed (a sphere may be crossed twice); they are then walked in order.
+        let ray = Ray::new(from, seg / dist);
+        let mut crossings = [(0.0f32, 0u32); MAX_COLLECTED_CROSSINGS];
+        let mut n = 0;
+        let mut overflow = false;
+        let blocked = self.accel.visit(&ray, dist, |i, prim| {
+            let material = &self.materials[self.objects[prim.object as usize].material as usize];
+            if !material.value.is_null() {
+                return prim.shape.intersect(&ray, dist).is_some();
+            }
+            for t in segment_crossings(&prim.shape, &ray, dist)
+                .into_iter()
+                .flatten()
+            {
+                if n < crossings.len() {
+                    crossings[n] = (t, i);
+                    n += 1;
+                } else {
+                    overflow = true;
+                }
+            }
+            false
+        });
+        if blocked {
+            return Rgb::ZERO;
+        }
+        if overflow {
+            return self.transmittance_walk(p0, p1, from, to, medium);
+        }
+        let crossings = &mut crossings[..n];
+        crossings.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let prims = self.accel.primitives();
+        let mut tr = Rgb::ONE;
+        let mut medium = medium;
+        // Distances are measured from the end points themselves, not the offset origins.
+        let mut last = p0;
+        for &(t, i) in crossings.iter() {
+            let p = ray.at(t);
+            tr *= self.transmittance_over(medium, p.distance(last));
+            last = p;
+            let hit = Hit {
+                t,
+                p,
+                ng: prims[i as usize].shape.normal(p),
+                prim: i,
+            };
+            medium = self.medium_after(&hit, ray.dir, medium);
+        }
+        tr * self.transmittance_over(medium, p1.distance(last))
+    }
+
+    /// exp(-sigma_t d) in `medium` (one in vacuum).
+    fn transmittance_over(&self, medium: Option<u32>, d: f32) -> Rgb {
+        match medium {
+            Some(m) => self.media[m as usize].value.transmittance_over(d),
+            None => Rgb::ONE,
+        }
+    }
+
+    /// [`Scene::transmittance`] by closest hits, one boundary after another: for segments
+    /// that cross more boundaries than one traversal collects.
+    fn transmittance_walk(
+        &self,
+        p0: Vec3,
+        p1: Vec3,
+        from: Vec3,
+        to: Vec3,
+        medium: Option<u32>,
+    ) -> Rgb {
+        let d = p1 - p0;
+        let tr_over = |medium: Option<u32>, d: f32| self.transmittance_over(medium, d);
+        let mut tr = Rgb::ONE;
+        let mut medium = medium;
+        let mut origin = from;
+        let mut last = p0;
+        for _ in 0..MAX_BOUNDARY_CROSSINGS {
+            let seg = to - origin;
+            let dist = seg.length();
+            if dist <= 0.0 || seg.dot(d) <= 0.0 {
+                break;
+            }
+            let ray = Ray::new(origin, seg / dist);
+            let Some(hit) = self.intersect(&ray, dist) else {
+                break;
+            };
+            if !self.material(&hit).is_null() {
+                return Rgb::ZERO;
+            }
+            tr *= tr_over(medium, hit.p.distance(last));
+            if tr == Rgb::ZERO {
+                return tr;
+            }
+            last = hit.p;
+            medium = self.medium_after(&hit, ray.dir, medium);
+            origin = offset_origin(hit.p, hit.ng, ray.dir);
+        }
+        tr * tr_over(medium, p1.distance(last))
+    }
+
+    /// Whether the segment between two surface points is blocked by anything but null
+    /// boundaries. The ends are offset along their normals (a zero normal: no offset).
+    pub fn occluded(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
+        let d = p1 - p0;
+        let from = if n0 == Vec3::ZERO {
+            p0
+        } else {
+            offset_origin(p0, n0, d)
+        };
+        let to = if n1 == Vec3::ZERO {
+            p1
+        } else {
+            offset_origin(p1, n1, -d)
+        };
+        let seg = to - from;
+        let dist = seg.length();
+        if dist <= 0.0 {
+            return false;
+        }
+        let ray = Ray::new(from, seg / dist);
+        let prims_objects = &self.objects;
+        let materials = &self.materials;
+        self.accel.occluded(&ray, dist, |prim| {
+            !materials[prims_objects[prim.object as usize].material as usize]
+                .value
+                .is_null()
+        })
+    }
+}
+
+/// Null boundaries a shadow ray may cross before it is taken as blocked (guards against rays
+/// stuck on coincident boundaries).
+const MAX_BOUNDARY_CROSSINGS: u32 = 256;
+
+/// Null-boundary crossings one traversal of a shadow ray collects; more, and it walks them
+/// one closest hit at a time.
+const MAX_COLLECTED_CROSSINGS: usize = 16;
+
+/// Where a ray crosses a shape within (0, tmax): both roots of a sphere, the one point of a
+/// quad or triangle.
+fn segment_crossings(shape: &Shape, ray: &Ray, tmax: f32) -> [Option<f32>; 2] {
+    match *shape {
+        Shape::Sphere { center, radius } => {
+            // As Shape::intersect (Ray Tracing Gems ch. 7), keeping both roots.
+            let f = ray.origin - center;
+            let b = -f.dot(ray.dir);
+            let l = f + b * ray.dir;
+            let disc = radius * radius - l.dot(l);
+            if disc < 0.0 {
+                return [None, None];
+            }
+            let c = f.dot(f) - radius * radius;
+            let q = b + b.signum() * disc.sqrt();
+            if q == 0.0 {
+                return [None, None];
+            }
+            let inside = |t: f32| (t > 0.0 && t < tmax).then_some(t);
+            [inside(c / q), inside(q)]
+        }
+        _ => [shape.intersect(ray, tmax), None],
+    }
+}

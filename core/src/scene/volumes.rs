@@ -1,0 +1,318 @@
+//! Where media are: which closed shapes bound volumes and how they nest (their medium
+//! interfaces), the medium at a point, and the medium a ray enters or leaves into at a
+//! boundary.
+
+use super::{Named, Object, Scene};
+use crate::accel::Accel;
+use crate::geometry::{Hit, Ray, Shape};
+use crate::material::Material;
+use glam::Vec3;
+
+/// The media on the two sides of a closed shape that bounds a volume: pbrt's MediumInterface,
+/// except that the outside is not written in the scene but found from how the shapes nest.
+/// A ray crossing the shape against its outward normal enters `inside`, along it leaves to
+/// `outside`, so that every boundary crossing sets the medium afresh and an error made
+/// between two crossings does not propagate along the path.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MediumInterface {
+    /// The `interior` medium; None: vacuum (clear glass, a bubble).
+    pub inside: Option<u32>,
+    /// The inside of the innermost boundary enclosing this one, or the scene medium.
+    pub outside: Option<u32>,
+    /// Number of boundaries enclosing this one (0: outermost). Decides between coincident
+    /// boundaries.
+    pub depth: u32,
+}
+
+impl Scene {
+    /// The medium at a point in free space: the inside of the innermost medium boundary that
+    /// contains it, or the scene medium. An error (saying why) if the point lies on a boundary
+    /// or inside boundaries that overlap without one containing the other. Costs a few rays
+    /// per boundary: for starting points (camera, lights), not for every vertex of a path.
+    pub fn medium_at(&self, p: Vec3) -> std::result::Result<Option<u32>, String> {
+        locate_medium(
+            &self.accel,
+            &self.objects,
+            &self.interfaces,
+            &self.volumes,
+            self.medium,
+            p,
+        )
+    }
+
+    /// The medium on the side of the surface at `hit` that `dir` points into: the medium a
+    /// ray crossing the surface along `dir` enters, or the one a ray leaving the surface
+    /// along `dir` (reflected, or a shadow ray) travels in. `current` is the medium the path
+    /// was in; it is kept unless the surface bounds a volume.
+    ///
+    /// Coincident boundaries (two volumes touching, a volume sharing a face with its
+    /// container) are crossed together: every boundary through the point is found, and the
+    /// innermost one entered wins, or if none is entered, the outermost one left.
+    pub fn medium_after(&self, hit: &Hit, dir: Vec3, current: Option<u32>) -> Option<u32> {
+        let object = self.primitive(hit).object as usize;
+        let Some(own) = self.interfaces[object] else {
+            return current;
+        };
+        if self.alone[object] {
+            return if hit.ng.dot(dir) < 0.0 {
+                own.inside
+            } else {
+                own.outside
+            };
+        }
+        let eps = 1e-4 * (1.0 + hit.p.abs().max_element());
+        let probe = Ray::new(hit.p - dir * eps, dir);
+        let mut entered: Option<MediumInterface> = None;
+        let mut left: Option<MediumInterface> = None;
+        let mut consider = |iface: MediumInterface, n: Vec3| {
+            if n.dot(dir) < 0.0 {
+                if entered.is_none_or(|e| iface.depth > e.depth) {
+                    entered = Some(iface);
+                }
+            } else if left.is_none_or(|l| iface.depth < l.depth) {
+                left = Some(iface);
+            }
+        };
+        consider(own, hit.ng);
+        let prims = self.accel.primitives();
+        self.accel.for_each_hit(&probe, 2.0 * eps, |i, t| {
+            let prim = &prims[i as usize];
+            if let Some(iface) = self.interfaces[prim.object as usize] {
+                consider(iface, prim.shape.normal(probe.at(t)));
+            }
+        });
+        match (entered, left) {
+            (Some(e), _) => e.inside,
+            (None, Some(l)) => l.outside,
+            (None, None) => current,
+        }
+    }
+}
+
+/// An object that bounds a volume, with what point-in-volume tests need.
+pub(super) struct Volume {
+    object: u32,
+    /// Its primitives (indices into the BVH's primitives).
+    prims: Vec<u32>,
+    /// Its bounding box.
+    lo: Vec3,
+    hi: Vec3,
+}
+
+/// Directions of the rays that decide whether a point is inside a closed shape: five, not
+/// aligned with the axes (axis-aligned rays run along the edges and faces of boxes).
+const INSIDE_PROBES: [Vec3; 5] = [
+    Vec3::new(0.267_261_24, 0.534_522_5, 0.801_783_7),
+    Vec3::new(-0.617_213_4, 0.154_303_35, 0.771_516_8),
+    Vec3::new(0.408_248_3, -0.816_496_6, 0.408_248_3),
+    Vec3::new(-0.301_511_35, -0.301_511_35, -0.904_534_04),
+    Vec3::new(0.872_871_6, 0.218_217_9, -0.436_435_8),
+];
+
+/// Whether `p` is inside a volume: along each probe direction, the nearest surface of the
+/// volume is seen from its inside (outward normal along the ray) or not; the majority decides,
+/// so that a probe that slips through an edge between two triangles does not. Err if `p` is
+/// on the surface.
+fn inside_volume(accel: &Accel, volume: &Volume, p: Vec3) -> std::result::Result<bool, ()> {
+    let on_surface = 1e-5 * (1.0 + p.abs().max_element());
+    if (p - volume.lo).min_element() < -on_surface || (volume.hi - p).min_element() < -on_surface {
+        return Ok(false);
+    }
+    let prims = accel.primitives();
+    // The probes cannot see a surface at distance zero: a point on it is found by distance.
+    if volume
+        .prims
+        .iter()
+        .any(|&i| distance_to(&prims[i as usize].shape, p) < on_surface)
+    {
+        return Err(());
+    }
+    let mut votes = 0;
+    for dir in INSIDE_PROBES {
+        let ray = Ray::new(p, dir);
+        let mut nearest: Option<(f32, u32)> = None;
+        accel.for_each_hit(&ray, f32::INFINITY, |i, t| {
+            if prims[i as usize].object == volume.object && nearest.is_none_or(|(tn, _)| t < tn) {
+                nearest = Some((t, i));
+            }
+        });
+        if let Some((t, i)) = nearest {
+            if t < on_surface {
+                return Err(());
+            }
+            let n = prims[i as usize].shape.normal(ray.at(t));
+            votes += (n.dot(dir) > 0.0) as u32;
+        }
+    }
+    Ok(votes * 2 > INSIDE_PROBES.len() as u32)
+}
+
+/// Distance from `p` to a closed object's primitive (spheres and triangles; quads are never
+/// closed).
+fn distance_to(shape: &Shape, p: Vec3) -> f32 {
+    let segment = |a: Vec3, e: Vec3| {
+        let s = ((p - a).dot(e) / e.length_squared()).clamp(0.0, 1.0);
+        p.distance(a + s * e)
+    };
+    match *shape {
+        Shape::Sphere { center, radius } => (p.distance(center) - radius).abs(),
+        Shape::Triangle { p0, e1, e2 } => {
+            // The nearest point is inside the triangle (the projection) or on an edge.
+            let n = e1.cross(e2);
+            let q = p - p0;
+            let b1 = q.cross(e2).dot(n) / n.length_squared();
+            let b2 = e1.cross(q).dot(n) / n.length_squared();
+            if b1 >= 0.0 && b2 >= 0.0 && b1 + b2 <= 1.0 {
+                q.dot(n).abs() / n.length()
+            } else {
+                segment(p0, e1)
+                    .min(segment(p0, e2))
+                    .min(segment(p0 + e1, e2 - e1))
+            }
+        }
+        Shape::Quad { origin, u, v, .. } => segment(origin, u)
+            .min(segment(origin, v))
+            .min(segment(origin + u, v))
+            .min(segment(origin + v, u)),
+    }
+}
+
+/// A point strictly inside a closed object, near its surface: the centroid of its largest
+/// primitive pushed inwards (the centre, for a sphere). Used to ask which boundaries contain
+/// the object.
+fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
+    let mut best: Option<(f32, Shape)> = None;
+    for &i in &volume.prims {
+        let prim = &accel.primitives()[i as usize];
+        let area = prim.shape.area();
+        if best.is_none_or(|(a, _)| area > a) {
+            best = Some((area, prim.shape));
+        }
+    }
+    match best.map(|(_, s)| s) {
+        Some(Shape::Sphere { center, .. }) => center,
+        Some(Shape::Triangle { p0, e1, e2 }) => {
+            let c = p0 + (e1 + e2) / 3.0;
+            let inward = -e1.cross(e2).normalize();
+            // Far enough from the surface for the probes' on-surface test, well inside any
+            // triangle-sized feature.
+            let step =
+                (1e-3 * (1.0 + c.abs().max_element())).min(0.05 * e1.length().min(e2.length()));
+            c + inward * step
+        }
+        Some(Shape::Quad {
+            origin,
+            u,
+            v,
+            normal,
+            ..
+        }) => origin + 0.5 * (u + v) - normal * 1e-3,
+        None => Vec3::ZERO,
+    }
+}
+
+/// Which objects bound volumes, and their medium interfaces. A closed shape bounds a volume
+/// if it has an `interior` medium, or if light can enter it (a null or dielectric material):
+/// then its inside is vacuum (clear glass in fog). Opaque shapes without an interior leave
+/// the medium as it is (light reflected there stays on its side).
+pub(super) fn medium_interfaces(
+    objects: &[Object],
+    materials: &[Named<Material>],
+    accel: &Accel,
+    scene_medium: Option<u32>,
+) -> (Vec<Option<MediumInterface>>, Vec<Volume>, Vec<bool>) {
+    let mut index = vec![None; objects.len()];
+    let mut volumes: Vec<Volume> = Vec::new();
+    for (i, o) in objects.iter().enumerate() {
+        let m = &materials[o.material as usize].value;
+        if o.closed
+            && (o.interior.is_some() || m.is_null() || matches!(m, Material::Dielectric { .. }))
+        {
+            index[i] = Some(volumes.len());
+            volumes.push(Volume {
+                object: i as u32,
+                prims: Vec::new(),
+                lo: Vec3::splat(f32::INFINITY),
+                hi: Vec3::splat(f32::NEG_INFINITY),
+            });
+        }
+    }
+    for (k, prim) in accel.primitives().iter().enumerate() {
+        if let Some(v) = index[prim.object as usize] {
+            let volume: &mut Volume = &mut volumes[v];
+            volume.prims.push(k as u32);
+            let b = prim.shape.aabb();
+            volume.lo = volume.lo.min(b.min.into());
+            volume.hi = volume.hi.max(b.max.into());
+        }
+    }
+    // containers[k]: the volumes that contain volume k.
+    let containers: Vec<Vec<usize>> = volumes
+        .iter()
+        .enumerate()
+        .map(|(k, volume)| {
+            let q = point_inside(accel, volume);
+            (0..volumes.len())
+                .filter(|&c| c != k && inside_volume(accel, &volumes[c], q).unwrap_or(false))
+                .collect()
+        })
+        .collect();
+    let depth: Vec<u32> = containers.iter().map(|c| c.len() as u32).collect();
+    let mut out = vec![None; objects.len()];
+    for (k, volume) in volumes.iter().enumerate() {
+        let parent = containers[k].iter().copied().max_by_key(|&c| depth[c]);
+        let i = volume.object as usize;
+        out[i] = Some(MediumInterface {
+            inside: objects[i].interior,
+            outside: parent.map_or(scene_medium, |c| {
+                objects[volumes[c].object as usize].interior
+            }),
+            depth: depth[k],
+        });
+    }
+    let mut alone = vec![false; objects.len()];
+    let pad = |v: &Volume| 1e-3 * (1.0 + v.lo.abs().max(v.hi.abs()).max_element());
+    for (k, v) in volumes.iter().enumerate() {
+        alone[v.object as usize] = volumes.iter().enumerate().all(|(c, w)| {
+            let e = pad(v).max(pad(w));
+            c == k || (v.lo - e).cmpgt(w.hi).any() || (w.lo - e).cmpgt(v.hi).any()
+        });
+    }
+    (out, volumes, alone)
+}
+
+/// See [`Scene::medium_at`].
+pub(super) fn locate_medium(
+    accel: &Accel,
+    objects: &[Object],
+    interfaces: &[Option<MediumInterface>],
+    volumes: &[Volume],
+    scene_medium: Option<u32>,
+    p: Vec3,
+) -> std::result::Result<Option<u32>, String> {
+    let mut innermost: Option<(usize, MediumInterface)> = None;
+    for volume in volumes {
+        let i = volume.object as usize;
+        let Some(iface) = interfaces[i] else { continue };
+        match inside_volume(accel, volume, p) {
+            Err(()) => {
+                return Err(format!(
+                    "it lies on the surface of {}, a medium boundary",
+                    objects[i].name
+                ));
+            }
+            Ok(false) => {}
+            Ok(true) => match innermost {
+                Some((j, other)) if other.depth == iface.depth => {
+                    return Err(format!(
+                        "it is inside both {} and {}, which overlap without one containing the other",
+                        objects[j].name, objects[i].name
+                    ));
+                }
+                Some((_, other)) if other.depth > iface.depth => {}
+                _ => innermost = Some((i, iface)),
+            },
+        }
+    }
+    Ok(innermost.map_or(scene_medium, |(_, iface)| iface.inside))
+}
