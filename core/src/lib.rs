@@ -10,7 +10,7 @@
 
 pub mod accel;
 pub mod camera;
-pub mod camera_path;
+
 pub mod direct;
 pub mod error;
 pub mod film;
@@ -26,6 +26,7 @@ pub mod render;
 pub mod sampling;
 pub mod scene;
 pub mod value;
+pub mod walk;
 
 pub use error::{Error, Result};
 pub use glam::Vec3;

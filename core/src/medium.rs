@@ -1,5 +1,5 @@
-//! Participating media: the homogeneous medium, phase functions, transmittance and free-flight
-//! distance sampling. Where media are in a scene (which medium a point or ray is in, and how
+//! Participating media: the `Medium` interface every integrator uses, the homogeneous medium,
+//! phase functions, transmittance and free-flight distance sampling. Where media are in a scene (which medium a point or ray is in, and how
 //! it changes at boundaries) is the scene's business: `Scene::medium_at`,
 //! `Scene::medium_after` and `Scene::transmittance`.
 //!
@@ -146,17 +146,28 @@ pub fn free_flight_pass_probability(sigma_t: Rgb, tmax: f32) -> f32 {
     crate::average(transmittance_homogeneous(sigma_t, tmax))
 }
 
-/// A participating medium.
+/// A participating medium: the interface every integrator uses (Mitsuba's `Medium`,
+/// pbrt-v4's `Medium`), so that a new kind of medium is one implementation of this trait and no
+/// integrator changes. Positions and rays are in world space; a medium knows nothing of its
+/// boundaries (the scene's medium interfaces say where it is).
 pub trait Medium: Send + Sync + std::fmt::Debug {
+    /// Whether the medium neither absorbs nor scatters anywhere: integrators skip it entirely,
+    /// so that an empty medium renders exactly (bit for bit) as no medium.
+    fn is_vacuum(&self) -> bool;
     /// Absorption coefficient (1/m) at `p`.
     fn sigma_a(&self, p: Vec3) -> Rgb;
     /// Scattering coefficient (1/m) at `p`.
     fn sigma_s(&self, p: Vec3) -> Rgb;
+    /// Extinction coefficient (1/m) at `p`.
+    fn sigma_t(&self, p: Vec3) -> Rgb {
+        self.sigma_a(p) + self.sigma_s(p)
+    }
     fn phase(&self) -> Phase;
-    /// Transmittance along the segment from `a` to `b`.
-    fn transmittance(&self, a: Vec3, b: Vec3) -> Rgb;
-    /// Samples with channel `channel`'s free-flight density where light travelling back
-    /// along `ray` last scattered within (0, tmax); `u` is uniform in [0, 1).
+    /// Transmittance along `ray` from its origin over the distance `d` (which may be
+    /// infinite; `ray.dir` is a unit vector).
+    fn transmittance(&self, ray: &Ray, d: f32) -> Rgb;
+    /// Samples a free-flight distance along `ray` within (0, `tmax`) with channel `channel`'s
+    /// density (see the module comment for the weights); `u` is uniform in [0, 1).
     fn sample_free_flight(&self, ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight;
 }
 
@@ -173,21 +184,32 @@ impl Homogeneous {
         self.sigma_a + self.sigma_s
     }
 
-    /// A medium that neither absorbs nor scatters: integrators skip it entirely, so that an
-    /// empty medium renders exactly (bit for bit) as no medium.
-    pub fn is_vacuum(&self) -> bool {
-        self.sigma_t().max_element() == 0.0
-    }
-
     /// Transmittance over a distance `d` (which may be infinite).
     #[inline]
     pub fn transmittance_over(&self, d: f32) -> Rgb {
         transmittance_homogeneous(self.sigma_t(), d)
     }
+}
 
-    /// Samples a free-flight distance with channel `channel`'s density
-    /// sigma_t,c exp(-sigma_t,c t), up to `tmax` (see the module comment for the weights).
-    pub fn sample_free_flight(&self, tmax: f32, channel: usize, u: f32) -> FreeFlight {
+impl Medium for Homogeneous {
+    fn is_vacuum(&self) -> bool {
+        self.sigma_t().max_element() == 0.0
+    }
+    fn sigma_a(&self, _: Vec3) -> Rgb {
+        self.sigma_a
+    }
+    fn sigma_s(&self, _: Vec3) -> Rgb {
+        self.sigma_s
+    }
+    fn phase(&self) -> Phase {
+        self.phase
+    }
+    /// Beer-Lambert: exp(-sigma_t d) per channel.
+    fn transmittance(&self, _ray: &Ray, d: f32) -> Rgb {
+        self.transmittance_over(d)
+    }
+    /// t is drawn from sigma_t,c exp(-sigma_t,c t) for the given channel c.
+    fn sample_free_flight(&self, _ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight {
         let sigma_t = self.sigma_t();
         let s = sigma_t[channel];
         // 1 - u is in (0, 1]: the logarithm is finite.
@@ -216,25 +238,6 @@ impl Homogeneous {
     }
 }
 
-impl Medium for Homogeneous {
-    fn sigma_a(&self, _: Vec3) -> Rgb {
-        self.sigma_a
-    }
-    fn sigma_s(&self, _: Vec3) -> Rgb {
-        self.sigma_s
-    }
-    fn phase(&self) -> Phase {
-        self.phase
-    }
-    /// Beer-Lambert: exp(-sigma_t d) per channel.
-    fn transmittance(&self, a: Vec3, b: Vec3) -> Rgb {
-        self.transmittance_over(a.distance(b))
-    }
-    fn sample_free_flight(&self, _ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight {
-        Homogeneous::sample_free_flight(self, tmax, channel, u)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -249,7 +252,8 @@ mod tests {
             phase: Phase::Isotropic,
         };
         // Channel 0 (vacuum) chosen: the sample passes with weight Tr / P(pass) = 1 / (1/3).
-        let f = m.sample_free_flight(f32::INFINITY, channel(0.1), 0.5);
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        let f = m.sample_free_flight(&ray, f32::INFINITY, channel(0.1), 0.5);
         assert!(!f.scattered);
         assert_eq!(f.weight(), Rgb::new(3.0, 0.0, 0.0));
         let mut hero = HeroChannel::new(0.1);

@@ -51,7 +51,7 @@ fn main() {
     let t = Instant::now();
     let mut checksum = 0.0f64;
     for q in &query_points {
-        checksum += map.knn(*q, k, max_radius, |_| true, &mut out) as f64;
+        checksum += map.knn(*q, k, max_radius, |_, _| true, &mut out) as f64;
     }
     let secs = t.elapsed().as_secs_f64();
     println!(

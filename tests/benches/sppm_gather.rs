@@ -11,10 +11,10 @@
 //!
 //!   cargo bench -p foton-tests --bench sppm_gather
 
-use foton_core::camera_path::trace_to_diffuse;
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
+use foton_core::walk::trace_to_diffuse;
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::repo_root;

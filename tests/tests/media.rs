@@ -164,13 +164,13 @@ fn transmittance_through_slabs_is_exp_minus_sigma_t_d_per_channel() {
     let sphere_c = "\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.5, 0.0]\nradius = 0.25\nmaterial = \"boundary\"\ninterior = \"C\"\n";
     let (dir, path) = scene_dir("media-slabs", &nested_scene(sphere_c), &nested_boxes());
     let scene = load(&path);
-    let sigma = |name: &str| scene.media[medium_index(&scene, name).unwrap() as usize].value;
-    let (s, a, b, c) = (
-        sigma("S").sigma_t(),
-        sigma("A").sigma_t(),
-        sigma("B").sigma_t(),
-        sigma("C").sigma_t(),
-    );
+    // Homogeneous media: sigma_t is the same at every point.
+    let sigma_t = |name: &str| {
+        scene
+            .medium(medium_index(&scene, name).unwrap())
+            .sigma_t(Vec3::ZERO)
+    };
+    let (s, a, b, c) = (sigma_t("S"), sigma_t("A"), sigma_t("B"), sigma_t("C"));
     let tr = |p0: Vec3, p1: Vec3| {
         let m = scene.medium_at(p0).unwrap();
         scene.transmittance(p0, Vec3::ZERO, p1, Vec3::ZERO, m)

@@ -15,7 +15,7 @@ use foton_core::geometry::Shape;
 use foton_core::kernel::{BUILTIN_KERNELS, NormalizedKernel, builtin};
 use foton_core::light::{Light, area_light};
 use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
-use foton_core::medium::{Homogeneous, Phase, channel};
+use foton_core::medium::{Homogeneous, Medium, Phase, channel};
 use foton_core::sampling::{self, Distribution1D, Rng};
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -1786,11 +1786,13 @@ fn free_flight_sampling_follows_the_spectral_mis_density_and_is_unbiased() {
 
         let mut observed = vec![0u64; cells];
         let mut rng = Rng::new(&[60, k as u64]);
+        // Through the Medium interface, as the integrators sample it.
+        let ray = foton_core::geometry::Ray::new(Vec3::ZERO, Vec3::Z);
         // Per channel: sum of weights of scattering events, and of passing samples.
         let (mut scattered, mut passed) = (DVec3::ZERO, DVec3::ZERO);
         for _ in 0..N {
             let c = channel(rng.next_f32());
-            let f = medium.sample_free_flight(tmax, c, rng.next_f32());
+            let f = medium.sample_free_flight(&ray, tmax, c, rng.next_f32());
             let w = f.weight().as_dvec3();
             if f.scattered {
                 assert!(f.t >= 0.0 && f.t < tmax, "{name}: t = {}", f.t);

@@ -49,7 +49,7 @@ fn fog_box_from_other_tooling_parses_its_media() {
     let scene = Scene::load(&repo_root().join("scenes/fog_box.toml"), &[]).unwrap();
     assert!(scene.has_media());
     let fog = scene.media.iter().find(|m| m.name == "fog").unwrap();
-    assert_eq!(fog.value.sigma_t(), glam::Vec3::splat(1.05));
+    assert_eq!(fog.value.sigma_t(glam::Vec3::ZERO), glam::Vec3::splat(1.05));
     // The closed cube mesh carries the fog as its interior.
     assert_eq!(
         scene

@@ -5,7 +5,7 @@
 
 use super::mesh::load_obj;
 use super::volumes::{locate_medium, medium_interfaces};
-use super::{FilmSettings, Named, Object, RenderSettings, Scene};
+use super::{BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene};
 use crate::Rgb;
 use crate::accel::Accel;
 use crate::camera::Camera;
@@ -373,7 +373,7 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
     Ok((out, index))
 }
 
-fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<Homogeneous>>, Index)> {
+fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<BoxedMedium>>, Index)> {
     let mut out = Vec::new();
     let mut index = HashMap::new();
     let Some(all) = root.table("media")? else {
@@ -437,11 +437,11 @@ fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<Homog
         index.insert(name.to_string(), out.len() as u32);
         out.push(Named {
             name: name.to_string(),
-            value: Homogeneous {
+            value: Box::new(Homogeneous {
                 sigma_a,
                 sigma_s,
                 phase,
-            },
+            }),
         });
         ld.done(&m);
     }

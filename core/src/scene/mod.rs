@@ -18,7 +18,7 @@ use crate::error::{Location, Result};
 use crate::geometry::{Hit, Primitive, Ray};
 use crate::light::Light;
 use crate::material::Material;
-use crate::medium::Homogeneous;
+use crate::medium::Medium;
 use crate::props::Properties;
 use crate::sampling::Distribution1D;
 use crate::value::{Document, Value};
@@ -58,6 +58,9 @@ pub struct Object {
     pub closed: bool,
 }
 
+/// A medium of any kind.
+pub type BoxedMedium = Box<dyn Medium>;
+
 /// A named material or medium, as referenced from shapes.
 #[derive(Clone, Debug)]
 pub struct Named<T> {
@@ -71,7 +74,8 @@ pub struct Scene {
     pub film: FilmSettings,
     pub camera: Camera,
     pub materials: Vec<Named<Material>>,
-    pub media: Vec<Named<Homogeneous>>,
+    /// The media, each behind the `Medium` interface (a new kind is one implementation).
+    pub media: Vec<Named<BoxedMedium>>,
     pub objects: Vec<Object>,
     pub lights: Vec<Light>,
     /// Chooses a light proportionally to its power.
@@ -174,6 +178,12 @@ impl Scene {
     /// Total emitted power of all lights (W).
     pub fn total_power(&self) -> Rgb {
         self.lights.iter().map(|l| l.power()).sum()
+    }
+
+    /// Medium `id` (an index into `media`).
+    #[inline]
+    pub fn medium(&self, id: u32) -> &dyn Medium {
+        self.media[id as usize].value.as_ref()
     }
 
     /// Whether any participating medium is used. Cheap (every shadow ray asks): a shape with

@@ -4,6 +4,7 @@
 use super::Scene;
 use crate::Rgb;
 use crate::geometry::{Hit, Ray, Shape, offset_origin};
+use crate::walk::MAX_NULL_CROSSINGS;
 use glam::Vec3;
 
 impl Scene {
@@ -41,7 +42,7 @@ impl Scene {
         let seg = to - from;
         let dist = seg.length();
         if dist <= 0.0 || seg.dot(d) <= 0.0 {
-            return self.transmittance_over(medium, p0.distance(p1));
+            return self.transmittance_between(medium, p0, p1);
         }
         // One traversal of the segment: it stops at the first blocker, and collects the null
         // boundaries crossed (a sphere may be crossed twice); they are then walked in order.
@@ -82,7 +83,7 @@ impl Scene {
         let mut last = p0;
         for &(t, i) in crossings.iter() {
             let p = ray.at(t);
-            tr *= self.transmittance_over(medium, p.distance(last));
+            tr *= self.transmittance_between(medium, last, p);
             last = p;
             let hit = Hit {
                 t,
@@ -92,14 +93,20 @@ impl Scene {
             };
             medium = self.medium_after(&hit, ray.dir, medium);
         }
-        tr * self.transmittance_over(medium, p1.distance(last))
+        tr * self.transmittance_between(medium, last, p1)
     }
 
-    /// exp(-sigma_t d) in `medium` (one in vacuum).
-    fn transmittance_over(&self, medium: Option<u32>, d: f32) -> Rgb {
-        match medium {
-            Some(m) => self.media[m as usize].value.transmittance_over(d),
-            None => Rgb::ONE,
+    /// The transmittance of `medium` (one in vacuum) along the straight segment from `a` to
+    /// `b`.
+    fn transmittance_between(&self, medium: Option<u32>, a: Vec3, b: Vec3) -> Rgb {
+        let Some(m) = medium else {
+            return Rgb::ONE;
+        };
+        let d = a.distance(b);
+        if d > 0.0 {
+            self.medium(m).transmittance(&Ray::new(a, (b - a) / d), d)
+        } else {
+            Rgb::ONE
         }
     }
 
@@ -114,25 +121,24 @@ impl Scene {
         medium: Option<u32>,
     ) -> Rgb {
         let d = p1 - p0;
-        let tr_over = |medium: Option<u32>, d: f32| self.transmittance_over(medium, d);
         let mut tr = Rgb::ONE;
         let mut medium = medium;
         let mut origin = from;
         let mut last = p0;
-        for _ in 0..MAX_BOUNDARY_CROSSINGS {
+        for _ in 0..=MAX_NULL_CROSSINGS {
             let seg = to - origin;
             let dist = seg.length();
             if dist <= 0.0 || seg.dot(d) <= 0.0 {
-                break;
+                return tr * self.transmittance_between(medium, last, p1);
             }
             let ray = Ray::new(origin, seg / dist);
             let Some(hit) = self.intersect(&ray, dist) else {
-                break;
+                return tr * self.transmittance_between(medium, last, p1);
             };
             if !self.material(&hit).is_null() {
                 return Rgb::ZERO;
             }
-            tr *= tr_over(medium, hit.p.distance(last));
+            tr *= self.transmittance_between(medium, last, hit.p);
             if tr == Rgb::ZERO {
                 return tr;
             }
@@ -140,7 +146,8 @@ impl Scene {
             medium = self.medium_after(&hit, ray.dir, medium);
             origin = offset_origin(hit.p, hit.ng, ray.dir);
         }
-        tr * tr_over(medium, p1.distance(last))
+        // Past the crossing limit the shadow ray is ended like any other ray (crate::walk).
+        Rgb::ZERO
     }
 
     /// Whether the segment between two surface points is blocked by anything but null
@@ -172,10 +179,6 @@ impl Scene {
         })
     }
 }
-
-/// Null boundaries a shadow ray may cross before it is taken as blocked (guards against rays
-/// stuck on coincident boundaries).
-const MAX_BOUNDARY_CROSSINGS: u32 = 256;
 
 /// Null-boundary crossings one traversal of a shadow ray collects; more, and it walks them
 /// one closest hit at a time.

@@ -18,19 +18,17 @@
 //! exactly to an EXR, sRGB-encoded to a PNG like any other linear value.
 
 use foton_core::film::Film;
-use foton_core::geometry::{Ray, offset_origin};
+use foton_core::geometry::Ray;
 use foton_core::integrator::{Integrator, Parameter, RenderContext};
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::scene::Scene;
+use foton_core::walk::first_surface;
 use foton_core::{Result, Rgb};
 
 pub struct Normals {
     flip_to_camera: bool,
 }
-
-/// Null boundaries crossed by one camera ray before it is given up (as in `path`).
-const MAX_NULL_CROSSINGS: u32 = 256;
 
 impl Normals {
     pub fn new(flip_to_camera: bool) -> Self {
@@ -38,23 +36,16 @@ impl Normals {
     }
 
     /// The colour seen along a camera ray; adds the rays traced to `rays` (statistics).
-    pub fn shade(&self, scene: &Scene, mut ray: Ray, rays: &mut u64) -> Rgb {
-        for _ in 0..=MAX_NULL_CROSSINGS {
-            *rays += 1;
-            let Some(hit) = scene.intersect(&ray, f32::INFINITY) else {
-                return Rgb::ZERO;
-            };
-            if scene.material(&hit).is_null() {
-                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
-                continue;
-            }
-            let mut n = hit.ng;
-            if self.flip_to_camera && n.dot(ray.dir) > 0.0 {
-                n = -n;
-            }
-            return n * 0.5 + Rgb::splat(0.5);
+    pub fn shade(&self, scene: &Scene, ray: Ray, rays: &mut u64) -> Rgb {
+        // Core's walk crosses null boundaries (and gives up, black, past its crossing limit).
+        let Some((hit, _)) = first_surface(scene, ray, scene.camera_medium, rays) else {
+            return Rgb::ZERO;
+        };
+        let mut n = hit.ng;
+        if self.flip_to_camera && n.dot(ray.dir) > 0.0 {
+            n = -n;
         }
-        Rgb::ZERO
+        n * 0.5 + Rgb::splat(0.5)
     }
 }
 

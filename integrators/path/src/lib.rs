@@ -29,8 +29,8 @@
 //! volumetric caustics too) cannot be sampled: they are missing. Volumetric caustics from
 //! area lights are found, slowly. That is what photon mapping is for.
 
-use foton_core::Vec3;
-use foton_core::geometry::{Ray, offset_origin};
+use foton_core::direct::{Mis, Scatter, estimate_direct};
+use foton_core::geometry::Ray;
 use foton_core::integrator::{Integrator, Parameter, RenderContext};
 use foton_core::material::TransportMode;
 use foton_core::medium::HeroChannel;
@@ -38,16 +38,13 @@ use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::{Sampler, power_heuristic};
 use foton_core::scene::Scene;
+use foton_core::walk::RayWalk;
 use foton_core::{Result, Rgb, film::Film};
 
 pub struct PathTracer {
     max_depth: u32,
     rr_depth: u32,
 }
-
-/// Null boundaries crossed by one ray segment before the path is abandoned (guards against a
-/// ray stuck on coincident boundaries).
-const MAX_NULL_CROSSINGS: u32 = 256;
 
 impl PathTracer {
     pub fn new(max_depth: u32, rr_depth: u32) -> Self {
@@ -58,7 +55,7 @@ impl PathTracer {
     }
 
     /// Radiance arriving at the camera along `ray`; adds the rays traced to `rays`.
-    pub fn li(&self, scene: &Scene, mut ray: Ray, sampler: &mut Sampler, rays: &mut u64) -> Rgb {
+    pub fn li(&self, scene: &Scene, ray: Ray, sampler: &mut Sampler, rays: &mut u64) -> Rgb {
         let mut radiance = Rgb::ZERO;
         let mut beta = Rgb::ONE;
         let mut depth = 0u32;
@@ -66,101 +63,66 @@ impl PathTracer {
         let mut specular = true;
         let mut prev_pdf = 0.0f32;
         let mut prev_p = ray.origin;
-        let mut crossings = 0u32;
-        // The medium the ray travels in (None: vacuum).
-        let mut medium = scene.camera_medium;
+        // The ray, the medium it travels in and the null boundaries it crosses.
+        let mut walk = RayWalk::new(ray, scene.camera_medium);
         // Spectral MIS over the whole path, chosen at the first medium the path meets.
         let mut hero: Option<HeroChannel> = None;
-        // How far the ray's origin lies past the null boundary it just crossed, along the ray:
-        // that piece of the medium is sampled too (as if the ray started on the boundary).
-        let mut next_gap = 0.0f32;
 
         loop {
-            *rays += 1;
-            let hit = scene.intersect(&ray, f32::INFINITY);
-            let gap = std::mem::take(&mut next_gap);
+            let seg = walk.segment(scene, rays);
 
             // ---- Medium: free flight to a scattering event or to the surface ----
-            if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
-                && !m.is_vacuum()
-            {
-                let tmax = hit.map_or(f32::INFINITY, |h| h.t + gap);
+            if let Some(m) = seg.interacting_medium(scene) {
                 let hero = hero.get_or_insert_with(|| HeroChannel::new(sampler.next_f32()));
-                let flight = m.sample_free_flight(tmax, hero.channel, sampler.next_f32());
+                let flight = m.sample_free_flight(
+                    &seg.start(),
+                    seg.length(),
+                    hero.channel,
+                    sampler.next_f32(),
+                );
                 beta *= hero.update(&flight);
                 if beta == Rgb::ZERO {
                     break;
                 }
                 if flight.scattered {
-                    crossings = 0;
                     if depth >= self.max_depth {
                         break;
                     }
-                    let x = ray.at(flight.t - gap);
-                    let phase = m.phase;
+                    let x = seg.at(flight.t);
+                    let phase = m.phase();
+                    let wo = -seg.ray.dir;
 
                     // ---- Emitter sampling from the medium ----
-                    // The phase function takes the cosine between the directions light
-                    // travels in: from the light (-wi) and on towards the camera (-ray.dir).
-                    if let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) {
-                        let light = &scene.lights[light_id];
-                        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-                        if let Some(ls) = light.sample_li(x, u, uc)
-                            && ls.li != Rgb::ZERO
-                        {
-                            *rays += 1;
-                            let tr = scene.transmittance(x, Vec3::ZERO, ls.p, ls.n, medium);
-                            if tr != Rgb::ZERO {
-                                let p = phase.eval(ray.dir.dot(ls.wi));
-                                if ls.delta {
-                                    radiance += beta * tr * p * ls.li / pmf;
-                                } else {
-                                    let pdf_light = pmf * ls.pdf;
-                                    let w = power_heuristic(pdf_light, p);
-                                    radiance += beta * tr * p * ls.li * w / pdf_light;
-                                }
-                            }
-                        }
-                    }
+                    let at = Scatter::Medium { p: x, phase };
+                    let mis = Mis::WithScatterSampling;
+                    radiance +=
+                        beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
 
                     // ---- Phase-function sampling: p / pdf = 1, beta is unchanged ----
-                    let (wi, pdf) = phase.sample(ray.dir, sampler.next_2d());
+                    let (wi, pdf) = phase.sample(seg.ray.dir, sampler.next_2d());
                     specular = false;
                     prev_pdf = pdf;
                     prev_p = x;
                     depth += 1;
-                    if depth >= self.rr_depth {
-                        let survive = beta.max_element().min(0.95);
-                        if survive <= 0.0 || sampler.next_f32() >= survive {
-                            break;
-                        }
-                        beta /= survive;
+                    if !self.russian_roulette(depth, &mut beta, sampler) {
+                        break;
                     }
-                    ray = Ray::new(x, wi);
+                    walk.scatter_in_medium(x, wi);
                     continue;
                 }
             }
 
-            let Some(hit) = hit else {
+            let Some(hit) = seg.hit else {
                 break;
             };
             let material = *scene.material(&hit);
             if material.is_null() {
-                crossings += 1;
-                if crossings > MAX_NULL_CROSSINGS {
+                if !walk.cross(scene, &hit) {
                     break;
                 }
-                medium = scene.medium_after(&hit, ray.dir, medium);
-                let origin = offset_origin(hit.p, hit.ng, ray.dir);
-                // The origin is offset along the normal; back along the ray to the boundary's
-                // plane is offset / |cos| (bounded, for grazing rays, by 10 offsets).
-                let offset = (origin - hit.p).length();
-                next_gap = offset / hit.ng.dot(ray.dir).abs().max(0.1);
-                ray = Ray::new(origin, ray.dir);
                 continue;
             }
-            crossings = 0;
-            let wo = -ray.dir;
+            let wo = -seg.ray.dir;
 
             // ---- Emission (weighted against light sampling at the previous vertex) ----
             if let Some((light_id, light)) = scene.area_light(&hit) {
@@ -180,36 +142,13 @@ impl PathTracer {
             }
 
             // ---- Emitter sampling ----
-            if !material.is_delta()
-                && let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32())
-            {
-                let light = &scene.lights[light_id];
-                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-                if let Some(ls) = light.sample_li(hit.p, u, uc)
-                    && ls.li != Rgb::ZERO
-                {
-                    let f = material.eval(wo, ls.wi, hit.ng);
-                    *rays += (f != Rgb::ZERO) as u64;
-                    let tr = if f != Rgb::ZERO {
-                        let side = scene.medium_after(&hit, ls.wi, medium);
-                        scene.transmittance(hit.p, hit.ng, ls.p, ls.n, side)
-                    } else {
-                        Rgb::ZERO
-                    };
-                    if tr != Rgb::ZERO {
-                        // Without media tr is exactly one: the image is bit for bit the one
-                        // rendered before media existed.
-                        let cos = ls.wi.dot(hit.ng).abs();
-                        if ls.delta {
-                            radiance += beta * f * cos * ls.li * tr / pmf;
-                        } else {
-                            let pdf_light = pmf * ls.pdf;
-                            let pdf_bsdf = material.pdf(wo, ls.wi, hit.ng);
-                            let w = power_heuristic(pdf_light, pdf_bsdf);
-                            radiance += beta * f * cos * ls.li * tr * w / pdf_light;
-                        }
-                    }
-                }
+            if !material.is_delta() {
+                let at = Scatter::Surface {
+                    hit: &hit,
+                    material: &material,
+                };
+                let mis = Mis::WithScatterSampling;
+                radiance += beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
             }
 
             // ---- BSDF sampling ----
@@ -222,20 +161,26 @@ impl PathTracer {
             prev_pdf = bs.pdf;
             prev_p = hit.p;
             depth += 1;
-            // Refraction into or out of a volume changes the medium; reflection keeps it.
-            medium = scene.medium_after(&hit, bs.wi, medium);
-
-            // ---- Russian roulette: keep the throughput's expectation, end dim paths ----
-            if depth >= self.rr_depth {
-                let survive = beta.max_element().min(0.95);
-                if survive <= 0.0 || sampler.next_f32() >= survive {
-                    break;
-                }
-                beta /= survive;
+            if !self.russian_roulette(depth, &mut beta, sampler) {
+                break;
             }
-            ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+            walk.scatter_at_surface(scene, &hit, bs.wi);
         }
         radiance
+    }
+
+    /// Russian roulette past `rr_depth`: keeps the throughput's expectation and ends dim
+    /// paths. False if the path ends.
+    fn russian_roulette(&self, depth: u32, beta: &mut Rgb, sampler: &mut Sampler) -> bool {
+        if depth < self.rr_depth {
+            return true;
+        }
+        let survive = beta.max_element().min(0.95);
+        if survive <= 0.0 || sampler.next_f32() >= survive {
+            return false;
+        }
+        *beta /= survive;
+        true
     }
 }
 

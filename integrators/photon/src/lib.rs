@@ -37,8 +37,8 @@
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
 
-use foton_core::camera_path::{VisiblePoint, direct_light, next_surface, trace_to_diffuse};
 use foton_core::direct::Direct;
+use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::Film;
 use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
@@ -48,12 +48,12 @@ use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
+use foton_core::walk::{VisiblePoint, first_surface, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
-use foton_photonmap::map::{Estimate, Neighbour, Photon, PhotonMap};
+use foton_photonmap::map::{Estimate, Photon, PhotonMap};
 use foton_photonmap::trace::{
     PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
 };
-use std::cell::RefCell;
 
 pub struct PhotonMapper {
     pub global_photons: u64,
@@ -86,10 +86,6 @@ struct Vertex<'a> {
 
 /// Specular (delta) bounces a gather ray may follow before giving up.
 const MAX_SPECULAR: u32 = 64;
-thread_local! {
-    /// Per-thread buffer for the k nearest photons of an estimate.
-    static SCRATCH: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
-}
 
 impl PhotonMapper {
     /// The photon pass: traces both budgets and sorts the stored photons into the direct
@@ -166,20 +162,23 @@ impl PhotonMapper {
         })
     }
 
-    /// Irradiance at `hit` (on the side `n` faces) from one map's photons of at most
-    /// `max_depth` scattering events.
-    fn irradiance(&self, map: &PhotonMap, hit: &Hit, n: Vec3, max_depth: u32) -> Rgb {
-        if map.is_empty() || max_depth == 0 {
-            return Rgb::ZERO;
-        }
-        SCRATCH.with_borrow_mut(|scratch| {
-            let estimate = Estimate {
-                k: self.k,
-                max_radius: self.max_radius,
-                kernel: &self.kernel,
-            };
-            map.irradiance(hit.p, n, max_depth, &estimate, scratch)
-        })
+    /// Radiance reflected towards `wo` at `hit` (on the side `n` faces) by one map's photons
+    /// of at most `max_depth` scattering events.
+    fn estimate(
+        &self,
+        map: &PhotonMap,
+        material: &Material,
+        hit: &Hit,
+        wo: Vec3,
+        n: Vec3,
+        max_depth: u32,
+    ) -> Rgb {
+        let estimate = Estimate {
+            k: self.k,
+            max_radius: self.max_radius,
+            kernel: &self.kernel,
+        };
+        map.reflected(&estimate, material, hit, wo, n, max_depth)
     }
 
     /// Radiance reflected at a diffuse point towards `wo` by the photons of `maps` (all of
@@ -197,12 +196,12 @@ impl PhotonMapper {
         } else {
             -hit.ng
         };
-        let mut e = self.irradiance(&maps.caustic, hit, n, max_depth)
-            + self.irradiance(&maps.indirect, hit, n, max_depth);
+        let mut l = self.estimate(&maps.caustic, material, hit, wo, n, max_depth)
+            + self.estimate(&maps.indirect, material, hit, wo, n, max_depth);
         if let Some(direct) = &maps.direct {
-            e += self.irradiance(direct, hit, n, max_depth);
+            l += self.estimate(direct, material, hit, wo, n, max_depth);
         }
-        material.eval(wo, n, hit.ng) * e
+        l
     }
 
     /// Indirect light at a diffuse point by final gathering: cosine-distributed rays, followed
@@ -235,11 +234,11 @@ impl PhotonMapper {
             let mut beta = bs.weight;
             let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
             for b in 0..MAX_SPECULAR.min(budget) {
-                let Some((y, arrived)) = next_surface(scene, ray, rays) else {
+                let Some((y, arrived)) = first_surface(scene, ray, None, rays) else {
                     break;
                 };
                 let m = *scene.material(&y);
-                let wo_y = -arrived.dir;
+                let wo_y = -arrived.ray.dir;
                 if !m.is_delta() {
                     sum += beta * self.map_radiance(maps, &m, &y, wo_y, budget - b);
                     break;
@@ -278,7 +277,6 @@ impl PhotonMapper {
             bounces,
             ..
         } = vp;
-        let f = material.eval(wo, n, hit.ng);
         let vertex = Vertex {
             hit: &hit,
             material: &material,
@@ -288,14 +286,23 @@ impl PhotonMapper {
         // Photons here may have taken the scattering events the camera path has left.
         let depth = self.max_depth - bounces;
         let direct = match self.direct {
-            Direct::ShadowRays => direct_light(scene, &hit, &material, wo, sampler, rays),
-            Direct::Photons => f * self.irradiance(maps.direct.as_ref().unwrap(), &hit, n, depth),
+            Direct::ShadowRays => {
+                let at = Scatter::Surface {
+                    hit: &hit,
+                    material: &material,
+                };
+                estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
+            }
+            Direct::Photons => {
+                let map = maps.direct.as_ref().unwrap();
+                self.estimate(map, &material, &hit, wo, n, depth)
+            }
         };
-        let caustic = f * self.irradiance(&maps.caustic, &hit, n, depth);
+        let caustic = self.estimate(&maps.caustic, &material, &hit, wo, n, depth);
         let indirect = if self.final_gather {
             self.final_gather(scene, maps, &vertex, sampler, rays)
         } else {
-            f * self.irradiance(&maps.indirect, &hit, n, depth)
+            self.estimate(&maps.indirect, &material, &hit, wo, n, depth)
         };
         path.emitted + beta * (direct + caustic + indirect)
     }

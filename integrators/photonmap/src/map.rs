@@ -10,7 +10,9 @@
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
 use foton_core::Rgb;
+use foton_core::geometry::Hit;
 use foton_core::kernel::NormalizedKernel;
+use foton_core::material::Material;
 use foton_core::medium::Phase;
 use glam::Vec3;
 
@@ -104,6 +106,24 @@ impl Photon {
 }
 
 const LEAF: usize = 8;
+
+/// Photons farther from a surface estimate's tangent plane than this fraction of its radius
+/// are not counted: the estimate gathers from a disc, not a ball, so that photons on a
+/// parallel surface within reach (the top of a low box beside the floor, a step, a rug) do not
+/// leak into it. A quarter keeps curved surfaces whole: a sphere of radius R bends away from
+/// its tangent plane by about r^2 / 2R at distance r, under r / 4 while R >= 2r.
+pub const DISC_THICKNESS: f32 = 0.25;
+
+thread_local! {
+    /// Per-thread buffer for the k nearest photons of an estimate.
+    static SCRATCH: std::cell::RefCell<Vec<Neighbour>> = const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// Runs `f` with this thread's buffer for the neighbours of an estimate (no allocation per
+/// estimate).
+pub fn with_scratch<R>(f: impl FnOnce(&mut Vec<Neighbour>) -> R) -> R {
+    SCRATCH.with_borrow_mut(f)
+}
 
 /// How a k-nearest-neighbour radiance estimate is made.
 #[derive(Clone, Copy)]
@@ -346,14 +366,15 @@ impl PhotonMap {
     }
 
     /// The (up to) k nearest photons within `max_radius` of `p` that `accept` takes, into
-    /// `out` (unordered). Returns the squared search radius: the distance to the k-th photon
-    /// if k were found, else `max_radius`^2.
+    /// `out` (unordered). `accept(photon, r2)` is asked with the current squared search
+    /// radius, which only shrinks. Returns the squared search radius: the distance to the
+    /// k-th photon if k were found, else `max_radius`^2.
     pub fn knn(
         &self,
         p: Vec3,
         k: usize,
         max_radius: f32,
-        accept: impl Fn(&Photon) -> bool,
+        accept: impl Fn(&Photon, f32) -> bool,
         out: &mut Vec<Neighbour>,
     ) -> f32 {
         out.clear();
@@ -367,7 +388,7 @@ impl PhotonMap {
         };
         let mut r2 = cand.r2;
         self.search(p, &mut r2, |i, d2, r2| {
-            if accept(&self.photons[i as usize]) {
+            if accept(&self.photons[i as usize], *r2) {
                 cand.offer(Neighbour { d2, index: i });
                 *r2 = cand.r2;
             }
@@ -450,7 +471,8 @@ impl PhotonMap {
 
     /// The k-nearest density estimate shared by surfaces and volumes: the sum of
     /// `contribution(photon, d, r)` over the k nearest photons (within `max_radius`) that
-    /// `accept` takes, r the distance to the k-th.
+    /// `accept` takes (see [`PhotonMap::knn`]), r the distance to the k-th, and of those the
+    /// ones `keep(photon, r)` keeps.
     ///
     /// That photon lies on the boundary of the disc (ball) of radius r, so only the k - 1
     /// inside are summed (for a uniform density the expected count inside the k-th
@@ -460,9 +482,10 @@ impl PhotonMap {
         &self,
         p: Vec3,
         estimate: &Estimate<'_>,
-        accept: impl Fn(&Photon) -> bool,
+        accept: impl Fn(&Photon, f32) -> bool,
+        keep: impl Fn(&Photon, f32) -> bool,
         scratch: &mut Vec<Neighbour>,
-        contribution: impl Fn(&Photon, f32, f32) -> Rgb,
+        mut contribution: impl FnMut(&Photon, f32, f32) -> Rgb,
     ) -> Rgb {
         let k = estimate.k;
         let r2 = self.knn(p, k, estimate.max_radius, accept, scratch);
@@ -476,14 +499,80 @@ impl PhotonMap {
             if full && nb.d2 >= r2 {
                 continue; // the k-th photon, on the boundary
             }
-            sum += contribution(&self.photons[nb.index as usize], nb.d2.sqrt(), r);
+            let photon = &self.photons[nb.index as usize];
+            if keep(photon, r) {
+                sum += contribution(photon, nb.d2.sqrt(), r);
+            }
         }
         sum
     }
 
-    /// Irradiance at a surface point: sum of photon power times the surface kernel K2 over
-    /// the k nearest photons (see `knn_estimate`) stored on the same side of the same surface
-    /// whose paths have at most `max_depth` scattering events.
+    /// Radiance reflected at a surface point p (normal `n` on the side looked at) from the
+    /// photons of a disc around it: sum over the k nearest photons (see `knn_estimate`) of
+    /// f(wi_p) Phi_p K2(d_p, r), with `f` the BSDF towards the viewer evaluated with each
+    /// photon's own incoming direction, so that any BSDF, glossy ones included, is right.
+    ///
+    /// Photons are taken from a disc, not a ball: stored on the same side of a surface facing
+    /// the same way (normals within about 25 degrees), with paths of at most `max_depth`
+    /// scattering events, and no farther from the tangent plane than [`DISC_THICKNESS`] times
+    /// the radius.
+    #[allow(clippy::too_many_arguments)]
+    pub fn radiance(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        max_depth: u32,
+        estimate: &Estimate<'_>,
+        scratch: &mut Vec<Neighbour>,
+        f: impl Fn(Vec3) -> Rgb,
+    ) -> Rgb {
+        let thickness2 = DISC_THICKNESS * DISC_THICKNESS;
+        let height2 = |ph: &Photon| {
+            let h = (ph.position - p).dot(n);
+            h * h
+        };
+        self.knn_estimate(
+            p,
+            estimate,
+            // Rejected early against the current radius, which only shrinks: a photon too far
+            // from the plane for it is too far for the final one.
+            |ph, r2| {
+                ph.depth() <= max_depth
+                    && ph.normal().dot(n) > 0.9
+                    && height2(ph) <= thickness2 * r2
+            },
+            |ph, r| height2(ph) <= thickness2 * r * r,
+            scratch,
+            |ph, d, r| f(ph.wi()) * ph.power() * estimate.kernel.weight_2d(d, r),
+        )
+    }
+
+    /// Radiance reflected towards `wo` by `material` at `hit` (`n`: the normal on the side
+    /// looked at) from the photons of at most `max_depth` scattering events: the surface
+    /// estimate every photon integrator makes, with the BSDF evaluated per photon. Uses this
+    /// thread's scratch buffer.
+    #[allow(clippy::too_many_arguments)]
+    pub fn reflected(
+        &self,
+        estimate: &Estimate<'_>,
+        material: &Material,
+        hit: &Hit,
+        wo: Vec3,
+        n: Vec3,
+        max_depth: u32,
+    ) -> Rgb {
+        if self.is_empty() || max_depth == 0 {
+            return Rgb::ZERO;
+        }
+        with_scratch(|scratch| {
+            self.radiance(hit.p, n, max_depth, estimate, scratch, |wi| {
+                material.eval(wo, wi, hit.ng)
+            })
+        })
+    }
+
+    /// Irradiance at a surface point: [`PhotonMap::radiance`] with f = 1, the sum of photon
+    /// power times the surface kernel K2 over the photons of the disc.
     pub fn irradiance(
         &self,
         p: Vec3,
@@ -492,13 +581,7 @@ impl PhotonMap {
         estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
-        self.knn_estimate(
-            p,
-            estimate,
-            |ph| ph.depth() <= max_depth && ph.normal().dot(n) > 0.9,
-            scratch,
-            |ph, d, r| ph.power() * estimate.kernel.weight_2d(d, r),
-        )
+        self.radiance(p, n, max_depth, estimate, scratch, |_| Rgb::ONE)
     }
 
     /// In-scattered radiance at a point in a medium towards the camera, sigma_s times the
@@ -519,7 +602,8 @@ impl PhotonMap {
         self.knn_estimate(
             p,
             estimate,
-            |ph| ph.depth() <= max_depth,
+            |ph, _| ph.depth() <= max_depth,
+            |_, _| true,
             scratch,
             // Light travelled along -wi_p and leaves along -dir.
             |ph, d, r| {
@@ -593,7 +677,7 @@ mod tests {
         for _ in 0..200 {
             let q = Vec3::new(rng.next_f32(), rng.next_f32(), 0.05);
             let k = 1 + (rng.next_u32() % 60) as usize;
-            let r2 = map.knn(q, k, 0.2, |_| true, &mut out);
+            let r2 = map.knn(q, k, 0.2, |_, _| true, &mut out);
             let mut d: Vec<f32> = all
                 .iter()
                 .map(|p| p.position.distance_squared(q))

@@ -18,6 +18,7 @@ use foton_core::medium::HeroChannel;
 use foton_core::render::with_pool;
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
+use foton_core::walk::RayWalk;
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -52,9 +53,6 @@ pub const STREAM_VOLUME: u64 = 0x766f_6c75;
 
 /// Photons per parallel work unit (also the granularity of progress reports).
 const CHUNK: u64 = 4096;
-
-/// Null boundaries crossed in a row before a photon is abandoned.
-const MAX_NULL_CROSSINGS: u32 = 256;
 
 /// Where a photon is stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -118,12 +116,10 @@ pub fn trace_one(
     } else {
         offset_origin(emitted.origin, emitted.n, emitted.dir)
     };
-    let mut ray = Ray::new(origin, emitted.dir);
-    let mut medium = light_media[light_id];
+    let mut walk = RayWalk::new(Ray::new(origin, emitted.dir), light_media[light_id]);
     let mut hero: Option<HeroChannel> = None;
     let mut hits = 0u32;
     let mut specular_only = true;
-    let mut crossings = 0;
     let class_of = |hits: u32, specular_only: bool| {
         if hits == 1 {
             PathClass::Direct
@@ -134,24 +130,21 @@ pub fn trace_one(
         }
     };
     loop {
-        let hit = scene.intersect(&ray, f32::INFINITY);
-        if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
-            && !m.is_vacuum()
-        {
-            let tmax = hit.map_or(f32::INFINITY, |h| h.t);
+        let seg = walk.segment(scene, &mut 0);
+        if let Some(m) = seg.interacting_medium(scene) {
             let hero = hero.get_or_insert_with(|| HeroChannel::new(rng.next_f32()));
-            let flight = m.sample_free_flight(tmax, hero.channel, rng.next_f32());
+            let flight =
+                m.sample_free_flight(&seg.start(), seg.length(), hero.channel, rng.next_f32());
             let weight = hero.update(&flight);
             if flight.scattered {
-                crossings = 0;
                 hits += 1;
-                let x = ray.at(flight.t);
+                let x = seg.at(flight.t);
                 let scattered = flux * weight;
                 if scattered == Rgb::ZERO {
                     return; // absorbed: a medium that does not scatter stores nothing
                 }
                 store(
-                    Photon::new(x, scattered, -ray.dir, glam::Vec3::ZERO).with_depth(hits),
+                    Photon::new(x, scattered, -seg.ray.dir, glam::Vec3::ZERO).with_depth(hits),
                     Site::Volume,
                     class_of(hits, specular_only),
                 );
@@ -168,8 +161,8 @@ pub fn trace_one(
                     return;
                 }
                 flux = scattered / survive;
-                let (wi, _) = m.phase.sample(ray.dir, rng.next_2d());
-                ray = Ray::new(x, wi);
+                let (wi, _) = m.phase().sample(seg.ray.dir, rng.next_2d());
+                walk.scatter_in_medium(x, wi);
                 continue;
             }
             flux *= weight;
@@ -177,22 +170,18 @@ pub fn trace_one(
                 return;
             }
         }
-        let Some(hit) = hit else {
+        let Some(hit) = seg.hit else {
             return;
         };
         let material = *scene.material(&hit);
         if material.is_null() {
-            crossings += 1;
-            if crossings > MAX_NULL_CROSSINGS {
+            if !walk.cross(scene, &hit) {
                 return;
             }
-            medium = scene.medium_after(&hit, ray.dir, medium);
-            ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
             continue;
         }
-        crossings = 0;
         hits += 1;
-        let wi = -ray.dir;
+        let wi = -seg.ray.dir;
         if !material.is_delta() {
             let n = if hit.ng.dot(wi) > 0.0 {
                 hit.ng
@@ -224,9 +213,7 @@ pub fn trace_one(
             return;
         }
         flux *= bs.weight / survive;
-        // Refraction into or out of a volume changes the medium; reflection keeps it.
-        medium = scene.medium_after(&hit, bs.wi, medium);
-        ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
+        walk.scatter_at_surface(scene, &hit, bs.wi);
     }
 }
 

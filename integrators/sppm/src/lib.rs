@@ -47,8 +47,8 @@
 //! from a kd-tree built in a fixed order (core's `PhotonMap`), so images are identical for
 //! any number of threads. Memory is bounded: one iteration's photons at a time.
 
-use foton_core::camera_path::{direct_light, trace_to_diffuse};
 use foton_core::direct::Direct;
+use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::Film;
 use foton_core::integrator::{
     Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
@@ -58,8 +58,9 @@ use foton_core::props::Properties;
 use foton_core::render::with_pool;
 use foton_core::sampling::{Rng, splitmix64};
 use foton_core::scene::Scene;
+use foton_core::walk::{VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
-use foton_photonmap::map::PhotonMap;
+use foton_photonmap::map::{DISC_THICKNESS, PhotonMap};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use glam::{DVec3, Vec2};
 use rayon::prelude::*;
@@ -125,7 +126,7 @@ const STREAM_CAMERA: u64 = 0x7370_706d;
 struct CameraSample {
     /// Emission and shadow-ray direct light, weighted by the path throughput.
     ld: Rgb,
-    visible: Option<foton_core::camera_path::VisiblePoint>,
+    visible: Option<VisiblePoint>,
 }
 
 impl Sppm {
@@ -151,12 +152,17 @@ impl Sppm {
                         );
                         let mut ld = path.emitted;
                         if let (Some(vp), Direct::ShadowRays) = (&path.visible, self.direct) {
+                            let at = Scatter::Surface {
+                                hit: &vp.hit,
+                                material: &vp.material,
+                            };
                             ld += vp.beta
-                                * direct_light(
+                                * estimate_direct(
                                     scene,
-                                    &vp.hit,
-                                    &vp.material,
+                                    at,
                                     vp.wo,
+                                    vp.medium,
+                                    Mis::LightOnly,
                                     &mut sampler,
                                     &mut row_rays,
                                 );
@@ -288,8 +294,13 @@ impl Integrator for Sppm {
                         let (mut m, mut phi) = (0.0f64, DVec3::ZERO);
                         // No light path longer than max_depth, as in the path tracer.
                         let depth = self.max_depth - vp.bounces;
+                        // A disc, as the k-nearest estimates gather from (foton-photonmap).
+                        let thickness = DISC_THICKNESS * r;
                         map.within(vp.hit.p, r, |photon, d2| {
-                            if photon.depth() > depth || photon.normal().dot(vp.n) <= 0.9 {
+                            if photon.depth() > depth
+                                || photon.normal().dot(vp.n) <= 0.9
+                                || (photon.position - vp.hit.p).dot(vp.n).abs() > thickness
+                            {
                                 return; // too long, another surface, or its other side
                             }
                             let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;

@@ -51,25 +51,24 @@
 //! the volume map's first-event photons), everything else by the volume map; at surfaces as in
 //! `photon` (docs/photon-mapping.md).
 
-use foton_core::camera_path::{MAX_NULL_CROSSINGS, direct_light_in};
 use foton_core::direct::Direct;
+use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::Film;
-use foton_core::geometry::{Ray, offset_origin};
+use foton_core::geometry::Ray;
 use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::material::TransportMode;
-use foton_core::medium::{Homogeneous, transmittance_homogeneous};
+use foton_core::medium::Medium;
 use foton_core::props::Properties;
 use foton_core::render::{render_pixels, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
+use foton_core::walk::{Segment, VisiblePoint, walk_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
-use foton_photonmap::map::{Estimate, Neighbour, Photon, PhotonMap};
+use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
 use foton_photonmap::trace::{
     PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
 };
 use rayon::prelude::*;
-use std::cell::RefCell;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum VolumeEstimate {
@@ -106,10 +105,6 @@ pub struct Maps {
     /// Where camera rays that leave the scene stop marching: the box around the geometry,
     /// the lights and the volume photons, grown by the volume radius.
     pub bounds: (Vec3, Vec3),
-}
-
-thread_local! {
-    static SCRATCH: RefCell<Vec<Neighbour>> = const { RefCell::new(Vec::new()) };
 }
 
 /// Distance along `ray` to where it leaves the box (0 if it misses it).
@@ -218,7 +213,7 @@ impl Vpm {
                                 p.position,
                                 self.k_volume,
                                 self.max_radius_volume,
-                                |_| true,
+                                |_, _| true,
                                 scratch,
                             )
                             .sqrt()
@@ -255,42 +250,44 @@ impl Vpm {
         }
     }
 
-    fn irradiance(&self, map: &PhotonMap, p: Vec3, n: Vec3, max_depth: u32) -> Rgb {
-        if map.is_empty() || max_depth == 0 {
-            return Rgb::ZERO;
-        }
-        SCRATCH.with_borrow_mut(|s| map.irradiance(p, n, max_depth, &self.surface_estimate(), s))
-    }
-
-    /// Single scattering at a point in a medium: one shadow ray to a light chosen by power,
-    /// sigma_s p(theta) Li Tr / pdf.
+    /// The in-scattering integral along the segment `seg` through medium `m` (the radiance
+    /// the medium scatters towards the camera, not yet weighted by the throughput before it),
+    /// by ray marching or the beam estimate; `bounces` delta bounces precede it.
     #[allow(clippy::too_many_arguments)]
-    fn single_scattering(
+    fn in_medium(
         &self,
         scene: &Scene,
-        m: &Homogeneous,
-        medium: Option<u32>,
-        x: Vec3,
-        dir: Vec3,
+        maps: &Maps,
+        seg: &Segment,
+        m: &dyn Medium,
+        bounces: u32,
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let Some((light_id, pmf)) = scene.sample_light(sampler.next_f32()) else {
-            return Rgb::ZERO;
-        };
-        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-        let Some(ls) = scene.lights[light_id].sample_li(x, u, uc) else {
-            return Rgb::ZERO;
-        };
-        if ls.li == Rgb::ZERO {
+        // A march point is a scattering event: the light paths through it have one event
+        // more than the camera path before it.
+        if bounces >= self.max_depth {
             return Rgb::ZERO;
         }
-        *rays += 1;
-        let tr = scene.transmittance(x, Vec3::ZERO, ls.p, ls.n, medium);
-        if tr == Rgb::ZERO {
+        let start = seg.start();
+        let t_end = if seg.hit.is_some() {
+            seg.length()
+        } else {
+            exit_distance(&start, maps.bounds)
+        };
+        if t_end.is_nan() || t_end <= 0.0 {
             return Rgb::ZERO;
         }
-        m.sigma_s * m.phase.eval(dir.dot(ls.wi)) * ls.li * tr / (pmf * ls.pdf)
+        let mut inscattered = Rgb::ZERO;
+        if self.estimate == VolumeEstimate::Beam {
+            inscattered += self.beam(maps, m, &start, t_end, bounces);
+        }
+        if self.estimate == VolumeEstimate::March || self.direct == Direct::ShadowRays {
+            inscattered += self.march(
+                scene, maps, m, seg.medium, &start, t_end, bounces, sampler, rays,
+            );
+        }
+        inscattered
     }
 
     /// The in-scattering integral along `ray` from 0 to `t_end` in medium `m`, by ray
@@ -300,7 +297,7 @@ impl Vpm {
         &self,
         scene: &Scene,
         maps: &Maps,
-        m: &Homogeneous,
+        m: &dyn Medium,
         medium: Option<u32>,
         ray: &Ray,
         t_end: f32,
@@ -308,25 +305,20 @@ impl Vpm {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        // A march point is a scattering event: the light paths through it have one event
-        // more than the camera path before it.
-        if bounces >= self.max_depth || t_end.is_nan() || t_end <= 0.0 {
-            return Rgb::ZERO;
-        }
         let depth = self.max_depth - bounces;
         let estimate = Estimate {
             k: self.k_volume,
             max_radius: self.max_radius_volume,
             kernel: &self.kernel,
         };
-        let sigma_t = m.sigma_t();
+        let phase = m.phase();
         let u = sampler.next_f32();
         let mut sum = Rgb::ZERO;
         let mut t0 = 0.0f32;
         while t0 < t_end {
             let dt = self.step.min(t_end - t0);
             let t = t0 + u * dt;
-            let tr = transmittance_homogeneous(sigma_t, t);
+            let tr = m.transmittance(ray, t);
             // Past this, what is left of the integral is below a millionth of what the
             // surface behind would get: not worth a photon query.
             if tr.max_element() < 1e-6 {
@@ -337,13 +329,16 @@ impl Vpm {
             {
                 Rgb::ZERO
             } else {
-                SCRATCH.with_borrow_mut(|s| {
+                with_scratch(|s| {
                     maps.volume
-                        .in_scattered(x, ray.dir, &m.phase, depth, &estimate, s)
+                        .in_scattered(x, ray.dir, &phase, depth, &estimate, s)
                 })
             };
             if self.direct == Direct::ShadowRays {
-                inscattered += self.single_scattering(scene, m, medium, x, ray.dir, sampler, rays);
+                // Single scattering: sigma_s times the phase-weighted direct light.
+                let at = Scatter::Medium { p: x, phase };
+                inscattered += m.sigma_s(x)
+                    * estimate_direct(scene, at, -ray.dir, medium, Mis::LightOnly, sampler, rays);
             }
             sum += tr * inscattered * dt;
             t0 += dt;
@@ -353,12 +348,12 @@ impl Vpm {
 
     /// The beam radiance estimate of the in-scattering integral along `ray` from 0 to
     /// `t_end` in medium `m`.
-    fn beam(&self, maps: &Maps, m: &Homogeneous, ray: &Ray, t_end: f32, bounces: u32) -> Rgb {
-        if bounces >= self.max_depth || t_end.is_nan() || t_end <= 0.0 || maps.volume.is_empty() {
+    fn beam(&self, maps: &Maps, m: &dyn Medium, ray: &Ray, t_end: f32, bounces: u32) -> Rgb {
+        if maps.volume.is_empty() {
             return Rgb::ZERO;
         }
         let depth = self.max_depth - bounces;
-        let sigma_t = m.sigma_t();
+        let phase = m.phase();
         let mut sum = Rgb::ZERO;
         maps.volume.along_ray(
             ray.origin,
@@ -370,102 +365,69 @@ impl Vpm {
                 if d2 >= r * r || photon.depth() > depth {
                     return;
                 }
-                let w =
-                    self.kernel.weight_2d(d2.sqrt(), r) * m.phase.eval(photon.wi().dot(ray.dir));
-                sum += transmittance_homogeneous(sigma_t, t) * photon.power() * w;
+                let w = self.kernel.weight_2d(d2.sqrt(), r) * phase.eval(photon.wi().dot(ray.dir));
+                sum += m.transmittance(ray, t) * photon.power() * w;
             },
         );
         sum
     }
 
-    /// Radiance arriving at the camera along `ray`.
+    /// Radiance arriving at the camera along `ray`: the camera walk (core's) through null
+    /// boundaries, media and delta surfaces, with the in-scattered radiance of each medium
+    /// segment, then at the first diffuse surface emission + direct + caustic + indirect.
     pub fn li(
         &self,
         scene: &Scene,
         maps: &Maps,
-        mut ray: Ray,
+        ray: Ray,
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let mut radiance = Rgb::ZERO;
-        let mut beta = Rgb::ONE;
-        let mut medium = scene.camera_medium;
-        let mut bounces = 0u32;
-        let mut crossings = 0u32;
-        loop {
-            *rays += 1;
-            let hit = scene.intersect(&ray, f32::INFINITY);
-            if let Some(m) = medium.map(|m| &scene.media[m as usize].value)
-                && !m.is_vacuum()
-            {
-                let t_end = hit.map_or_else(|| exit_distance(&ray, maps.bounds), |h| h.t);
-                let mut inscattered = Rgb::ZERO;
-                if self.estimate == VolumeEstimate::Beam {
-                    inscattered += self.beam(maps, m, &ray, t_end, bounces);
-                }
-                if self.estimate == VolumeEstimate::March || self.direct == Direct::ShadowRays {
-                    inscattered +=
-                        self.march(scene, maps, m, medium, &ray, t_end, bounces, sampler, rays);
-                }
-                radiance += beta * inscattered;
-                beta *= m.transmittance_over(hit.map_or(f32::INFINITY, |h| h.t));
-                if beta == Rgb::ZERO {
-                    break;
-                }
-            }
-            let Some(hit) = hit else {
-                break;
-            };
-            let material = *scene.material(&hit);
-            if material.is_null() {
-                crossings += 1;
-                if crossings > MAX_NULL_CROSSINGS {
-                    break;
-                }
-                medium = scene.medium_after(&hit, ray.dir, medium);
-                ray = Ray::new(offset_origin(hit.p, hit.ng, ray.dir), ray.dir);
-                continue;
-            }
-            crossings = 0;
-            let wo = -ray.dir;
-            if let Some((_, light)) = scene.area_light(&hit) {
-                radiance += beta * light.emitted(hit.ng, wo);
-            }
-            if bounces >= self.max_depth {
-                break;
-            }
-            if material.is_delta() {
-                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-                let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
-                    break;
+        let path = walk_to_diffuse(
+            scene,
+            ray,
+            self.max_depth,
+            sampler,
+            rays,
+            |seg: &Segment, m: &dyn Medium, bounces: u32, sampler: &mut Sampler, rays: &mut u64| {
+                self.in_medium(scene, maps, seg, m, bounces, sampler, rays)
+            },
+        );
+        let Some(vp) = path.visible else {
+            return path.emitted;
+        };
+        let VisiblePoint {
+            hit,
+            material,
+            wo,
+            n,
+            beta,
+            bounces,
+            medium,
+            ..
+        } = vp;
+        let depth = self.max_depth - bounces;
+        let estimate = self.surface_estimate();
+        let direct = match self.direct {
+            Direct::ShadowRays => {
+                let at = Scatter::Surface {
+                    hit: &hit,
+                    material: &material,
                 };
-                beta *= bs.weight;
-                bounces += 1;
-                medium = scene.medium_after(&hit, bs.wi, medium);
-                ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
-                continue;
+                estimate_direct(scene, at, wo, medium, Mis::LightOnly, sampler, rays)
             }
-            let n = if hit.ng.dot(wo) > 0.0 {
-                hit.ng
-            } else {
-                -hit.ng
-            };
-            let f = material.eval(wo, n, hit.ng);
-            let depth = self.max_depth - bounces;
-            let direct = match self.direct {
-                Direct::ShadowRays => {
-                    direct_light_in(scene, &hit, &material, wo, medium, sampler, rays)
-                }
-                Direct::Photons => {
-                    f * self.irradiance(maps.direct.as_ref().unwrap(), hit.p, n, depth)
-                }
-            };
-            let caustic = f * self.irradiance(&maps.caustic, hit.p, n, depth);
-            let indirect = f * self.irradiance(&maps.indirect, hit.p, n, depth);
-            radiance += beta * (direct + caustic + indirect);
-            break;
-        }
-        radiance
+            Direct::Photons => {
+                let map = maps.direct.as_ref().unwrap();
+                map.reflected(&estimate, &material, &hit, wo, n, depth)
+            }
+        };
+        let caustic = maps
+            .caustic
+            .reflected(&estimate, &material, &hit, wo, n, depth);
+        let indirect = maps
+            .indirect
+            .reflected(&estimate, &material, &hit, wo, n, depth);
+        path.emitted + beta * (direct + caustic + indirect)
     }
 }
 
