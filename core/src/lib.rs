@@ -45,5 +45,8 @@ pub fn average(c: Rgb) -> f32 {
 pub const CORE_VERSION: &str = env!("CARGO_PKG_VERSION");
 /// rustc that compiled this crate (from build.rs).
 pub const RUSTC_VERSION: &str = env!("FOTON_RUSTC_VERSION");
-/// Hash of the core sources, rustc, target and code-generation settings (from build.rs).
+/// Hash of what defines the plugin ABI: core's sources, the versions of its dependencies,
+/// rustc, the target and the settings that change layouts (build.rs, build_id.rs).
 pub const BUILD_ID: &str = env!("FOTON_BUILD_ID");
+/// The settings hashed into [`BUILD_ID`] (`;`-separated), for the tests that recompute it.
+pub const BUILD_SETTINGS: &str = env!("FOTON_BUILD_SETTINGS");
