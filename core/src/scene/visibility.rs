@@ -29,16 +29,7 @@ impl Scene {
             };
         }
         let d = p1 - p0;
-        let from = if n0 == Vec3::ZERO {
-            p0
-        } else {
-            offset_origin(p0, n0, d)
-        };
-        let to = if n1 == Vec3::ZERO {
-            p1
-        } else {
-            offset_origin(p1, n1, -d)
-        };
+        let (from, to) = shadow_ends(p0, n0, p1, n1);
         let seg = to - from;
         let dist = seg.length();
         if dist <= 0.0 || seg.dot(d) <= 0.0 {
@@ -153,17 +144,7 @@ impl Scene {
     /// Whether the segment between two surface points is blocked by anything but null
     /// boundaries. The ends are offset along their normals (a zero normal: no offset).
     pub fn occluded(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
-        let d = p1 - p0;
-        let from = if n0 == Vec3::ZERO {
-            p0
-        } else {
-            offset_origin(p0, n0, d)
-        };
-        let to = if n1 == Vec3::ZERO {
-            p1
-        } else {
-            offset_origin(p1, n1, -d)
-        };
+        let (from, to) = shadow_ends(p0, n0, p1, n1);
         let seg = to - from;
         let dist = seg.length();
         if dist <= 0.0 {
@@ -178,6 +159,23 @@ impl Scene {
                 .is_null()
         })
     }
+}
+
+/// The ends of a shadow ray between two points, each pushed off its surface along its normal
+/// towards the other (a zero normal, a point in a medium or a point light: not moved).
+fn shadow_ends(p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> (Vec3, Vec3) {
+    let d = p1 - p0;
+    let from = if n0 == Vec3::ZERO {
+        p0
+    } else {
+        offset_origin(p0, n0, d)
+    };
+    let to = if n1 == Vec3::ZERO {
+        p1
+    } else {
+        offset_origin(p1, n1, -d)
+    };
+    (from, to)
 }
 
 /// Null-boundary crossings one traversal of a shadow ray collects; more, and it walks them

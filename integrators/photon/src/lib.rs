@@ -38,7 +38,6 @@
 //! come out well.
 
 use foton_core::direct::Direct;
-use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::Film;
 use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
@@ -48,12 +47,10 @@ use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
-use foton_core::walk::{VisiblePoint, first_surface, trace_to_diffuse};
+use foton_core::walk::{first_surface, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
-use foton_photonmap::map::{Estimate, Photon, PhotonMap};
-use foton_photonmap::trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, TraceOptions, trace_photons,
-};
+use foton_photonmap::map::Estimate;
+use foton_photonmap::surface::{Budgets, SurfaceMaps, trace_surface_photons};
 
 pub struct PhotonMapper {
     pub global_photons: u64,
@@ -65,13 +62,6 @@ pub struct PhotonMapper {
     pub final_gather: bool,
     pub gather_rays: u32,
     pub max_depth: u32,
-}
-
-/// The photon maps. `direct` exists when direct light or final gathering reads it.
-pub struct Maps {
-    pub direct: Option<PhotonMap>,
-    pub caustic: PhotonMap,
-    pub indirect: PhotonMap,
 }
 
 /// A diffuse point reached by a camera ray: where it is, what it is, where the ray came from.
@@ -88,120 +78,32 @@ struct Vertex<'a> {
 const MAX_SPECULAR: u32 = 64;
 
 impl PhotonMapper {
-    /// The photon pass: traces both budgets and sorts the stored photons into the direct
-    /// (only if `keep_direct`), caustic and indirect lists. Without a caustic budget the
-    /// global pass keeps its L S+ D photons in the indirect list: caustics then come from the
-    /// global map instead of vanishing.
-    fn trace_lists(
-        &self,
-        scene: &Scene,
-        ctx: &RenderContext<'_>,
-        keep_direct: bool,
-    ) -> Result<[Vec<Photon>; 3]> {
-        let seed = scene.render.seed;
-        let global = TraceOptions {
-            photons: self.global_photons,
+    fn budgets(&self) -> Budgets {
+        Budgets {
+            global: self.global_photons,
+            caustic: self.caustic_photons,
             max_depth: self.max_depth,
-            seed,
-            stream: STREAM_GLOBAL,
-            stop_at_diffuse: false,
-        };
-        let caustic_map = self.caustic_photons > 0;
-        // With a caustic map, L S+ D photons of the global budget are dropped: the caustic
-        // budget counts them.
-        let mut lists = trace_photons(scene, &global, ctx, 2, |_, class| match class {
-            PathClass::Direct => keep_direct.then_some(0),
-            PathClass::Caustic => (!caustic_map).then_some(1),
-            PathClass::Indirect => Some(1),
-        })?;
-        let indirect = lists.pop().unwrap();
-        let direct = lists.pop().unwrap();
-        let caustic = if caustic_map {
-            let opts = TraceOptions {
-                photons: self.caustic_photons,
-                max_depth: self.max_depth,
-                seed,
-                stream: STREAM_CAUSTIC,
-                stop_at_diffuse: true,
-            };
-            trace_photons(scene, &opts, ctx, 1, |_, c| {
-                (c == PathClass::Caustic).then_some(0)
-            })?
-            .pop()
-            .unwrap()
-        } else {
-            Vec::new()
-        };
-        Ok([direct, caustic, indirect])
+        }
     }
 
-    /// The photon pass: traces both budgets and builds the maps.
-    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
-        let need_direct = self.direct == Direct::Photons || self.final_gather;
-        let [direct, caustic, indirect] = self.trace_lists(scene, ctx, need_direct)?;
-        for (name, len) in [
-            ("direct", direct.len()),
-            ("caustic", caustic.len()),
-            ("indirect", indirect.len()),
-        ] {
-            if len > 0 && len < self.k {
-                return Err(Error::Usage(format!(
-                    "integrators.photon.k = {} is larger than the {len} photons stored in the {name} map; lower k or emit more photons",
-                    self.k
-                )));
-            }
-        }
-        if indirect.is_empty() && !scene.lights.is_empty() {
-            ctx.progress
-                .warn("no photon reached a second diffuse surface: the indirect map is empty");
-        }
-        Ok(Maps {
-            direct: need_direct.then(|| PhotonMap::build(direct)),
-            caustic: PhotonMap::build(caustic),
-            indirect: PhotonMap::build(indirect),
-        })
-    }
-
-    /// Radiance reflected towards `wo` at `hit` (on the side `n` faces) by one map's photons
-    /// of at most `max_depth` scattering events.
-    fn estimate(
-        &self,
-        map: &PhotonMap,
-        material: &Material,
-        hit: &Hit,
-        wo: Vec3,
-        n: Vec3,
-        max_depth: u32,
-    ) -> Rgb {
-        let estimate = Estimate {
+    fn estimate(&self) -> Estimate<'_> {
+        Estimate {
             k: self.k,
             max_radius: self.max_radius,
             kernel: &self.kernel,
-        };
-        map.reflected(&estimate, material, hit, wo, n, max_depth)
+        }
     }
 
-    /// Radiance reflected at a diffuse point towards `wo` by the photons of `maps` (all of
-    /// them: direct, caustic and indirect), as seen at the end of a gather ray.
-    fn map_radiance(
-        &self,
-        maps: &Maps,
-        material: &Material,
-        hit: &Hit,
-        wo: Vec3,
-        max_depth: u32,
-    ) -> Rgb {
-        let n = if hit.ng.dot(wo) > 0.0 {
-            hit.ng
-        } else {
-            -hit.ng
-        };
-        let mut l = self.estimate(&maps.caustic, material, hit, wo, n, max_depth)
-            + self.estimate(&maps.indirect, material, hit, wo, n, max_depth);
-        if let Some(direct) = &maps.direct {
-            l += self.estimate(direct, material, hit, wo, n, max_depth);
+    /// The photon pass: traces both budgets and builds the maps (foton-photonmap's surface
+    /// maps; the direct map only when direct light or final gathering reads it).
+    pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<SurfaceMaps> {
+        let need_direct = self.direct == Direct::Photons || self.final_gather;
+        let lists = trace_surface_photons(scene, ctx, &self.budgets(), need_direct)?;
+        if lists[2].is_empty() && !scene.lights.is_empty() {
+            ctx.progress
+                .warn("no photon reached a second diffuse surface: the indirect map is empty");
         }
-        l
+        SurfaceMaps::build(lists, need_direct, self.k, "integrators.photon.k")
     }
 
     /// Indirect light at a diffuse point by final gathering: cosine-distributed rays, followed
@@ -211,7 +113,7 @@ impl PhotonMapper {
     fn final_gather(
         &self,
         scene: &Scene,
-        maps: &Maps,
+        maps: &SurfaceMaps,
         v: &Vertex<'_>,
         sampler: &mut Sampler,
         rays: &mut u64,
@@ -240,7 +142,8 @@ impl PhotonMapper {
                 let m = *scene.material(&y);
                 let wo_y = -arrived.ray.dir;
                 if !m.is_delta() {
-                    sum += beta * self.map_radiance(maps, &m, &y, wo_y, budget - b);
+                    let depth = budget - b;
+                    sum += beta * maps.reflected_by_all(&self.estimate(), &m, &y, wo_y, depth);
                     break;
                 }
                 let (u, uc) = (sampler.next_2d(), sampler.next_f32());
@@ -259,7 +162,7 @@ impl PhotonMapper {
     pub fn li(
         &self,
         scene: &Scene,
-        maps: &Maps,
+        maps: &SurfaceMaps,
         ray: Ray,
         sampler: &mut Sampler,
         rays: &mut u64,
@@ -268,43 +171,29 @@ impl PhotonMapper {
         let Some(vp) = path.visible else {
             return path.emitted;
         };
-        let VisiblePoint {
-            hit,
-            material,
-            wo,
-            n,
-            beta,
-            bounces,
-            ..
-        } = vp;
-        let vertex = Vertex {
-            hit: &hit,
-            material: &material,
-            wo,
-            bounces,
-        };
         // Photons here may have taken the scattering events the camera path has left.
-        let depth = self.max_depth - bounces;
-        let direct = match self.direct {
-            Direct::ShadowRays => {
-                let at = Scatter::Surface {
-                    hit: &hit,
-                    material: &material,
-                };
-                estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
-            }
-            Direct::Photons => {
-                let map = maps.direct.as_ref().unwrap();
-                self.estimate(map, &material, &hit, wo, n, depth)
-            }
-        };
-        let caustic = self.estimate(&maps.caustic, &material, &hit, wo, n, depth);
-        let indirect = if self.final_gather {
-            self.final_gather(scene, maps, &vertex, sampler, rays)
-        } else {
-            self.estimate(&maps.indirect, &material, &hit, wo, n, depth)
-        };
-        path.emitted + beta * (direct + caustic + indirect)
+        let depth = self.max_depth - vp.bounces;
+        let estimate = self.estimate();
+        let mut l = maps.reflected_at(
+            scene,
+            &vp,
+            &estimate,
+            self.direct,
+            depth,
+            !self.final_gather,
+            sampler,
+            rays,
+        );
+        if self.final_gather {
+            let vertex = Vertex {
+                hit: &vp.hit,
+                material: &vp.material,
+                wo: vp.wo,
+                bounces: vp.bounces,
+            };
+            l += self.final_gather(scene, maps, &vertex, sampler, rays);
+        }
+        path.emitted + vp.beta * l
     }
 }
 
@@ -359,7 +248,8 @@ impl Integrator for PhotonMapper {
     /// a render keeps the direct ones only for `direct = "photons"` or final gathering), and
     /// `caustic`: the L S+ D photons of the caustic budget.
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
-        let [mut global, caustic, indirect] = self.trace_lists(scene, ctx, true)?;
+        let [mut global, caustic, indirect] =
+            trace_surface_photons(scene, ctx, &self.budgets(), true)?;
         global.extend(indirect);
         Ok(vec![
             foton_photonmap::view(

@@ -13,6 +13,7 @@
 //! `integrator::PhotonMapView`.
 
 pub mod map;
+pub mod surface;
 pub mod trace;
 
 pub use map::{Estimate, Neighbour, Photon, PhotonMap};

@@ -62,12 +62,11 @@ use foton_core::props::Properties;
 use foton_core::render::{render_pixels, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
-use foton_core::walk::{Segment, VisiblePoint, walk_to_diffuse};
-use foton_core::{Error, Result, Rgb, Vec3};
+use foton_core::walk::{Segment, walk_to_diffuse};
+use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
-use foton_photonmap::trace::{
-    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, STREAM_VOLUME, Site, TraceOptions, trace_photons,
-};
+use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
+use foton_photonmap::trace::{PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons};
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,9 +93,8 @@ pub struct Vpm {
 }
 
 pub struct Maps {
-    pub direct: Option<PhotonMap>,
-    pub caustic: PhotonMap,
-    pub indirect: PhotonMap,
+    /// The direct (with `direct = "photons"`), caustic and indirect surface maps.
+    pub surface: SurfaceMaps,
     pub volume: PhotonMap,
     /// For the beam estimate: each volume photon's radius (in the map's order) and the
     /// largest.
@@ -118,89 +116,53 @@ fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
 }
 
 impl Vpm {
-    fn check_size(&self, name: &str, len: usize, k: usize, key: &str) -> Result<()> {
-        if len > 0 && len < k {
-            return Err(Error::Usage(format!(
-                "integrators.vpm.{key} = {k} is larger than the {len} photons stored in the {name} map; lower it or emit more photons"
-            )));
-        }
-        Ok(())
-    }
-
-    /// The three photon passes, sorted into the direct (only if `keep_direct`), caustic,
-    /// indirect and volume lists. Without a caustic budget the global pass keeps its L S+ D
-    /// surface photons in the indirect list (caustics then come from the global map). The
-    /// volume list holds L M photons (first scattering events) only with `direct = "photons"`:
-    /// otherwise shadow rays count them.
+    /// The three photon passes: the surface maps' two (foton-photonmap's surface passes:
+    /// [direct, caustic, indirect], the direct list only if `keep_direct`) and the volume
+    /// pass, which stores photons at scattering events in media: L M photons (first
+    /// scattering events) only with `direct = "photons"`, otherwise shadow rays count them.
     fn trace_lists(
         &self,
         scene: &Scene,
         ctx: &RenderContext<'_>,
         keep_direct: bool,
-    ) -> Result<[Vec<Photon>; 4]> {
-        let seed = scene.render.seed;
-        let photons_direct = self.direct == Direct::Photons;
-        let caustic_map = self.caustic_photons > 0;
-        let pass = |photons: u64, stream: u64, stop_at_diffuse: bool| TraceOptions {
-            photons,
+    ) -> Result<([Vec<Photon>; 3], Vec<Photon>)> {
+        let budgets = Budgets {
+            global: self.global_photons,
+            caustic: self.caustic_photons,
             max_depth: self.max_depth,
-            seed,
-            stream,
-            stop_at_diffuse,
         };
-        let mut lists = trace_photons(
-            scene,
-            &pass(self.global_photons, STREAM_GLOBAL, false),
-            ctx,
-            2,
-            |site, class| match (site, class) {
-                (Site::Surface, PathClass::Direct) if keep_direct => Some(0),
-                (Site::Surface, PathClass::Caustic) if !caustic_map => Some(1),
-                (Site::Surface, PathClass::Indirect) => Some(1),
-                _ => None,
-            },
-        )?;
-        let indirect = lists.pop().unwrap();
-        let direct = lists.pop().unwrap();
-        let caustic = if caustic_map {
-            trace_photons(
-                scene,
-                &pass(self.caustic_photons, STREAM_CAUSTIC, true),
-                ctx,
-                1,
-                |site, class| (site == Site::Surface && class == PathClass::Caustic).then_some(0),
-            )?
-            .pop()
-            .unwrap()
-        } else {
-            Vec::new()
-        };
+        let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct)?;
+        let photons_direct = self.direct == Direct::Photons;
         let volume = if self.volume_photons > 0 && scene.has_media() {
-            trace_photons(
-                scene,
-                &pass(self.volume_photons, STREAM_VOLUME, false),
-                ctx,
-                1,
-                |site, class| {
-                    (site == Site::Volume && (class != PathClass::Direct || photons_direct))
-                        .then_some(0)
-                },
-            )?
+            let opts = TraceOptions {
+                photons: self.volume_photons,
+                max_depth: self.max_depth,
+                seed: scene.render.seed,
+                stream: STREAM_VOLUME,
+                stop_at_diffuse: false,
+            };
+            trace_photons(scene, &opts, ctx, 1, |site, class| {
+                (site == Site::Volume && (class != PathClass::Direct || photons_direct))
+                    .then_some(0)
+            })?
             .pop()
             .unwrap()
         } else {
             Vec::new()
         };
-        Ok([direct, caustic, indirect, volume])
+        Ok((surface, volume))
     }
 
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
         let photons_direct = self.direct == Direct::Photons;
-        let [direct, caustic, indirect, volume] = self.trace_lists(scene, ctx, photons_direct)?;
-        self.check_size("direct", direct.len(), self.k, "k")?;
-        self.check_size("caustic", caustic.len(), self.k, "k")?;
-        self.check_size("indirect", indirect.len(), self.k, "k")?;
-        self.check_size("volume", volume.len(), self.k_volume, "k_volume")?;
+        let (surface, volume) = self.trace_lists(scene, ctx, photons_direct)?;
+        let surface = SurfaceMaps::build(surface, photons_direct, self.k, "integrators.vpm.k")?;
+        check_k(
+            "integrators.vpm.k_volume",
+            self.k_volume,
+            "volume",
+            volume.len(),
+        )?;
         let volume = PhotonMap::build(volume);
         let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
             with_pool(ctx.threads, || {
@@ -232,9 +194,7 @@ impl Vpm {
         }
         let grow = Vec3::splat(self.max_radius_volume);
         Ok(Maps {
-            direct: photons_direct.then(|| PhotonMap::build(direct)),
-            caustic: PhotonMap::build(caustic),
-            indirect: PhotonMap::build(indirect),
+            surface,
             volume,
             volume_radius,
             volume_radius_max,
@@ -396,38 +356,19 @@ impl Vpm {
         let Some(vp) = path.visible else {
             return path.emitted;
         };
-        let VisiblePoint {
-            hit,
-            material,
-            wo,
-            n,
-            beta,
-            bounces,
-            medium,
-            ..
-        } = vp;
-        let depth = self.max_depth - bounces;
+        let depth = self.max_depth - vp.bounces;
         let estimate = self.surface_estimate();
-        let direct = match self.direct {
-            Direct::ShadowRays => {
-                let at = Scatter::Surface {
-                    hit: &hit,
-                    material: &material,
-                };
-                estimate_direct(scene, at, wo, medium, Mis::LightOnly, sampler, rays)
-            }
-            Direct::Photons => {
-                let map = maps.direct.as_ref().unwrap();
-                map.reflected(&estimate, &material, &hit, wo, n, depth)
-            }
-        };
-        let caustic = maps
-            .caustic
-            .reflected(&estimate, &material, &hit, wo, n, depth);
-        let indirect = maps
-            .indirect
-            .reflected(&estimate, &material, &hit, wo, n, depth);
-        path.emitted + beta * (direct + caustic + indirect)
+        let l = maps.surface.reflected_at(
+            scene,
+            &vp,
+            &estimate,
+            self.direct,
+            depth,
+            true,
+            sampler,
+            rays,
+        );
+        path.emitted + vp.beta * l
     }
 }
 
@@ -486,7 +427,7 @@ impl Integrator for Vpm {
     /// `global` (direct and indirect surface photons of the global budget), `caustic` (L S+ D
     /// surface photons of the caustic budget) and `volume` (the volume map as rendered).
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
-        let [mut global, caustic, indirect, volume] = self.trace_lists(scene, ctx, true)?;
+        let ([mut global, caustic, indirect], volume) = self.trace_lists(scene, ctx, true)?;
         global.extend(indirect);
         Ok(vec![
             foton_photonmap::view(
