@@ -4,7 +4,9 @@
 //! geometry and orientation. Each camera ray is followed to the first surface whose material
 //! is not `null` (null boundaries are crossed); the pixel is the unit geometric normal `n` there
 //! mapped to a colour, `n * 0.5 + 0.5` (x to red, y to green, z to blue), and black when the
-//! ray hits nothing.
+//! ray hits nothing. The walk is core's `foton_core::walk::first_surface` (the crossing loop
+//! every integrator shares): past `MAX_NULL_CROSSINGS` null boundaries in a row the ray is
+//! given up, and the pixel is black.
 //!
 //! | parameter        | type    | meaning                                                | default |
 //! |------------------|---------|--------------------------------------------------------|---------|

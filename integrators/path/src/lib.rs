@@ -1,5 +1,8 @@
 //! # `path`: unidirectional path tracer
 //!
+//! This table is the one list of the parameters (`[integrators.path]`); the README and the
+//! scene-format page point here.
+//!
 //! | parameter  | type    | meaning                                                  | default |
 //! |------------|---------|----------------------------------------------------------|---------|
 //! | `rr_depth` | integer | scattering events before Russian roulette may end a path | 5       |
@@ -28,6 +31,16 @@
 //! or cast by delta surfaces from point lights (L S+ D E paths from a point light, L S+ M E
 //! volumetric caustics too) cannot be sampled: they are missing. Volumetric caustics from
 //! area lights are found, slowly. That is what photon mapping is for.
+//!
+//! **Shared code.** The ray's walk through null boundaries and media is core's
+//! (`foton_core::walk::RayWalk`, the one crossing loop every integrator and the photon pass
+//! use): a segment is measured from the boundary the ray last crossed, so the gap between the
+//! boundary and the ray's offset origin is sampled too, and past `MAX_NULL_CROSSINGS` (256)
+//! crossings in a row the path is ended and carries nothing further. Light sampling is core's
+//! direct-light estimator (`foton_core::direct::estimate_direct` with
+//! `Mis::WithScatterSampling`: the power heuristic against the BSDF's or phase function's
+//! pdf), the same one `photon`, `sppm` and `vpm` use (without MIS); media are queried through
+//! core's `Medium` interface.
 
 use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::geometry::Ray;

@@ -1,37 +1,62 @@
 //! # `photon`: photon mapping (Jensen)
 //!
+//! This table is the one list of the parameters (`[integrators.photon]`); the README, the
+//! scene-format page and docs/photon-mapping.md point here.
+//!
 //! | parameter         | type    | meaning                                                        | default  |
 //! |-------------------|---------|----------------------------------------------------------------|----------|
-//! | `global_photons`  | integer | photons emitted for the direct and indirect maps               | 200000   |
-//! | `caustic_photons` | integer | photons emitted for the caustic map (0: no caustic map)        | 100000   |
-//! | `k`               | integer | photons per radiance estimate (k nearest, >= 2)                | 50       |
-//! | `max_radius`      | float   | largest estimate radius (world units)                          | 1/20 of the scene's diagonal |
+//! | `global_photons`  | integer | photons emitted for the direct and indirect ("global") maps, >= 1 | 200000 |
+//! | `caustic_photons` | integer | photons emitted for the caustic map; 0: no caustic map, the global map keeps the L S+ D photons (below) | 100000 |
+//! | `k`               | integer | photons per radiance estimate (k nearest, >= 2: the k-th only sets the radius) | 50 |
+//! | `max_radius`      | float   | largest estimate radius (world units), > 0                     | 1/20 of the scene's bounding-box diagonal |
 //! | `kernel`          | string  | `box`, `cone`, `gaussian` or a kernel plugin's name            | `box`    |
-//! | `cone_c`          | float   | the cone kernel's c >= 1                                       | 1        |
+//! | `cone_c`          | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`)    | 1        |
 //! | `direct`          | string  | `nee` (shadow rays) or `photons` (first-hit photons)           | `nee`    |
 //! | `final_gather`    | bool    | indirect light by gather rays that look the maps up            | false    |
-//! | `gather_rays`     | integer | gather rays per camera sample                                  | 32       |
+//! | `gather_rays`     | integer | gather rays per camera sample, >= 1 (used with `final_gather`) | 32       |
 //!
 //! `[render] max_depth` bounds the scattering events of a whole light path, as in the path
 //! tracer: a photon's surface hits plus the camera path's delta bounces (each photon records
 //! its count, and an estimate takes only the photons that fit). `[render] spp` camera samples.
+//! A `k` larger than the photons stored in a non-empty map is an error; a scene with
+//! participating media is refused (`vpm` renders those).
 //!
-//! Two passes. **Photons** leave the lights in proportion to power (core's `photon_trace`),
-//! bounce by BSDF sampling with Russian roulette, and are stored at diffuse surfaces only, by
-//! path: L D (first hit) in the direct map (only when `direct = "photons"` or with final
-//! gathering), L S+ D in the caustic map (from the caustic budget), and every other path in
-//! the indirect map. **Camera rays** follow mirrors and glass to the first diffuse point x,
-//! where radiance = emission + direct + caustic + indirect:
+//! Two passes. **Photons** leave the lights in proportion to power (the photon pass of
+//! foton-photonmap, `foton_photonmap::trace`), bounce by BSDF sampling with Russian roulette,
+//! and are stored at diffuse surfaces only, by path: L D (first hit) in the direct map (only
+//! when `direct = "photons"` or with final gathering), L S+ D in the caustic map (from the
+//! caustic budget), and every other path in the indirect map. **Camera rays** follow mirrors
+//! and glass to the first diffuse point x (core's camera walk, `foton_core::walk`), where
+//! radiance = emission + direct + caustic + indirect:
 //!
-//! * direct: shadow rays to the lights, or the direct map's estimate;
+//! * direct: core's direct-light estimator (`foton_core::direct::estimate_direct`: one shadow
+//!   ray to a light chosen by power), or the direct map's estimate;
 //! * caustic: the caustic map's estimate;
 //! * indirect: the indirect map's estimate, or with `final_gather` the mean over cosine-
 //!   distributed gather rays of the radiance leaving the diffuse point they reach (through
 //!   mirrors and glass), estimated from all three maps there.
 //!
-//! Each light path is counted once (docs/photon-mapping.md). An estimate is
-//! L = f_r sum_p Phi_p K(d_p, r) over the k nearest photons on the same side of the same
-//! surface, r the distance to the k-th (which, on the boundary, is not summed).
+//! Each light path is counted once (docs/photon-mapping.md). An estimate
+//! (`PhotonMap::reflected`) is L = sum_p f(x, w_p, w) Phi_p K(d_p, r) over the k nearest
+//! photons of a disc around x, r the distance to the k-th (which, on the boundary, is not
+//! summed).
+//!
+//! **What changed** (with foton-photonmap and core's `walk` and `direct` modules):
+//!
+//! * `caustic_photons = 0` no longer drops the caustics: without a caustic map the global
+//!   pass keeps its L S+ D photons in the indirect map, so caustics come from the global
+//!   budget (fewer photons, more blur) instead of vanishing. With a caustic budget the global
+//!   pass drops them, as before (the caustic pass counts those paths).
+//! * The BSDF is evaluated per photon with the photon's own incoming direction w_p (not a
+//!   reflectance times the density), so the estimate is right for any BSDF.
+//! * Photons are taken from a disc, not a ball: on the same side of a surface facing the same
+//!   way (stored normals within about 25 degrees) and no farther from the tangent plane than
+//!   `DISC_THICKNESS` = 1/4 of the radius, so photons on a parallel surface within the radius
+//!   (the top of a low box beside the floor) no longer leak into the estimate.
+//! * The camera walk (null boundaries crossed by core's one crossing loop, with its limit of
+//!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
+//!   the gather rays' walk (`first_surface`) and the direct light (`estimate_direct`) are
+//!   core's, the same code as `path`, `sppm` and `vpm` use.
 //!
 //! The method is consistent, not unbiased: estimates blur light over the radius r, which
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,

@@ -1,16 +1,24 @@
 //! foton-photonmap: the photon machinery that the photon-mapping integrators (`photon`,
-//! `sppm`, `vpm`) share, linked into each of them.
+//! `sppm`, `vpm`) share, linked into each of them. An ordinary library crate, not a plugin.
 //!
 //! - [`trace`]: the photon pass: photons leave the lights in proportion to power, walk the
-//!   scene (surfaces and media) by BSDF and phase-function sampling with Russian roulette, and
-//!   are offered for storage at every non-delta surface and scattering event, classified by
-//!   their path (L D, L S+ D, the rest);
-//! - [`map`]: the compact photon and the photon map (a kd-tree) with its k-nearest and
-//!   fixed-radius queries and the density estimates made from them.
+//!   scene (surfaces and media, through core's `walk::RayWalk`, the one null-boundary crossing
+//!   loop) by BSDF and phase-function sampling with Russian roulette, and are offered for
+//!   storage at every non-delta surface and scattering event, classified by their path (L D,
+//!   L S+ D, the rest); the caller sorts them into its maps;
+//! - [`map`]: the compact photon (32 bytes) and the photon map (a balanced kd-tree) with its
+//!   k-nearest (`knn`), fixed-radius (`within`) and beam (`along_ray`) queries, and the
+//!   density estimates made from them: `radiance` (reflected radiance, the BSDF evaluated per
+//!   photon with the photon's own incoming direction), `reflected` (the same for a material at
+//!   a hit), `irradiance` and `in_scattered` (the volume estimate). Surface estimates gather
+//!   from a disc, not a ball: photons farther from the tangent plane than
+//!   [`map::DISC_THICKNESS`] (1/4) of the radius are not counted.
 //!
 //! Nothing here crosses the plugin boundary: the host never sees a `PhotonMap`. What the
 //! `foton photons` tool draws comes back through `Integrator::photon_maps` as core's plain
-//! `integrator::PhotonMapView`.
+//! `integrator::PhotonMapView` ([`view`] makes one), so an integrator can expose maps without
+//! linking this crate. It is not part of the build identifier either: each plugin that links
+//! it carries its own copy (docs/crates.md).
 
 pub mod map;
 pub mod surface;

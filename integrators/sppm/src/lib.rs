@@ -1,36 +1,52 @@
 //! # `sppm`: stochastic progressive photon mapping (Hachisuka and Jensen 2009)
 //!
+//! This table is the one list of the parameters (`[integrators.sppm]`); the README, the
+//! scene-format page and docs/photon-mapping.md point here.
+//!
 //! | parameter               | type    | meaning                                                   | default |
 //! |-------------------------|---------|-----------------------------------------------------------|---------|
-//! | `iterations`            | integer | camera + photon passes to run                             | 64 (unlimited with `time`) |
-//! | `time`                  | float   | run until this many seconds have passed                   | none    |
-//! | `photons_per_iteration` | integer | photons emitted in each iteration                         | 100000  |
-//! | `initial_radius`        | float   | every pixel's starting gather radius (world units)        | automatic, below |
+//! | `iterations`            | integer | camera + photon passes to run, >= 1                       | 64 (unlimited with `time`) |
+//! | `time`                  | float   | run until this many seconds have passed, > 0              | none    |
+//! | `photons_per_iteration` | integer | photons emitted in each iteration, >= 1                   | 100000  |
+//! | `initial_radius`        | float   | every pixel's starting gather radius (world units), > 0   | automatic, below |
 //! | `alpha`                 | float   | fraction of new photons kept, in (0, 1]                   | 0.7     |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name       | `box`   |
-//! | `cone_c`                | float   | the cone kernel's c >= 1                                  | 1       |
+//! | `cone_c`                | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1     |
 //! | `direct`                | string  | `nee` (shadow rays) or `photons`                          | `nee`   |
 //!
 //! `[render] max_depth` bounds the scattering events of a whole light path, camera path's
-//! delta bounces and photon's surface hits together, as in the path tracer; `[render] spp` is not used (each iteration takes one new jittered camera sample per
-//! pixel). With `time`, `iterations` (if given) is an upper bound.
+//! delta bounces and photon's surface hits together, as in the path tracer; `[render] spp` is
+//! not used (each iteration takes one new jittered camera sample per pixel). With `time`,
+//! `iterations` (if given) is an upper bound. A scene with participating media is refused.
+//! For `foton compare --time` the work is counted in iterations (`Integrator::budget`:
+//! `integrators.sppm.iterations`); `foton photons` draws one iteration's photons (the map
+//! `iteration`).
 //!
 //! Each iteration traces a new camera path per pixel through mirrors and glass to its first
-//! diffuse point, the *visible point* (so anti-aliasing comes for free), adds the emission met
-//! and, with `direct = "nee"`, direct light by a shadow ray; then traces a batch of photons
-//! (core's photon pass: stored at diffuse surfaces only, never on mirrors or glass), gathers
-//! at each visible point the photons within the pixel's radius R on the same side of the same
-//! surface, and updates the pixel's statistics:
+//! diffuse point, the *visible point* (core's camera walk, `foton_core::walk`, so
+//! anti-aliasing comes for free), adds the emission met and, with `direct = "nee"`, direct
+//! light by core's estimator (`foton_core::direct::estimate_direct`, one shadow ray); then
+//! traces a batch of photons (foton-photonmap's photon pass: stored at diffuse surfaces only,
+//! never on mirrors or glass), gathers at each visible point the photons within the pixel's
+//! radius R that lie on a disc of the same surface (below), and updates the pixel's
+//! statistics:
 //!
 //! ```text
 //! N' = N + alpha M,   R' = R sqrt((N + alpha M) / (N + M)),   tau' = (tau + Phi) R'^2 / R^2
 //! ```
 //!
-//! where M is the number of photons gathered and Phi = beta sum_p f_r Phi_p their reflected
-//! flux. The pixel's radiance after n iterations is Ld / n + tau / (n pi R^2) (photon flux
-//! is divided by the photons of one iteration, so n is the number of iterations). R shrinks
-//! to zero while N grows without bound: the estimate is consistent, converging to the image
-//! the path tracer converges to.
+//! where M is the number of photons gathered and Phi = beta sum_p f(x, w_p, w) Phi_p their
+//! reflected flux, the BSDF evaluated per photon with its own incoming direction w_p. The
+//! pixel's radiance after n iterations is Ld / n + tau / (n pi R^2) (photon flux is divided by
+//! the photons of one iteration, so n is the number of iterations). R shrinks to zero while N
+//! grows without bound: the estimate is consistent, converging to the image the path tracer
+//! converges to.
+//!
+//! **The gather disc.** A photon counts if it lies within R, its stored normal agrees with the
+//! visible point's (within about 25 degrees: the same side of the same surface), its path has
+//! at most the scattering events the camera path leaves, and it lies no farther from the
+//! tangent plane than `DISC_THICKNESS` (foton-photonmap: 1/4) of R, as in the k-nearest
+//! estimates of `photon` and `vpm`: photons on a parallel surface within R are not counted.
 //!
 //! **Kernels.** With a kernel K other than the box, a photon at distance d counts with weight
 //! w = pi R^2 K(d, R) (1 for the box inside the disc): M is the weighted count and Phi the
@@ -44,8 +60,13 @@
 //! iterations find photons, and small against the scene.
 //!
 //! **Determinism.** Photons are traced with per-photon random streams and gathered per pixel
-//! from a kd-tree built in a fixed order (core's `PhotonMap`), so images are identical for
-//! any number of threads. Memory is bounded: one iteration's photons at a time.
+//! from a kd-tree built in a fixed order (foton-photonmap's `PhotonMap`), so images are
+//! identical for any number of threads. Memory is bounded: one iteration's photons at a time.
+//!
+//! **What changed** (with foton-photonmap and core's `walk` and `direct` modules): the gather
+//! selects a disc (above) and evaluates the BSDF per photon; the camera walk (null boundaries
+//! crossed by core's one crossing loop, a ray ended past `MAX_NULL_CROSSINGS` crossings in a
+//! row) and the direct light are core's, the same code as `path`, `photon` and `vpm` use.
 
 use foton_core::direct::Direct;
 use foton_core::direct::{Mis, Scatter, estimate_direct};

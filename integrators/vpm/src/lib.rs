@@ -1,30 +1,39 @@
 //! # `vpm`: volumetric photon mapping (Jensen and Christensen 1998)
 //!
+//! This table is the one list of the parameters (`[integrators.vpm]`); the README, the
+//! scene-format page and docs/photon-mapping.md point here. "diagonal" is the scene's
+//! bounding-box diagonal.
+//!
 //! | parameter           | type    | meaning                                                    | default |
 //! |---------------------|---------|------------------------------------------------------------|---------|
-//! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps   | 200000  |
-//! | `caustic_photons`   | integer | photons emitted for the surface caustic map (0: none)      | 100000  |
-//! | `volume_photons`    | integer | photons emitted for the volume map                         | 200000  |
+//! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps, >= 1 | 200000 |
+//! | `caustic_photons`   | integer | photons emitted for the surface caustic map; 0: no caustic map, the global map keeps the L S+ D surface photons | 100000 |
+//! | `volume_photons`    | integer | photons emitted for the volume map (traced only when the scene has media); 0: no volume map | 200000 |
 //! | `k`                 | integer | photons per surface estimate (>= 2)                        | 50      |
-//! | `max_radius`        | float   | largest surface estimate radius                            | 1/20 of the scene diagonal |
-//! | `k_volume`          | integer | photons per volume estimate (>= 2)                         | 50      |
-//! | `max_radius_volume` | float   | largest volume estimate radius                             | 1/20 of the scene diagonal |
-//! | `step`              | float   | ray-marching step (jittered per camera sample)             | 1/100 of the scene diagonal |
-//! | `kernel`, `cone_c`  | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces, 3-D in volumes) | `box` |
+//! | `max_radius`        | float   | largest surface estimate radius, > 0                       | 1/20 of the diagonal |
+//! | `k_volume`          | integer | photons per volume estimate (>= 2); with `estimate = "beam"`, the neighbour that sets each photon's radius | 50 |
+//! | `max_radius_volume` | float   | largest volume estimate radius, > 0                        | 1/20 of the diagonal |
+//! | `step`              | float   | ray-marching step (jittered per camera sample), > 0        | 1/100 of the diagonal |
+//! | `kernel`            | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces and for the beam estimate, in 3-D for the marched volume estimate) | `box` |
+//! | `cone_c`            | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1      |
 //! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
 //! | `estimate`          | string  | `march` (ray marching) or `beam` (beam radiance estimate)  | `march` |
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
-//! medium scattering events alike), as in the path tracer. `[render] spp` camera samples.
+//! medium scattering events alike), as in the path tracer. `[render] spp` camera samples. A
+//! `k` (or `k_volume`) larger than the photons stored in a non-empty map is an error.
 //!
-//! **Photons** (core's photon pass through media): three budgets, each with its own random
-//! stream. The global pass stores surface photons in the direct (only if `direct =
-//! "photons"`) and indirect maps; the caustic pass stores L S+ D surface photons; the volume
-//! pass stores photons at scattering events in media, the volume map (with `direct = "nee"`
-//! the first scattering events, L M, are not stored: shadow rays count them).
+//! **Photons** (foton-photonmap's photon pass through media, `foton_photonmap::trace`): three
+//! budgets, each with its own random stream. The global pass stores surface photons in the
+//! direct (only if `direct = "photons"`) and indirect maps; the caustic pass stores L S+ D
+//! surface photons; the volume pass stores photons at scattering events in media, the volume
+//! map (with `direct = "nee"` the first scattering events, L M, are not stored: shadow rays
+//! count them). `foton photons` draws the maps `global`, `caustic` and `volume`.
 //!
-//! **Camera rays** are followed through null boundaries and delta surfaces (murky glass
-//! included), tracking the medium. Along each segment through a medium of length s:
+//! **Camera rays** are followed by core's camera walk (`foton_core::walk::walk_to_diffuse`)
+//! through null boundaries and delta surfaces (murky glass included), tracking the medium.
+//! Along each segment through a medium of length s (measured from the boundary the ray last
+//! crossed, so the gap between a boundary and the ray's offset origin is not skipped):
 //!
 //! ```text
 //! L(x, w) = Tr(x, x_s) L_s(x_s, w) + integral_0^s Tr(x, x_t) sigma_s L_i(x_t, w) dt
@@ -34,10 +43,12 @@
 //! same offset for every step of a camera sample, so each point stands for its whole step):
 //! at each point the in-scattered radiance sigma_s L_i is the volume estimate
 //! sum_p p(w_p, w) Phi_p K3(d_p, r) over the `k_volume` nearest volume photons, plus, with
-//! `direct = "nee"`, single scattering by one shadow ray to a light (with its transmittance).
-//! Transmittance exp(-sigma_t d) is exact per channel. At the first diffuse surface, L_s is
-//! the photon mapper's: emission + direct (shadow ray with transmittance, or photons) +
-//! caustic + indirect estimates, attenuated by the transmittance in front of it.
+//! `direct = "nee"`, single scattering by core's direct-light estimator in the medium (one
+//! shadow ray to a light, with its transmittance). Transmittance comes from the medium
+//! (`Medium::transmittance`: exp(-sigma_t d) per channel, exact, for the homogeneous medium).
+//! At the first diffuse surface, L_s is the photon mapper's: emission + direct
+//! (`estimate_direct`, or photons) + caustic + indirect estimates, attenuated by the
+//! transmittance in front of it.
 //!
 //! **Beam radiance estimate** (`estimate = "beam"`, Jarosz, Zwicker and Jensen 2008): instead
 //! of a k-nearest query at every step, each volume photon gets its own radius at build time
@@ -50,6 +61,19 @@
 //! Each light path is counted once: through a march point x_t, L M (x_t) by shadow rays (or
 //! the volume map's first-event photons), everything else by the volume map; at surfaces as in
 //! `photon` (docs/photon-mapping.md).
+//!
+//! **What changed** (with foton-photonmap and core's `walk`, `direct` and `Medium`):
+//!
+//! * `caustic_photons = 0` keeps the L S+ D surface photons of the global pass in the indirect
+//!   map (caustics come from the global budget) instead of dropping them.
+//! * Surface estimates (`PhotonMap::reflected`) evaluate the BSDF per photon with its own
+//!   incoming direction, and take photons from a disc: same side of the same surface (normals
+//!   within about 25 degrees), no farther from the tangent plane than `DISC_THICKNESS` = 1/4 of
+//!   the radius.
+//! * The camera walk, the null-boundary crossing (one loop in core, with its limit of
+//!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
+//!   the direct light and every medium query (`dyn Medium`) are core's, shared with `path`,
+//!   `photon` and `sppm`; the gap after a crossing is now sampled, as `path` samples it.
 
 use foton_core::direct::Direct;
 use foton_core::direct::{Mis, Scatter, estimate_direct};
