@@ -25,7 +25,8 @@ fn main() {
         "CARGO_CFG_TARGET_FEATURE",
     ]
     .iter()
-    .map(|var| format!("{var}={}", std::env::var(var).unwrap_or_default()))
+    // Set but empty (debug assertions on) is not the same as unset: compare the OsStrings.
+    .map(|var| format!("{var}={:?}", std::env::var_os(var)))
     .collect();
     // The workspace's lock file (core is a member of the workspace at its parent).
     let lock_path = manifest.join("../Cargo.lock");

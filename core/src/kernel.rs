@@ -14,6 +14,11 @@ pub trait Kernel: Send + Sync {
     fn name(&self) -> &str;
     /// Unnormalised weight at t = d / r in [0, 1]; finite and non-negative.
     fn profile(&self, t: f64) -> f64;
+    /// The kernel's own parameters as an integrator reads them (`cone_c`), for
+    /// `Integrator::parameters`.
+    fn parameters(&self) -> Vec<(&'static str, f64)> {
+        Vec::new()
+    }
 }
 
 /// 1 / (pi r^2) on the disc.
@@ -37,6 +42,9 @@ impl Kernel for ConeKernel {
     }
     fn profile(&self, t: f64) -> f64 {
         1.0 - t / self.c
+    }
+    fn parameters(&self) -> Vec<(&'static str, f64)> {
+        vec![("cone_c", self.c)]
     }
 }
 
@@ -105,6 +113,17 @@ impl NormalizedKernel {
 
     pub fn name(&self) -> &str {
         self.kernel.name()
+    }
+
+    /// `kernel = NAME` and the kernel's own parameters, as `Integrator::parameters` lists
+    /// them.
+    pub fn parameters(&self) -> Vec<crate::integrator::Parameter> {
+        use crate::integrator::Parameter;
+        let mut p = vec![Parameter::str("kernel", self.name())];
+        for (key, value) in self.kernel.parameters() {
+            p.push(Parameter::float(key, value as f32));
+        }
+        p
     }
 
     /// Weight of a photon at distance d in a surface estimate of radius r (per unit area).

@@ -243,13 +243,13 @@ impl Integrator for PhotonMapper {
             Parameter::int("caustic_photons", self.caustic_photons),
             Parameter::int("k", self.k),
             Parameter::float("max_radius", self.max_radius),
-            Parameter::str("kernel", self.kernel.name()),
+        ];
+        p.extend(self.kernel.parameters());
+        p.extend([
             Parameter::str("direct", self.direct.name()),
             Parameter::bool("final_gather", self.final_gather),
-        ];
-        if self.final_gather {
-            p.push(Parameter::int("gather_rays", self.gather_rays));
-        }
+            Parameter::int("gather_rays", self.gather_rays),
+        ]);
         p
     }
 

@@ -379,11 +379,9 @@ impl Integrator for Sppm {
             Some(r) => Parameter::float("initial_radius", r),
             None => Parameter::str("initial_radius", "auto"),
         });
-        p.extend([
-            Parameter::float("alpha", self.alpha as f32),
-            Parameter::str("kernel", self.kernel.name()),
-            Parameter::str("direct", self.direct.name()),
-        ]);
+        p.push(Parameter::float("alpha", self.alpha as f32));
+        p.extend(self.kernel.parameters());
+        p.push(Parameter::str("direct", self.direct.name()));
         p
     }
 

@@ -412,7 +412,7 @@ impl Integrator for Vpm {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        vec![
+        let mut p = vec![
             Parameter::int("global_photons", self.global_photons),
             Parameter::int("caustic_photons", self.caustic_photons),
             Parameter::int("volume_photons", self.volume_photons),
@@ -421,7 +421,9 @@ impl Integrator for Vpm {
             Parameter::float("max_radius", self.max_radius),
             Parameter::float("max_radius_volume", self.max_radius_volume),
             Parameter::float("step", self.step),
-            Parameter::str("kernel", self.kernel.name()),
+        ];
+        p.extend(self.kernel.parameters());
+        p.extend([
             Parameter::str("direct", self.direct.name()),
             Parameter::str(
                 "estimate",
@@ -430,7 +432,8 @@ impl Integrator for Vpm {
                     VolumeEstimate::Beam => "beam",
                 },
             ),
-        ]
+        ]);
+        p
     }
 
     fn budget(&self) -> Budget {
