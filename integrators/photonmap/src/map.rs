@@ -565,6 +565,12 @@ impl PhotonMap {
             return Rgb::ZERO;
         }
         with_scratch(|scratch| {
+            if let Material::Diffuse { .. } = material {
+                // A Lambertian BSDF is the same for every photon of the disc (each arrived on
+                // the side looked at): f once, outside the sum, and no direction to decode.
+                let f = material.eval(wo, n, hit.ng);
+                return f * self.radiance(hit.p, n, max_depth, estimate, scratch, |_| Rgb::ONE);
+            }
             self.radiance(hit.p, n, max_depth, estimate, scratch, |wi| {
                 material.eval(wo, wi, hit.ng)
             })
