@@ -53,7 +53,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene to an image (.exr linear float32 or .png sRGB).
+    /// Render a scene to an image (.exr linear float32, or .png: 8-bit sRGB after the scene's
+    /// [film] exposure and tonemap).
     Render(RenderArgs),
     /// Parse and validate a scene; list what it uses and any unused field.
     Check(CheckArgs),
@@ -70,7 +71,8 @@ enum Command {
     ///
     /// Exposure: a dot's colour is the photon's flux divided by the 99th percentile of the
     /// drawn photons' largest channel, so that 99% of the dots are unclipped and photons of
-    /// equal flux on a white surface come out white. Prints the photons stored and drawn.
+    /// equal flux on a white surface come out white; a PNG then applies the scene's [film]
+    /// exposure and tonemap, as to a render. Prints the photons stored and drawn.
     Photons(photons::PhotonsArgs),
     /// Render a scene with several integrators and lay the renders side by side, labelled.
     ///
@@ -97,7 +99,8 @@ enum Command {
     /// --set KEY.PATH=V1,V2,... sweeps a scene value; the first --set with several values runs
     /// along the columns, the second down the rows, any further ones down the rows as well
     /// (row-major, earlier sets varying faster). A --set with one value applies to every cell.
-    /// Each cell is labelled with its values and its render time.
+    /// Each cell is labelled with its values and its render time, and in a PNG shown through
+    /// its scene's [film] exposure and tonemap (so film.exposure can be swept).
     Sweep(sweep::SweepArgs),
 }
 
@@ -363,7 +366,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     let mut progress = TermProgress::new(a.quiet);
     if let Some(every) = a.checkpoint {
-        progress = progress.with_checkpoint(every, output.clone());
+        progress = progress.with_checkpoint(every, output.clone(), p.scene.film.display());
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
@@ -378,7 +381,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     for w in progress.take_warnings() {
         let _ = writeln!(err, "warning: {w}");
     }
-    film.write(&output)?;
+    film.write(&output, &p.scene.film.display())?;
     let samples = film.total_samples();
     let secs = elapsed.as_secs_f64();
     let _ = writeln!(

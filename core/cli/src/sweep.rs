@@ -3,7 +3,7 @@
 //! down the rows, further ones down the rows too (row-major, the earlier varying faster); a
 //! `--set` with one value applies to every cell.
 
-use crate::montage::{Image, Tile, grid};
+use crate::montage::{Tile, grid, render_image};
 use crate::threads;
 use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
 use clap::Args;
@@ -241,8 +241,9 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             secs
         );
         label.push(format!("{:.2} s", secs));
+        // Each cell through its own scene's display transform: a sweep may vary the exposure.
         tiles.push(Tile {
-            image: Image::from_film(&film),
+            image: render_image(&film, &p.scene.film.display(), &output),
             label,
         });
     }
