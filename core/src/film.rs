@@ -18,6 +18,14 @@ pub struct Film {
     count: Vec<u32>,
     /// Rays traced to make the image (statistics; 0 if the integrator does not count).
     pub rays: u64,
+    /// Iterations a progressive integrator (sppm) completed; 0 for the others, whose work is
+    /// counted in samples ([`Film::total_samples`]).
+    pub iterations: u64,
+    /// The iterations the progressive integrator was asked for; 0 when it has no fixed number
+    /// (a time budget), or is not progressive. Fewer `iterations` mean it was interrupted.
+    pub iterations_planned: u64,
+    /// Photons emitted over all the iterations of a progressive integrator; 0 for the others.
+    pub photons: u64,
 }
 
 impl Film {
@@ -29,6 +37,9 @@ impl Film {
             sum: vec![[0.0; 3]; n],
             count: vec![0; n],
             rays: 0,
+            iterations: 0,
+            iterations_planned: 0,
+            photons: 0,
         }
     }
 

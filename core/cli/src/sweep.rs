@@ -232,13 +232,16 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             return Ok(130);
         }
         let secs = elapsed.as_secs_f64();
+        let work = if film.iterations > 0 {
+            format!("{} iterations", film.iterations)
+        } else {
+            format!("{} spp", p.scene.render.spp)
+        };
         let _ = writeln!(
             out,
-            "[{}] {}: {} spp in {:.2} s",
+            "[{}] {}: {work} in {secs:.2} s",
             label.join(", "),
             p.integrator.describe(),
-            p.scene.render.spp,
-            secs
         );
         label.push(format!("{:.2} s", secs));
         // Each cell through its own scene's display transform: a sweep may vary the exposure.
