@@ -1,5 +1,10 @@
 //! The film: per-pixel sums of radiance samples and their counts (box filter: a sample lands
 //! in its own pixel), and writing it out atomically as linear EXR or sRGB PNG.
+//!
+//! An EXR holds the radiance as it is. A PNG holds display values: each linear value is
+//! scaled by the exposure and tone mapped into [0, 1] ([`DisplayTransform`]), then encoded with
+//! the sRGB curve. Every PNG foton writes goes through [`write_image`] so that the tools show
+//! a scene the same way.
 
 use crate::Rgb;
 use crate::error::{Error, Result};
@@ -13,6 +18,14 @@ pub struct Film {
     count: Vec<u32>,
     /// Rays traced to make the image (statistics; 0 if the integrator does not count).
     pub rays: u64,
+    /// Iterations a progressive integrator (sppm) completed; 0 for the others, whose work is
+    /// counted in samples ([`Film::total_samples`]).
+    pub iterations: u64,
+    /// The iterations the progressive integrator was asked for; 0 when it has no fixed number
+    /// (a time budget), or is not progressive. Fewer `iterations` mean it was interrupted.
+    pub iterations_planned: u64,
+    /// Photons emitted over all the iterations of a progressive integrator; 0 for the others.
+    pub photons: u64,
 }
 
 impl Film {
@@ -24,6 +37,9 @@ impl Film {
             sum: vec![[0.0; 3]; n],
             count: vec![0; n],
             rays: 0,
+            iterations: 0,
+            iterations_planned: 0,
+            photons: 0,
         }
     }
 
@@ -98,8 +114,106 @@ impl Film {
         (sum / px.len().max(1) as f64).as_vec3()
     }
 
-    pub fn write(&self, path: &Path) -> Result<()> {
-        write_image(path, self.width, self.height, &self.pixels())
+    /// Writes the image atomically: an EXR as linear radiance, a PNG through `display`.
+    pub fn write(&self, path: &Path, display: &DisplayTransform) -> Result<()> {
+        write_image(path, self.width, self.height, &self.pixels(), display)
+    }
+}
+
+/// How exposed radiance is squeezed into the [0, 1] an 8-bit image can hold.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum ToneMap {
+    /// Values above 1 are cut to 1 (white): exact below 1, so that tests can compare pixels
+    /// with radiance.
+    #[default]
+    Clamp,
+    /// [`filmic`]: a smooth shoulder that keeps detail in highlights up to about 7 and
+    /// desaturates them towards white.
+    Filmic,
+}
+
+impl ToneMap {
+    /// The names `[film] tonemap` takes, in the order of the documentation.
+    pub const NAMES: [&'static str; 2] = ["clamp", "filmic"];
+
+    pub fn from_name(name: &str) -> Option<ToneMap> {
+        match name {
+            "clamp" => Some(ToneMap::Clamp),
+            "filmic" => Some(ToneMap::Filmic),
+            _ => None,
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            ToneMap::Clamp => "clamp",
+            ToneMap::Filmic => "filmic",
+        }
+    }
+
+    /// The display value in [0, 1] of an exposed linear value; negative and NaN give 0 (a NaN
+    /// pixel is a bug to see as black, not a reason to fail writing the image).
+    #[inline]
+    pub fn apply(self, x: f32) -> f32 {
+        // `max` returns the other operand for NaN, so NaN becomes 0 here.
+        let x = x.max(0.0);
+        match self {
+            ToneMap::Clamp => x.min(1.0),
+            ToneMap::Filmic => filmic(x),
+        }
+    }
+}
+
+/// The ACES filmic curve as fitted by Krzysztof Narkowicz ("ACES Filmic Tone Mapping Curve",
+/// 2016), applied to each channel:
+///
+/// ```text
+/// f(x) = min(1, x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14))     for x >= 0
+/// ```
+///
+/// It maps 0 to 0, rises monotonically (its derivative's numerator is 1.408 x^2 + 0.7028 x +
+/// 0.0042 > 0), gives 0.80 at x = 1 and reaches 1 at x = 7.24, above which it stays at 1. The
+/// fit is to ACES's RRT + ODT with its input pre-exposed so that an image keeps roughly its
+/// untone-mapped brightness; the unexposed ACES curve is f(0.6 x), i.e. `exposure = -0.737`.
+#[inline]
+pub fn filmic(x: f32) -> f32 {
+    let x = x.max(0.0);
+    if x.is_infinite() {
+        return 1.0;
+    }
+    let (a, b, c, d, e) = (2.51f32, 0.03f32, 2.43f32, 0.59f32, 0.14f32);
+    ((x * (a * x + b)) / (x * (c * x + d) + e)).min(1.0)
+}
+
+/// The display transform of 8-bit outputs: linear radiance is multiplied by 2^`exposure`,
+/// then tone mapped into [0, 1] (then a PNG encodes it with the sRGB curve). From the scene's
+/// `[film] exposure` and `tonemap`; the default (0 stops, clamp) is the plain clip.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct DisplayTransform {
+    /// In stops (powers of two).
+    pub exposure: f32,
+    pub tonemap: ToneMap,
+}
+
+impl DisplayTransform {
+    pub fn new(exposure: f32, tonemap: ToneMap) -> DisplayTransform {
+        DisplayTransform { exposure, tonemap }
+    }
+
+    /// The display value in [0, 1] (linear, before the sRGB curve) of linear radiance `c`.
+    #[inline]
+    pub fn map(&self, c: Rgb) -> Rgb {
+        let scale = self.exposure.exp2();
+        let f = |x: f32| self.tonemap.apply(x * scale);
+        Rgb::new(f(c.x), f(c.y), f(c.z))
+    }
+
+    /// The 8-bit sRGB value a PNG stores for linear radiance `c`.
+    #[inline]
+    pub fn encode(&self, c: Rgb) -> [u8; 3] {
+        self.map(c)
+            .to_array()
+            .map(|v| (srgb_encode(v) * 255.0 + 0.5) as u8)
     }
 }
 
@@ -183,9 +297,17 @@ pub fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes linear RGB pixels (row-major, top-left first): EXR as linear float32, PNG as 8-bit
-/// sRGB. Atomic: written to a temporary file in the same folder, then renamed over `path`.
-pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Result<()> {
+/// Writes linear RGB pixels (row-major, top-left first): EXR as linear float32, unchanged
+/// (`display` is not applied: an EXR keeps the radiance); PNG as 8-bit sRGB of the pixels
+/// through `display`. Atomic: written to a temporary file in the same folder, then renamed
+/// over `path`.
+pub fn write_image(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Rgb],
+    display: &DisplayTransform,
+) -> Result<()> {
     let format = format_of(path)?;
     let file_name = path
         .file_name()
@@ -201,11 +323,7 @@ pub fn write_image(path: &Path, width: u32, height: u32, pixels: &[Rgb]) -> Resu
                 .save_with_format(&tmp, image::ImageFormat::OpenExr)
         }
         ImageFormat::Png => {
-            let data: Vec<u8> = pixels
-                .iter()
-                .flat_map(|p| p.to_array())
-                .map(|c| (srgb_encode(c) * 255.0 + 0.5) as u8)
-                .collect();
+            let data: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
             let img = image::RgbImage::from_raw(width, height, data)
                 .ok_or_else(|| Error::io(path, "pixel buffer has the wrong size"))?;
             img.save_with_format(&tmp, image::ImageFormat::Png)
@@ -238,6 +356,84 @@ pub fn read_image(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn filmic_is_its_formula_monotonic_and_bounded() {
+        assert_eq!(filmic(0.0), 0.0);
+        // Values of x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14) worked out by hand.
+        for (x, f) in [
+            (0.18, 0.086_724 / 0.324_932),
+            (1.0, 2.54 / 3.16),
+            (4.0, 40.28 / 41.38),
+        ] {
+            assert!(
+                (filmic(x) - f).abs() < 1e-5,
+                "f({x}) = {} vs {f}",
+                filmic(x)
+            );
+        }
+        let mut last = 0.0;
+        for i in 1..=100_000 {
+            let x = i as f32 * 1e-3;
+            let f = filmic(x);
+            assert!(f >= last, "f decreases at {x}: {f} < {last}");
+            // Strictly increasing up to where it reaches 1 (x = 7.24).
+            assert!(x > 7.2 || f > last, "f is flat at {x}");
+            assert!(f <= 1.0, "f({x}) = {f}");
+            last = f;
+        }
+        for x in [1e3, 1e10, f32::MAX, f32::INFINITY] {
+            assert_eq!(filmic(x), 1.0, "{x}");
+        }
+        assert!(filmic(7.0) < 1.0);
+        // No negative or undefined display values.
+        assert_eq!(ToneMap::Filmic.apply(-1.0), 0.0);
+        assert_eq!(ToneMap::Filmic.apply(f32::NAN), 0.0);
+    }
+
+    #[test]
+    fn display_transform_exposes_then_tone_maps() {
+        let clamp = |e| DisplayTransform::new(e, ToneMap::Clamp);
+        assert_eq!(
+            clamp(-1.0).map(Rgb::new(1.5, 0.5, 4.0)),
+            Rgb::new(0.75, 0.25, 1.0)
+        );
+        assert_eq!(
+            clamp(2.0).map(Rgb::new(0.1, -1.0, f32::NAN)),
+            Rgb::new(0.4, 0.0, 0.0)
+        );
+        let filmic_one = DisplayTransform::new(1.0, ToneMap::Filmic).map(Rgb::splat(0.5));
+        assert!((filmic_one.x - filmic(1.0)).abs() < 1e-7);
+        // The default is the plain clip.
+        assert_eq!(DisplayTransform::default(), clamp(0.0));
+        assert_eq!(
+            DisplayTransform::default().encode(Rgb::new(0.0, 1.0, 7.0)),
+            [0, 255, 255]
+        );
+        for name in ToneMap::NAMES {
+            assert_eq!(ToneMap::from_name(name).unwrap().name(), name);
+        }
+        assert_eq!(ToneMap::from_name("aces"), None);
+    }
+
+    #[test]
+    fn png_goes_through_the_display_transform_and_exr_does_not() {
+        let dir = std::env::temp_dir().join(format!("foton-film-test-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let pixels = [Rgb::new(0.2, 1.0, 3.0), Rgb::new(0.02, 0.5, 100.0)];
+        let display = DisplayTransform::new(-1.5, ToneMap::Filmic);
+        let png = dir.join("a.png");
+        write_image(&png, 2, 1, &pixels, &display).unwrap();
+        let bytes = image::open(&png).unwrap().to_rgb8().into_raw();
+        let expected: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
+        assert_eq!(bytes, expected);
+        // And that is not the plain clip: the transform was applied.
+        assert_ne!(bytes[..3], DisplayTransform::default().encode(pixels[0]));
+        let exr = dir.join("a.exr");
+        write_image(&exr, 2, 1, &pixels, &display).unwrap();
+        assert_eq!(read_image(&exr).unwrap().2, pixels);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     #[test]
     fn srgb_decode_inverts_encode() {

@@ -179,18 +179,116 @@ fn convert_table(src: &str, table: &DeTable<'_>, file: &Path) -> Result<Table> {
     Ok(out)
 }
 
+/// toml's message for a key written twice; it points at the second one and names neither the
+/// key's table nor where the first one is.
+const DUPLICATE_KEY: &str = "duplicate key";
+
+/// Stands for a duplicate key while the text is parsed again; `{}` is a counter. A bare key
+/// no scene uses.
+const PLACEHOLDER: &str = "foton-duplicate-key-placeholder-";
+
+/// "`materials.white.reflectance`: duplicate key (first written on line 12)" for the duplicate
+/// key whose second occurrence is at `span` of `text`.
+///
+/// The key's path is found by parsing the text again with that occurrence renamed to a
+/// placeholder, then looking the placeholder up in the tree: so dotted keys, table headers,
+/// inline tables and arrays of tables all get their full path, without a second TOML parser.
+/// Further duplicates (the same key a third time, or other keys) make the renamed text fail
+/// again: each is renamed in turn to a placeholder of its own. Should that fail anyway, the
+/// message names the key as written.
+fn duplicate_key_message(text: &str, span: std::ops::Range<usize>) -> String {
+    let written = text.get(span.clone()).unwrap_or_default().trim();
+    let name = written.trim_matches(|c| c == '"' || c == '\'');
+    let mut renamed = text.to_string();
+    let mut span = span;
+    for i in 0..16 {
+        if renamed.get(span.clone()).is_none() {
+            break;
+        }
+        renamed.replace_range(span, &format!("{PLACEHOLDER}{i}"));
+        match DeTable::parse(&renamed) {
+            Ok(tree) => {
+                let placeholder = format!("{PLACEHOLDER}0");
+                if let Some((path, first)) =
+                    find_renamed(tree.get_ref(), &placeholder, name, String::new())
+                {
+                    let first = first
+                        .map(|at| format!(" (first written on line {})", line_col(&renamed, at).0))
+                        .unwrap_or_default();
+                    return format!("`{path}`: {DUPLICATE_KEY}{first}");
+                }
+                break;
+            }
+            Err(e) if e.message().trim() == DUPLICATE_KEY && e.span().is_some() => {
+                span = e.span().unwrap_or_default();
+            }
+            Err(_) => break,
+        }
+    }
+    format!("`{name}`: {DUPLICATE_KEY}")
+}
+
+/// The key path of `placeholder` in `table` (whose own path is `path`), and the offset of its
+/// sibling `name`, the first occurrence of the duplicate key.
+fn find_renamed(
+    table: &DeTable<'_>,
+    placeholder: &str,
+    name: &str,
+    path: String,
+) -> Option<(String, Option<usize>)> {
+    let join = |key: &str| {
+        if path.is_empty() {
+            key.to_string()
+        } else {
+            format!("{path}.{key}")
+        }
+    };
+    for (key, value) in table.iter() {
+        if key.get_ref() == placeholder {
+            let first = table
+                .iter()
+                .find(|(k, _)| k.get_ref() == name)
+                .map(|(k, _)| k.span().start);
+            return Some((join(name), first));
+        }
+        let found = match value.get_ref() {
+            DeValue::Table(t) => find_renamed(t, placeholder, name, join(key.get_ref())),
+            DeValue::Array(items) => items.iter().enumerate().find_map(|(i, item)| {
+                let DeValue::Table(t) = item.get_ref() else {
+                    return None;
+                };
+                find_renamed(
+                    t,
+                    placeholder,
+                    name,
+                    format!("{}[{i}]", join(key.get_ref())),
+                )
+            }),
+            _ => None,
+        };
+        if found.is_some() {
+            return found;
+        }
+    }
+    None
+}
+
 impl Document {
     /// Parses TOML text; `file` is only used in messages and to resolve relative paths.
     pub fn parse(text: &str, file: &Path) -> Result<Document> {
         let parsed = DeTable::parse(text).map_err(|e| {
             let (line, column) = e.span().map_or((0, 0), |s| line_col(text, s.start));
+            let mut message = e.message().trim().to_string();
+            if let Some(span) = e.span().filter(|_| message == DUPLICATE_KEY) {
+                message = duplicate_key_message(text, span);
+            }
             Error::Syntax {
                 location: Location {
                     file: file.to_path_buf(),
                     line,
                     column,
                 },
-                message: e.message().trim().to_string(),
+                message,
             }
         })?;
         Ok(Document {
@@ -275,5 +373,68 @@ impl Document {
             },
         );
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The message of parsing `text`, which must fail.
+    fn error(text: &str) -> String {
+        Document::parse(text, Path::new("scene.toml"))
+            .unwrap_err()
+            .to_string()
+    }
+
+    #[test]
+    fn duplicate_keys_are_named_by_their_path_and_first_line() {
+        let cases = [
+            (
+                "[materials.white]\nreflectance = 1\nreflectance = 2\n",
+                "scene.toml:3:1: TOML syntax error: `materials.white.reflectance`: duplicate key (first written on line 2)",
+            ),
+            (
+                "a = 1\nb = 2\na = 3\n",
+                "scene.toml:3:1: TOML syntax error: `a`: duplicate key (first written on line 1)",
+            ),
+            (
+                "[film]\nwidth = 1\n\n[film]\nheight = 2\n",
+                "`film`: duplicate key (first written on line 1)",
+            ),
+            (
+                "[media.fog]\nphase = { type = \"hg\", g = 0.1, g = 0.2 }\n",
+                "`media.fog.phase.g`: duplicate key (first written on line 2)",
+            ),
+            (
+                "[a]\nb.c = 1\nb.c = 2\n",
+                "`a.b.c`: duplicate key (first written on line 2)",
+            ),
+            (
+                "[[shapes]]\ntype = 'sphere'\n\n[[shapes]]\ntype = 'quad'\n\"type\" = 'mesh'\n",
+                "scene.toml:6:1: TOML syntax error: `shapes[1].type`: duplicate key (first written on line 5)",
+            ),
+            // Another duplicate further on does not hide the first one's path.
+            (
+                "[film]\nwidth = 1\n\n[film]\nheight = 2\n[camera]\nfov = 1\nfov = 2\n",
+                "scene.toml:4:2: TOML syntax error: `film`: duplicate key (first written on line 1)",
+            ),
+            // Three times: the second is reported.
+            (
+                "x = 1\nx = 2\nx = 3\n",
+                "scene.toml:2:1: TOML syntax error: `x`: duplicate key (first written on line 1)",
+            ),
+        ];
+        for (text, expected) in cases {
+            let message = error(text);
+            assert!(message.contains(expected), "{text:?}:\n{message}");
+        }
+    }
+
+    #[test]
+    fn other_syntax_errors_keep_their_message() {
+        let message = error("[film\nwidth = 1\n");
+        assert!(message.starts_with("scene.toml:1:"), "{message}");
+        assert!(!message.contains(DUPLICATE_KEY), "{message}");
     }
 }

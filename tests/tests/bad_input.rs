@@ -1658,3 +1658,39 @@ fn camera_inside_overlapping_media() {
         ],
     );
 }
+
+#[test]
+fn toml_duplicate_key_names_its_path_and_first_line() {
+    let scene = scene_with(
+        "duplicate-key-path",
+        "reflectance = [0.5, 0.5, 0.5]",
+        "reflectance = [0.5, 0.5, 0.5]\nreflectance = [0.9, 0.9, 0.9]",
+    );
+    let first = line_of(&scene.text, "reflectance = [0.5, 0.5, 0.5]");
+    let run = scene.check(&[]);
+    assert_error(
+        &run,
+        &[
+            &scene.at("reflectance = [0.9, 0.9, 0.9]"),
+            "`materials.white.reflectance`: duplicate key",
+            &format!("first written on line {first}"),
+        ],
+    );
+    // A table header written twice, and a key repeated in the second of two [[shapes]].
+    let second_shape = "\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0.3, 0]\nradius = 0.2\nradius = 0.3\nmaterial = \"white\"\n";
+    let text = format!("{BASE}\n[film]\nwidth = 16\n{second_shape}");
+    let scene = SceneFile::new("duplicate-header-and-array", &text);
+    let run = scene.check(&[]);
+    assert_error(&run, &["`film`: duplicate key", "first written on line 7"]);
+    let text = format!("{BASE}{second_shape}");
+    let scene = SceneFile::new("duplicate-in-array", &text);
+    let run = scene.check(&[]);
+    assert_error(
+        &run,
+        &[
+            &scene.at("radius = 0.3"),
+            "`shapes[1].radius`: duplicate key",
+            &format!("first written on line {}", line_of(&text, "radius = 0.2")),
+        ],
+    );
+}

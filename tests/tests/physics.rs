@@ -325,12 +325,12 @@ fn exr_reads_back_identically_and_png_is_srgb() {
     );
     let dir = temp_dir("exr");
     let exr = dir.join("out.exr");
-    film.write(&exr).unwrap();
+    film.write(&exr, &Default::default()).unwrap();
     let (w, h, px) = foton_core::film::read_image(&exr).unwrap();
     assert_eq!((w, h), (16, 12));
     assert_eq!(px, film.pixels());
     let png = dir.join("out.png");
-    film.write(&png).unwrap();
+    film.write(&png, &Default::default()).unwrap();
     let (_, _, back) = foton_core::film::read_image(&png).unwrap();
     for (a, b) in back.iter().zip(film.pixels()) {
         let b = b.clamp(Vec3::ZERO, Vec3::ONE);

@@ -4,7 +4,7 @@
 
 use foton_cli::{INTERRUPTED, TermProgress, prepare, render_prepared};
 use foton_core::film::read_image;
-use foton_tests::{plugin_dir, repo_root, temp_dir};
+use foton_tests::{foton_with_plugins, plugin_dir, repo_root, temp_dir};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
@@ -29,7 +29,7 @@ fn checkpoints_are_written_and_ctrl_c_keeps_the_estimate() {
         true,
     )
     .unwrap();
-    let progress = TermProgress::new(true).with_checkpoint(3, out.clone());
+    let progress = TermProgress::new(true).with_checkpoint(3, out.clone(), Default::default());
     // Far too many iterations to finish: only the interrupt ends it.
     let stopper = std::thread::spawn(|| {
         std::thread::sleep(Duration::from_millis(1500));
@@ -58,5 +58,67 @@ fn checkpoints_are_written_and_ctrl_c_keeps_the_estimate() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(leftovers.len(), 1, "temporary files left: {leftovers:?}");
+    let _ = std::fs::remove_dir_all(&dir);
+
+    interrupted_render_reports_iterations();
+}
+
+/// `foton render` stopped by Ctrl-C says how many whole iterations the image holds, and its
+/// summary counts iterations and photons (not the one camera sample per pixel per iteration).
+/// Run after the test above, not beside it: both raise the process-wide interrupt flag.
+fn interrupted_render_reports_iterations() {
+    let dir = temp_dir("sppm-interrupt-message");
+    let out = dir.join("interrupted.png");
+    let scene = repo_root().join("scenes/cornell-box.toml");
+    // The checkpoint of the first iteration shows that the render is under way (the command
+    // clears the interrupt flag when it starts): only then is Ctrl-C simulated.
+    let watched = out.clone();
+    let stopper = std::thread::spawn(move || {
+        let start = std::time::Instant::now();
+        while !watched.exists() && start.elapsed() < Duration::from_secs(120) {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        INTERRUPTED.store(true, Ordering::SeqCst);
+    });
+    let run = foton_with_plugins(&[
+        "render",
+        scene.to_str().unwrap(),
+        "-q",
+        "-o",
+        out.to_str().unwrap(),
+        "--checkpoint",
+        "1",
+        "--set",
+        "render.integrator=\"sppm\"",
+        "--set",
+        "film.width=16",
+        "--set",
+        "film.height=16",
+        "--set",
+        "integrators.sppm.iterations=100000000",
+        "--set",
+        "integrators.sppm.photons_per_iteration=2000",
+    ]);
+    stopper.join().unwrap();
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let shown = format!("stdout:\n{}stderr:\n{}", run.stdout, run.stderr);
+    assert_eq!(run.code, 130, "{shown}");
+    let prefix = "interrupted: wrote the estimate of the ";
+    let rest = run
+        .stderr
+        .lines()
+        .find_map(|l| l.strip_prefix(prefix))
+        .unwrap_or_else(|| panic!("no `{prefix}...` line:\n{shown}"));
+    let (done, rest) = rest.split_once(' ').unwrap();
+    let done: u64 = done.parse().unwrap();
+    assert!(done >= 1, "{shown}");
+    assert_eq!(rest, "of 100000000 iterations done", "{shown}");
+    // The summary agrees with it: every iteration emitted its 2000 photons.
+    assert!(
+        run.stdout
+            .contains(&format!("{done} iterations, {} photons in", done * 2000)),
+        "{shown}"
+    );
+    assert!(!run.stdout.contains("samples"), "{shown}");
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -2,13 +2,13 @@
 //! image; against a reference, with a false-colour difference image and error numbers per
 //! render. Each render is also written as EXR, and the numbers as JSON.
 
-use crate::montage::{Image, Series, Tile, diverging, grid, log_log_plot};
+use crate::montage::{Image, Series, Tile, diverging, grid, log_log_plot, render_image};
 use crate::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare, threads};
 use crate::{render_prepared, write_atomic};
 use clap::Args;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
-use foton_core::film::{Film, check_output, read_image};
+use foton_core::film::{DisplayTransform, Film, check_output, read_image};
 use foton_core::integrator::{Budget, Work};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -274,6 +274,8 @@ struct Entry {
     /// The scene values --time chose (`--set` overrides), empty without --time.
     settings: Vec<String>,
     film: Film,
+    /// The scene's exposure and tone map, for the render's tile in a PNG.
+    display: DisplayTransform,
     image: PathBuf,
     errors: Option<Errors>,
     /// With --curve: the renders at the smaller budgets, then this one.
@@ -651,7 +653,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render.spp);
         let budget = budget_text(&p, &settings);
         let image = exr_of(name);
-        film.write(&image)?;
+        film.write(&image, &p.scene.film.display())?;
         let errors = reference
             .as_ref()
             .map(|(_, _, r)| errors(&film.pixels(), r));
@@ -663,6 +665,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             seconds: elapsed.as_secs_f64(),
             settings,
             film,
+            display: p.scene.film.display(),
             image,
             errors,
             curve,
@@ -688,7 +691,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let mut tiles: Vec<Tile> = entries
         .iter()
         .map(|e| Tile {
-            image: Image::from_film(&e.film),
+            image: render_image(&e.film, &e.display, &output),
             label: vec![
                 format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
                 // Narrow tiles: `k=50` wraps better than `k = 50`.

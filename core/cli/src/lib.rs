@@ -53,7 +53,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Render a scene to an image (.exr linear float32 or .png sRGB).
+    /// Render a scene to an image (.exr linear float32, or .png: 8-bit sRGB after the scene's
+    /// [film] exposure and tonemap).
     Render(RenderArgs),
     /// Parse and validate a scene; list what it uses and any unused field.
     Check(CheckArgs),
@@ -70,7 +71,8 @@ enum Command {
     ///
     /// Exposure: a dot's colour is the photon's flux divided by the 99th percentile of the
     /// drawn photons' largest channel, so that 99% of the dots are unclipped and photons of
-    /// equal flux on a white surface come out white. Prints the photons stored and drawn.
+    /// equal flux on a white surface come out white; a PNG then applies the scene's [film]
+    /// exposure and tonemap, as to a render. Prints the photons stored and drawn.
     Photons(photons::PhotonsArgs),
     /// Render a scene with several integrators and lay the renders side by side, labelled.
     ///
@@ -97,7 +99,8 @@ enum Command {
     /// --set KEY.PATH=V1,V2,... sweeps a scene value; the first --set with several values runs
     /// along the columns, the second down the rows, any further ones down the rows as well
     /// (row-major, earlier sets varying faster). A --set with one value applies to every cell.
-    /// Each cell is labelled with its values and its render time.
+    /// Each cell is labelled with its values and its render time, and in a PNG shown through
+    /// its scene's [film] exposure and tonemap (so film.exposure can be swept).
     Sweep(sweep::SweepArgs),
 }
 
@@ -363,7 +366,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     let mut progress = TermProgress::new(a.quiet);
     if let Some(every) = a.checkpoint {
-        progress = progress.with_checkpoint(every, output.clone());
+        progress = progress.with_checkpoint(every, output.clone(), p.scene.film.display());
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
@@ -378,31 +381,70 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     for w in progress.take_warnings() {
         let _ = writeln!(err, "warning: {w}");
     }
-    film.write(&output)?;
-    let samples = film.total_samples();
-    let secs = elapsed.as_secs_f64();
+    film.write(&output, &p.scene.film.display())?;
     let _ = writeln!(
         out,
-        "{}: {}x{}, {} samples in {:.2} s ({:.2} M samples/s, {} threads) with {} -> {}",
+        "{}: {}x{}, {} with {} -> {}",
         p.scene.file.display(),
         film.width,
         film.height,
-        samples,
-        secs,
-        samples as f64 / secs.max(1e-9) / 1e6,
-        threads,
+        work_done(&film, elapsed, threads),
         p.integrator.describe(),
         output.display()
     );
     if INTERRUPTED.load(Ordering::SeqCst) {
-        let full = film.width as u64 * film.height as u64 * p.scene.render.spp as u64;
         let _ = writeln!(
             err,
-            "interrupted: wrote the image of the {samples} of {full} samples done so far"
+            "interrupted: {}",
+            kept_after_interrupt(&film, &p.scene)
         );
         return Ok(130);
     }
     Ok(0)
+}
+
+/// What a render did, for its summary line: the iterations and photons of a progressive
+/// integrator (its camera samples are one per pixel per iteration, a meaningless rate), or the
+/// samples of the others.
+fn work_done(film: &Film, elapsed: Duration, threads: usize) -> String {
+    let secs = elapsed.as_secs_f64();
+    let per_second = |n: u64| n as f64 / secs.max(1e-9);
+    if film.iterations > 0 {
+        format!(
+            "{} iterations, {} photons in {secs:.2} s ({:.2} M photons/s, {:.2} iterations/s, {threads} threads)",
+            film.iterations,
+            film.photons,
+            per_second(film.photons) / 1e6,
+            per_second(film.iterations),
+        )
+    } else {
+        let samples = film.total_samples();
+        format!(
+            "{samples} samples in {secs:.2} s ({:.2} M samples/s, {threads} threads)",
+            per_second(samples) / 1e6
+        )
+    }
+}
+
+/// What an interrupted render wrote: the estimate of the iterations done (an iteration is
+/// kept whole or dropped), or the samples done.
+fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
+    if film.iterations > 0 || film.iterations_planned > 0 {
+        let of = match film.iterations_planned {
+            0 => String::new(),
+            n => format!(" of {n}"),
+        };
+        format!(
+            "wrote the estimate of the {}{of} iterations done",
+            film.iterations
+        )
+    } else {
+        let full = film.width as u64 * film.height as u64 * scene.render.spp as u64;
+        format!(
+            "wrote the image of the {} of {full} samples done so far",
+            film.total_samples()
+        )
+    }
 }
 
 fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
@@ -533,27 +575,38 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     let progress = TermProgress::new(true);
     INTERRUPTED.store(false, Ordering::SeqCst);
     let mut best = f64::INFINITY;
-    let mut samples = 0;
-    let mut rays = 0;
+    let mut last = None;
     for i in 0..a.repeat.max(1) {
         let (film, t) = render_prepared(&p, threads, &progress)?;
-        samples = film.total_samples();
-        rays = film.rays;
         let _ = writeln!(out, "run {}: {:.3} s", i + 1, t.as_secs_f64());
         best = best.min(t.as_secs_f64());
+        last = Some(film);
     }
+    let film = last.expect("at least one run");
+    let rate = |n: u64| n as f64 / best / 1e6;
+    let work = if film.iterations > 0 {
+        format!(
+            "{} iterations of {} photons, {threads} threads: best {best:.3} s, {:.3} M photons/s, {:.2} iterations/s",
+            film.iterations,
+            film.photons / film.iterations,
+            rate(film.photons),
+            film.iterations as f64 / best
+        )
+    } else {
+        format!(
+            "{} spp, {threads} threads: best {best:.3} s, {:.3} M samples/s",
+            p.scene.render.spp,
+            rate(film.total_samples())
+        )
+    };
     let _ = writeln!(
         out,
-        "{} with {}: {}x{} x {} spp, {} threads: best {:.3} s, {:.3} M samples/s, {:.3} M rays/s",
+        "{} with {}: {}x{} x {work}, {:.3} M rays/s",
         a.scene.display(),
         p.integrator.describe(),
         p.scene.film.width,
         p.scene.film.height,
-        p.scene.render.spp,
-        threads,
-        best,
-        samples as f64 / best / 1e6,
-        rays as f64 / best / 1e6
+        rate(film.rays)
     );
     Ok(0)
 }

@@ -2,16 +2,18 @@
 //! grid of tiles, each under a band of text in an 8x8 bitmap font (font8x8), white on dark
 //! grey.
 //!
-//! Pixels are linear RGB like a film's, and the result is written with `film::write_image`,
-//! so a PNG gets the same display transform as every render: clamp to [0, 1], then the sRGB
-//! curve. Colours chosen for display (the false-colour map) are therefore stored decoded.
+//! Pixels are display values, linear (before the sRGB curve) and in [0, 1]: a render enters
+//! through [`render_image`], which applies the scene's exposure and tone map when the montage
+//! is a PNG, so that a render looks in a montage as `foton render` writes it; colours chosen
+//! for display (text, the false-colour map) are stored sRGB-decoded. The montage is written
+//! with `film::write_image` and the plain clamp, which leaves such values as they are.
 //!
 //! Layout: cells as large as the largest tile, `BORDER` pixels around and between them; the
 //! label bands of a row have the height of the row's longest label, so the images line up.
 
 use foton_core::Rgb;
 use foton_core::error::Result;
-use foton_core::film::{Film, srgb_decode, write_image};
+use foton_core::film::{DisplayTransform, Film, ImageFormat, format_of, srgb_decode, write_image};
 use std::path::Path;
 
 /// Pixels around and between the cells of a grid.
@@ -91,10 +93,30 @@ impl Image {
         }
     }
 
-    /// Writes the image atomically (.png: sRGB 8-bit; .exr: linear float).
+    /// Writes the image atomically (.png: sRGB 8-bit; .exr: linear float). Its pixels are
+    /// display values already: no exposure or tone map is applied.
     pub fn write(&self, path: &Path) -> Result<()> {
-        write_image(path, self.width, self.height, &self.pixels)
+        write_image(
+            path,
+            self.width,
+            self.height,
+            &self.pixels,
+            &DisplayTransform::default(),
+        )
     }
+}
+
+/// A render as a montage written to `output` shows it: for a PNG, through `display` (the
+/// scene's exposure and tone map), as `foton render` would write it; for an EXR, the radiance
+/// unscaled (an EXR never gets the display transform), clamped by the grid.
+pub fn render_image(film: &Film, display: &DisplayTransform, output: &Path) -> Image {
+    let mut image = Image::from_film(film);
+    if matches!(format_of(output), Ok(ImageFormat::Png)) {
+        for p in &mut image.pixels {
+            *p = display.map(*p);
+        }
+    }
+    image
 }
 
 /// One cell of a grid: an image and its label, one string per line (long lines are wrapped

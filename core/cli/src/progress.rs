@@ -1,7 +1,7 @@
 //! Terminal progress: a bar with elapsed time, ETA and throughput on a terminal, nothing
 //! otherwise. Warnings from the render are collected and printed after it.
 
-use foton_core::film::Film;
+use foton_core::film::{DisplayTransform, Film};
 use foton_core::integrator::Progress;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
@@ -16,8 +16,9 @@ pub struct TermProgress {
     pub warnings: Mutex<Vec<String>>,
     rays: AtomicU64,
     start: Mutex<Instant>,
-    /// Write the image every N iterations of a progressive integrator to this file.
-    checkpoint: Option<(u64, PathBuf)>,
+    /// Write the image every N iterations of a progressive integrator to this file, a PNG
+    /// through this display transform (the scene's, as the final image).
+    checkpoint: Option<(u64, PathBuf, DisplayTransform)>,
     /// Checkpoint calls received (0 after a render: the integrator is not progressive).
     pub checkpoints: AtomicU64,
 }
@@ -35,10 +36,10 @@ impl TermProgress {
         }
     }
 
-    /// Writes the current image to `path` (atomically) every `every` iterations of a
-    /// progressive integrator.
-    pub fn with_checkpoint(mut self, every: u64, path: PathBuf) -> Self {
-        self.checkpoint = Some((every.max(1), path));
+    /// Writes the current image to `path` (atomically; a PNG through `display`) every `every`
+    /// iterations of a progressive integrator.
+    pub fn with_checkpoint(mut self, every: u64, path: PathBuf, display: DisplayTransform) -> Self {
+        self.checkpoint = Some((every.max(1), path, display));
         self
     }
 
@@ -92,9 +93,9 @@ impl Progress for TermProgress {
     }
     fn checkpoint(&self, iteration: u64, image: &dyn Fn() -> Film) {
         self.checkpoints.fetch_add(1, Ordering::Relaxed);
-        if let Some((every, path)) = &self.checkpoint
+        if let Some((every, path, display)) = &self.checkpoint
             && iteration.is_multiple_of(*every)
-            && let Err(e) = image().write(path)
+            && let Err(e) = image().write(path, display)
         {
             self.warn(&format!("checkpoint at iteration {iteration}: {e}"));
         }

@@ -3,7 +3,7 @@
 //! down the rows, further ones down the rows too (row-major, the earlier varying faster); a
 //! `--set` with one value applies to every cell.
 
-use crate::montage::{Image, Tile, grid};
+use crate::montage::{Tile, grid, render_image};
 use crate::threads;
 use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
 use clap::Args;
@@ -232,17 +232,21 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             return Ok(130);
         }
         let secs = elapsed.as_secs_f64();
+        let work = if film.iterations > 0 {
+            format!("{} iterations", film.iterations)
+        } else {
+            format!("{} spp", p.scene.render.spp)
+        };
         let _ = writeln!(
             out,
-            "[{}] {}: {} spp in {:.2} s",
+            "[{}] {}: {work} in {secs:.2} s",
             label.join(", "),
             p.integrator.describe(),
-            p.scene.render.spp,
-            secs
         );
         label.push(format!("{:.2} s", secs));
+        // Each cell through its own scene's display transform: a sweep may vary the exposure.
         tiles.push(Tile {
-            image: Image::from_film(&film),
+            image: render_image(&film, &p.scene.film.display(), &output),
             label,
         });
     }

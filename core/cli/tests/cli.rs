@@ -185,7 +185,17 @@ fn ctrl_c_writes_the_samples_done_so_far() {
     let out = child.wait_with_output().unwrap();
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(130), "{err}");
-    assert!(err.contains("interrupted"), "{err}");
+    // A path tracer counts its work in samples: the message says how many of all.
+    let samples = err
+        .lines()
+        .find_map(|l| l.strip_prefix("interrupted: wrote the image of the "))
+        .and_then(|rest| rest.strip_suffix(" samples done so far"))
+        .unwrap_or_else(|| panic!("no `interrupted: ...` line: {err}"));
+    let full = (32 * 32 * 100_000u64).to_string();
+    let (done, of) = samples.split_once(" of ").unwrap();
+    assert_eq!(of, full, "{err}");
+    let done: u64 = done.parse().unwrap();
+    assert!(done > 0 && done < 32 * 32 * 100_000, "{err}");
     let (w, h, px) = foton_core::film::read_image(&output).unwrap();
     assert_eq!((w, h), (32, 32));
     // Every pixel has samples from the passes completed: none is black in a lit box.

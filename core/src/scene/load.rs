@@ -263,10 +263,25 @@ fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
             format!("{output:?}: unsupported format; expected a .exr or .png file name"),
         )
     })?;
+    use crate::film::ToneMap;
+    // 2^64 still fits a float with room to spare; beyond, an image is all black or all
+    // white whatever the scene, which is surely a typo.
+    const MAX_EXPOSURE: f32 = 64.0;
+    let exposure = t.f32("exposure", 0.0)?;
+    if exposure.abs() > MAX_EXPOSURE {
+        return Err(t.error(
+            "exposure",
+            format!("must be between -{MAX_EXPOSURE} and {MAX_EXPOSURE} stops, found {exposure}"),
+        ));
+    }
+    let tonemap =
+        ToneMap::from_name(t.choice("tonemap", &ToneMap::NAMES, "clamp")?).unwrap_or_default();
     let film = FilmSettings {
         width,
         height,
         output: ld.dir.join(out),
+        exposure,
+        tonemap,
     };
     ld.done(&t);
     Ok(film)

@@ -15,6 +15,7 @@ use crate::Rgb;
 use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::error::{Location, Result};
+use crate::film::{DisplayTransform, ToneMap};
 use crate::geometry::{Hit, Primitive, Ray};
 use crate::light::Light;
 use crate::material::Material;
@@ -42,6 +43,17 @@ pub struct FilmSettings {
     pub height: u32,
     /// Resolved against the scene file's folder.
     pub output: PathBuf,
+    /// Stops by which 8-bit outputs (PNG) scale the radiance: x 2^exposure. EXR ignores it.
+    pub exposure: f32,
+    /// How 8-bit outputs fit the exposed radiance into [0, 1]. EXR ignores it.
+    pub tonemap: ToneMap,
+}
+
+impl FilmSettings {
+    /// The transform from radiance to the display values of a PNG.
+    pub fn display(&self) -> DisplayTransform {
+        DisplayTransform::new(self.exposure, self.tonemap)
+    }
 }
 
 /// What a primitive belongs to: a `[[shapes]]` entry.

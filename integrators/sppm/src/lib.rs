@@ -356,6 +356,9 @@ impl Integrator for Sppm {
         ctx.progress.finish();
         let mut film = film_of(&stats, width, height, done);
         film.rays = rays;
+        film.iterations = done;
+        film.iterations_planned = self.iterations.unwrap_or(0);
+        film.photons = photons_total;
         Ok(film)
     }
 
