@@ -13,12 +13,7 @@ use foton_tests::{
     header, region_mean, render_file, render_toml, repo_root, temp_dir, with_area_light, write,
 };
 use glam::{DVec3, Vec3};
-use std::f32::consts::PI;
 use std::sync::atomic::AtomicBool;
-
-fn load(name: &str) -> Scene {
-    Scene::load(&repo_root().join("scenes").join(name), &[]).unwrap()
-}
 
 fn scene_from(name: &str, toml: &str) -> Scene {
     let dir = temp_dir(name);
@@ -205,7 +200,6 @@ intensity = [1.0, 1.0, 1.0]
         "mean relative error {}",
         sum_rel / points as f32
     );
-    let _ = PI;
 }
 
 #[test]
@@ -270,19 +264,8 @@ fn photon_mapper_is_deterministic_across_threads() {
     let one = render_file(&path, &small, 1);
     let many = render_file(&path, &small, 3);
     assert_eq!(one.pixels(), many.pixels());
-}
-
-#[test]
-fn scenes_load() {
-    for s in [
-        "caustics.toml",
-        "diffuse-spheres.toml",
-        "glass-orange.toml",
-        "two-lights.toml",
-    ] {
-        let scene = load(s);
-        assert!(!scene.lights.is_empty());
-    }
+    // Not two black images.
+    assert!(one.mean().min_element() > 0.0, "{}", one.mean());
 }
 
 #[test]

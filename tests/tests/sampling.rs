@@ -1588,8 +1588,6 @@ fn free_flight_sampling_follows_the_spectral_mis_density_and_is_unbiased() {
             .map(|w| free_flight_mass(sigma_t, w[0], w[1]))
             .collect();
         expected.push(1.0 - free_flight_mass(sigma_t, 0.0, tmax as f64));
-        assert_eq!(expected.len(), cells);
-        assert_close(&format!("{name}: total"), expected.iter().sum(), 1.0, 1e-9);
 
         let mut observed = vec![0u64; cells];
         let mut rng = Rng::new(&[60, k as u64]);
