@@ -9,16 +9,12 @@ use foton_photonmap::map::{Estimate, PhotonMap};
 use foton_photonmap::trace::{
     PathClass, STREAM_GLOBAL, TraceOptions, light_media, trace_one, trace_photons,
 };
+use foton_tests::stats::{Tolerance, assert_blocks_agree, assert_blocks_agree_by, rel_err};
 use foton_tests::{
     header, region_mean, render_file, render_toml, repo_root, temp_dir, with_area_light, write,
 };
 use glam::{DVec3, Vec3};
-use std::f32::consts::PI;
 use std::sync::atomic::AtomicBool;
-
-fn load(name: &str) -> Scene {
-    Scene::load(&repo_root().join("scenes").join(name), &[]).unwrap()
-}
 
 fn scene_from(name: &str, toml: &str) -> Scene {
     let dir = temp_dir(name);
@@ -205,7 +201,6 @@ intensity = [1.0, 1.0, 1.0]
         "mean relative error {}",
         sum_rel / points as f32
     );
-    let _ = PI;
 }
 
 #[test]
@@ -228,8 +223,9 @@ fn white_furnace_gives_le_over_one_minus_rho() {
 fn photon_mapper_agrees_with_path_tracer_and_converges() {
     let path = repo_root().join("scenes/cornell-box.toml");
     let small = ["film.width=32", "film.height=32"];
-    let reference = render_file(&path, &[&small[..], &["render.spp=1024"]].concat(), 2).mean();
+    let reference = render_file(&path, &[&small[..], &["render.spp=1024"]].concat(), 2);
     let mut errors = Vec::new();
+    let mut last = None;
     for photons in ["20000", "400000"] {
         let g = format!("integrators.photon.global_photons={photons}");
         let film = render_file(
@@ -246,8 +242,8 @@ fn photon_mapper_agrees_with_path_tracer_and_converges() {
             .concat(),
             2,
         );
-        let m = film.mean();
-        errors.push(((m - reference) / reference).abs().max_element());
+        errors.push(rel_err(film.mean(), reference.mean()));
+        last = Some(film);
     }
     // The photon mapper's bias (blurring over the radius) shrinks as photons grow.
     assert!(
@@ -255,6 +251,31 @@ fn photon_mapper_agrees_with_path_tracer_and_converges() {
         "relative error of the image mean {errors:?}"
     );
     assert!(errors[1] < errors[0], "{errors:?}");
+    // And region by region: 4x4 blocks of 8x8 pixels, each within max(rel, 4 se) of the
+    // path tracer's, se the standard error of the block mean of the pixel-wise difference
+    // (the camera samples' noise of both renders, largest where 16 jittered samples fall on
+    // the point light's hot spot on the ceiling). rel covers what the pixel statistics do not
+    // see. In the four inner blocks (the back wall and the spheres) that is the photon map's
+    // own noise, block to block: 3 % (measured over five seeds: means of -0.9 to +1.4 %,
+    // spreads up to 0.9 %, single renders up to 2.4 %). The twelve outer blocks hold the
+    // box's edges, where the estimate's disc reaches past a wall's edge, into area without
+    // photons of that wall, and darkens it: there 5 % (measured 2 to 3 % low in the corner
+    // blocks, mean of five seeds, single renders up to 4 %; photons near the edges are
+    // handled alike in the furnace test). The blur over the radius (measured 0.018 on the
+    // back wall, 0.056 in a corner of the floor; a pixel is 0.11 wide there) is well below
+    // the blocks' size. No block is black: no floor.
+    let film = last.unwrap();
+    assert_blocks_agree_by(
+        "cornell box, photon (400k) vs path",
+        &film,
+        &reference,
+        4,
+        |block| Tolerance {
+            rel: if block.on_border(32, 32) { 0.05 } else { 0.03 },
+            z: 4.0,
+            floor: 0.0,
+        },
+    );
 }
 
 #[test]
@@ -270,19 +291,8 @@ fn photon_mapper_is_deterministic_across_threads() {
     let one = render_file(&path, &small, 1);
     let many = render_file(&path, &small, 3);
     assert_eq!(one.pixels(), many.pixels());
-}
-
-#[test]
-fn scenes_load() {
-    for s in [
-        "caustics.toml",
-        "diffuse-spheres.toml",
-        "glass-orange.toml",
-        "two-lights.toml",
-    ] {
-        let scene = load(s);
-        assert!(!scene.lights.is_empty());
-    }
+    // Not two black images.
+    assert!(one.mean().min_element() > 0.0, "{}", one.mean());
 }
 
 #[test]
@@ -333,14 +343,47 @@ fn caustic_under_the_glass_sphere_matches_the_path_tracer() {
         let region = format!("pixels ({x0},{y0})-({x1},{y1})");
         // Tolerance: 5% of the path tracer's mean (its noise at 8192 spp and the photon
         // mapper's blur over the estimate radius).
-        let rel = ((b - a) / a).abs().max_element();
+        let rel = rel_err(b, a);
         assert!(rel < 0.05, "{region}: photon {b} vs path {a} ({rel})");
-        let rel = ((c - a) / a).abs().max_element();
+        let rel = rel_err(c, a);
         assert!(
             rel < 0.10,
             "{region}: without a caustic map {c} vs path {a} ({rel})"
         );
     }
+    // And all over the image, quadrant by quadrant (2x2 blocks of 16x16 pixels), at the same
+    // 5 % and 10 %, or 4 standard errors of the block mean of the pixel-wise difference (the
+    // camera samples' noise of both renders), whichever is larger. Nearly the whole image is
+    // seen through the glass sphere, which magnifies what lies behind it: each estimate's
+    // disc (radius 0.034 in the global map, 0.013 in the caustic map, measured under the
+    // sphere) and each photon's blotch cover many pixels. 8x8 blocks are the known
+    // exception: their photon noise is correlated over the block, which the pixels' standard
+    // error does not see, and the blur is not averaged out within them (measured over five
+    // seeds with the caustic map: the bottom row 5 to 11 % too bright, spreads of 3 to 6 %;
+    // with 4x the photons the bottom row's means within 3 %, spreads up to 7 %: the photon
+    // map's bias and noise, which shrink as photons grow). Quadrants average over four
+    // times the area: within 3.5 % with the caustic map and 4.3 % without, over five seeds
+    // (the path tracer's 8x8 blocks are good to 1.4 %, against 32768 spp). No quadrant is
+    // black.
+    let tolerance = |rel| Tolerance {
+        rel,
+        z: 4.0,
+        floor: 0.0,
+    };
+    assert_blocks_agree(
+        "caustic view, photon vs path",
+        &photon,
+        &path,
+        2,
+        tolerance(0.05),
+    );
+    assert_blocks_agree(
+        "caustic view, photon without a caustic map vs path",
+        &no_caustic,
+        &path,
+        2,
+        tolerance(0.10),
+    );
     let _ = std::fs::remove_dir_all(scene.parent().unwrap());
 }
 
@@ -369,12 +412,33 @@ fn without_a_caustic_map_caustics_come_from_the_global_map() {
         let (a, _) = region_mean(&with, x0, y0, x1, y1);
         let (b, _) = region_mean(&without, x0, y0, x1, y1);
         assert!(a.x > 0.05, "the orange sphere is lit: {a}");
-        let rel = ((b - a) / a).abs().max_element();
+        let rel = rel_err(b, a);
         assert!(
             rel < tolerance,
             "pixels ({x0},{y0})-({x1},{y1}): without a caustic map {b}, with {a} ({rel})"
         );
     }
+    // All over the image, in 4x4 blocks of 16x16 pixels, at the sphere's 10 % (or 4 standard
+    // errors of the block mean of the pixel-wise difference, the two renders' pixel noise).
+    // Both images are photon maps, blurred and noisy, and the blocks that hold the orange
+    // sphere's lower half and the floor under the glass are the known exception: at the
+    // sphere's bottom the caustic map (100k photons) holds so few photons that its estimates
+    // take the largest radius, 0.173 (measured), more than half the orange sphere's radius,
+    // and blur its lit top into its dark bottom, while the global map of the image without
+    // it (400k) estimates there over 0.015. Measured in those blocks over three seeds: 4 to
+    // 7.5 % darker without the caustic map than with it (single renders up to 8.9 %);
+    // elsewhere within 4 %.
+    assert_blocks_agree(
+        "glass-orange, without a caustic map vs with",
+        &without,
+        &with,
+        4,
+        Tolerance {
+            rel: 0.10,
+            z: 4.0,
+            floor: 0.0,
+        },
+    );
 }
 
 #[test]
@@ -407,10 +471,44 @@ fn sphere_inside_glass_matches_the_path_tracer() {
         .concat(),
         2,
     );
-    let (a, _) = region_mean(&path, 0, 0, 16, 16);
-    let (b, _) = region_mean(&photon, 0, 0, 16, 16);
-    let rel = ((b - a) / a).abs().max_element();
+    let (a, b) = (path.mean(), photon.mean());
+    let rel = rel_err(b, a);
     assert!(rel < 0.05, "photon {b} vs path {a} ({rel})");
+    // Quadrant by quadrant, the default largest radius is the known exception: at the orange
+    // sphere's dark bottom even a million caustic photons are too few for k = 50 inside it,
+    // so the estimates take the largest radius, 0.173 (measured), more than half the orange
+    // sphere's radius and, seen magnified through the glass, most of the image: they blur
+    // the lit top into the bottom. Measured in the lower left quadrant against 32768 spp:
+    // +7.6 to +16 % (three seeds), -1.3 % with 4M caustic photons, +2.8 % with the largest
+    // radius 0.05: blur, not a fault. So the quadrants are compared on a render with the
+    // largest radius 0.05, each within max(5 %, 4 se) of the path tracer's (the whole image's
+    // 5 %; se the standard error of the block mean of the pixel-wise difference; the path
+    // tracer's quadrants at 8192 spp are good to 2.2 %, against 32768 spp). No quadrant is
+    // black.
+    let bounded = render_file(
+        &scene,
+        &[
+            &view[..],
+            &[
+                "render.spp=16",
+                "integrators.photon.caustic_photons=1000000",
+                "integrators.photon.max_radius=0.05",
+            ],
+        ]
+        .concat(),
+        2,
+    );
+    assert_blocks_agree(
+        "orange sphere in glass, photon (largest radius 0.05) vs path",
+        &bounded,
+        &path,
+        2,
+        Tolerance {
+            rel: 0.05,
+            z: 4.0,
+            floor: 0.0,
+        },
+    );
     let _ = std::fs::remove_dir_all(scene.parent().unwrap());
 }
 
@@ -566,8 +664,7 @@ fn max_depth_bounds_whole_light_paths_as_in_the_path_tracer() {
         &scene,
         &[&view[..], &["render.integrator=path", "render.spp=4096"]].concat(),
         2,
-    )
-    .mean();
+    );
     let photon = render_file(
         &scene,
         &[
@@ -581,8 +678,7 @@ fn max_depth_bounds_whole_light_paths_as_in_the_path_tracer() {
         ]
         .concat(),
         2,
-    )
-    .mean();
+    );
     let sppm = render_file(
         &scene,
         &[
@@ -595,11 +691,26 @@ fn max_depth_bounds_whole_light_paths_as_in_the_path_tracer() {
         ]
         .concat(),
         2,
-    )
-    .mean();
-    for (name, m) in [("photon", photon), ("sppm", sppm)] {
-        let rel = ((m - path) / path).abs().max_element();
-        eprintln!("max_depth 2: {name} {m} vs path {path} ({rel})");
-        assert!(rel < 0.03, "{name}: image mean {m} vs path {path} ({rel})");
+    );
+    for (name, film) in [("photon", &photon), ("sppm", &sppm)] {
+        let (m, p) = (film.mean(), path.mean());
+        let rel = rel_err(m, p);
+        eprintln!("max_depth 2: {name} {m} vs path {p} ({rel})");
+        assert!(rel < 0.03, "{name}: image mean {m} vs path {p} ({rel})");
+        // Region by region (3x3 blocks of 8x8 pixels) at the same 3 %, or 4 standard errors
+        // of the block mean of the pixel-wise difference (the path tracer's noise dominates:
+        // a mirror sphere reflecting a small light). The mirror's middle reflects the box's
+        // open front, black: the floor, 0.5 % of the image mean, is for it.
+        assert_blocks_agree(
+            &format!("max_depth 2: {name} vs path"),
+            film,
+            &path,
+            3,
+            Tolerance {
+                rel: 0.03,
+                z: 4.0,
+                floor: 0.005 * p.max_element() as f64,
+            },
+        );
     }
 }

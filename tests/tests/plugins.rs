@@ -1,7 +1,7 @@
 //! The integrator plugins built by cargo are found, and the minimal example plugin of
 //! docs/plugins.md (`normals`) loads and renders what it says.
 
-use foton_tests::{header, registry, render_toml};
+use foton_tests::{header, plugin_dir, registry, render_toml};
 use glam::Vec3;
 
 #[test]
@@ -14,7 +14,14 @@ fn built_plugins_are_registered_with_descriptions() {
             .find(|p| p.name == name)
             .unwrap_or_else(|| panic!("{name} not found; problems: {:?}", reg.problems));
         assert!(!p.description.is_empty());
-        assert!(p.file.is_file());
+        // Loaded from the file cargo built for it (the search only lists existing files, so
+        // `is_file` could not fail; this can, if a name were read from the wrong library).
+        let file = plugin_dir().join(format!(
+            "{}foton_{name}{}",
+            std::env::consts::DLL_PREFIX,
+            std::env::consts::DLL_SUFFIX
+        ));
+        assert_eq!(p.file, file, "{name}");
     }
     assert!(
         reg.problems

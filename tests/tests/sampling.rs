@@ -17,6 +17,7 @@ use foton_core::light::{Light, area_light};
 use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
 use foton_core::medium::{Homogeneous, Medium, Phase, channel};
 use foton_core::sampling::{self, Distribution1D, Rng};
+use foton_tests::stats::{self, Gof, assert_close, assert_rel, chi2_gof, chi2_sf, ln_gamma};
 use glam::{DVec3, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
 
@@ -26,9 +27,6 @@ use std::f64::consts::{PI, TAU};
 
 /// Family-wise significance of all the goodness-of-fit tests of this file.
 const ALPHA: f64 = 0.01;
-
-/// Cells expecting fewer samples than this are pooled into one cell.
-const MIN_EXPECTED: f64 = 5.0;
 
 /// Goodness-of-fit tests in this file, for the Sidak correction. Keep in step with the tests.
 const NUM_GOF_TESTS: usize = 7 // uniform_sphere, cosine_hemisphere, 3 x uniform_cone, disc, triangle
@@ -45,200 +43,9 @@ fn alpha_each() -> f64 {
     1.0 - (1.0 - ALPHA).powf(1.0 / NUM_GOF_TESTS as f64)
 }
 
-/// ln Gamma(x) for x > 0 (Lanczos, g = 7, 9 terms; relative error ~1e-15).
-fn ln_gamma(x: f64) -> f64 {
-    const G: f64 = 7.0;
-    const C: [f64; 9] = [
-        0.999_999_999_999_809_9,
-        676.520_368_121_885_1,
-        -1_259.139_216_722_402_8,
-        771.323_428_777_653_1,
-        -176.615_029_162_140_6,
-        12.507_343_278_686_905,
-        -0.138_571_095_265_720_12,
-        9.984_369_578_019_572e-6,
-        1.505_632_735_149_311_6e-7,
-    ];
-    if x < 0.5 {
-        // Reflection formula.
-        PI.ln() - (PI * x).sin().ln() - ln_gamma(1.0 - x)
-    } else {
-        let x = x - 1.0;
-        let t = x + G + 0.5;
-        let mut a = C[0];
-        for (i, &c) in C.iter().enumerate().skip(1) {
-            a += c / (x + i as f64);
-        }
-        0.5 * TAU.ln() + (x + 0.5) * t.ln() - t + a.ln()
-    }
-}
-
-/// Regularised upper incomplete gamma function Q(a, x) = Gamma(a, x) / Gamma(a): by its
-/// series below x = a + 1, by its continued fraction (modified Lentz) above (Numerical
-/// Recipes' gser and gcf).
-fn gamma_q(a: f64, x: f64) -> f64 {
-    assert!(a > 0.0 && x >= 0.0, "gamma_q({a}, {x})");
-    if x == 0.0 {
-        return 1.0;
-    }
-    let prefactor = (-x + a * x.ln() - ln_gamma(a)).exp();
-    if x < a + 1.0 {
-        let (mut ap, mut del) = (a, 1.0 / a);
-        let mut sum = del;
-        for _ in 0..100_000 {
-            ap += 1.0;
-            del *= x / ap;
-            sum += del;
-            if del.abs() < sum.abs() * 1e-16 {
-                break;
-            }
-        }
-        (1.0 - sum * prefactor).max(0.0)
-    } else {
-        const TINY: f64 = 1e-300;
-        let mut b = x + 1.0 - a;
-        let mut c = 1.0 / TINY;
-        let mut d = 1.0 / b;
-        let mut h = d;
-        for i in 1..100_000 {
-            let an = -(i as f64) * (i as f64 - a);
-            b += 2.0;
-            d = an * d + b;
-            if d.abs() < TINY {
-                d = TINY;
-            }
-            c = b + an / c;
-            if c.abs() < TINY {
-                c = TINY;
-            }
-            d = 1.0 / d;
-            let del = d * c;
-            h *= del;
-            if (del - 1.0).abs() < 1e-16 {
-                break;
-            }
-        }
-        prefactor * h
-    }
-}
-
-/// P(X > x) for X chi-square distributed with `dof` degrees of freedom.
-fn chi2_sf(x: f64, dof: f64) -> f64 {
-    gamma_q(0.5 * dof, 0.5 * x)
-}
-
-#[derive(Debug)]
-struct Gof {
-    stat: f64,
-    dof: usize,
-    p: f64,
-}
-
-/// Pearson's chi-square test of observed counts against expected counts (Mitsuba's variant:
-/// cells are sorted by expected count and the smallest pooled until the pool expects at least
-/// MIN_EXPECTED). A sample in a cell that expects exactly nothing is an error.
-fn chi2_gof(observed: &[u64], expected: &[f64]) -> Result<Gof, String> {
-    assert_eq!(observed.len(), expected.len());
-    let mut order: Vec<usize> = (0..observed.len()).collect();
-    order.sort_by(|&a, &b| expected[a].total_cmp(&expected[b]));
-    let (mut pool_o, mut pool_e) = (0.0, 0.0);
-    let mut stat = 0.0;
-    let mut cells = 0usize;
-    for &i in &order {
-        let (o, e) = (observed[i] as f64, expected[i]);
-        assert!(e >= 0.0 && e.is_finite(), "expected count {e} in cell {i}");
-        if e == 0.0 {
-            if o > 0.0 {
-                return Err(format!(
-                    "{o} samples in cell {i}, where the pdf integrates to exactly zero"
-                ));
-            }
-            continue;
-        }
-        if e < MIN_EXPECTED || (pool_e > 0.0 && pool_e < MIN_EXPECTED) {
-            pool_o += o;
-            pool_e += e;
-        } else {
-            stat += (o - e) * (o - e) / e;
-            cells += 1;
-        }
-    }
-    if pool_e > 0.0 {
-        stat += (pool_o - pool_e) * (pool_o - pool_e) / pool_e;
-        cells += 1;
-    }
-    if cells < 2 {
-        return Err(format!(
-            "only {cells} cell(s) after pooling: the test is void"
-        ));
-    }
-    let dof = cells - 1;
-    Ok(Gof {
-        stat,
-        dof,
-        p: chi2_sf(stat, dof as f64),
-    })
-}
-
-/// The cells that contribute most to the statistic, for failure messages.
-fn worst_cells(observed: &[u64], expected: &[f64]) -> String {
-    let mut v: Vec<(usize, f64)> = (0..observed.len())
-        .filter(|&i| expected[i] > 0.0)
-        .map(|i| {
-            let d = observed[i] as f64 - expected[i];
-            (i, d * d / expected[i])
-        })
-        .collect();
-    v.sort_by(|a, b| b.1.total_cmp(&a.1));
-    v.iter()
-        .take(8)
-        .map(|&(i, c)| {
-            format!(
-                "cell {i}: observed {} expected {:.1} (contributes {c:.1})",
-                observed[i], expected[i]
-            )
-        })
-        .collect::<Vec<_>>()
-        .join("; ")
-}
-
 /// Panics unless the observed counts fit the expected ones at significance `alpha_each()`.
 fn assert_gof(name: &str, observed: &[u64], expected: &[f64]) {
-    match chi2_gof(observed, expected) {
-        Err(e) => panic!("{name}: {e}"),
-        Ok(g) => {
-            println!(
-                "{name}: chi2 = {:.1}, dof = {}, p = {:.3e} (reject below {:.2e})",
-                g.stat,
-                g.dof,
-                g.p,
-                alpha_each()
-            );
-            assert!(
-                g.p >= alpha_each(),
-                "{name}: the samples do not follow the pdf: chi2 = {:.1} with {} dof, p = {:.3e} < {:.2e}. Worst cells: {}",
-                g.stat,
-                g.dof,
-                g.p,
-                alpha_each(),
-                worst_cells(observed, expected)
-            );
-        }
-    }
-}
-
-fn assert_close(what: &str, got: f64, want: f64, tol: f64) {
-    assert!(
-        (got - want).abs() <= tol,
-        "{what}: got {got}, expected {want} (tolerance {tol})"
-    );
-}
-
-fn assert_rel(what: &str, got: f64, want: f64, rel: f64) {
-    assert!(
-        (got - want).abs() <= rel * want.abs().max(got.abs()),
-        "{what}: got {got}, expected {want} (relative tolerance {rel})"
-    );
+    stats::assert_gof(name, observed, expected, alpha_each());
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -1781,8 +1588,6 @@ fn free_flight_sampling_follows_the_spectral_mis_density_and_is_unbiased() {
             .map(|w| free_flight_mass(sigma_t, w[0], w[1]))
             .collect();
         expected.push(1.0 - free_flight_mass(sigma_t, 0.0, tmax as f64));
-        assert_eq!(expected.len(), cells);
-        assert_close(&format!("{name}: total"), expected.iter().sum(), 1.0, 1e-9);
 
         let mut observed = vec![0u64; cells];
         let mut rng = Rng::new(&[60, k as u64]);

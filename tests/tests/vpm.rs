@@ -1,34 +1,34 @@
 //! The volumetric photon mapper (`vpm`) against the volumetric path tracer, its convergence,
 //! determinism and parameters.
 
+use foton_core::film::Film;
+use foton_tests::stats::{Tolerance, assert_blocks_agree_by, rel_err};
 use foton_tests::{assert_refused, foton_with_plugins, render_file, repo_root};
 
 const VIEW: [&str; 2] = ["film.width=32", "film.height=32"];
 
-/// The path tracer's image mean (2048 spp).
-fn path_mean(scene: &str) -> glam::Vec3 {
+/// The path tracer's image (2048 spp).
+fn path_film(scene: &str) -> Film {
     render_file(
         &repo_root().join(scene),
         &[&VIEW[..], &["render.integrator=path", "render.spp=2048"]].concat(),
         2,
     )
-    .mean()
 }
 
-/// Relative error of vpm's image mean against the path tracer's at two settings: a coarse one
-/// (50k photons per map, volume radius 0.2) and a fine one (800k, radius 0.05).
-fn vpm_errors(scene: &str, path: glam::Vec3, extra: &[&str]) -> [f32; 2] {
+/// vpm's image at a coarse setting (50k photons per map, volume radius 0.2) and a fine one
+/// (800k, radius 0.05).
+fn vpm_films(scene: &str, extra: &[&str]) -> [Film; 2] {
     let scene = repo_root().join(scene);
     let view = [&VIEW[..], extra].concat();
-    let mut errors = [0.0; 2];
-    for (i, (photons, radius)) in [("50000", "0.2"), ("800000", "0.05")].iter().enumerate() {
+    [("50000", "0.2"), ("800000", "0.05")].map(|(photons, radius)| {
         let set = [
             format!("integrators.vpm.global_photons={photons}"),
             format!("integrators.vpm.volume_photons={photons}"),
             format!("integrators.vpm.max_radius_volume={radius}"),
         ];
         let set: Vec<&str> = set.iter().map(|s| s.as_str()).collect();
-        let vpm = render_file(
+        render_file(
             &scene,
             &[
                 &view[..],
@@ -38,46 +38,77 @@ fn vpm_errors(scene: &str, path: glam::Vec3, extra: &[&str]) -> [f32; 2] {
             .concat(),
             2,
         )
-        .mean();
-        errors[i] = ((vpm - path) / path).abs().max_element();
-        eprintln!(
-            "{}: path {path}, vpm ({photons}, r {radius}) {vpm}",
-            scene.display()
-        );
-    }
-    errors
+    })
 }
 
-// The bound: the volume estimate blurs over its radius, which darkens it within a radius of
-// surfaces (the ball reaches where no photon can be); measured 1.8 % and 0.6 % (fog cube),
-// 1.6 % and 0.5 % (thin fog) for the two settings. The path tracer's mean at 2048 spp is
-// good to about 0.3 %. The fine setting must be within 1.5 % and better than the coarse one.
+/// vpm against the path tracer: the relative error of the image mean must be below BOUND at
+/// the fine setting and below the coarse setting's (it converges), and the fine setting's
+/// image must agree block by block.
+fn assert_agrees_and_converges(what: &str, scene: &str, path: &Film, extra: &[&str]) {
+    let [coarse, fine] = vpm_films(scene, extra);
+    let p = path.mean();
+    let errors = [rel_err(coarse.mean(), p), rel_err(fine.mean(), p)];
+    eprintln!(
+        "{what}: path {p}, vpm (50k, r 0.2) {}, (800k, r 0.05) {}: {errors:?}",
+        coarse.mean(),
+        fine.mean()
+    );
+    assert!(
+        errors[1] < BOUND && errors[1] < errors[0],
+        "{what}: {} then {}",
+        errors[0],
+        errors[1]
+    );
+    assert_blocks_agree_by(what, &fine, path, 4, |block| Tolerance {
+        rel: if block.on_border(32, 32) { 0.07 } else { 0.04 },
+        z: 4.0,
+        floor: 0.0,
+    });
+}
+
+// The bound on the image mean: the volume estimate blurs over its radius, which darkens it
+// within a radius of surfaces (the ball reaches where no photon can be); measured 1.8 % and
+// 0.6 % (fog cube), 1.6 % and 0.5 % (thin fog) for the two settings. The path tracer's mean
+// at 2048 spp is good to about 0.3 %. The fine setting must be within 1.5 % and better than
+// the coarse one.
+//
+// Block by block (4x4 blocks of 8x8 pixels, the fine setting): each within max(rel, 4 se) of
+// the path tracer's, se the standard error of the block mean of the pixel-wise difference
+// (the camera samples' noise of both renders; largest on the ceiling's light and, in the
+// murky glass, on the sphere, where each pixel sees a few photons' blotches magnified).
+// rel is for what the pixel statistics do not see, a bias and the photon maps' own noise.
+// The four inner blocks (the fog in front of the back wall, the murky sphere) hold the fog
+// cube's edges, where the volume estimate's ball reaches out of the fog and darkens it (the
+// bound above): with direct = "photons" up to 2.6 % low (seed 0; 1.2 to 1.6 % over three
+// other seeds), else within 1.5 %, with spreads up to 0.6 % (but for the murky sphere's
+// block, which se covers): 4 %. The twelve outer blocks hold the box's edges, where the
+// surface estimate's disc reaches past a wall's edge into area without its photons, which
+// darkens it: 7 % (measured up to 4.7 % low, mean of three seeds, spreads up to 1.2 %;
+// single renders up to 6.9 %; with 3.2M surface photons the worst block is 2.7 % low, with
+// k = 200 instead of 50 it is 4.4 % low: it is that bias). No block is black: no floor.
 const BOUND: f32 = 0.015;
 
 #[test]
 fn agrees_with_path_on_the_fog_cube_and_converges() {
-    let path = path_mean("scenes/fog_box.toml");
-    let [coarse, fine] = vpm_errors("scenes/fog_box.toml", path, &[]);
-    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    let scene = "scenes/fog_box.toml";
+    let path = path_film(scene);
+    assert_agrees_and_converges("fog cube", scene, &path, &[]);
     // direct = "photons": the first scattering events come from the volume map instead of
     // shadow rays.
     let photons = ["integrators.vpm.direct=\"photons\""];
-    let [coarse, fine] = vpm_errors("scenes/fog_box.toml", path, &photons);
-    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    assert_agrees_and_converges("fog cube, direct photons", scene, &path, &photons);
     // The beam radiance estimate instead of marching, all scattering by photons.
     let beam = [
         "integrators.vpm.estimate=\"beam\"",
         "integrators.vpm.direct=\"photons\"",
     ];
-    let [coarse, fine] = vpm_errors("scenes/fog_box.toml", path, &beam);
-    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    assert_agrees_and_converges("fog cube, beam estimate", scene, &path, &beam);
 }
 
 #[test]
 fn agrees_with_path_on_the_fog_filled_cornell_box_and_converges() {
-    let path = path_mean("scenes/cornell-fog.toml");
-    let [coarse, fine] = vpm_errors("scenes/cornell-fog.toml", path, &[]);
-    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    let scene = "scenes/cornell-fog.toml";
+    assert_agrees_and_converges("fog-filled cornell box", scene, &path_film(scene), &[]);
 }
 
 #[test]
@@ -177,8 +208,11 @@ fn agrees_with_path_on_murky_glass_and_converges() {
     // and camera rays enter it by refraction. Image means: measured 0.86 % and 0.27 %. (Over
     // the sphere's pixels alone, one render's photon-map noise is +-4 to 12 % from seed to
     // seed, all pixels seeing the same few magnified blotches through the sphere; the mean of
-    // four seeds agreed with the path tracer within 0.7 %.)
-    let path = path_mean("scenes/murky-glass.toml");
-    let [coarse, fine] = vpm_errors("scenes/murky-glass.toml", path, &[]);
-    assert!(fine < BOUND && fine < coarse, "{coarse} then {fine}");
+    // four seeds agreed with the path tracer within 0.7 %.) Block by block, the sphere's
+    // blocks are the known exception: the blotches make their pixels differ, so the
+    // standard error of the difference is large there (measured up to 11 % of the block, so
+    // about 45 % is allowed; one of three seeds put a sphere block 28 % off, at 2.4 se):
+    // those blocks are only loosely checked, the image mean and the other blocks are not.
+    let scene = "scenes/murky-glass.toml";
+    assert_agrees_and_converges("murky glass", scene, &path_film(scene), &[]);
 }

@@ -568,7 +568,6 @@ mod tests {
             (img.width, img.height),
             (3 * 32 + 4 * BORDER, band + band2 + 2 * 16 + 3 * BORDER)
         );
-        assert_eq!(img.pixels.len(), (img.width * img.height) as usize);
         // The first tile's image lies below its band; its band has text in it.
         assert_eq!(img.get(BORDER, BORDER + band), Rgb::splat(0.5));
         let band_pixels: Vec<Rgb> = (0..band)
@@ -577,6 +576,14 @@ mod tests {
             .collect();
         assert!(band_pixels.contains(&INK));
         assert!(band_pixels.contains(&BAND));
+        // The smaller fourth tile (30x10) starts the second row, below its three-line band, at
+        // the top left of its 32x16 cell; the rest of the cell is background.
+        let top = BORDER + band + 16 + BORDER + band2;
+        assert_eq!(img.get(BORDER, top), Rgb::splat(0.5));
+        assert_eq!(img.get(BORDER + 29, top + 9), Rgb::splat(0.5));
+        assert_ne!(img.get(BORDER, top - 1), Rgb::splat(0.5), "its band");
+        assert_eq!(img.get(BORDER + 30, top), BACKGROUND);
+        assert_eq!(img.get(BORDER, top + 10), BACKGROUND);
     }
 
     #[test]
