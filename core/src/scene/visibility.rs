@@ -163,6 +163,7 @@ impl Scene {
 
 /// The ends of a shadow ray between two points, each pushed off its surface along its normal
 /// towards the other (a zero normal, a point in a medium or a point light: not moved).
+#[inline]
 fn shadow_ends(p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> (Vec3, Vec3) {
     let d = p1 - p0;
     let from = if n0 == Vec3::ZERO {
