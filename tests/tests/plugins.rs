@@ -78,3 +78,27 @@ material = "m"
             < 1e-6
     );
 }
+
+/// The test fixture that panics on purpose is built beside the real plugins (cargo puts every
+/// cdylib of the workspace in target/<profile>/, and `cargo build --workspace` builds it), but
+/// under a name the plugin search skips: the folder cargo built into lists the real plugins
+/// only, and the fixture is found only where the tests copy it under a plugin's name.
+#[test]
+fn the_panicking_fixture_is_not_found_beside_the_real_plugins() {
+    let mut names: Vec<String> = registry()
+        .integrators
+        .iter()
+        .map(|p| p.name.clone())
+        .collect();
+    names.sort();
+    assert_eq!(names, ["normals", "path", "photon", "sppm", "vpm"]);
+    let built = plugin_dir().join(format!(
+        "{}panicky_fixture{}",
+        std::env::consts::DLL_PREFIX,
+        std::env::consts::DLL_SUFFIX
+    ));
+    assert!(built.is_file(), "{}", built.display());
+    assert!(!foton_core::plugin::is_plugin_file(&built));
+    let copied = foton_core::plugin::Registry::discover(&[foton_tests::fixture_plugin_dir()]);
+    assert!(copied.integrators.iter().any(|p| p.name == "panicky"));
+}
