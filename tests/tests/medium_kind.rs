@@ -11,7 +11,8 @@ use foton_core::Rgb;
 use foton_core::film::Film;
 use foton_core::geometry::Ray;
 use foton_core::medium::{FreeFlight, Medium, Phase};
-use foton_tests::{header, plugin_dir, region_mean, temp_dir, write};
+use foton_tests::stats::{Tolerance, assert_blocks_agree};
+use foton_tests::{header, plugin_dir, temp_dir, write};
 use glam::{Vec2, Vec3};
 
 #[derive(Debug)]
@@ -79,25 +80,6 @@ impl Medium for Ramp {
                 f: tr,
                 pdf: tr,
             }
-        }
-    }
-}
-
-/// Compares two images by `n` x `n` blocks: each block's means agree within `rel` of the
-/// second or within `z` standard errors of their difference (from both images' pixels).
-fn blocks_agree(what: &str, a: &Film, b: &Film, n: u32, rel: f32, z: f32) {
-    let (w, h) = (a.width / n, a.height / n);
-    for by in 0..n {
-        for bx in 0..n {
-            let (x0, y0) = (bx * w, by * h);
-            let (ma, sa) = region_mean(a, x0, y0, x0 + w, y0 + h);
-            let (mb, sb) = region_mean(b, x0, y0, x0 + w, y0 + h);
-            let se = (sa * sa + sb * sb).max_element().sqrt();
-            let diff = (ma - mb).abs().max_element();
-            assert!(
-                diff <= (rel * mb.max_element()).max(z * se),
-                "{what}: block ({bx}, {by}): {ma} against {mb} (difference {diff}, standard error {se})"
-            );
         }
     }
 }
@@ -236,7 +218,12 @@ fn a_medium_kind_of_the_tests_renders_through_the_medium_interface() {
             exact.set_pixel(x, y, Rgb::splat(exact_pixel(&camera, &ramp, x, y)));
         }
     }
-    blocks_agree("path through the ramp medium", &film, &exact, 4, 0.02, 4.0);
+    let tolerance = Tolerance {
+        rel: 0.02,
+        z: 4.0,
+        floor: 0.0,
+    };
+    assert_blocks_agree("path through the ramp medium", &film, &exact, 4, tolerance);
 }
 
 /// With scattering (albedo 0.8), `vpm` (volume photons traced through the ramp by its
@@ -251,12 +238,16 @@ fn vpm_and_path_agree_in_a_scattering_medium_of_another_kind() {
     };
     let (vpm, _) = render_with("ramp-vpm-scattering", "vpm", 16, ramp());
     let (path, _) = render_with("ramp-path-scattering", "path", 1024, ramp());
-    blocks_agree(
+    let tolerance = Tolerance {
+        rel: 0.05,
+        z: 4.0,
+        floor: 0.0,
+    };
+    assert_blocks_agree(
         "vpm against path, scattering ramp",
         &vpm,
         &path,
         4,
-        0.05,
-        4.0,
+        tolerance,
     );
 }
