@@ -12,7 +12,9 @@
 //! **The crossing limit.** A ray may cross at most [`MAX_NULL_CROSSINGS`] null boundaries in a
 //! row (between two scattering events). Past that it is ended and carries nothing further: a
 //! loss of energy, which only a ray trapped among hundreds of coincident boundaries can meet.
-//! Shadow rays follow the same rule (`Scene::transmittance`: zero past the limit).
+//! Shadow rays through media follow the same rule (`Scene::transmittance`: zero past the
+//! limit); without media a shadow ray is one BVH traversal that passes every null boundary,
+//! with no loop to limit.
 
 use crate::Rgb;
 use crate::geometry::{Hit, Ray, offset_origin};
