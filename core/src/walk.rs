@@ -39,6 +39,17 @@ pub struct RayWalk {
     crossings: u32,
 }
 
+/// What a walk's ray met at the end of a segment ([`RayWalk::reach`]).
+#[derive(Clone, Copy, Debug)]
+pub enum Reached {
+    /// A surface that scatters, with its material.
+    Surface(Material),
+    /// A null boundary, crossed: trace the next segment.
+    Crossed,
+    /// A null boundary past the crossing limit: the ray is ended.
+    Ended,
+}
+
 /// The piece of a walk's ray from its start (its origin, or the null boundary it just
 /// crossed) to the next surface, null or not.
 #[derive(Clone, Copy, Debug)]
@@ -120,6 +131,20 @@ impl RayWalk {
         true
     }
 
+    /// What the ray met at `hit`, the end of the last segment: a surface that scatters (its
+    /// material), or a null boundary, which is crossed ([`RayWalk::cross`]).
+    #[inline]
+    pub fn reach(&mut self, scene: &Scene, hit: &Hit) -> Reached {
+        let material = *scene.material(hit);
+        if !material.is_null() {
+            Reached::Surface(material)
+        } else if self.cross(scene, hit) {
+            Reached::Crossed
+        } else {
+            Reached::Ended
+        }
+    }
+
     /// Goes on from a surface at `hit` in direction `wi` (reflected or refracted): refraction
     /// into or out of a volume changes the medium, reflection keeps it.
     #[inline]
@@ -152,11 +177,10 @@ pub fn first_surface(
     loop {
         let seg = walk.segment(scene, rays);
         let hit = seg.hit?;
-        if !scene.material(&hit).is_null() {
-            return Some((hit, seg));
-        }
-        if !walk.cross(scene, &hit) {
-            return None;
+        match walk.reach(scene, &hit) {
+            Reached::Surface(_) => return Some((hit, seg)),
+            Reached::Crossed => continue,
+            Reached::Ended => return None,
         }
     }
 }
@@ -229,13 +253,11 @@ pub fn walk_to_diffuse(
             break;
         };
         distance += hit.p.distance(seg.ray.origin);
-        let material = *scene.material(&hit);
-        if material.is_null() {
-            if !walk.cross(scene, &hit) {
-                break;
-            }
-            continue;
-        }
+        let material = match walk.reach(scene, &hit) {
+            Reached::Surface(material) => material,
+            Reached::Crossed => continue,
+            Reached::Ended => break,
+        };
         let wo = -seg.ray.dir;
         if let Some((_, light)) = scene.area_light(&hit) {
             emitted += beta * light.emitted(hit.ng, wo);

@@ -51,7 +51,7 @@ use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::{Sampler, power_heuristic};
 use foton_core::scene::Scene;
-use foton_core::walk::RayWalk;
+use foton_core::walk::{RayWalk, Reached};
 use foton_core::{Result, Rgb, film::Film};
 
 pub struct PathTracer {
@@ -128,13 +128,11 @@ impl PathTracer {
             let Some(hit) = seg.hit else {
                 break;
             };
-            let material = *scene.material(&hit);
-            if material.is_null() {
-                if !walk.cross(scene, &hit) {
-                    break;
-                }
-                continue;
-            }
+            let material = match walk.reach(scene, &hit) {
+                Reached::Surface(material) => material,
+                Reached::Crossed => continue,
+                Reached::Ended => break,
+            };
             let wo = -seg.ray.dir;
 
             // ---- Emission (weighted against light sampling at the previous vertex) ----

@@ -18,7 +18,7 @@ use foton_core::medium::HeroChannel;
 use foton_core::render::with_pool;
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
-use foton_core::walk::RayWalk;
+use foton_core::walk::{RayWalk, Reached};
 use glam::Vec2;
 use rayon::prelude::*;
 
@@ -173,13 +173,11 @@ pub fn trace_one(
         let Some(hit) = seg.hit else {
             return;
         };
-        let material = *scene.material(&hit);
-        if material.is_null() {
-            if !walk.cross(scene, &hit) {
-                return;
-            }
-            continue;
-        }
+        let material = match walk.reach(scene, &hit) {
+            Reached::Surface(material) => material,
+            Reached::Crossed => continue,
+            Reached::Ended => return,
+        };
         hits += 1;
         let wi = -seg.ray.dir;
         if !material.is_delta() {
