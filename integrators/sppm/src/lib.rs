@@ -9,10 +9,20 @@
 //! | `time`                  | float   | run until this many seconds have passed, > 0              | none    |
 //! | `photons_per_iteration` | integer | photons emitted in each iteration, >= 1                   | 100000  |
 //! | `initial_radius`        | float   | every pixel's starting gather radius (world units), > 0   | automatic, below |
-//! | `alpha`                 | float   | fraction of new photons kept, in (0, 1]                   | 0.7     |
+//! | `alpha`                 | float   | fraction of new photons kept (pixel schedule) or the radius schedule's exponent (global), in (0, 1] | 0.7 |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name       | `box`   |
 //! | `cone_c`                | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1     |
 //! | `direct`                | string  | `nee` (shadow rays) or `photons`                          | `nee`   |
+//! | `radius_schedule`       | string  | `pixel` (each pixel's radius from its photon statistics) or `global` (from the iteration number alone, below) | `pixel` |
+//!
+//! **Global radius schedule** (`radius_schedule = "global"`, Knaus and Zwicker 2011,
+//! "Progressive photon mapping: a probabilistic approach"): iteration i gathers with
+//! r_i^2 = r_1^2 prod_{j=1}^{i-1} (j + alpha) / (j + 1) (r_1 the pixel's first radius, from
+//! its first iteration's camera sample alone), makes its own estimate of reflected radiance
+//! beta sum_p f Phi_p K(d_p, r_i), and the pixel's radiance is the mean over iterations. The
+//! radius depends on the iteration's number alone, so iterations are independent: any subset
+//! of them can be rendered apart and averaged (what rendering in parts needs). The pixel
+//! schedule (the default) adapts each pixel's radius to its own photon density.
 //!
 //! `[render] max_depth` bounds the scattering events of a whole light path, camera path's
 //! delta bounces and photon's surface hits together, as in the path tracer; `[render] spp` is
@@ -98,6 +108,25 @@ pub struct Sppm {
     pub kernel: NormalizedKernel,
     pub direct: Direct,
     pub max_depth: u32,
+    pub schedule: RadiusSchedule,
+}
+
+/// How the gather radius shrinks from iteration to iteration.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RadiusSchedule {
+    /// Per pixel, from the photons it has gathered (Hachisuka and Jensen 2009).
+    Pixel,
+    /// The same for every pixel, from the iteration's number alone (Knaus and Zwicker 2011):
+    /// iterations are independent estimates, averaged.
+    Global,
+}
+
+/// Knaus and Zwicker's radius schedule: r_i^2 / r_1^2 for iteration i (1-based),
+/// prod_{j=1}^{i-1} (j + alpha) / (j + 1). It falls like i^(alpha - 1), so the radius shrinks
+/// to zero while the photons gathered per iteration, about r_i^2 times the photon count, fall
+/// slowly enough that the average over iterations converges: variance and bias both vanish.
+pub fn global_radius2_scale(iteration: u64, alpha: f64) -> f64 {
+    (1..iteration).fold(1.0, |s, j| s * (j as f64 + alpha) / (j as f64 + 1.0))
 }
 
 /// A pixel's progressive statistics.
@@ -111,6 +140,9 @@ pub struct PixelStats {
     pub tau: DVec3,
     /// Sum over iterations of the emission and shadow-ray direct light.
     pub ld: DVec3,
+    /// With the global schedule: the sum over iterations of each iteration's own photon
+    /// estimate of reflected radiance (`radius` is then the pixel's first radius r_1).
+    pub photon_sum: DVec3,
 }
 
 impl PixelStats {
@@ -132,7 +164,7 @@ impl PixelStats {
             return DVec3::ZERO;
         }
         let k = iterations as f64;
-        let mut l = self.ld / k;
+        let mut l = (self.ld + self.photon_sum) / k;
         if self.radius > 0.0 {
             l += self.tau / (k * PI * self.radius * self.radius);
         }
@@ -304,13 +336,26 @@ impl Integrator for Sppm {
                     .zip(camera.par_iter())
                     .for_each(|(st, cs)| {
                         st.ld += cs.ld.as_dvec3();
+                        let global = self.schedule == RadiusSchedule::Global;
+                        if global && done == 0 {
+                            // r_1 from the first iteration's camera sample alone (a pixel
+                            // without a visible point there gets the largest automatic one),
+                            // so that every iteration's radius is a function of its number.
+                            let distance =
+                                cs.visible.as_ref().map_or(f32::INFINITY, |vp| vp.distance);
+                            st.radius = self.first_radius(scene, angle, distance);
+                        }
                         let Some(vp) = &cs.visible else {
                             return;
                         };
                         if st.radius == 0.0 {
                             st.radius = self.first_radius(scene, angle, vp.distance);
                         }
-                        let r = st.radius as f32;
+                        let r = if global {
+                            (st.radius * global_radius2_scale(done + 1, alpha).sqrt()) as f32
+                        } else {
+                            st.radius as f32
+                        };
                         let disc = std::f32::consts::PI * r * r;
                         let (mut m, mut phi) = (0.0f64, DVec3::ZERO);
                         // No light path longer than max_depth, as in the path tracer.
@@ -329,7 +374,14 @@ impl Integrator for Sppm {
                             m += w as f64;
                             phi += (f * photon.power() * w).as_dvec3();
                         });
-                        st.update(alpha, m, phi * vp.beta.as_dvec3());
+                        let phi = phi * vp.beta.as_dvec3();
+                        if global {
+                            // This iteration's estimate of reflected radiance, tau / (pi r^2)
+                            // with its own radius; iterations are averaged.
+                            st.photon_sum += phi / disc as f64;
+                        } else {
+                            st.update(alpha, m, phi);
+                        }
                     })
             })?;
             done += 1;
@@ -338,9 +390,13 @@ impl Integrator for Sppm {
                 .iter()
                 .filter(|s| s.radius > 0.0)
                 .fold((0.0, 0u64), |(s, n), st| (s + st.radius, n + 1));
+            let shrink = match self.schedule {
+                RadiusSchedule::Pixel => 1.0,
+                RadiusSchedule::Global => global_radius2_scale(done, self.alpha).sqrt(),
+            };
             ctx.progress.status(&format!(
                 "iteration {done}, {photons_total} photons, mean radius {:.4}",
-                sum_r / lit.max(1) as f64
+                shrink * sum_r / lit.max(1) as f64
             ));
             match self.time {
                 None => ctx.progress.advance(1),
@@ -385,6 +441,13 @@ impl Integrator for Sppm {
         p.push(Parameter::float("alpha", self.alpha as f32));
         p.extend(self.kernel.parameters());
         p.push(Parameter::str("direct", self.direct.name()));
+        p.push(Parameter::str(
+            "radius_schedule",
+            match self.schedule {
+                RadiusSchedule::Pixel => "pixel",
+                RadiusSchedule::Global => "global",
+            },
+        ));
         p
     }
 
@@ -450,6 +513,10 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }
     let kernel = props.kernel("kernel", "box")?;
     let direct = Direct::read(props)?;
+    let schedule = match props.choice("radius_schedule", &["pixel", "global"], "pixel")? {
+        "global" => RadiusSchedule::Global,
+        _ => RadiusSchedule::Pixel,
+    };
     if scene.has_media() {
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `sppm` does not render (use `vpm` or `path`)",
@@ -465,6 +532,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         kernel,
         direct,
         max_depth: scene.render.max_depth,
+        schedule,
     }))
 }
 
