@@ -14,6 +14,7 @@ pub mod camera;
 pub mod direct;
 pub mod error;
 pub mod film;
+pub mod filter;
 pub mod geometry;
 pub mod integrator;
 pub mod kernel;

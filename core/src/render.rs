@@ -12,7 +12,6 @@ use crate::geometry::Ray;
 use crate::integrator::RenderContext;
 use crate::sampling::Sampler;
 use crate::scene::Scene;
-use glam::Vec2;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -71,10 +70,8 @@ where
                             let mut sum = [0.0f64; 3];
                             for s in s0..s1 {
                                 let mut sampler = pixel_sampler(seed, width, x, y, s);
-                                let jitter = sampler.next_2d();
-                                let ray = scene
-                                    .camera
-                                    .generate_ray(Vec2::new(x as f32, y as f32) + jitter);
+                                let at = scene.film.filter.film_position(x, y, sampler.next_2d());
+                                let ray = scene.camera.generate_ray(at);
                                 let mut l = radiance(&ray, &mut sampler, &mut tile_rays);
                                 if !l.is_finite() || l.min_element() < 0.0 {
                                     bad_samples.fetch_add(1, Ordering::Relaxed);

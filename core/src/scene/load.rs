@@ -10,6 +10,7 @@ use crate::Rgb;
 use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::error::{Location, Result};
+use crate::filter::{Filter, FilterSampler};
 use crate::geometry::{Primitive, Shape};
 use crate::light::{Light, area_light};
 use crate::material::Material;
@@ -276,15 +277,65 @@ fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
     }
     let tonemap =
         ToneMap::from_name(t.choice("tonemap", &ToneMap::NAMES, "clamp")?).unwrap_or_default();
+    let filter = read_filter(&t, ld)?;
     let film = FilmSettings {
         width,
         height,
         output: ld.dir.join(out),
         exposure,
         tonemap,
+        filter: FilterSampler::new(filter),
     };
     ld.done(&t);
     Ok(film)
+}
+
+/// `[film] filter`: "box" (the default), "tent", "gaussian", or a table with `type` and the
+/// filter's parameter (`radius` of the tent, default 1; `stddev` of the gaussian, default
+/// 0.5), in pixels.
+fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
+    const TYPES: [&str; 3] = ["box", "tent", "gaussian"];
+    let expected = "expected \"box\", \"tent\", \"gaussian\" or a table such as { type = \"tent\", radius = 1.0 }";
+    let ty = match t.node("filter").map(|n| &n.value) {
+        None => return Ok(Filter::Box),
+        Some(Value::Str(s)) if TYPES.contains(&s.as_str()) => s.as_str(),
+        Some(Value::Str(s)) => {
+            return Err(t.error("filter", format!("unknown filter {s:?}; {expected}")));
+        }
+        Some(Value::Table(_)) => {
+            let f = t.table("filter")?.unwrap();
+            let ty = f.choice("type", &TYPES, "box")?;
+            let positive = |key: &str, default: f32| -> Result<f32> {
+                let x = f.f32(key, default)?;
+                if !(x > 0.0 && x <= 64.0) {
+                    return Err(f.error(key, format!("must be in (0, 64] pixels, found {x}")));
+                }
+                Ok(x)
+            };
+            let filter = match ty {
+                "tent" => Filter::Tent {
+                    radius: positive("radius", 1.0)?,
+                },
+                "gaussian" => Filter::Gaussian {
+                    stddev: positive("stddev", 0.5)?,
+                },
+                _ => Filter::Box,
+            };
+            ld.done(&f);
+            return Ok(filter);
+        }
+        Some(other) => {
+            return Err(t.error(
+                "filter",
+                format!("{expected}, found {} `{}`", other.type_name(), other.show()),
+            ));
+        }
+    };
+    Ok(match ty {
+        "tent" => Filter::Tent { radius: 1.0 },
+        "gaussian" => Filter::Gaussian { stddev: 0.5 },
+        _ => Filter::Box,
+    })
 }
 
 fn read_camera(root: &Properties<'_>, film: &FilmSettings, ld: &mut Loader) -> Result<Camera> {
@@ -301,6 +352,25 @@ fn read_camera(root: &Properties<'_>, film: &FilmSettings, ld: &mut Loader) -> R
     if !(fov > 0.0 && fov < 180.0) {
         return Err(t.error("fov", format!("must be in (0, 180) degrees, found {fov}")));
     }
+    // Which extent of the image `fov` spans (Mitsuba's fov_axis); the camera takes the
+    // vertical one. tan of the half angles: horizontal = aspect x vertical.
+    let axis = t.choice(
+        "fov_axis",
+        &["y", "x", "diagonal", "smaller", "larger"],
+        "y",
+    )?;
+    let aspect = film.width as f32 / film.height as f32;
+    let tan_half = (fov.to_radians() * 0.5).tan();
+    let wide = film.width >= film.height;
+    let tan_vertical = match axis {
+        "x" => tan_half / aspect,
+        "diagonal" => tan_half / (1.0 + aspect * aspect).sqrt(),
+        "smaller" if wide => tan_half,
+        "smaller" => tan_half / aspect,
+        "larger" if wide => tan_half / aspect,
+        _ => tan_half,
+    };
+    let fov = 2.0 * tan_vertical.atan().to_degrees();
     let forward = look_at - position;
     if forward.length_squared() == 0.0 {
         return Err(t.error("look_at", "is the same point as position"));

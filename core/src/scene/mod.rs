@@ -47,6 +47,8 @@ pub struct FilmSettings {
     pub exposure: f32,
     /// How 8-bit outputs fit the exposed radiance into [0, 1]. EXR ignores it.
     pub tonemap: ToneMap,
+    /// The pixel filter, as camera samples are placed with it (filter importance sampling).
+    pub filter: crate::filter::FilterSampler,
 }
 
 impl FilmSettings {

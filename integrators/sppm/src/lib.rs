@@ -194,7 +194,7 @@ impl Sppm {
                     .map(|x| {
                         let pixel = y as u64 * width as u64 + x as u64;
                         let mut sampler = Rng::new(&[seed, STREAM_CAMERA, pixel, iteration]);
-                        let film = Vec2::new(x as f32, y as f32) + sampler.next_2d();
+                        let film = scene.film.filter.film_position(x, y, sampler.next_2d());
                         let ray = scene.camera.generate_ray(film);
                         let path = trace_to_diffuse(
                             scene,
