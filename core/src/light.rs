@@ -1,5 +1,6 @@
-//! Lights: point lights and area lights (any emissive shape). An area light emits radiance
-//! `radiance` on the side its geometric normal points to, and nothing on the other side.
+//! Lights: point lights, spot lights and area lights (any emissive shape). An area light emits
+//! radiance `radiance` on the side its geometric normal points to, and nothing on the other
+//! side.
 
 use crate::Rgb;
 use crate::geometry::Shape;
@@ -13,6 +14,19 @@ pub enum Light {
         position: Vec3,
         /// W/sr.
         intensity: Rgb,
+    },
+    /// A point light emitting in a cone (Mitsuba's `spot`): intensity `intensity` within
+    /// `beam_width` of the axis, falling linearly in angle to zero at `cutoff`.
+    Spot {
+        position: Vec3,
+        /// Unit direction of the cone's axis.
+        axis: Vec3,
+        /// W/sr at the centre.
+        intensity: Rgb,
+        /// Angles (radians) from the axis: full intensity within `beam_width`, none past
+        /// `cutoff`.
+        beam_width: f32,
+        cutoff: f32,
     },
     Area {
         /// The emitting primitives (one for a sphere or quad, the triangles of a mesh).
@@ -61,17 +75,58 @@ fn sphere_cone(center: Vec3, radius: f32, x: Vec3) -> Option<f32> {
     (d2 > r2 * 1.0001).then(|| (1.0 - r2 / d2).max(0.0).sqrt())
 }
 
+/// The spot light's falloff at angle theta from its axis (Mitsuba's `falloff_curve`): 1 within
+/// the beam width, linear in the angle down to 0 at the cutoff, 0 beyond.
+#[inline]
+pub fn spot_falloff(cos_theta: f32, beam_width: f32, cutoff: f32) -> f32 {
+    if cos_theta <= cutoff.cos() {
+        return 0.0;
+    }
+    if cos_theta >= beam_width.cos() {
+        return 1.0;
+    }
+    ((cutoff - cos_theta.clamp(-1.0, 1.0).acos()) / (cutoff - beam_width)).clamp(0.0, 1.0)
+}
+
+/// The integral of the spot falloff over the sphere of directions (its power per unit
+/// intensity): 2 pi [1 - cos b + ((c - b) cos b + sin b - sin c) / (c - b)], b the beam width
+/// and c the cutoff (2 pi (1 - cos c) when they are equal).
+pub fn spot_solid_angle(beam_width: f32, cutoff: f32) -> f32 {
+    let (b, c) = (beam_width as f64, cutoff as f64);
+    let ramp = if c - b > 1e-9 {
+        ((c - b) * b.cos() + b.sin() - c.sin()) / (c - b)
+    } else {
+        0.0
+    };
+    (2.0 * std::f64::consts::PI * (1.0 - b.cos() + ramp)) as f32
+}
+
 impl Light {
-    /// Total emitted power in W: 4 pi I for a point light, pi A L for a one-sided area light.
+    /// Total emitted power in W: 4 pi I for a point light, I times the falloff's solid angle
+    /// for a spot light, pi A L for a one-sided area light.
     pub fn power(&self) -> Rgb {
         match self {
             Light::Point { intensity, .. } => 4.0 * PI * *intensity,
+            Light::Spot {
+                intensity,
+                beam_width,
+                cutoff,
+                ..
+            } => *intensity * spot_solid_angle(*beam_width, *cutoff),
             Light::Area { area, radiance, .. } => PI * *area * *radiance,
         }
     }
 
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. })
+        matches!(self, Light::Point { .. } | Light::Spot { .. })
+    }
+
+    /// Where a delta light is (a point or spot light), for the scene's bounds.
+    pub fn position(&self) -> Option<Vec3> {
+        match self {
+            Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
+            Light::Area { .. } => None,
+        }
     }
 
     /// Samples a direction from `x` towards the light.
@@ -91,6 +146,31 @@ impl Light {
                     wi: d / dist,
                     dist,
                     li: *intensity / dist2,
+                    pdf: 1.0,
+                    delta: true,
+                    p: *position,
+                    n: Vec3::ZERO,
+                })
+            }
+            Light::Spot {
+                position,
+                axis,
+                intensity,
+                beam_width,
+                cutoff,
+            } => {
+                let d = *position - x;
+                let dist2 = d.length_squared();
+                if dist2 == 0.0 {
+                    return None;
+                }
+                let dist = dist2.sqrt();
+                let wi = d / dist;
+                let falloff = spot_falloff(axis.dot(-wi), *beam_width, *cutoff);
+                Some(LightSample {
+                    wi,
+                    dist,
+                    li: *intensity * (falloff / dist2),
                     pdf: 1.0,
                     delta: true,
                     p: *position,
@@ -162,7 +242,7 @@ impl Light {
     /// this light. Needed for MIS when a BSDF-sampled ray hits the light.
     pub fn pdf_li(&self, x: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
-            Light::Point { .. } => 0.0,
+            Light::Point { .. } | Light::Spot { .. } => 0.0,
             Light::Area { shapes, area, .. } => {
                 if let Shape::Sphere { center, radius } = shapes[0]
                     && shapes.len() == 1
@@ -202,6 +282,24 @@ impl Light {
                 n: Vec3::ZERO,
                 flux: 4.0 * PI * *intensity,
             },
+            Light::Spot {
+                position,
+                axis,
+                intensity,
+                beam_width,
+                cutoff,
+            } => {
+                // Uniform in the cone of the cutoff, weighted by the falloff: I f / pdf.
+                let cos_max = cutoff.cos();
+                let dir = to_world(uniform_cone(u_dir, cos_max), *axis);
+                let falloff = spot_falloff(axis.dot(dir), *beam_width, *cutoff);
+                EmittedRay {
+                    origin: *position,
+                    dir,
+                    n: Vec3::ZERO,
+                    flux: *intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
+                }
+            }
             Light::Area {
                 shapes,
                 by_area,

@@ -35,7 +35,7 @@ const SECTIONS: &[&str] = &[
 ];
 const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "null"];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
-const LIGHT_TYPES: &[&str] = &["point"];
+const LIGHT_TYPES: &[&str] = &["point", "spot"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
 /// Collects the bags of a load so that unused keys can be listed at the end.
@@ -135,11 +135,9 @@ impl Scene {
             lo = lo.min(b.min.into());
             hi = hi.max(b.max.into());
         }
-        for l in &lights {
-            if let Light::Point { position, .. } = l {
-                lo = lo.min(*position);
-                hi = hi.max(*position);
-            }
+        for position in lights.iter().filter_map(Light::position) {
+            lo = lo.min(position);
+            hi = hi.max(position);
         }
         if !lo.is_finite() {
             lo = camera.position;
@@ -288,6 +286,55 @@ fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
     };
     ld.done(&t);
     Ok(film)
+}
+
+/// A `type = "spot"` light (Mitsuba's `spot`): `intensity` (W/sr at the centre, default 1),
+/// the axis by `look_at` (a point) or `direction`, `cutoff_angle` (degrees from the axis,
+/// default 20) and `beam_width` (default 3/4 of the cutoff).
+fn read_spot(l: &Properties<'_>, position: Vec3) -> Result<Light> {
+    let intensity = l.rgb("intensity", Rgb::ONE)?;
+    let axis = match (l.vec3_opt("look_at")?, l.vec3_opt("direction")?) {
+        (Some(target), None) => target - position,
+        (None, Some(d)) => d,
+        (Some(_), Some(_)) => {
+            return Err(l.error("direction", "give either look_at or direction, not both"));
+        }
+        (None, None) => {
+            return Err(l.error(
+                "look_at",
+                "missing; a spot light needs look_at = [x, y, z] or direction = [x, y, z]",
+            ));
+        }
+    };
+    if axis.length_squared() == 0.0 {
+        let key = if l.has("look_at") {
+            "look_at"
+        } else {
+            "direction"
+        };
+        return Err(l.error(key, "gives no direction (zero length)"));
+    }
+    let cutoff = l.f32("cutoff_angle", 20.0)?;
+    if !(cutoff > 0.0 && cutoff <= 90.0) {
+        return Err(l.error(
+            "cutoff_angle",
+            format!("must be in (0, 90] degrees, found {cutoff}"),
+        ));
+    }
+    let beam_width = l.f32("beam_width", 0.75 * cutoff)?;
+    if !(beam_width >= 0.0 && beam_width <= cutoff) {
+        return Err(l.error(
+            "beam_width",
+            format!("must be in [0, cutoff_angle = {cutoff}] degrees, found {beam_width}"),
+        ));
+    }
+    Ok(Light::Spot {
+        position,
+        axis: axis.normalize(),
+        intensity,
+        beam_width: beam_width.to_radians(),
+        cutoff: cutoff.to_radians(),
+    })
 }
 
 /// `[film] filter`: "box" (the default), "tent", "gaussian", or a table with `type` and the
@@ -698,7 +745,7 @@ fn read_point_lights(
                 format!("missing; expected one of: {}", LIGHT_TYPES.join(", ")),
             )
         })?;
-        if ty != "point" {
+        if !LIGHT_TYPES.contains(&ty) {
             return Err(l.error(
                 "type",
                 format!(
@@ -708,6 +755,11 @@ fn read_point_lights(
             ));
         }
         let position = l.vec3_required("position")?;
+        if ty == "spot" {
+            lights.push(read_spot(&l, position)?);
+            ld.done(&l);
+            continue;
+        }
         let intensity = match (l.rgb_opt("intensity")?, l.rgb_opt("power")?) {
             (Some(i), None) => i,
             (None, Some(p)) => p / (4.0 * std::f32::consts::PI),

@@ -1,0 +1,155 @@
+//! The spot light (Mitsuba's `spot`): its falloff, its power, its photons and its light on a
+//! plane against the formulas, and path and photon mapping agreeing under it.
+
+use foton_core::Rgb;
+use foton_core::light::{Light, spot_falloff, spot_solid_angle};
+use foton_core::sampling::Rng;
+use foton_tests::stats::{Tolerance, assert_blocks_agree};
+use foton_tests::{header, render_toml};
+use glam::{Vec2, Vec3};
+use std::f64::consts::PI;
+
+fn spot() -> Light {
+    Light::Spot {
+        position: Vec3::new(0.0, 2.0, 0.0),
+        axis: Vec3::NEG_Y,
+        intensity: Rgb::new(3.0, 2.0, 1.0),
+        beam_width: 15f32.to_radians(),
+        cutoff: 30f32.to_radians(),
+    }
+}
+
+/// Full intensity inside the beam, none past the cutoff, linear in the angle between.
+#[test]
+fn falloff_is_linear_in_the_angle_between_beam_and_cutoff() {
+    let (b, c) = (15f32.to_radians(), 30f32.to_radians());
+    let f = |degrees: f32| spot_falloff(degrees.to_radians().cos(), b, c);
+    assert_eq!(f(0.0), 1.0);
+    assert_eq!(f(14.9), 1.0);
+    assert!((f(22.5) - 0.5).abs() < 1e-4, "{}", f(22.5));
+    assert!((f(18.75) - 0.75).abs() < 1e-4, "{}", f(18.75));
+    assert_eq!(f(30.1), 0.0);
+    assert_eq!(f(120.0), 0.0);
+}
+
+/// Power = I times the falloff's integral over the sphere: the closed form against a
+/// quadrature, and the mean flux of the photons the light emits against it.
+#[test]
+fn power_is_the_falloff_integral_and_photons_carry_it() {
+    let (b, c) = (15f32.to_radians(), 30f32.to_radians());
+    let n = 200_000;
+    let quadrature: f64 = (0..n)
+        .map(|i| {
+            let theta = (i as f64 + 0.5) / n as f64 * PI;
+            spot_falloff(theta.cos() as f32, b, c) as f64 * 2.0 * PI * theta.sin() * PI / n as f64
+        })
+        .sum();
+    let closed = spot_solid_angle(b, c) as f64;
+    assert!(
+        (closed - quadrature).abs() < 1e-4 * closed,
+        "{closed} against {quadrature}"
+    );
+    let light = spot();
+    let power = light.power();
+    assert!((power.x as f64 - 3.0 * closed).abs() < 1e-4 * power.x as f64);
+
+    let mut rng = Rng::new(&[5]);
+    let photons = 400_000;
+    let mut sum = glam::DVec3::ZERO;
+    for _ in 0..photons {
+        let e = light.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+        assert!(e.dir.dot(Vec3::NEG_Y) >= 30f32.to_radians().cos() - 1e-5);
+        sum += e.flux.as_dvec3();
+    }
+    let mean = sum / photons as f64;
+    let rel = ((mean - power.as_dvec3()) / power.as_dvec3())
+        .abs()
+        .max_element();
+    // The flux varies by at most a factor 1 / (fraction of the cone's solid angle at full
+    // falloff): the mean of 400k is within 0.5%.
+    assert!(rel < 5e-3, "mean photon flux {mean} against power {power}");
+}
+
+/// Irradiance on the plane y = 0 from the spot 2 above it: E = I f(theta) cos(theta) / r^2,
+/// from the light sample the integrators use.
+#[test]
+fn irradiance_on_a_plane_is_i_falloff_cos_over_r2() {
+    let light = spot();
+    for x in [0.0f32, 0.4, 0.7, 0.9, 1.1, 1.3] {
+        let p = Vec3::new(x, 0.0, 0.3);
+        let ls = light.sample_li(p, Vec2::splat(0.5), 0.5).unwrap();
+        let d = Vec3::new(0.0, 2.0, 0.0) - p;
+        let cos = d.normalize().dot(Vec3::Y);
+        let want = Rgb::new(3.0, 2.0, 1.0)
+            * spot_falloff(cos, 15f32.to_radians(), 30f32.to_radians())
+            * cos
+            / d.length_squared();
+        let got = ls.li * ls.wi.dot(Vec3::Y);
+        assert!(
+            (got - want).abs().max_element() < 1e-5,
+            "x = {x}: {got} against {want}"
+        );
+    }
+}
+
+/// A white floor under a spot light in an open scene: `photon` with direct light from the
+/// photons (the spot's emission sampler) and `path` (its light sample) agree by blocks.
+/// Tolerance: 5% (the photon estimate's blur over the beam's edge and its noise at 400k
+/// photons), 4 standard errors, and a floor for the dark blocks outside the cone.
+#[test]
+fn path_and_photon_agree_under_a_spot_light() {
+    let scene = |integrator: &str, spp: u32| {
+        header(integrator, spp, 2, 32, 32)
+            + r#"
+[camera]
+position = [0.0, 3.0, 2.5]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 50.0
+
+[integrators.photon]
+global_photons = 400000
+caustic_photons = 0
+k = 80
+max_radius = 0.08
+direct = "photons"
+
+[materials.white]
+type = "diffuse"
+reflectance = [0.8, 0.8, 0.8]
+
+[[shapes]]
+type = "quad"
+origin = [-3.0, 0.0, -3.0]
+u = [0.0, 0.0, 6.0]
+v = [6.0, 0.0, 0.0]
+material = "white"
+
+[[lights]]
+type = "spot"
+position = [0.0, 2.0, 0.0]
+look_at = [0.3, 0.0, 0.0]
+intensity = [3.0, 3.0, 3.0]
+cutoff_angle = 30.0
+beam_width = 15.0
+"#
+    };
+    let path = render_toml("spot-path", &scene("path", 256), &[], 2);
+    let photon = render_toml("spot-photon", &scene("photon", 16), &[], 2);
+    assert!(
+        path.mean().x > 0.01,
+        "the spot lights the floor: {}",
+        path.mean()
+    );
+    assert_blocks_agree(
+        "photon against path under a spot light",
+        &photon,
+        &path,
+        4,
+        Tolerance {
+            rel: 0.05,
+            z: 4.0,
+            floor: 0.01 * path.mean().x as f64,
+        },
+    );
+}
