@@ -3,7 +3,7 @@
 //! Every table is read through a [`Properties`] bag, so every error names file, line, key path
 //! and what was expected, and every key that was never read is reported as unused.
 
-use super::mesh::load_obj;
+use super::mesh::load_mesh;
 use super::volumes::{locate_medium, medium_interfaces};
 use super::{BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene};
 use crate::Rgb;
@@ -673,7 +673,7 @@ fn read_shapes(
             "mesh" => {
                 let file = s.string_required("file")?;
                 let transform = read_transform(&s, ld)?;
-                let (tris, is_closed) = load_obj(&s, &ld.dir.join(file), transform)?;
+                let (tris, is_closed) = load_mesh(&s, &ld.dir.join(file), transform)?;
                 closed = is_closed;
                 tris
             }

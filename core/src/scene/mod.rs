@@ -1,10 +1,11 @@
 //! The scene: what a scene file describes, as the integrators use it, and the queries they
 //! make of it (closest hits, materials, lights). The rest of it, one concept per file:
-//! [`load`]ing a TOML file, [`mesh`]es (OBJ), [`volumes`] (which medium is where, from how
+//! [`load`]ing a TOML file, [`mesh`]es (OBJ, [`ply`]), [`volumes`] (which medium is where, from how
 //! closed shapes nest) and [`visibility`] (shadow rays, through null boundaries and media).
 
 mod load;
 pub mod mesh;
+pub mod ply;
 mod visibility;
 mod volumes;
 
