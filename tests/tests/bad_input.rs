@@ -364,9 +364,9 @@ fn unknown_light_type_lists_the_types() {
     assert_bad_value(
         "unknown-light",
         "type = \"point\"",
-        "type = \"spot\"",
+        "type = \"sun\"",
         "lights[0].type",
-        &["unknown light type \"spot\"", "expected one of: point"],
+        &["unknown light type \"sun\"", "expected one of: point, spot"],
     );
 }
 

@@ -153,3 +153,48 @@ beam_width = 15.0
         },
     );
 }
+
+/// Bad spot parameters are errors naming the key and what was expected.
+#[test]
+fn bad_spot_parameters_are_clear_errors() {
+    let base = header("path", 1, 1, 4, 4)
+        + "[camera]\nposition = [0.0, 0.0, 3.0]\nlook_at = [0.0, 0.0, 0.0]\n"
+        + "[[lights]]\ntype = \"spot\"\nposition = [0.0, 2.0, 0.0]\n";
+    for (extra, key, words) in [
+        ("", "lights[0].look_at", "needs look_at"),
+        (
+            "look_at = [0.0, 0.0, 0.0]\ndirection = [0.0, -1.0, 0.0]\n",
+            "lights[0].direction",
+            "not both",
+        ),
+        (
+            "direction = [0.0, 0.0, 0.0]\n",
+            "lights[0].direction",
+            "zero length",
+        ),
+        (
+            "direction = [0.0, -1.0, 0.0]\ncutoff_angle = 120.0\n",
+            "lights[0].cutoff_angle",
+            "(0, 90]",
+        ),
+        (
+            "direction = [0.0, -1.0, 0.0]\ncutoff_angle = 20.0\nbeam_width = 25.0\n",
+            "lights[0].beam_width",
+            "[0, cutoff_angle = 20]",
+        ),
+    ] {
+        let dir = foton_tests::temp_dir("bad-spot");
+        let path = foton_tests::write(&dir, "scene.toml", &(base.clone() + extra));
+        let run = foton_tests::foton_with_plugins(&["check", path.to_str().unwrap()]);
+        assert_eq!(run.code, 1, "{extra}: {}", run.stderr);
+        assert!(
+            run.stderr.contains(key)
+                && run.stderr.contains(words)
+                && run.stderr.contains("scene.toml:"),
+            "{extra}: {}",
+            run.stderr
+        );
+        assert!(!run.stderr.contains("panicked"));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
