@@ -28,6 +28,16 @@ pub enum Light {
         beam_width: f32,
         cutoff: f32,
     },
+    /// Parallel light from infinitely far (Mitsuba's `directional`, a sun), travelling along
+    /// `direction` and giving `irradiance` (W/m^2) to a surface facing it. Its photons leave a
+    /// disc of the scene's bounding sphere (`centre`, `radius`, set once the scene is loaded),
+    /// as pbrt's distant light's do.
+    Directional {
+        direction: Vec3,
+        irradiance: Rgb,
+        centre: Vec3,
+        radius: f32,
+    },
     Area {
         /// The emitting primitives (one for a sphere or quad, the triangles of a mesh).
         shapes: Vec<Shape>,
@@ -113,19 +123,34 @@ impl Light {
                 cutoff,
                 ..
             } => *intensity * spot_solid_angle(*beam_width, *cutoff),
+            Light::Directional {
+                irradiance, radius, ..
+            } => *irradiance * (PI * radius * radius),
             Light::Area { area, radiance, .. } => PI * *area * *radiance,
         }
     }
 
     pub fn is_delta(&self) -> bool {
-        matches!(self, Light::Point { .. } | Light::Spot { .. })
+        matches!(
+            self,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. }
+        )
+    }
+
+    /// For a light at infinity: the scene's bounding sphere, which its power (the flux
+    /// through the sphere's disc) and its photons' origins need. Other lights ignore it.
+    pub fn fit_to_scene(&mut self, scene_centre: Vec3, scene_radius: f32) {
+        if let Light::Directional { centre, radius, .. } = self {
+            *centre = scene_centre;
+            *radius = scene_radius;
+        }
     }
 
     /// Where a delta light is (a point or spot light), for the scene's bounds.
     pub fn position(&self) -> Option<Vec3> {
         match self {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-            Light::Area { .. } => None,
+            Light::Directional { .. } | Light::Area { .. } => None,
         }
     }
 
@@ -174,6 +199,25 @@ impl Light {
                     pdf: 1.0,
                     delta: true,
                     p: *position,
+                    n: Vec3::ZERO,
+                })
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+                centre,
+                radius,
+            } => {
+                // The shadow ray ends past the scene's bounding sphere.
+                let wi = -*direction;
+                let dist = 2.0 * radius + x.distance(*centre);
+                Some(LightSample {
+                    wi,
+                    dist,
+                    li: *irradiance,
+                    pdf: 1.0,
+                    delta: true,
+                    p: x + wi * dist,
                     n: Vec3::ZERO,
                 })
             }
@@ -242,7 +286,7 @@ impl Light {
     /// this light. Needed for MIS when a BSDF-sampled ray hits the light.
     pub fn pdf_li(&self, x: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
-            Light::Point { .. } | Light::Spot { .. } => 0.0,
+            Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
             Light::Area { shapes, area, .. } => {
                 if let Shape::Sphere { center, radius } = shapes[0]
                     && shapes.len() == 1
@@ -298,6 +342,22 @@ impl Light {
                     dir,
                     n: Vec3::ZERO,
                     flux: *intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
+                }
+            }
+            Light::Directional {
+                direction,
+                irradiance,
+                centre,
+                radius,
+            } => {
+                // A uniform point of the disc facing the light, just outside the sphere.
+                let d = crate::sampling::concentric_disc(u_pos) * *radius;
+                let (s, t) = crate::sampling::basis(*direction);
+                EmittedRay {
+                    origin: *centre - *direction * *radius + s * d.x + t * d.y,
+                    dir: *direction,
+                    n: Vec3::ZERO,
+                    flux: *irradiance * (PI * radius * radius),
                 }
             }
             Light::Area {

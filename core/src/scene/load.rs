@@ -35,7 +35,7 @@ const SECTIONS: &[&str] = &[
 ];
 const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "null"];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
-const LIGHT_TYPES: &[&str] = &["point", "spot"];
+const LIGHT_TYPES: &[&str] = &["point", "spot", "directional"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
 /// Collects the bags of a load so that unused keys can be listed at the end.
@@ -125,9 +125,6 @@ impl Scene {
                 file.display()
             ));
         }
-        let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
-        let light_distribution = Distribution1D::new(&powers);
-
         let mut lo = Vec3::splat(f32::INFINITY);
         let mut hi = Vec3::splat(f32::NEG_INFINITY);
         for p in &prims {
@@ -143,6 +140,17 @@ impl Scene {
             lo = camera.position;
             hi = camera.position;
         }
+        // A light at infinity covers the scene's bounding sphere (the camera included), which
+        // its power and photons need.
+        let (centre, radius) = {
+            let (l, h) = (lo.min(camera.position), hi.max(camera.position));
+            (0.5 * (l + h), (0.5 * (h - l).length()).max(1e-3))
+        };
+        for light in &mut lights {
+            light.fit_to_scene(centre, radius);
+        }
+        let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
+        let light_distribution = Distribution1D::new(&powers);
 
         let accel = Accel::build(prims);
         let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
@@ -286,6 +294,22 @@ fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
     };
     ld.done(&t);
     Ok(film)
+}
+
+/// A `type = "directional"` light (Mitsuba's `directional`): `direction` it travels in, and
+/// the `irradiance` (W/m^2) it gives a surface facing it.
+fn read_directional(l: &Properties<'_>) -> Result<Light> {
+    let direction = l.vec3_required("direction")?;
+    if direction.length_squared() == 0.0 {
+        return Err(l.error("direction", "gives no direction (zero length)"));
+    }
+    let irradiance = l.rgb("irradiance", Rgb::ONE)?;
+    Ok(Light::Directional {
+        direction: direction.normalize(),
+        irradiance,
+        centre: Vec3::ZERO,
+        radius: 0.0,
+    })
 }
 
 /// A `type = "spot"` light (Mitsuba's `spot`): `intensity` (W/sr at the centre, default 1),
@@ -753,6 +777,11 @@ fn read_point_lights(
                     LIGHT_TYPES.join(", ")
                 ),
             ));
+        }
+        if ty == "directional" {
+            lights.push(read_directional(&l)?);
+            ld.done(&l);
+            continue;
         }
         let position = l.vec3_required("position")?;
         if ty == "spot" {
