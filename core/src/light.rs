@@ -38,6 +38,14 @@ pub enum Light {
         centre: Vec3,
         radius: f32,
     },
+    /// Constant radiance from every direction at infinity (Mitsuba's `constant`, a uniform
+    /// sky). Rays leaving the scene see it; its photons leave the disc of the scene's bounding
+    /// sphere facing their direction (`centre`, `radius`, set once the scene is loaded).
+    Constant {
+        radiance: Rgb,
+        centre: Vec3,
+        radius: f32,
+    },
     Area {
         /// The emitting primitives (one for a sphere or quad, the triangles of a mesh).
         shapes: Vec<Shape>,
@@ -126,6 +134,10 @@ impl Light {
             Light::Directional {
                 irradiance, radius, ..
             } => *irradiance * (PI * radius * radius),
+            // The flux through the bounding sphere's disc from every direction: 4 pi L pi R^2.
+            Light::Constant {
+                radiance, radius, ..
+            } => *radiance * (4.0 * PI * PI * radius * radius),
             Light::Area { area, radiance, .. } => PI * *area * *radiance,
         }
     }
@@ -140,7 +152,9 @@ impl Light {
     /// For a light at infinity: the scene's bounding sphere, which its power (the flux
     /// through the sphere's disc) and its photons' origins need. Other lights ignore it.
     pub fn fit_to_scene(&mut self, scene_centre: Vec3, scene_radius: f32) {
-        if let Light::Directional { centre, radius, .. } = self {
+        if let Light::Directional { centre, radius, .. } | Light::Constant { centre, radius, .. } =
+            self
+        {
             *centre = scene_centre;
             *radius = scene_radius;
         }
@@ -150,7 +164,7 @@ impl Light {
     pub fn position(&self) -> Option<Vec3> {
         match self {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-            Light::Directional { .. } | Light::Area { .. } => None,
+            Light::Directional { .. } | Light::Constant { .. } | Light::Area { .. } => None,
         }
     }
 
@@ -221,6 +235,24 @@ impl Light {
                     n: Vec3::ZERO,
                 })
             }
+            Light::Constant {
+                radiance,
+                centre,
+                radius,
+            } => {
+                // Uniform over the sphere of directions; the shadow ray ends beyond the scene.
+                let wi = crate::sampling::uniform_sphere(u);
+                let dist = 2.0 * radius + x.distance(*centre);
+                Some(LightSample {
+                    wi,
+                    dist,
+                    li: *radiance,
+                    pdf: crate::sampling::UNIFORM_SPHERE_PDF,
+                    delta: false,
+                    p: x + wi * dist,
+                    n: Vec3::ZERO,
+                })
+            }
             Light::Area {
                 shapes,
                 by_area,
@@ -287,6 +319,7 @@ impl Light {
     pub fn pdf_li(&self, x: Vec3, p: Vec3, n: Vec3) -> f32 {
         match self {
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
+            Light::Constant { .. } => crate::sampling::UNIFORM_SPHERE_PDF,
             Light::Area { shapes, area, .. } => {
                 if let Shape::Sphere { center, radius } = shapes[0]
                     && shapes.len() == 1
@@ -301,6 +334,16 @@ impl Light {
                 }
                 d.length_squared() / (cos_l * *area)
             }
+        }
+    }
+
+    /// Radiance arriving from infinitely far along -`dir` (a ray travelling along `dir` that
+    /// leaves the scene): an environment light's, zero for the others.
+    #[inline]
+    pub fn environment(&self, _dir: Vec3) -> Rgb {
+        match self {
+            Light::Constant { radiance, .. } => *radiance,
+            _ => Rgb::ZERO,
         }
     }
 
@@ -358,6 +401,23 @@ impl Light {
                     dir: *direction,
                     n: Vec3::ZERO,
                     flux: *irradiance * (PI * radius * radius),
+                }
+            }
+            Light::Constant {
+                radiance,
+                centre,
+                radius,
+            } => {
+                // A uniform direction, then a uniform point of the disc facing it: L cos /
+                // (1/(pi R^2) x 1/(4 pi)) with cos = 1 on the disc.
+                let dir = -crate::sampling::uniform_sphere(u_dir);
+                let d = crate::sampling::concentric_disc(u_pos) * *radius;
+                let (s, t) = crate::sampling::basis(dir);
+                EmittedRay {
+                    origin: *centre - dir * *radius + s * d.x + t * d.y,
+                    dir,
+                    n: Vec3::ZERO,
+                    flux: *radiance * (4.0 * PI * PI * radius * radius),
                 }
             }
             Light::Area {

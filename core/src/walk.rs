@@ -250,6 +250,9 @@ pub fn walk_to_diffuse(
             }
         }
         let Some(hit) = seg.hit else {
+            if let Some((_, le)) = scene.escaped(seg.ray.dir) {
+                emitted += beta * le;
+            }
             break;
         };
         distance += hit.p.distance(seg.ray.origin);

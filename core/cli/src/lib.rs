@@ -491,13 +491,31 @@ fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
         s.objects.len(),
         s.accel.primitives().len()
     );
-    let points = s.lights.iter().filter(|l| l.is_delta()).count();
+    use foton_core::light::Light;
+    let count = |f: fn(&Light) -> bool| s.lights.iter().filter(|l| f(l)).count();
+    let kinds = [
+        ("point", count(|l| matches!(l, Light::Point { .. }))),
+        ("spot", count(|l| matches!(l, Light::Spot { .. }))),
+        (
+            "directional",
+            count(|l| matches!(l, Light::Directional { .. })),
+        ),
+        (
+            "environment",
+            count(|l| matches!(l, Light::Constant { .. })),
+        ),
+        ("area", count(|l| matches!(l, Light::Area { .. }))),
+    ];
+    let listed: Vec<String> = kinds
+        .iter()
+        .filter(|(kind, n)| *n > 0 || matches!(*kind, "point" | "area"))
+        .map(|(kind, n)| format!("{n} {kind}"))
+        .collect();
     let power = s.total_power();
     let _ = writeln!(
         out,
-        "lights     {} point, {} area; total power [{:.4}, {:.4}, {:.4}] W",
-        points,
-        s.lights.len() - points,
+        "lights     {}; total power [{:.4}, {:.4}, {:.4}] W",
+        listed.join(", "),
         power.x,
         power.y,
         power.z

@@ -35,7 +35,7 @@ const SECTIONS: &[&str] = &[
 ];
 const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "null"];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
-const LIGHT_TYPES: &[&str] = &["point", "spot", "directional"];
+const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
 /// Collects the bags of a load so that unused keys can be listed at the end.
@@ -149,6 +149,10 @@ impl Scene {
         for light in &mut lights {
             light.fit_to_scene(centre, radius);
         }
+        let environment = lights
+            .iter()
+            .position(|l| matches!(l, Light::Constant { .. }))
+            .map(|i| i as u32);
         let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
         let light_distribution = Distribution1D::new(&powers);
 
@@ -198,6 +202,7 @@ impl Scene {
             objects,
             lights,
             light_distribution,
+            environment,
             accel,
             medium,
             interfaces,
@@ -777,6 +782,21 @@ fn read_point_lights(
                     LIGHT_TYPES.join(", ")
                 ),
             ));
+        }
+        if ty == "constant" {
+            if lights.iter().any(|l| matches!(l, Light::Constant { .. })) {
+                return Err(l.error(
+                    "type",
+                    "a scene has at most one constant (environment) light",
+                ));
+            }
+            lights.push(Light::Constant {
+                radiance: l.rgb("radiance", Rgb::ONE)?,
+                centre: Vec3::ZERO,
+                radius: 0.0,
+            });
+            ld.done(&l);
+            continue;
         }
         if ty == "directional" {
             lights.push(read_directional(&l)?);

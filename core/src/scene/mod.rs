@@ -95,6 +95,8 @@ pub struct Scene {
     pub lights: Vec<Light>,
     /// Chooses a light proportionally to its power.
     pub light_distribution: Distribution1D,
+    /// The environment light (`constant`), seen by rays that leave the scene.
+    pub environment: Option<u32>,
     pub accel: Accel,
     /// The medium filling free space, if any.
     pub medium: Option<u32>,
@@ -188,6 +190,14 @@ impl Scene {
     #[inline]
     pub fn light_pmf(&self, i: usize) -> f32 {
         self.light_distribution.pmf(i)
+    }
+
+    /// Radiance arriving along a ray travelling along `dir` that leaves the scene, and the
+    /// environment light's index (for MIS).
+    #[inline]
+    pub fn escaped(&self, dir: Vec3) -> Option<(u32, Rgb)> {
+        let id = self.environment?;
+        Some((id, self.lights[id as usize].environment(dir)))
     }
 
     /// Total emitted power of all lights (W).

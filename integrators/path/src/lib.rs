@@ -52,7 +52,7 @@ use foton_core::render::render_pixels;
 use foton_core::sampling::{Sampler, power_heuristic};
 use foton_core::scene::Scene;
 use foton_core::walk::{RayWalk, Reached};
-use foton_core::{Result, Rgb, film::Film};
+use foton_core::{Result, Rgb, Vec3, film::Film};
 
 pub struct PathTracer {
     max_depth: u32,
@@ -126,6 +126,17 @@ impl PathTracer {
             }
 
             let Some(hit) = seg.hit else {
+                // ---- The environment, weighted against light sampling as an emitter ----
+                if let Some((light_id, le)) = scene.escaped(seg.ray.dir) {
+                    if specular {
+                        radiance += beta * le;
+                    } else {
+                        let light = &scene.lights[light_id as usize];
+                        let pdf_light = scene.light_pmf(light_id as usize)
+                            * light.pdf_li(prev_p, prev_p + seg.ray.dir, Vec3::ZERO);
+                        radiance += beta * le * power_heuristic(prev_pdf, pdf_light);
+                    }
+                }
                 break;
             };
             let material = match walk.reach(scene, &hit) {

@@ -1,0 +1,101 @@
+//! The constant environment light (Mitsuba's `constant`): a diffuse sphere inside a constant
+//! environment L shows rho L (it sees L over its whole upper hemisphere everywhere), the
+//! background shows L, for every integrator; the photons it emits deliver pi L to every point
+//! of the sphere.
+
+use foton_core::scene::Scene;
+use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, light_media, trace_one};
+use foton_tests::{header, region_mean, render_toml, temp_dir, write};
+use glam::{DVec3, Vec3};
+
+const L: [f32; 3] = [1.0, 0.8, 0.6];
+
+fn scene(integrator: &str, spp: u32) -> String {
+    header(integrator, spp, 4, 32, 32)
+        + r#"
+[camera]
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 40.0
+
+[integrators.photon]
+global_photons = 200000
+caustic_photons = 0
+k = 50
+
+[integrators.sppm]
+iterations = 16
+photons_per_iteration = 50000
+
+[integrators.vpm]
+global_photons = 200000
+caustic_photons = 0
+
+[materials.grey]
+type = "diffuse"
+reflectance = [0.5, 0.5, 0.5]
+
+[[shapes]]
+type = "sphere"
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+material = "grey"
+
+[[lights]]
+type = "constant"
+radiance = [1.0, 0.8, 0.6]
+"#
+}
+
+/// The sphere's centre (8x8 pixels) is rho L = [0.5, 0.4, 0.3] within 3% (path: 64 spp of
+/// MIS between the environment's samples and the BSDF's; the photon mappers' shadow rays);
+/// the image's corners see the environment itself, L exactly.
+#[test]
+fn a_diffuse_sphere_in_a_constant_environment_shows_rho_l() {
+    let rho_l = Vec3::from(L) * 0.5;
+    for (integrator, spp) in [("path", 64), ("photon", 16), ("sppm", 1), ("vpm", 16)] {
+        let film = render_toml("environment", &scene(integrator, spp), &[], 2);
+        let (centre, _) = region_mean(&film, 12, 12, 20, 20);
+        let rel = ((centre - rho_l) / rho_l).abs().max_element();
+        assert!(
+            rel < 0.03,
+            "{integrator}: sphere {centre} against rho L {rho_l} ({rel})"
+        );
+        assert_eq!(film.pixel(0, 0), Vec3::from(L), "{integrator}: background");
+    }
+}
+
+/// The environment's photons: those whose first hit is the unit sphere carry, in all, the
+/// irradiance pi L times its area 4 pi (every point of a convex shape sees the whole
+/// environment above it). Binomial noise of the share of photons that hit it: 4 sigma.
+#[test]
+fn environment_photons_deliver_pi_l_everywhere() {
+    let dir = temp_dir("environment-photons");
+    let path = write(&dir, "scene.toml", &scene("photon", 1));
+    let scene = Scene::load(&path, &[]).unwrap();
+    let _ = std::fs::remove_dir_all(dir);
+    let power = scene.lights[0].power().as_dvec3();
+    let opts = TraceOptions {
+        photons: 200_000,
+        max_depth: 1,
+        seed: 8,
+        stream: STREAM_GLOBAL,
+        stop_at_diffuse: true,
+    };
+    let media = light_media(&scene).unwrap();
+    let mut total = DVec3::ZERO;
+    for i in 0..opts.photons {
+        trace_one(&scene, &opts, &media, i, |p, _, _| {
+            total += p.power().as_dvec3()
+        });
+    }
+    let want = Vec3::from(L).as_dvec3() * (4.0 * std::f64::consts::PI.powi(2));
+    let q = want.x / power.x;
+    let sigma = ((1.0 - q) / (q * opts.photons as f64)).sqrt();
+    let rel = ((total - want) / want).abs().max_element();
+    assert!(
+        rel < 4.0 * sigma,
+        "{total} against {want} ({rel}, sigma {sigma})"
+    );
+}
