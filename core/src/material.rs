@@ -15,6 +15,10 @@ pub enum Material {
     /// Smooth dielectric interface with Fresnel reflection and refraction; `ior` is the index
     /// of the side the normal points away from (inside), relative to the outside.
     Dielectric { ior: f32 },
+    /// A thin sheet of glass (Mitsuba's `thindielectric`): light is reflected or passes
+    /// straight through, with the Fresnel reflectance of the sheet's two faces and their
+    /// interreflections, R' = 2R / (1 + R). It bounds no volume.
+    ThinDielectric { ior: f32 },
     /// An invisible boundary (of a medium): rays cross it without scattering.
     Null,
 }
@@ -74,7 +78,10 @@ impl Material {
     /// True when the BSDF is a sum of Dirac deltas (mirror, smooth glass): it cannot be
     /// evaluated for a given pair of directions, only sampled. Photons are never stored there.
     pub fn is_delta(&self) -> bool {
-        matches!(self, Material::Mirror { .. } | Material::Dielectric { .. })
+        matches!(
+            self,
+            Material::Mirror { .. } | Material::Dielectric { .. } | Material::ThinDielectric { .. }
+        )
     }
 
     pub fn is_null(&self) -> bool {
@@ -162,6 +169,27 @@ impl Material {
                     wi,
                     weight: Rgb::splat(scale),
                     pdf: 1.0 - f,
+                    delta: true,
+                })
+            }
+            Material::ThinDielectric { ior } => {
+                // Air-glass-air: the same reflectance from either side; the infinite series of
+                // reflections inside the sheet sums to R' = R + T^2 R / (1 - R^2) = 2R / (1 + R).
+                let r = fresnel_dielectric(cos_o.abs(), ior);
+                let r = 2.0 * r / (1.0 + r);
+                if uc < r {
+                    return Some(BsdfSample {
+                        wi: reflect(wo, n),
+                        weight: Rgb::ONE,
+                        pdf: r,
+                        delta: true,
+                    });
+                }
+                // Straight through: the two refractions undo each other (no 1/eta^2 either).
+                Some(BsdfSample {
+                    wi: -wo,
+                    weight: Rgb::ONE,
+                    pdf: 1.0 - r,
                     delta: true,
                 })
             }

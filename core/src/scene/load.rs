@@ -33,7 +33,7 @@ const SECTIONS: &[&str] = &[
     "lights",
     "scene",
 ];
-const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "null"];
+const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "thindielectric", "null"];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
 const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
@@ -511,6 +511,13 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                     return Err(m.error("ior", format!("must be positive, found {ior}")));
                 }
                 Material::Dielectric { ior }
+            }
+            "thindielectric" => {
+                let ior = m.f32("ior", 1.5)?;
+                if ior <= 0.0 {
+                    return Err(m.error("ior", format!("must be positive, found {ior}")));
+                }
+                Material::ThinDielectric { ior }
             }
             "null" => Material::Null,
             other => {
