@@ -330,6 +330,8 @@ impl Integrator for Sppm {
             }
             let map = PhotonMap::build(photons);
             let alpha = self.alpha;
+            // r_i / r_1 of this iteration under the global schedule, the same for every pixel.
+            let global_shrink = global_radius2_scale(done + 1, alpha).sqrt();
             with_pool(ctx.threads, || {
                 stats
                     .par_iter_mut()
@@ -352,7 +354,7 @@ impl Integrator for Sppm {
                             st.radius = self.first_radius(scene, angle, vp.distance);
                         }
                         let r = if global {
-                            (st.radius * global_radius2_scale(done + 1, alpha).sqrt()) as f32
+                            (st.radius * global_shrink) as f32
                         } else {
                             st.radius as f32
                         };
