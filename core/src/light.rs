@@ -119,6 +119,29 @@ pub fn spot_solid_angle(beam_width: f32, cutoff: f32) -> f32 {
     (2.0 * std::f64::consts::PI * (1.0 - b.cos() + ramp)) as f32
 }
 
+/// A light sample from infinitely far along `wi` (a delta direction with unit pdf, to be
+/// adjusted by the caller): the shadow ray ends past the scene's bounding sphere.
+fn sample_at_infinity(x: Vec3, wi: Vec3, centre: Vec3, radius: f32) -> LightSample {
+    let dist = 2.0 * radius + x.distance(centre);
+    LightSample {
+        wi,
+        dist,
+        li: Rgb::ZERO,
+        pdf: 1.0,
+        delta: true,
+        p: x + wi * dist,
+        n: Vec3::ZERO,
+    }
+}
+
+/// Where a photon from infinitely far, travelling along `dir`, starts: a uniform point of the
+/// bounding sphere's disc facing it, just outside the sphere (pbrt's distant light).
+fn disc_origin(dir: Vec3, centre: Vec3, radius: f32, u: Vec2) -> Vec3 {
+    let d = crate::sampling::concentric_disc(u) * radius;
+    let (s, t) = crate::sampling::basis(dir);
+    centre - dir * radius + s * d.x + t * d.y
+}
+
 impl Light {
     /// Total emitted power in W: 4 pi I for a point light, I times the falloff's solid angle
     /// for a spot light, pi A L for a one-sided area light.
@@ -222,36 +245,22 @@ impl Light {
                 centre,
                 radius,
             } => {
-                // The shadow ray ends past the scene's bounding sphere.
-                let wi = -*direction;
-                let dist = 2.0 * radius + x.distance(*centre);
-                Some(LightSample {
-                    wi,
-                    dist,
-                    li: *irradiance,
-                    pdf: 1.0,
-                    delta: true,
-                    p: x + wi * dist,
-                    n: Vec3::ZERO,
-                })
+                let mut ls = sample_at_infinity(x, -*direction, *centre, *radius);
+                ls.li = *irradiance;
+                Some(ls)
             }
             Light::Constant {
                 radiance,
                 centre,
                 radius,
             } => {
-                // Uniform over the sphere of directions; the shadow ray ends beyond the scene.
+                // Uniform over the sphere of directions.
                 let wi = crate::sampling::uniform_sphere(u);
-                let dist = 2.0 * radius + x.distance(*centre);
-                Some(LightSample {
-                    wi,
-                    dist,
-                    li: *radiance,
-                    pdf: crate::sampling::UNIFORM_SPHERE_PDF,
-                    delta: false,
-                    p: x + wi * dist,
-                    n: Vec3::ZERO,
-                })
+                let mut ls = sample_at_infinity(x, wi, *centre, *radius);
+                ls.li = *radiance;
+                ls.pdf = crate::sampling::UNIFORM_SPHERE_PDF;
+                ls.delta = false;
+                Some(ls)
             }
             Light::Area {
                 shapes,
@@ -392,17 +401,12 @@ impl Light {
                 irradiance,
                 centre,
                 radius,
-            } => {
-                // A uniform point of the disc facing the light, just outside the sphere.
-                let d = crate::sampling::concentric_disc(u_pos) * *radius;
-                let (s, t) = crate::sampling::basis(*direction);
-                EmittedRay {
-                    origin: *centre - *direction * *radius + s * d.x + t * d.y,
-                    dir: *direction,
-                    n: Vec3::ZERO,
-                    flux: *irradiance * (PI * radius * radius),
-                }
-            }
+            } => EmittedRay {
+                origin: disc_origin(*direction, *centre, *radius, u_pos),
+                dir: *direction,
+                n: Vec3::ZERO,
+                flux: *irradiance * (PI * radius * radius),
+            },
             Light::Constant {
                 radiance,
                 centre,
@@ -411,10 +415,8 @@ impl Light {
                 // A uniform direction, then a uniform point of the disc facing it: L cos /
                 // (1/(pi R^2) x 1/(4 pi)) with cos = 1 on the disc.
                 let dir = -crate::sampling::uniform_sphere(u_dir);
-                let d = crate::sampling::concentric_disc(u_pos) * *radius;
-                let (s, t) = crate::sampling::basis(dir);
                 EmittedRay {
-                    origin: *centre - dir * *radius + s * d.x + t * d.y,
+                    origin: disc_origin(dir, *centre, *radius, u_pos),
                     dir,
                     n: Vec3::ZERO,
                     flux: *radiance * (4.0 * PI * PI * radius * radius),

@@ -505,19 +505,16 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                 }
                 Material::Mirror { reflectance }
             }
-            "dielectric" => {
+            "dielectric" | "thindielectric" => {
                 let ior = m.f32("ior", 1.5)?;
                 if ior <= 0.0 {
                     return Err(m.error("ior", format!("must be positive, found {ior}")));
                 }
-                Material::Dielectric { ior }
-            }
-            "thindielectric" => {
-                let ior = m.f32("ior", 1.5)?;
-                if ior <= 0.0 {
-                    return Err(m.error("ior", format!("must be positive, found {ior}")));
+                if ty == "dielectric" {
+                    Material::Dielectric { ior }
+                } else {
+                    Material::ThinDielectric { ior }
                 }
-                Material::ThinDielectric { ior }
             }
             "null" => Material::Null,
             other => {
