@@ -30,7 +30,17 @@ impl RadianceSum {
     /// the range (non-finite samples are zeroed before they get here).
     #[inline]
     fn fixed(x: f64) -> i128 {
-        (x * 2f64.powi(FRACTION_BITS)) as i128
+        const ONE: f64 = (1u128 << FRACTION_BITS) as f64;
+        if (0.0..9.0e18).contains(&x) {
+            // The same value as the general conversion below, without its library call (a
+            // few percent of a cheap camera sample): the integer part by one truncating
+            // instruction, the fraction (exact: x minus its integer part) scaled by 2^64.
+            let whole = x as i64;
+            let fraction = ((x - whole as f64) * ONE) as u64;
+            ((whole as i128) << FRACTION_BITS) | fraction as i128
+        } else {
+            (x * ONE) as i128
+        }
     }
 
     #[inline]

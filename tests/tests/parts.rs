@@ -404,6 +404,15 @@ fn radiance_sums_are_exact_in_any_order() {
     }
     assert_eq!(forward, backward);
     assert_eq!(forward, blocks);
+    // Values on either side of the fast conversion's range convert as the general one does.
+    for x in [
+        0.0f32, 1e-30, 0.75, 1.0, 3.0e9, 8.9e18, 9.1e18, 1e30, -0.5, -3.0,
+    ] {
+        let mut a = RadianceSum::ZERO;
+        a.add(Rgb::splat(x));
+        let expected = (x as f64 * 2f64.powi(64)) as i128;
+        assert_eq!(a.0, [expected; 3], "{x}");
+    }
     let exact: [f64; 3] = [0, 1, 2].map(|c| samples.iter().map(|s| s[c] as f64).sum());
     for (c, (got, exact)) in forward.to_f64().into_iter().zip(exact).enumerate() {
         assert!(
