@@ -68,6 +68,9 @@ enum Command {
     /// The merged image equals the render done in one process with the same seed, bit for
     /// bit. Nothing is written if a check fails.
     Merge(part::MergeArgs),
+    /// Write a Mitsuba 3 XML scene as the equivalent TOML scene (the same image for the same
+    /// seed); lists what --lenient left out.
+    Convert(ConvertArgs),
     /// List the plugins found on the plugin search path.
     Plugins(PluginArgs),
     /// Render a scene several times and report samples per second (a benchmark, not a test).
@@ -124,8 +127,16 @@ pub(crate) struct PluginArgs {
 
 #[derive(Args, Clone, Default)]
 pub(crate) struct SceneArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
     scene: PathBuf,
+    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (Mitsuba's -D;
+    /// repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed as warnings)
+    /// instead of refusing the scene.
+    #[arg(long)]
+    lenient: bool,
     /// Use this integrator plugin instead of the scene's render.integrator.
     #[arg(long)]
     integrator: Option<String>,
@@ -144,6 +155,21 @@ pub(crate) struct SceneArgs {
     strict: bool,
     #[command(flatten)]
     plugins: PluginArgs,
+}
+
+#[derive(Args)]
+struct ConvertArgs {
+    /// The Mitsuba 3 scene (.xml).
+    scene: PathBuf,
+    /// The TOML scene to write; default: <scene stem>.toml beside the scene.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// NAME=VALUE: set a <default name="NAME"> (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Leave out what foton cannot render yet (listed) instead of refusing the scene.
+    #[arg(long)]
+    lenient: bool,
 }
 
 #[derive(Args)]
@@ -215,6 +241,7 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
         Command::Render(a) => cmd_render(a, out, err),
         Command::Check(a) => cmd_check(a, out, err),
         Command::Merge(a) => part::run(a, out, err),
+        Command::Convert(a) => cmd_convert(a, out, err),
         Command::Plugins(a) => cmd_plugins(a, out),
         Command::Bench(a) => cmd_bench(a, out, err),
         Command::Photons(a) => photons::run(a, out, err),
@@ -272,7 +299,31 @@ pub fn prepare(
     plugin_dirs: &[PathBuf],
     strict: bool,
 ) -> Result<Prepared> {
-    let scene = Scene::load(scene_path, overrides)?;
+    prepare_xml(scene_path, overrides, &[], false, plugin_dirs, strict)
+}
+
+/// [`prepare`] for the scene arguments of a command.
+pub(crate) fn prepare_args(a: &SceneArgs, overrides: &[String]) -> Result<Prepared> {
+    prepare_xml(
+        &a.scene,
+        overrides,
+        &a.defines,
+        a.lenient,
+        &a.plugins.plugin_dirs,
+        a.strict,
+    )
+}
+
+/// [`prepare`], with a Mitsuba XML scene's `-D` defines and `--lenient`.
+pub fn prepare_xml(
+    scene_path: &Path,
+    overrides: &[String],
+    defines: &[String],
+    lenient: bool,
+    plugin_dirs: &[PathBuf],
+    strict: bool,
+) -> Result<Prepared> {
+    let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
     let registry = Registry::discover(&search_path(plugin_dirs));
     let plugin = match registry.integrator(&scene.render.integrator) {
         Ok(p) => p.clone(),
@@ -392,12 +443,7 @@ pub fn render_part(
 
 fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
+    let p = prepare_args(&a.scene, &overrides)?;
     let output = match (&a.output, a.part) {
         (Some(o), _) => o.clone(),
         (None, Some(part)) => beside_scene(
@@ -442,7 +488,10 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     let of_part = match a.part {
         Some(part) => {
-            let info = part::PartInfo::of(&p.scene, &overrides, &p.integrator.describe(), &film)?;
+            // The defines change an XML scene as overrides do.
+            let mut hashed = overrides.clone();
+            hashed.extend(a.scene.defines.iter().map(|d| format!("-D {d}")));
+            let info = part::PartInfo::of(&p.scene, &hashed, &p.integrator.describe(), &film)?;
             part::write_part(&output, &film, &info, &[])?;
             format!(", part {part}")
         }
@@ -517,14 +566,47 @@ fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
     }
 }
 
+fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| a.scene.with_extension("toml"));
+    if output.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return Err(Error::Usage(format!(
+            "convert writes a TOML scene: name the output .toml, not {}",
+            output.display()
+        )));
+    }
+    let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    // Files are named relative to the scene; from another folder, by their full path.
+    let folder = |p: &Path| match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => std::fs::canonicalize(d).ok(),
+        _ => std::fs::canonicalize(".").ok(),
+    };
+    let base = folder(&a.scene).ok_or_else(|| Error::io(&a.scene, "cannot resolve its folder"))?;
+    if folder(&output).as_ref() != Some(&base) {
+        doc.absolutize_files(&base);
+    }
+    // The TOML must load: check it before writing.
+    Scene::from_document(doc.clone())?;
+    let header = format!(
+        "# Converted by `foton convert` from {}\n",
+        a.scene.display()
+    );
+    write_atomic(&output, (header + &doc.to_toml()).as_bytes())?;
+    for l in &report.left_out {
+        let _ = writeln!(err, "left out: {l}");
+    }
+    for n in &report.notes {
+        let _ = writeln!(err, "note: {n}");
+    }
+    let _ = writeln!(out, "{} -> {}", a.scene.display(), output.display());
+    Ok(0)
+}
+
 fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
+    let p = prepare_args(&a.scene, &overrides)?;
     let s = &p.scene;
     let _ = writeln!(out, "scene      {}", s.file.display());
     let _ = writeln!(out, "integrator {}", p.integrator.describe());

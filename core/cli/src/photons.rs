@@ -7,7 +7,7 @@
 //! budgets or classifications.
 
 use crate::{
-    INTERRUPTED, SceneArgs, TermProgress, beside_scene, prepare, scene_overrides, threads,
+    INTERRUPTED, SceneArgs, TermProgress, beside_scene, prepare_args, scene_overrides, threads,
 };
 use clap::Args;
 use foton_core::error::{Error, Result};
@@ -82,12 +82,7 @@ fn exposure(powers: &[Rgb]) -> f32 {
 
 pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
+    let p = prepare_args(&a.scene, &overrides)?;
     let scene = &p.scene;
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");

@@ -63,11 +63,46 @@ impl Loader {
 impl Scene {
     /// Loads a scene file, applying `--set` style overrides first.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Scene> {
-        let mut doc = Document::load(path)?;
+        Scene::load_with(path, overrides, &[], false)
+    }
+
+    /// Loads a scene file: TOML, or a Mitsuba 3 XML scene (`.xml`) whose `<default>`s
+    /// `defines` (`NAME=VALUE`, Mitsuba's `-D`) override and whose unsupported elements are
+    /// left out and listed among the warnings if `lenient`. `--set` style `overrides` apply
+    /// to the document in both cases (for XML: to the TOML it reads as).
+    pub fn load_with(
+        path: &Path,
+        overrides: &[String],
+        defines: &[String],
+        lenient: bool,
+    ) -> Result<Scene> {
+        let is_xml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+        let (mut doc, report) = if is_xml {
+            if path.is_dir() {
+                return Err(crate::Error::io(path, "is a directory, not a scene file"));
+            }
+            let (doc, report) = super::mitsuba::read_xml(path, defines, lenient)?;
+            (doc, Some(report))
+        } else {
+            if let Some(d) = defines.first() {
+                return Err(crate::Error::Usage(format!(
+                    "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
+                )));
+            }
+            (Document::load(path)?, None)
+        };
         for o in overrides {
             doc.set(o)?;
         }
-        Scene::from_document(doc)
+        let mut scene = Scene::from_document(doc)?;
+        if let Some(report) = report {
+            scene.sources.extend(report.included);
+            let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
+            scene.warnings.extend(left_out.chain(report.notes));
+        }
+        Ok(scene)
     }
 
     pub fn from_document(doc: Document) -> Result<Scene> {
@@ -643,6 +678,27 @@ fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
     let Some(t) = s.table("transform")? else {
         return Ok(Mat4::IDENTITY);
     };
+    if let Some(m) = t.floats_opt("matrix", 16)? {
+        if let Some(other) = ["translate", "rotate", "scale"].iter().find(|k| t.has(k)) {
+            return Err(t.error(
+                other,
+                "a transform is either `matrix` or translate, rotate and scale, not both",
+            ));
+        }
+        // Row-major, as written (and as Mitsuba's <matrix value="..."/>).
+        let m = Mat4::from_cols_slice(&m).transpose();
+        if m.row(3) != glam::Vec4::W {
+            return Err(t.error(
+                "matrix",
+                "the last row must be [0, 0, 0, 1] (an affine transform)",
+            ));
+        }
+        if m.determinant() == 0.0 {
+            return Err(t.error("matrix", "is singular (it flattens the mesh)"));
+        }
+        ld.done(&t);
+        return Ok(m);
+    }
     let translate = t.vec3("translate", Vec3::ZERO)?;
     let scale = match t.node("scale").map(|n| &n.value) {
         None => Vec3::ONE,

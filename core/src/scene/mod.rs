@@ -5,6 +5,7 @@
 
 mod load;
 pub mod mesh;
+pub mod mitsuba;
 pub mod ply;
 mod visibility;
 mod volumes;
