@@ -4,7 +4,7 @@
 # part succeeded (afterok) and merges them into one image. See docs/scale.md.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-# shellcheck source=submit-common.sh
+# shellcheck source=submit-common.sh source-path=SCRIPTDIR
 source "$here/submit-common.sh"
 
 usage() {

@@ -5,7 +5,7 @@
 # docs/scale.md.
 set -euo pipefail
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
-# shellcheck source=submit-common.sh
+# shellcheck source=submit-common.sh source-path=SCRIPTDIR
 source "$here/submit-common.sh"
 
 usage() {
