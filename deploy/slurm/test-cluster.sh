@@ -73,14 +73,20 @@ pids=()
 show_logs() {
     [[ -n $tmp && -d $tmp ]] || return 0
     local f
-    for f in "$tmp"/slurm/*.log "$tmp"/munge/*.log "$tmp"/daemon-*.out "$tmp"/out/*/logs/*; do
-        [[ -f $f ]] || continue
-        echo "----- ${f#"$tmp"/} (last 40 lines)" >&2
-        tail -n 40 "$f" >&2
+    # The jobs' own output first: a failed part says why there.
+    for f in "$tmp"/out/*/logs/* "$tmp"/daemon-*.out; do
+        [[ -s $f ]] || continue
+        echo "----- ${f#"$tmp"/} (last 25 lines)" >&2
+        tail -n 25 "$f" >&2
     done
-    if [[ -n ${SLURM_CONF:-} ]] && command -v squeue >/dev/null; then
-        echo "----- squeue" >&2
-        squeue -a -o '%.10i %.16j %.10T %.20r' 2>&1 | head -40 >&2 || true
+    if [[ -n ${SLURM_CONF:-} ]] && command -v scontrol >/dev/null; then
+        echo "----- jobs (scontrol show job)" >&2
+        scontrol show job -o 2>&1 | awk '{
+            line = ""
+            for (i = 1; i <= NF; i++)
+                if ($i ~ /^(JobId|ArrayTaskId|JobName|JobState|Reason|ExitCode)=/) line = line " " $i
+            print line
+        }' | head -40 >&2 || true
     fi
 }
 cleanup() {
@@ -192,8 +198,6 @@ StateSaveLocation=$tmp/slurm/state
 SlurmdSpoolDir=$tmp/slurm/spool
 SlurmctldPidFile=$tmp/slurm/slurmctld.pid
 SlurmdPidFile=$tmp/slurm/slurmd.pid
-SlurmctldLogFile=$tmp/slurm/slurmctld.log
-SlurmdLogFile=$tmp/slurm/slurmd.log
 SlurmctldDebug=info
 SlurmdDebug=info
 # No cgroups: Slurm's default proctrack/cgroup needs a cgroup tree slurmd may manage, which a
@@ -218,6 +222,8 @@ PartitionName=test Nodes=$node Default=YES MaxTime=INFINITE State=UP
 CONF
 
 log "starting slurmctld and slurmd on $node ($cpus CPUs, $memory MB, port $ctld_port)"
+# In the foreground (-D) of a background job: their pids are ours to stop, and without a
+# LogFile they log to these files.
 slurmctld -D -i >"$tmp/daemon-slurmctld.out" 2>&1 &
 pids+=($!)
 slurmd -D -N "$node" >"$tmp/daemon-slurmd.out" 2>&1 &
