@@ -96,11 +96,7 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let progress = TermProgress::new(a.quiet);
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
-    let ctx = RenderContext {
-        threads,
-        cancel: &INTERRUPTED,
-        progress: &progress,
-    };
+    let ctx = RenderContext::new(threads, &INTERRUPTED, &progress);
     let name = p.integrator.name().to_string();
     let mut maps = p
         .integrator

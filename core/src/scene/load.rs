@@ -41,6 +41,7 @@ const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 /// Collects the bags of a load so that unused keys can be listed at the end.
 struct Loader {
     dir: PathBuf,
+    sources: Vec<PathBuf>,
     bags: Vec<Vec<(String, Location)>>,
     warnings: Vec<String>,
 }
@@ -74,6 +75,7 @@ impl Scene {
         let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut ld = Loader {
             dir,
+            sources: Vec::new(),
             bags: Vec::new(),
             warnings: Vec::new(),
         };
@@ -192,6 +194,7 @@ impl Scene {
         let mut unused: Vec<(String, Location)> = ld.bags.into_iter().flatten().collect();
         unused.sort_by(|a, b| (a.1.line, &a.0).cmp(&(b.1.line, &b.0)));
         let warnings = ld.warnings;
+        let sources = ld.sources;
         Ok(Scene {
             file,
             render,
@@ -211,6 +214,7 @@ impl Scene {
             camera_medium,
             bounds: (lo, hi),
             document: doc,
+            sources,
             unused,
             warnings,
         })
@@ -706,7 +710,9 @@ fn read_shapes(
             "mesh" => {
                 let file = s.string_required("file")?;
                 let transform = read_transform(&s, ld)?;
-                let (tris, is_closed) = load_mesh(&s, &ld.dir.join(file), transform)?;
+                let path = ld.dir.join(file);
+                let (tris, is_closed) = load_mesh(&s, &path, transform)?;
+                ld.sources.push(path);
                 closed = is_closed;
                 tris
             }
