@@ -277,7 +277,7 @@ read -r parts_job merge_job <<<"$jobs"
 log "frame: $parts parts as job $parts_job, merge job $merge_job"
 wait_job "$merge_job" "merge"
 check_array "$parts_job" "frame parts"
-log "frame merged"
+log "frame merged: $(cat "$frame"/logs/merge-*.out)"
 
 "$foton" render "$scene" "${render_args[@]}" -o "$tmp/single.exr" -q 2>/dev/null ||
     fail "the single-process render failed"
