@@ -70,6 +70,7 @@ remove_policy_rc() {
 
 tmp=
 pids=()
+cluster_started=
 show_logs() {
     [[ -n $tmp && -d $tmp ]] || return 0
     local f
@@ -79,7 +80,7 @@ show_logs() {
         echo "----- ${f#"$tmp"/} (last 25 lines)" >&2
         tail -n 25 "$f" >&2
     done
-    if [[ -n ${SLURM_CONF:-} ]] && command -v scontrol >/dev/null; then
+    if [[ -n $cluster_started ]]; then
         echo "----- jobs (scontrol show job)" >&2
         scontrol show job -o 2>&1 | awk '{
             line = ""
@@ -90,19 +91,18 @@ show_logs() {
     fi
 }
 cleanup() {
-    local rc=$?
+    local rc=$? i pid
     set +e
     # Jobs first, while slurmd is there to end their steps: stopping the daemons under running
-    # jobs would leave slurmstepd processes behind.
-    if [[ ${#pids[@]} -gt 0 ]] && [[ -n ${SLURM_CONF:-} ]]; then
-        scancel --user=root >/dev/null 2>&1
-        local i
+    # jobs would leave slurmstepd processes behind. Bounded: a controller that no longer
+    # answers must not hang the exit.
+    if [[ -n $cluster_started ]]; then
+        timeout 10 scancel --user=root >/dev/null 2>&1
         for ((i = 0; i < 20; i++)); do
-            [[ -z $(squeue -h 2>/dev/null) ]] && break
+            [[ -z $(timeout 5 squeue -h 2>/dev/null) ]] && break
             sleep 0.5
         done
     fi
-    local pid
     for pid in "${pids[@]}"; do
         kill "$pid" 2>/dev/null
     done
@@ -221,6 +221,13 @@ NodeName=$node NodeAddr=127.0.0.1 $hw State=UNKNOWN
 PartitionName=test Nodes=$node Default=YES MaxTime=INFINITE State=UP
 CONF
 
+# A daemon left over from a run that was killed outright (no EXIT trap) holds the ports: say
+# so now rather than after the wait for the node.
+for port in "$ctld_port" "$((ctld_port + 1))"; do
+    if (exec 3<>"/dev/tcp/127.0.0.1/$port") 2>/dev/null; then
+        fail "port $port is in use (a slurmctld or slurmd of an earlier run?); set FOTON_SLURM_PORT to another"
+    fi
+done
 log "starting slurmctld and slurmd on $node ($cpus CPUs, $memory MB, port $ctld_port)"
 # In the foreground (-D) of a background job: their pids are ours to stop, and without a
 # LogFile they log to these files.
@@ -228,6 +235,7 @@ slurmctld -D -i >"$tmp/daemon-slurmctld.out" 2>&1 &
 pids+=($!)
 slurmd -D -N "$node" >"$tmp/daemon-slurmd.out" 2>&1 &
 pids+=($!)
+cluster_started=1
 node_idle() {
     [[ $(sinfo -h -N -n "$node" -o %T 2>/dev/null) == idle ]]
 }
