@@ -404,11 +404,30 @@ pub fn write_image(
     let tmp = path.with_file_name(format!(".{file_name}.tmp-{}", std::process::id()));
     let result = match format {
         ImageFormat::Exr => {
-            let data: Vec<f32> = pixels.iter().flat_map(|p| p.to_array()).collect();
-            let img = image::Rgb32FImage::from_raw(width, height, data)
-                .ok_or_else(|| Error::io(path, "pixel buffer has the wrong size"))?;
-            image::DynamicImage::ImageRgb32F(img)
-                .save_with_format(&tmp, image::ImageFormat::OpenExr)
+            if pixels.len() != width as usize * height as usize {
+                return Err(Error::io(path, "pixel buffer has the wrong size"));
+            }
+            // exr directly rather than through `image`, whose encoder writes compressed
+            // blocks in the order threads finish them: the same pixels must make the same
+            // bytes (a merged render is compared with the one-process render by its bytes).
+            use exr::prelude::{
+                Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
+            };
+            let w = width as usize;
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let p = pixels[y * w + x];
+                (p.x, p.y, p.z)
+            });
+            let layer = Layer::new(
+                (w, height as usize),
+                LayerAttributes::default(),
+                Encoding::SMALL_LOSSLESS,
+                channels,
+            );
+            Image::from_layer(layer)
+                .write()
+                .to_file(&tmp)
+                .map_err(|e| image::ImageError::IoError(std::io::Error::other(e.to_string())))
         }
         ImageFormat::Png => {
             let data: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
@@ -520,6 +539,30 @@ mod tests {
         let exr = dir.join("a.exr");
         write_image(&exr, 2, 1, &pixels, &display).unwrap();
         assert_eq!(read_image(&exr).unwrap().2, pixels);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The same pixels make the same bytes: an EXR of many compressed blocks (compressed in
+    /// parallel) is written in a fixed block order.
+    #[test]
+    fn an_exr_is_the_same_bytes_every_time() {
+        let dir = std::env::temp_dir().join(format!("foton-film-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (w, h) = (320u32, 240u32);
+        let mut rng = crate::sampling::Rng::new(&[3]);
+        let pixels: Vec<Rgb> = (0..w * h)
+            .map(|_| Rgb::new(rng.next_f32(), rng.next_f32() * 10.0, rng.next_f32() * 0.1))
+            .collect();
+        let write = |name: &str| {
+            let path = dir.join(name);
+            write_image(&path, w, h, &pixels, &DisplayTransform::default()).unwrap();
+            std::fs::read(path).unwrap()
+        };
+        let first = write("a.exr");
+        for i in 0..4 {
+            assert!(first == write(&format!("b{i}.exr")), "write {i} differs");
+        }
+        assert_eq!(read_image(&dir.join("a.exr")).unwrap().2, pixels);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

@@ -17,7 +17,7 @@ struct Case {
 
 impl Case {
     fn new(scene: &str, args: &[&str]) -> Case {
-        let mut all: Vec<String> = ["--set", "film.width=36", "--set", "film.height=24", "-q"]
+        let mut all: Vec<String> = ["--set", "film.width=48", "--set", "film.height=64", "-q"]
             .iter()
             .map(|s| s.to_string())
             .collect();
