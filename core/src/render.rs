@@ -60,6 +60,12 @@ where
         width as u64 * height as u64 * (spp - first) as u64,
     );
 
+    if first == spp && !ctx.part.is_whole() {
+        ctx.progress.warn(&format!(
+            "part {} of {} samples per pixel holds none: split into at most {} parts",
+            ctx.part, scene.render.spp, scene.render.spp
+        ));
+    }
     let mut done = first;
     while done < spp && !ctx.cancelled() {
         let batch = (done - first).max(1).min(spp - done);

@@ -242,6 +242,11 @@ fn bad_part_arguments_are_refused() {
         assert_eq!(run.code, 2, "{bad}: {}", run.stderr);
         assert!(run.stderr.contains("I/N"), "{bad}: {}", run.stderr);
     }
+    // More parts than samples: a part without any says so.
+    let empty = dir.join("empty.exr");
+    let run = case.render(&["--part", "3/4", "-o", empty.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stderr.contains("holds none"), "{}", run.stderr);
     let png = dir.join("p.png");
     let run = case.render(&["--part", "0/2", "-o", png.to_str().unwrap()]);
     assert_eq!(run.code, 1);
