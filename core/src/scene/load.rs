@@ -33,7 +33,14 @@ const SECTIONS: &[&str] = &[
     "lights",
     "scene",
 ];
-const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "thindielectric", "null"];
+const MATERIAL_TYPES: &[&str] = &[
+    "diffuse",
+    "mirror",
+    "conductor",
+    "dielectric",
+    "thindielectric",
+    "null",
+];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
 const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
@@ -543,6 +550,55 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                     );
                 }
                 Material::Mirror { reflectance }
+            }
+            "conductor" => {
+                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let named = m.string_opt("material")?;
+                let (eta, k) = (m.rgb_opt("eta")?, m.rgb_opt("k")?);
+                match (named, eta, k) {
+                    (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                        return Err(m.error(
+                            "material",
+                            "give either a named `material` or `eta` and `k`, not both",
+                        ));
+                    }
+                    (None, Some(eta), Some(k)) => Material::Conductor {
+                        eta,
+                        k,
+                        specular_reflectance,
+                    },
+                    (None, Some(_), None) | (None, None, Some(_)) => {
+                        let missing = if m.has("eta") { "k" } else { "eta" };
+                        return Err(m.error(
+                            missing,
+                            "missing: a conductor's index of refraction needs both eta and k",
+                        ));
+                    }
+                    // Mitsuba's default: a perfect mirror.
+                    (None, None, None) | (Some("none"), None, None) => Material::Mirror {
+                        reflectance: specular_reflectance,
+                    },
+                    (Some(name), None, None) => {
+                        let (eta, k) = crate::material::conductor(name).ok_or_else(|| {
+                            let names: Vec<&str> = crate::material::CONDUCTORS
+                                .iter()
+                                .map(|(n, _, _)| *n)
+                                .collect();
+                            m.error(
+                                "material",
+                                format!(
+                                    "unknown conductor `{name}`; expected none or one of: {}",
+                                    names.join(", ")
+                                ),
+                            )
+                        })?;
+                        Material::Conductor {
+                            eta,
+                            k,
+                            specular_reflectance,
+                        }
+                    }
+                }
             }
             "dielectric" | "thindielectric" => {
                 let ior = m.f32("ior", 1.5)?;

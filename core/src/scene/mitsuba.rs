@@ -899,15 +899,30 @@ impl Reader {
                 }
             }
             "conductor" => {
-                let material = o.string("material")?.unwrap_or_else(|| "none".into());
-                if material != "none" || o.props.iter().any(|(n, _, _)| n == "eta" || n == "k") {
-                    o.props.clear();
-                    self.unsupported(&o, "conductors other than material=\"none\" (a perfect mirror) are not supported yet")?;
-                    return Ok(None);
+                put("type", Value::Str("conductor".into()));
+                let material = o.string("material")?;
+                let (eta, k) = (o.take("eta"), o.take("k"));
+                match (eta, k) {
+                    (None, None) => {
+                        let name = material.unwrap_or_else(|| "none".into());
+                        if name != "none" && crate::material::conductor(&name).is_none() {
+                            return Err(o.error(format!("`material`: unknown conductor `{name}`")));
+                        }
+                        t.insert("material", at(Value::Str(name), line));
+                    }
+                    (Some((eta, l1)), Some((k, l2))) => {
+                        o.props.push(("eta".into(), eta, l1));
+                        o.props.push(("k".into(), k, l2));
+                        let (eta, k) = (o.color("eta", DVec3::ONE)?, o.color("k", DVec3::ZERO)?);
+                        t.insert("eta", vec3(eta, line));
+                        t.insert("k", vec3(k, line));
+                    }
+                    _ => {
+                        return Err(o.error("a conductor needs both `eta` and `k`, or a `material`"));
+                    }
                 }
-                put("type", Value::Str("mirror".into()));
                 let c = o.color("specular_reflectance", DVec3::ONE)?;
-                t.insert("reflectance", vec3(c, line));
+                t.insert("specular_reflectance", vec3(c, line));
             }
             "null" => put("type", Value::Str("null".into())),
             _ => {
