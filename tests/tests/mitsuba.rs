@@ -150,6 +150,7 @@ reflectance = [0.7, 0.7, 0.7]
 [materials.black]
 type = "diffuse"
 reflectance = [0, 0, 0]
+twosided = false
 [materials.glass]
 type = "dielectric"
 ior = 1.333
@@ -157,6 +158,7 @@ ior = 1.333
 type = "mirror"
 [materials.default]
 type = "diffuse"
+twosided = false
 
 # The floor: [-2, 2]^2 at y = 0, normal up.
 [[shapes]]
