@@ -535,3 +535,30 @@ fn sweep_takes_an_xml_scene_and_its_defines() {
     let (w32, _, _) = read_image(&out).unwrap();
     assert!(w32 > w16, "{w32} vs {w16}");
 }
+
+/// `foton compare` on an XML scene with -D: both integrators render the defined size.
+#[test]
+fn compare_takes_an_xml_scene_and_its_defines() {
+    let dir = scene_folder("mitsuba-compare");
+    let out = dir.join("cmp.png");
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&dir.join("scene.xml")),
+        "--integrators",
+        "path,sppm",
+        "-D",
+        "res=16",
+        "--spp",
+        "2",
+        "--set",
+        "integrators.sppm.iterations=2",
+        "--set",
+        "integrators.sppm.photons_per_iteration=1000",
+        "-q",
+        "-o",
+        s(&out),
+    ]);
+    ok(&run);
+    let (w, _, _) = read_image(&dir.join("cmp-path.exr")).unwrap();
+    assert_eq!(w, 16);
+}

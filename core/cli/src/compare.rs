@@ -3,7 +3,7 @@
 //! render. Each render is also written as EXR, and the numbers as JSON.
 
 use crate::montage::{Image, Series, Tile, diverging, grid, log_log_plot, render_image};
-use crate::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare, threads};
+use crate::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare_xml, threads};
 use crate::{render_prepared, write_atomic};
 use clap::Args;
 use foton_core::Rgb;
@@ -21,8 +21,14 @@ pub const REL_EPSILON: f64 = 1e-2;
 
 #[derive(Args)]
 pub(super) struct CompareArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
     scene: PathBuf,
+    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed) instead of refusing.
+    #[arg(long)]
+    lenient: bool,
     /// The integrator plugins to compare, comma-separated (e.g. path,photon), left to right.
     #[arg(
         long,
@@ -539,9 +545,11 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let mut prepared = Vec::new();
     let mut warned: Vec<String> = Vec::new();
     for name in &names {
-        let p = prepare(
+        let p = prepare_xml(
             &a.scene,
             &overrides(name, &[]),
+            &a.defines,
+            a.lenient,
             &a.plugins.plugin_dirs,
             a.strict,
         )?;
@@ -576,9 +584,11 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     for (name, mut p) in names.iter().zip(prepared) {
         // The scene with --time's choices for this integrator (warnings were printed above).
         let prep = |extra: &[String]| {
-            prepare(
+            prepare_xml(
                 &a.scene,
                 &overrides(name, extra),
+                &a.defines,
+                a.lenient,
                 &a.plugins.plugin_dirs,
                 a.strict,
             )
