@@ -354,7 +354,7 @@ fn unknown_material_type_lists_the_types() {
         "materials.white.type",
         &[
             "unknown material type \"plastic\"",
-            "diffuse, mirror, dielectric, thindielectric, null",
+            "diffuse, mirror, conductor, dielectric, thindielectric, null",
         ],
     );
 }
