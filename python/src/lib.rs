@@ -168,12 +168,22 @@ struct Report {
     /// (phase number, phase, units in the phase)
     phase: Mutex<(u64, String, u64)>,
     done: AtomicU64,
+    /// The phases that ended since the last report, as they ended (a phase shorter than the
+    /// interval between reports is reported all the same).
+    ended: Mutex<Vec<(u64, String, u64, u64)>>,
     warnings: Mutex<Vec<String>>,
 }
 
 impl Progress for Report {
     fn begin(&self, phase: &str, total: u64) {
         let mut p = self.phase.lock().unwrap();
+        if p.0 > 0 {
+            let done = self.done.load(Ordering::Relaxed);
+            self.ended
+                .lock()
+                .unwrap()
+                .push((p.0, std::mem::take(&mut p.1), done, p.2));
+        }
         *p = (p.0 + 1, phase.to_string(), total);
         self.done.store(0, Ordering::Relaxed);
     }
@@ -343,14 +353,16 @@ impl NativeScene {
         let mut stop: Option<PyErr> = None;
         let mut reported = (0u64, u64::MAX);
         let mut report_progress = |stop: &mut Option<PyErr>| {
-            if let (None, Some(cb)) = (&stop, &progress) {
-                let (n, phase, done, total) = report.snapshot();
-                if n > 0 && (n, done) != reported {
-                    reported = (n, done);
-                    if let Err(e) = cb.call1((phase, done, total)) {
-                        cancel.store(true, Ordering::SeqCst);
-                        *stop = Some(e);
-                    }
+            let Some(cb) = &progress else { return };
+            let ended = std::mem::take(&mut *report.ended.lock().unwrap());
+            for (n, phase, done, total) in ended.into_iter().chain([report.snapshot()]) {
+                if stop.is_some() || n == 0 || (n, done) == reported {
+                    continue;
+                }
+                reported = (n, done);
+                if let Err(e) = cb.call1((phase, done, total)) {
+                    cancel.store(true, Ordering::SeqCst);
+                    *stop = Some(e);
                 }
             }
         };
