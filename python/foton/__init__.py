@@ -38,6 +38,7 @@ __all__ = [
     "Scene",
     "write",
     "read",
+    "to_display",
     "compare",
     "Errors",
     "plugins",
@@ -339,6 +340,14 @@ def write(image: Any, path: PathLike, exposure: float = 0.0, tonemap: str = "cla
     a = _image(image, "write")
     h, w, _ = a.shape
     _foton.write(os.fspath(path), a.tobytes(), w, h, float(exposure), str(tonemap))
+
+
+def to_display(image: Any, exposure: float = 0.0, tonemap: str = "clamp") -> np.ndarray:
+    """The 8-bit sRGB image (uint8, (height, width, 3)) that :func:`write` puts in a PNG: for
+    showing a render, ``plt.imshow(foton.to_display(image, **scene.display))``."""
+    a = _image(image, "to_display")
+    h, w, _ = a.shape
+    return _foton.to_display(a.tobytes(), w, h, float(exposure), str(tonemap))
 
 
 def read(path: PathLike) -> np.ndarray:

@@ -526,16 +526,43 @@ fn write(
     exposure: f32,
     tonemap: &str,
 ) -> PyResult<()> {
-    let tonemap = ToneMap::from_name(tonemap).ok_or_else(|| {
-        PyValueError::new_err(format!(
-            "unknown tone map `{tonemap}`; expected one of: {}",
-            ToneMap::NAMES.join(", ")
-        ))
-    })?;
+    let display = DisplayTransform::new(exposure, tone_map(tonemap)?);
     let pixels = pixels_of(data, width, height)?;
-    let display = DisplayTransform::new(exposure, tonemap);
     py.detach(|| write_image(&path, width, height, &pixels, &display))
         .map_err(|e| py_error(py, e))
+}
+
+/// The 8-bit sRGB values a PNG of the pixels holds (`write`'s PNG), as a uint8 numpy array.
+#[pyfunction]
+fn to_display<'py>(
+    py: Python<'py>,
+    data: &[u8],
+    width: u32,
+    height: u32,
+    exposure: f32,
+    tonemap: &str,
+) -> PyResult<Bound<'py, PyAny>> {
+    let display = DisplayTransform::new(exposure, tone_map(tonemap)?);
+    let pixels = pixels_of(data, width, height)?;
+    let n = pixels.len() * 3;
+    let bytes = PyByteArray::new_with(py, n, |b| {
+        for (i, p) in pixels.iter().enumerate() {
+            b[3 * i..3 * i + 3].copy_from_slice(&display.encode(*p));
+        }
+        Ok(())
+    })?;
+    let np = py.import("numpy")?;
+    np.call_method1("frombuffer", (bytes, np.getattr("uint8")?))?
+        .call_method1("reshape", ((height as usize, width as usize, 3usize),))
+}
+
+fn tone_map(name: &str) -> PyResult<ToneMap> {
+    ToneMap::from_name(name).ok_or_else(|| {
+        PyValueError::new_err(format!(
+            "unknown tone map `{name}`; expected one of: {}",
+            ToneMap::NAMES.join(", ")
+        ))
+    })
 }
 
 /// Reads an image as linear RGB (EXR as stored, PNG decoded from sRGB).
@@ -569,6 +596,7 @@ fn _foton(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(build_info, m)?)?;
     m.add_function(wrap_pyfunction!(write, m)?)?;
     m.add_function(wrap_pyfunction!(read, m)?)?;
+    m.add_function(wrap_pyfunction!(to_display, m)?)?;
     m.add_function(wrap_pyfunction!(errors, m)?)?;
     Ok(())
 }

@@ -46,6 +46,18 @@ def test_png_is_srgb_through_exposure_and_tonemap(tmp_path):
     assert foton.read(tmp_path / "filmic.png")[0, 1, 0] < 1.0
 
 
+def test_to_display_is_what_a_png_holds(tmp_path):
+    rng = np.random.default_rng(3)
+    image = rng.exponential(size=(6, 5, 3)).astype(np.float32)
+    for exposure, tonemap in [(0.0, "clamp"), (-1.5, "filmic")]:
+        shown = foton.to_display(image, exposure, tonemap)
+        assert shown.dtype == np.uint8 and shown.shape == (6, 5, 3)
+        foton.write(image, tmp_path / "a.png", exposure=exposure, tonemap=tonemap)
+        png = foton.read(tmp_path / "a.png")  # decoded back to linear
+        encoded = np.where(png <= 0.0031308, 12.92 * png, 1.055 * png ** (1 / 2.4) - 0.055)
+        assert np.array_equal(np.round(encoded * 255).astype(np.uint8), shown)
+
+
 def test_compare_gives_the_figures_of_foton_compare_json(program, tmp_path):
     scene = SCENES / "caustics-area.toml"
     ref = tmp_path / "ref.exr"
