@@ -14,8 +14,9 @@ with them.
 The cargo profile is ``release`` unless chosen by the config setting ``profile``
 (``pip install ./python --config-settings=profile=dev``) or the environment variable
 ``FOTON_PYTHON_PROFILE``. CI uses ``dev``, whose artifacts ``cargo test --workspace`` has
-already built (this workspace's dev profile is optimised); a dev wheel's libraries are
-stripped of their debug info (it would make the wheel about 500 MB).
+already built (this workspace's dev profile is optimised). The libraries in the wheel are
+stripped of their debug info (maturin's --strip for the extension, unless the build args say
+otherwise; `strip --strip-debug` for the plugins).
 
 Wheels are built from the repository (``pip install ./python``, ``pip wheel ./python``); there
 is no sdist, since the plugins are built from the workspace around this folder.
@@ -64,9 +65,7 @@ def _maturin_settings(config_settings: Mapping[str, Any] | None, profile: str) -
     if isinstance(args, str):
         args = shlex.split(args)
     args = list(args)
-    strip = []
-    if profile == "dev" and not any(a.startswith("--strip") for a in args):
-        strip = ["--strip"]
+    strip = [] if any(a.startswith("--strip") for a in args) else ["--strip"]
     settings[key] = ["--profile", profile, *strip, *args]
     return settings
 
@@ -93,8 +92,9 @@ def _copy_plugins(profile: str) -> None:
     for crate in PLUGIN_CRATES:
         name = prefix + crate.replace("-", "_") + suffix
         shutil.copy2(deps / name, PLUGIN_DIR / name)
-        if profile == "dev" and shutil.which("strip"):
-            # Debug info only: the build identifier, a string in the library, stays.
+        if shutil.which("strip"):
+            # Debug info only (the build identifier, a string in the library, stays): a
+            # wheel of dev libraries would be about 500 MB, of release ones 30 MB.
             subprocess.run(["strip", "--strip-debug", str(PLUGIN_DIR / name)], check=True)
         _log(f"packaging {deps / name}")
 
