@@ -245,9 +245,11 @@ class Scene:
         parameters (``{"k": 50}`` is ``--set integrators.NAME.k=50``). ``threads``: worker
         threads (default: all cores; the image does not depend on it).
 
-        ``progress``: ``True`` shows a tqdm bar if tqdm is installed; a callable is called as
-        ``progress(phase, done, total)`` from the calling thread while the render runs (an
-        exception it raises stops the render and is raised); ``False`` or ``None``: nothing.
+        ``progress``: ``True`` shows a tqdm bar per phase if tqdm is installed; a callable is
+        called as ``progress(phase, done, total)`` from the calling thread while the render
+        runs: with ``done = 0`` when a phase ("photons", "pixels", "iterations") begins, then as
+        it advances (at most every 25 ms), and with its last count when it ends; an exception
+        it raises stops the render and is raised. ``False`` or ``None``: nothing.
 
         The GIL is released while the render runs. Ctrl-C (SIGINT in the main thread) stops
         it within a fraction of a second and raises ``KeyboardInterrupt`` with the partial
@@ -308,7 +310,8 @@ def _tqdm_progress() -> Any:
             self.phase: str | None = None
 
         def __call__(self, phase: str, done: int, total: int) -> None:
-            if self.bar is None or phase != self.phase or done < self.bar.n:
+            # A phase begins with done = 0 (see Scene.render): a new bar.
+            if self.bar is None or phase != self.phase or done < self.bar.n or total != self.bar.total:
                 self.close()
                 self.bar = tqdm(total=total, desc=phase, leave=False)
                 self.phase = phase

@@ -351,18 +351,29 @@ impl NativeScene {
         // The exception that stopped the render: KeyboardInterrupt (or what a signal handler
         // raised), or the progress callback's.
         let mut stop: Option<PyErr> = None;
+        // Each phase is reported with done = 0 first, then as it advances, and with its last
+        // count when it has ended.
         let mut reported = (0u64, u64::MAX);
         let mut report_progress = |stop: &mut Option<PyErr>| {
             let Some(cb) = &progress else { return };
             let ended = std::mem::take(&mut *report.ended.lock().unwrap());
             for (n, phase, done, total) in ended.into_iter().chain([report.snapshot()]) {
-                if stop.is_some() || n == 0 || (n, done) == reported {
+                if n == 0 || (n, done) == reported {
                     continue;
                 }
+                let mut calls = vec![done];
+                if n != reported.0 && done > 0 {
+                    calls.insert(0, 0);
+                }
                 reported = (n, done);
-                if let Err(e) = cb.call1((phase, done, total)) {
-                    cancel.store(true, Ordering::SeqCst);
-                    *stop = Some(e);
+                for done in calls {
+                    if stop.is_some() {
+                        return;
+                    }
+                    if let Err(e) = cb.call1((&phase, done, total)) {
+                        cancel.store(true, Ordering::SeqCst);
+                        *stop = Some(e);
+                    }
                 }
             }
         };
