@@ -1,5 +1,6 @@
-//! The film: per-pixel sums of radiance samples and their counts (box filter: a sample lands
-//! in its own pixel), and writing it out atomically as linear EXR or sRGB PNG.
+//! The film: per-pixel sums of radiance samples (exact, in fixed point: [`RadianceSum`]) and
+//! their counts (a sample lands in its own pixel: the reconstruction filter is importance
+//! sampled), and writing it out atomically as linear EXR or sRGB PNG.
 //!
 //! An EXR holds the radiance as it is. A PNG holds display values: each linear value is
 //! scaled by the exposure and tone mapped into [0, 1] ([`DisplayTransform`]), then encoded with
@@ -8,14 +9,74 @@
 
 use crate::Rgb;
 use crate::error::{Error, Result};
+use crate::integrator::Part;
 use std::path::Path;
+
+/// Fractional bits of the film's fixed-point sums.
+const FRACTION_BITS: i32 = 64;
+
+/// An exact sum of radiance samples, one per channel: fixed point with 64 fractional bits in
+/// an i128 (a resolution of 5e-20, sums up to 9e18). Integer addition is associative, so a
+/// pixel's sum does not depend on the order its samples are added in: the image is the same
+/// bit for bit whatever the thread count, the batches of samples and the parts a render is
+/// split into and merged from (`foton render --part`, `foton merge`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct RadianceSum(pub [i128; 3]);
+
+impl RadianceSum {
+    pub const ZERO: RadianceSum = RadianceSum([0; 3]);
+
+    /// A value in fixed point, rounded towards zero below the resolution; saturates beyond
+    /// the range (non-finite samples are zeroed before they get here).
+    #[inline]
+    fn fixed(x: f64) -> i128 {
+        const ONE: f64 = (1u128 << FRACTION_BITS) as f64;
+        if (0.0..9.0e18).contains(&x) {
+            // The same value as the general conversion below, without its library call (a
+            // few percent of a cheap camera sample): the integer part by one truncating
+            // instruction, the fraction (exact: x minus its integer part) scaled by 2^64.
+            let whole = x as i64;
+            let fraction = ((x - whole as f64) * ONE) as u64;
+            ((whole as i128) << FRACTION_BITS) | fraction as i128
+        } else {
+            (x * ONE) as i128
+        }
+    }
+
+    #[inline]
+    pub fn add(&mut self, radiance: Rgb) {
+        self.add_f64([radiance.x as f64, radiance.y as f64, radiance.z as f64]);
+    }
+
+    #[inline]
+    pub fn add_f64(&mut self, radiance: [f64; 3]) {
+        for (s, x) in self.0.iter_mut().zip(radiance) {
+            *s = s.saturating_add(Self::fixed(x));
+        }
+    }
+
+    #[inline]
+    pub fn merge(&mut self, other: &RadianceSum) {
+        for (s, x) in self.0.iter_mut().zip(other.0) {
+            *s = s.saturating_add(x);
+        }
+    }
+
+    /// The sum as floating point.
+    pub fn to_f64(&self) -> [f64; 3] {
+        self.0.map(|s| s as f64 * 2f64.powi(-FRACTION_BITS))
+    }
+}
 
 #[derive(Clone, Debug)]
 pub struct Film {
     pub width: u32,
     pub height: u32,
-    sum: Vec<[f64; 3]>,
+    sum: Vec<RadianceSum>,
     count: Vec<u32>,
+    /// The share of the render this film holds (set by the render loop from
+    /// `RenderContext::part`; [`Part::WHOLE`] unless the render was asked for a part).
+    pub part: Part,
     /// Rays traced to make the image (statistics; 0 if the integrator does not count).
     pub rays: u64,
     /// Iterations a progressive integrator (sppm) completed; 0 for the others, whose work is
@@ -34,13 +95,35 @@ impl Film {
         Film {
             width,
             height,
-            sum: vec![[0.0; 3]; n],
+            sum: vec![RadianceSum::ZERO; n],
             count: vec![0; n],
+            part: Part::WHOLE,
             rays: 0,
             iterations: 0,
             iterations_planned: 0,
             photons: 0,
         }
+    }
+
+    /// A film from its per-pixel sums and sample counts (row-major), as a partial result
+    /// stores them. None if the lengths do not match the size.
+    pub fn from_sums(
+        width: u32,
+        height: u32,
+        sum: Vec<RadianceSum>,
+        count: Vec<u32>,
+    ) -> Option<Film> {
+        let n = width as usize * height as usize;
+        if sum.len() != n || count.len() != n {
+            return None;
+        }
+        Some(Film {
+            width,
+            height,
+            sum,
+            count,
+            ..Film::new(0, 0)
+        })
     }
 
     #[inline]
@@ -51,19 +134,13 @@ impl Film {
     #[inline]
     pub fn add_sample(&mut self, x: u32, y: u32, radiance: Rgb) {
         let i = self.index(x, y);
-        let s = &mut self.sum[i];
-        s[0] += radiance.x as f64;
-        s[1] += radiance.y as f64;
-        s[2] += radiance.z as f64;
+        self.sum[i].add(radiance);
         self.count[i] += 1;
     }
 
-    /// Adds a pixel's accumulated sum and count (used when merging tiles).
-    pub fn add_pixel(&mut self, i: usize, sum: [f64; 3], count: u32) {
-        let s = &mut self.sum[i];
-        for c in 0..3 {
-            s[c] += sum[c];
-        }
+    /// Adds a pixel's accumulated sum and count (used when merging tiles and parts).
+    pub fn add_pixel(&mut self, i: usize, sum: &RadianceSum, count: u32) {
+        self.sum[i].merge(sum);
         self.count[i] += count;
     }
 
@@ -71,8 +148,19 @@ impl Film {
     /// whole estimates, e.g. progressive photon mapping).
     pub fn set_pixel(&mut self, x: u32, y: u32, value: Rgb) {
         let i = self.index(x, y);
-        self.sum[i] = [value.x as f64, value.y as f64, value.z as f64];
+        self.sum[i] = RadianceSum::ZERO;
+        self.sum[i].add(value);
         self.count[i] = 1;
+    }
+
+    /// The per-pixel sums, row-major.
+    pub fn sums(&self) -> &[RadianceSum] {
+        &self.sum
+    }
+
+    /// The per-pixel sample counts, row-major.
+    pub fn counts(&self) -> &[u32] {
+        &self.count
     }
 
     pub fn sample_count(&self, x: u32, y: u32) -> u32 {
@@ -86,12 +174,15 @@ impl Film {
     /// Pixel value: the mean of its samples, each pixel divided by its own count (an
     /// interrupted render has pixels with different counts); black without samples.
     pub fn pixel(&self, x: u32, y: u32) -> Rgb {
-        let i = self.index(x, y);
+        self.pixel_at(self.index(x, y))
+    }
+
+    fn pixel_at(&self, i: usize) -> Rgb {
         let n = self.count[i];
         if n == 0 {
             return Rgb::ZERO;
         }
-        let s = self.sum[i];
+        let s = self.sum[i].to_f64();
         Rgb::new(
             (s[0] / n as f64) as f32,
             (s[1] / n as f64) as f32,
@@ -101,10 +192,7 @@ impl Film {
 
     /// All pixels, row-major from the top-left.
     pub fn pixels(&self) -> Vec<Rgb> {
-        (0..self.height)
-            .flat_map(|y| (0..self.width).map(move |x| (x, y)))
-            .map(|(x, y)| self.pixel(x, y))
-            .collect()
+        (0..self.sum.len()).map(|i| self.pixel_at(i)).collect()
     }
 
     /// Mean of all pixel values.
@@ -316,11 +404,30 @@ pub fn write_image(
     let tmp = path.with_file_name(format!(".{file_name}.tmp-{}", std::process::id()));
     let result = match format {
         ImageFormat::Exr => {
-            let data: Vec<f32> = pixels.iter().flat_map(|p| p.to_array()).collect();
-            let img = image::Rgb32FImage::from_raw(width, height, data)
-                .ok_or_else(|| Error::io(path, "pixel buffer has the wrong size"))?;
-            image::DynamicImage::ImageRgb32F(img)
-                .save_with_format(&tmp, image::ImageFormat::OpenExr)
+            if pixels.len() != width as usize * height as usize {
+                return Err(Error::io(path, "pixel buffer has the wrong size"));
+            }
+            // exr directly rather than through `image`, whose encoder writes compressed
+            // blocks in the order threads finish them: the same pixels must make the same
+            // bytes (a merged render is compared with the one-process render by its bytes).
+            use exr::prelude::{
+                Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
+            };
+            let w = width as usize;
+            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
+                let p = pixels[y * w + x];
+                (p.x, p.y, p.z)
+            });
+            let layer = Layer::new(
+                (w, height as usize),
+                LayerAttributes::default(),
+                Encoding::SMALL_LOSSLESS,
+                channels,
+            );
+            Image::from_layer(layer)
+                .write()
+                .to_file(&tmp)
+                .map_err(|e| image::ImageError::IoError(std::io::Error::other(e.to_string())))
         }
         ImageFormat::Png => {
             let data: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
@@ -432,6 +539,30 @@ mod tests {
         let exr = dir.join("a.exr");
         write_image(&exr, 2, 1, &pixels, &display).unwrap();
         assert_eq!(read_image(&exr).unwrap().2, pixels);
+        let _ = std::fs::remove_dir_all(&dir);
+    }
+
+    /// The same pixels make the same bytes: an EXR of many compressed blocks (compressed in
+    /// parallel) is written in a fixed block order.
+    #[test]
+    fn an_exr_is_the_same_bytes_every_time() {
+        let dir = std::env::temp_dir().join(format!("foton-film-exr-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let (w, h) = (320u32, 240u32);
+        let mut rng = crate::sampling::Rng::new(&[3]);
+        let pixels: Vec<Rgb> = (0..w * h)
+            .map(|_| Rgb::new(rng.next_f32(), rng.next_f32() * 10.0, rng.next_f32() * 0.1))
+            .collect();
+        let write = |name: &str| {
+            let path = dir.join(name);
+            write_image(&path, w, h, &pixels, &DisplayTransform::default()).unwrap();
+            std::fs::read(path).unwrap()
+        };
+        let first = write("a.exr");
+        for i in 0..4 {
+            assert!(first == write(&format!("b{i}.exr")), "write {i} differs");
+        }
+        assert_eq!(read_image(&dir.join("a.exr")).unwrap().2, pixels);
         let _ = std::fs::remove_dir_all(&dir);
     }
 

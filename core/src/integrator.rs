@@ -52,11 +52,59 @@ pub struct RenderContext<'a> {
     /// has been done.
     pub cancel: &'a AtomicBool,
     pub progress: &'a dyn Progress,
+    /// The share of the work to do (`foton render --part I/N`); [`Part::WHOLE`] for all of it.
+    pub part: Part,
 }
 
-impl RenderContext<'_> {
+impl<'a> RenderContext<'a> {
+    /// A context for the whole render.
+    pub fn new(threads: usize, cancel: &'a AtomicBool, progress: &'a dyn Progress) -> Self {
+        RenderContext {
+            threads,
+            cancel,
+            progress,
+            part: Part::WHOLE,
+        }
+    }
+
     pub fn cancelled(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
+    }
+}
+
+/// One of `count` disjoint shares of a render's work, `index` counted from 0. The shares of
+/// the `count` parts cover the work exactly once, and a render of a part fills a film whose
+/// sums add up, over the parts, to the whole render's: the film records the part it holds
+/// ([`Film::part`]), so that a host can tell an integrator that ignored it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub struct Part {
+    pub index: u32,
+    pub count: u32,
+}
+
+impl Part {
+    pub const WHOLE: Part = Part { index: 0, count: 1 };
+
+    /// Part `index` of `count`; None unless index < count.
+    pub fn new(index: u32, count: u32) -> Option<Part> {
+        (index < count).then_some(Part { index, count })
+    }
+
+    pub fn is_whole(&self) -> bool {
+        self.count == 1
+    }
+
+    /// This part's share of `total` units of work (samples, iterations): the contiguous range
+    /// [total i / n, total (i + 1) / n), so that shares differ in size by one at most.
+    pub fn share(&self, total: u64) -> std::ops::Range<u64> {
+        let split = |i: u64| (total as u128 * i as u128 / self.count as u128) as u64;
+        split(self.index as u64)..split(self.index as u64 + 1)
+    }
+}
+
+impl std::fmt::Display for Part {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{}/{}", self.index, self.count)
     }
 }
 
@@ -190,8 +238,9 @@ pub trait Integrator: Send + Sync {
     /// Every parameter in force, with the key of `[integrators.NAME]` it is read from.
     fn parameters(&self) -> Vec<Parameter>;
 
-    /// Renders the scene's camera view. On cancellation, returns the film as it is (each pixel
-    /// holds its own sample count), not an error.
+    /// Renders the scene's camera view, or the share of it that `ctx.part` names (an
+    /// integrator that cannot split its work returns an error for a part). On cancellation,
+    /// returns the film as it is (each pixel holds its own sample count), not an error.
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film>;
 
     /// How a time budget scales the work (`foton compare --time`).

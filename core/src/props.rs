@@ -300,32 +300,38 @@ impl<'a> Properties<'a> {
         }
     }
 
-    pub fn vec3_opt(&self, name: &str) -> Result<Option<Vec3>> {
+    /// An array of exactly `n` finite numbers.
+    pub fn floats_opt(&self, name: &str, n: usize) -> Result<Option<Vec<f32>>> {
         let Some(node) = self.node(name) else {
             return Ok(None);
         };
+        let expected = format!("an array of {n} numbers");
         let Value::Array(items) = &node.value else {
-            return Err(self.expected(name, "an array of 3 numbers", &node.value));
+            return Err(self.expected(name, &expected, &node.value));
         };
-        if items.len() != 3 {
+        if items.len() != n {
             return Err(self.error(
                 name,
                 format!(
-                    "expected an array of 3 numbers, found {} element(s) `{}`",
+                    "expected {expected}, found {} element(s) `{}`",
                     items.len(),
                     node.value.show()
                 ),
             ));
         }
-        let mut v = [0.0f32; 3];
-        for (slot, item) in v.iter_mut().zip(items) {
+        let mut v = Vec::with_capacity(n);
+        for item in items {
             let x = item
                 .value
                 .as_f64()
-                .ok_or_else(|| self.expected(name, "an array of 3 numbers", &node.value))?;
-            *slot = self.finite(name, x)?;
+                .ok_or_else(|| self.expected(name, &expected, &node.value))?;
+            v.push(self.finite(name, x)?);
         }
-        Ok(Some(Vec3::from_array(v)))
+        Ok(Some(v))
+    }
+
+    pub fn vec3_opt(&self, name: &str) -> Result<Option<Vec3>> {
+        Ok(self.floats_opt(name, 3)?.map(|v| Vec3::from_slice(&v)))
     }
 
     pub fn vec3(&self, name: &str, default: Vec3) -> Result<Vec3> {

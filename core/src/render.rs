@@ -1,13 +1,16 @@
 //! The parallel image loop shared by integrators that estimate radiance per camera sample.
 //!
 //! Samples are taken in passes (1, 1, 2, 4, ... samples per pixel) over 16x16 tiles run in
-//! parallel; each pixel sums its samples in sample order, so the image is bit-identical for a
-//! given seed whatever the thread count. Ctrl-C stops between pixels: every pixel keeps the
-//! samples it has and is divided by its own count.
+//! parallel; each sample's random numbers depend on its pixel and index alone and pixels sum
+//! their samples exactly ([`RadianceSum`]), so the image is bit-identical for a given seed
+//! whatever the thread count, and a render split into parts (`RenderContext::part`: part i of
+//! n takes the samples [spp i / n, spp (i + 1) / n) of every pixel) sums to the whole render.
+//! Ctrl-C stops between pixels: every pixel keeps the samples it has and is divided by its own
+//! count.
 
 use crate::Rgb;
 use crate::error::{Error, Result};
-use crate::film::Film;
+use crate::film::{Film, RadianceSum};
 use crate::geometry::Ray;
 use crate::integrator::RenderContext;
 use crate::sampling::Sampler;
@@ -33,30 +36,41 @@ pub fn pixel_sampler(seed: u64, width: u32, x: u32, y: u32, sample: u32) -> Samp
     Sampler::new(&[seed, (y as u64) * width as u64 + x as u64, sample as u64])
 }
 
-/// Renders `scene.render.spp` samples per pixel; `radiance` estimates the radiance arriving
-/// along a camera ray and adds the rays it traced to its last argument (for statistics). The
-/// film position is jittered uniformly inside the pixel (box filter).
+/// Renders `scene.render.spp` samples per pixel, or the share of them `ctx.part` names;
+/// `radiance` estimates the radiance arriving along a camera ray and adds the rays it traced to
+/// its last argument (for statistics). The film position is drawn from the scene's
+/// reconstruction filter.
 pub fn render_pixels<F>(scene: &Scene, ctx: &RenderContext<'_>, radiance: F) -> Result<Film>
 where
     F: Fn(&Ray, &mut Sampler, &mut u64) -> Rgb + Sync,
 {
     let (width, height) = (scene.film.width, scene.film.height);
-    let spp = scene.render.spp;
+    let share = ctx.part.share(scene.render.spp as u64);
+    let (first, spp) = (share.start as u32, share.end as u32);
     let seed = scene.render.seed;
     let mut film = Film::new(width, height);
+    film.part = ctx.part;
     let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     let bad_samples = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
-    ctx.progress
-        .begin("pixels", width as u64 * height as u64 * spp as u64);
+    ctx.progress.begin(
+        "pixels",
+        width as u64 * height as u64 * (spp - first) as u64,
+    );
 
-    let mut done = 0u32;
+    if first == spp && !ctx.part.is_whole() {
+        ctx.progress.warn(&format!(
+            "part {} of {} samples per pixel holds none: split into at most {} parts",
+            ctx.part, scene.render.spp, scene.render.spp
+        ));
+    }
+    let mut done = first;
     while done < spp && !ctx.cancelled() {
-        let batch = done.max(1).min(spp - done);
+        let batch = (done - first).max(1).min(spp - done);
         let (s0, s1) = (done, done + batch);
-        let results: Vec<Vec<(usize, [f64; 3], u32)>> = with_pool(ctx.threads, || {
+        let results: Vec<Vec<(usize, RadianceSum, u32)>> = with_pool(ctx.threads, || {
             tiles
                 .par_iter()
                 .map(|&(x0, y0)| {
@@ -67,7 +81,7 @@ where
                             break;
                         }
                         for x in x0..(x0 + TILE).min(width) {
-                            let mut sum = [0.0f64; 3];
+                            let mut sum = RadianceSum::ZERO;
                             for s in s0..s1 {
                                 let mut sampler = pixel_sampler(seed, width, x, y, s);
                                 let at = scene.film.filter.film_position(x, y, sampler.next_2d());
@@ -77,9 +91,7 @@ where
                                     bad_samples.fetch_add(1, Ordering::Relaxed);
                                     l = Rgb::ZERO;
                                 }
-                                sum[0] += l.x as f64;
-                                sum[1] += l.y as f64;
-                                sum[2] += l.z as f64;
+                                sum.add(l);
                             }
                             out.push((film.index(x, y), sum, s1 - s0));
                         }
@@ -92,7 +104,7 @@ where
                 .collect()
         })?;
         for (i, sum, n) in results.into_iter().flatten() {
-            film.add_pixel(i, sum, n);
+            film.add_pixel(i, &sum, n);
         }
         done = s1;
     }

@@ -274,6 +274,67 @@ fn find_renamed(
 }
 
 impl Document {
+    /// Makes the relative `file` of every shape and the film's `output` absolute against
+    /// `base` (for a document written into another folder than the one it was read from).
+    pub fn absolutize_files(&mut self, base: &Path) {
+        let fix = |node: &mut Node| {
+            if let Value::Str(s) = &mut node.value
+                && Path::new(s.as_str()).is_relative()
+            {
+                *s = base.join(&*s).to_string_lossy().into_owned();
+            }
+        };
+        if let Some(Node {
+            value: Value::Array(shapes),
+            ..
+        }) = self.root.get_mut("shapes")
+        {
+            for shape in shapes {
+                if let Value::Table(t) = &mut shape.value
+                    && let Some(file) = t.get_mut("file")
+                {
+                    fix(file);
+                }
+            }
+        }
+        if let Some(Node {
+            value: Value::Table(film),
+            ..
+        }) = self.root.get_mut("film")
+            && let Some(output) = film.get_mut("output")
+        {
+            fix(output);
+        }
+    }
+
+    /// The document as TOML text (what `foton convert` writes): tables in key order, arrays of
+    /// tables as `[[...]]`.
+    pub fn to_toml(&self) -> String {
+        fn convert(v: &Value) -> toml::Value {
+            match v {
+                Value::Bool(b) => toml::Value::Boolean(*b),
+                Value::Int(i) => toml::Value::Integer(*i),
+                Value::Float(f) => toml::Value::Float(*f),
+                Value::Str(s) | Value::Datetime(s) => toml::Value::String(s.clone()),
+                Value::Array(items) => {
+                    toml::Value::Array(items.iter().map(|n| convert(&n.value)).collect())
+                }
+                Value::Table(t) => toml::Value::Table(
+                    t.0.iter()
+                        .map(|(k, n)| (k.clone(), convert(&n.value)))
+                        .collect(),
+                ),
+            }
+        }
+        let table: toml::Table = self
+            .root
+            .0
+            .iter()
+            .map(|(k, n)| (k.clone(), convert(&n.value)))
+            .collect();
+        toml::to_string(&table).unwrap_or_default()
+    }
+
     /// Parses TOML text; `file` is only used in messages and to resolve relative paths.
     pub fn parse(text: &str, file: &Path) -> Result<Document> {
         let parsed = DeTable::parse(text).map_err(|e| {

@@ -136,20 +136,38 @@ def _warn(messages: Iterable[str], stacklevel: int) -> None:
 # --- scenes ------------------------------------------------------------------------------------
 
 
+def _defines(defines: Mapping[str, Any] | None) -> list[str]:
+    out = []
+    for name, value in (defines or {}).items():
+        if isinstance(value, bool):
+            value = "true" if value else "false"
+        out.append(f"{name}={value}")
+    return out
+
+
 def load(
     path: PathLike,
     *,
+    defines: Mapping[str, Any] | None = None,
+    lenient: bool = False,
     plugin_dirs: Iterable[PathLike] = (),
     strict: bool = False,
     **overrides: Any,
 ) -> "Scene":
-    """Loads a scene file and creates its integrator, as ``foton render`` does.
+    """Loads a scene file and creates its integrator, as ``foton render`` does: a TOML scene,
+    or a Mitsuba 3 XML scene (``.xml``).
 
     ``overrides`` set scene values by their dotted key paths, like the program's ``--set``:
     ``foton.load("s.toml", **{"render.spp": 16, "integrators.photon.k": 50})``. A keyword
     whose value is a dict is merged key by key: ``foton.load("s.toml", render={"spp": 16})``
     is the same as ``**{"render.spp": 16}``. Values are Python values (bool, int, float, str,
     lists of them): a str is a TOML string.
+
+    For a Mitsuba XML scene, ``defines`` set its ``<default>`` values (the program's
+    ``-D NAME=VALUE``, Mitsuba's ``mi.load_file(path, **params)``): ``defines={"spp": 16}``;
+    ``lenient=True`` leaves out what foton cannot render yet (each listed in a warning)
+    instead of refusing the scene (``--lenient``). Overrides apply to XML scenes too, to the
+    TOML scene the XML reads as.
 
     ``plugin_dirs`` are searched for plugins first (``--plugin-dir``), then
     ``FOTON_PLUGIN_PATH``, the running executable's folder and its ``plugins/``, then the
@@ -159,7 +177,14 @@ def load(
     :class:`UsageError`. Unknown fields are :class:`FotonWarning` warnings.
     """
     native = _foton.load(
-        os.fspath(path), None, _overrides(overrides), _dirs(plugin_dirs), _extra_dirs(), strict
+        os.fspath(path),
+        None,
+        _overrides(overrides),
+        _defines(defines),
+        bool(lenient),
+        _dirs(plugin_dirs),
+        _extra_dirs(),
+        strict,
     )
     scene = Scene(native)
     _warn(native.warnings, stacklevel=2)
@@ -174,14 +199,15 @@ def loads(
     strict: bool = False,
     **overrides: Any,
 ) -> "Scene":
-    """Loads a scene from TOML text, as :func:`load` loads a file.
+    """Loads a scene from TOML text, as :func:`load` loads a file (for a Mitsuba XML scene,
+    write it to a file and :func:`load` that).
 
     Relative paths in the scene (meshes, the film output) are resolved against ``base_dir``
     (default: the current folder); messages name the scene ``<base_dir>/<string>``.
     """
     name = "<string>" if base_dir is None else os.path.join(os.fspath(base_dir), "<string>")
     native = _foton.load(
-        name, text, _overrides(overrides), _dirs(plugin_dirs), _extra_dirs(), strict
+        name, text, _overrides(overrides), [], False, _dirs(plugin_dirs), _extra_dirs(), strict
     )
     scene = Scene(native)
     _warn(native.warnings, stacklevel=2)

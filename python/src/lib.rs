@@ -2,7 +2,8 @@
 //!
 //! A thin layer over the program's own code paths, so that an image rendered from Python is
 //! the image `foton render` writes, bit for bit: scenes are loaded by foton-core
-//! (`Scene::load`, or `Document::parse` for TOML text) with `--set` style overrides, their
+//! (`Scene::load_with`, TOML or Mitsuba XML; `Document::parse` for TOML text) with `--set`
+//! style overrides, their
 //! integrator is created by `foton_cli::prepare_scene` from the plugins on the search path,
 //! and rendered by `foton_cli::render_with`; images are written and read by foton-core's film
 //! functions, and compared by `foton compare`'s error function. The Python side (argument
@@ -99,19 +100,25 @@ fn py_error(py: Python<'_>, e: Error) -> PyErr {
 
 /// Where a scene comes from.
 enum Source {
-    File(PathBuf),
-    /// TOML text; `file` names it in messages and relative paths are resolved from its folder.
-    Text {
-        text: String,
-        file: PathBuf,
+    /// A TOML or Mitsuba XML scene file, with the XML's `-D` defines and `--lenient`.
+    File {
+        path: PathBuf,
+        defines: Vec<String>,
+        lenient: bool,
     },
+    /// TOML text; `file` names it in messages and relative paths are resolved from its folder.
+    Text { text: String, file: PathBuf },
 }
 
 impl Source {
-    /// As `foton render` loads a scene file (`Scene::load`), or the same from text.
+    /// As `foton render` loads a scene file (`Scene::load_with`), or the same from text.
     fn load(&self, overrides: &[String]) -> foton_core::Result<Scene> {
         match self {
-            Source::File(path) => Scene::load(path, overrides),
+            Source::File {
+                path,
+                defines,
+                lenient,
+            } => Scene::load_with(path, overrides, defines, *lenient),
             Source::Text { text, file } => {
                 let mut doc = Document::parse(text, file)?;
                 for o in overrides {
@@ -379,11 +386,7 @@ impl NativeScene {
         };
         let result = std::thread::scope(|s| {
             let worker = s.spawn(|| {
-                let ctx = RenderContext {
-                    threads,
-                    cancel: &cancel,
-                    progress: &report,
-                };
+                let ctx = RenderContext::new(threads, &cancel, &report);
                 let result = render_with(&p, &ctx);
                 *finished.0.lock().unwrap() = true;
                 finished.1.notify_all();
@@ -445,21 +448,28 @@ impl NativeScene {
     }
 }
 
-/// Loads a scene (from `path`, or from `text` named `path`) and creates its integrator.
+/// Loads a scene (from `path`, or from TOML `text` named `path`) and creates its integrator.
 #[pyfunction]
-#[pyo3(signature = (path, text, overrides, plugin_dirs, extra_dirs, strict))]
+#[pyo3(signature = (path, text, overrides, defines, lenient, plugin_dirs, extra_dirs, strict))]
+#[allow(clippy::too_many_arguments)]
 fn load(
     py: Python<'_>,
     path: PathBuf,
     text: Option<String>,
     overrides: Vec<String>,
+    defines: Vec<String>,
+    lenient: bool,
     plugin_dirs: Vec<PathBuf>,
     extra_dirs: Vec<PathBuf>,
     strict: bool,
 ) -> PyResult<NativeScene> {
     let source = match text {
         Some(text) => Source::Text { text, file: path },
-        None => Source::File(path),
+        None => Source::File {
+            path,
+            defines,
+            lenient,
+        },
     };
     let search = search(&plugin_dirs, &extra_dirs);
     let base = py

@@ -16,11 +16,7 @@ use std::time::Instant;
 fn main() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let cancel = AtomicBool::new(false);
-    let ctx = RenderContext {
-        threads,
-        cancel: &cancel,
-        progress: &NoProgress,
-    };
+    let ctx = RenderContext::new(threads, &cancel, &NoProgress);
     let scene = Scene::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
     let n = 1_000_000;
     let opts = TraceOptions {

@@ -61,11 +61,7 @@ fn main() {
         .collect();
     let radius = 0.02f32;
     let cancel = Default::default();
-    let ctx = RenderContext {
-        threads,
-        cancel: &cancel,
-        progress: &NoProgress,
-    };
+    let ctx = RenderContext::new(threads, &cancel, &NoProgress);
     let n_photons = 100_000;
     let opts = TraceOptions {
         photons: n_photons,

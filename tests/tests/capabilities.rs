@@ -118,11 +118,8 @@ fn budgets_name_real_scene_keys() {
 #[test]
 fn photon_maps_are_the_integrators_own() {
     let cancel = AtomicBool::new(false);
-    let ctx = foton_core::integrator::RenderContext {
-        threads: 2,
-        cancel: &cancel,
-        progress: &foton_core::integrator::NoProgress,
-    };
+    let ctx =
+        foton_core::integrator::RenderContext::new(2, &cancel, &foton_core::integrator::NoProgress);
     let p = prepared(
         "photon",
         &[

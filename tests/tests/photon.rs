@@ -94,11 +94,7 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
     // All bounces: each bounce keeps the power in expectation, so the power stored at the
     // k-th hit sums to 20 rho^(k-1) W (Russian roulette only adds noise).
     let cancel = AtomicBool::new(false);
-    let ctx = RenderContext {
-        threads: 2,
-        cancel: &cancel,
-        progress: &NoProgress,
-    };
+    let ctx = RenderContext::new(2, &cancel, &NoProgress);
     let all = TraceOptions {
         max_depth: 1000,
         stop_at_diffuse: false,
@@ -148,11 +144,7 @@ intensity = [1.0, 1.0, 1.0]
     );
     let scene = scene_from("density", &toml);
     let cancel = AtomicBool::new(false);
-    let ctx = RenderContext {
-        threads: 2,
-        cancel: &cancel,
-        progress: &NoProgress,
-    };
+    let ctx = RenderContext::new(2, &cancel, &NoProgress);
     let opts = TraceOptions {
         photons: 1_000_000,
         max_depth: 1,

@@ -16,7 +16,7 @@ fn statistics_update_follows_hachisuka_and_jensen() {
         n: 0.0,
         tau: DVec3::ZERO,
         ld: DVec3::ZERO,
-        photon_sum: DVec3::ZERO,
+        sum: Default::default(),
     };
     let alpha = 0.7;
     // First iteration: N = 0, M = 10: N' = 7, R'^2 = R^2 * 7 / 10, tau' = Phi * 7 / 10.

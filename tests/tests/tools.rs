@@ -435,6 +435,107 @@ fn sweep_renders_one_tile_per_combination() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// A sweep as an array job: `--cells` sizes it, `--cell I` renders each cell into its file
+/// (the cell's own render, bit for bit), `--assemble` lays out the grid one process makes (but
+/// for the times in the labels); a missing cell or one of another sweep is refused.
+#[test]
+fn sweep_runs_as_an_array_job() {
+    let (dir, scene) = setup("sweep-array");
+    let cells = dir.join("cells");
+    std::fs::create_dir(&cells).unwrap();
+    let sets = [
+        "--set",
+        "render.max_depth=1,3",
+        "--set",
+        "render.seed=1,2,3",
+        "--set",
+        "render.spp=1",
+        "-q",
+    ];
+    let sweep = |extra: &[&str]| {
+        let mut args = vec!["sweep", s(&scene)];
+        args.extend(sets);
+        args.extend(extra);
+        foton_with_plugins(&args)
+    };
+    let run = sweep(&["--cells"]);
+    ok(&run);
+    assert_eq!(run.stdout.trim(), "6");
+    fails_with(
+        &sweep(&["--cell", "6", "--cells-dir", s(&cells)]),
+        &["--cell 6", "6 cells"],
+    );
+    // Cells in any order, as the tasks of an array finish.
+    for cell in [5, 0, 3, 1, 4] {
+        ok(&sweep(&[
+            "--cell",
+            &cell.to_string(),
+            "--cells-dir",
+            s(&cells),
+        ]));
+    }
+    let grid = dir.join("grid.png");
+    fails_with(
+        &sweep(&["--assemble", "--cells-dir", s(&cells), "-o", s(&grid)]),
+        &["missing cell(s) 2 of 6"],
+    );
+    assert!(!grid.exists());
+    ok(&sweep(&["--cell", "2", "--cells-dir", s(&cells)]));
+    let run = sweep(&["--assemble", "--cells-dir", s(&cells), "-o", s(&grid)]);
+    ok(&run);
+    assert!(run.stdout.contains("6 cells (2 x 3)"), "{}", run.stdout);
+
+    // Cell 4 is max_depth = 1 (the first list varies fastest), seed = 3.
+    let single = dir.join("single.exr");
+    ok(&foton_with_plugins(&[
+        "render",
+        s(&scene),
+        "--set",
+        "render.max_depth=1",
+        "--set",
+        "render.seed=3",
+        "--set",
+        "render.spp=1",
+        "-q",
+        "-o",
+        s(&single),
+    ]));
+    assert_eq!(
+        read_image(&cells.join("cell-4.exr")).unwrap(),
+        read_image(&single).unwrap()
+    );
+    // The one-process grid: the same size, the same tiles; only label times differ.
+    let one = dir.join("one.png");
+    ok(&sweep(&["-o", s(&one)]));
+    let (w, h, a) = read_image(&grid).unwrap();
+    let (w1, h1, b) = read_image(&one).unwrap();
+    assert_eq!((w, h), (w1, h1));
+    let differing = a.iter().zip(&b).filter(|(x, y)| x != y).count();
+    assert!(
+        differing * 100 < a.len() * 3,
+        "{differing} of {} pixels differ",
+        a.len()
+    );
+    // A cell of another sweep (another list of seeds) is refused.
+    let mut args = vec!["sweep", s(&scene)];
+    args.extend([
+        "--set",
+        "render.max_depth=1,3",
+        "--set",
+        "render.seed=1,2,4",
+        "--set",
+        "render.spp=1",
+        "-q",
+        "--assemble",
+        "--cells-dir",
+        s(&cells),
+        "-o",
+        s(&grid),
+    ]);
+    fails_with(&foton_with_plugins(&args), &["cell-0.exr", "another sweep"]);
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 #[test]
 fn sweep_keeps_arrays_whole() {
     assert_eq!(

@@ -1,6 +1,7 @@
-//! The `foton` program: `render`, `check`, `plugins`, `bench`, and the tools for seeing and
-//! comparing, `photons`, `compare` and `sweep` (one file each, their labelled images in
-//! `montage`, the terminal progress in `progress`).
+//! The `foton` program: `render`, `check`, `plugins`, `bench`, `merge` (of the parts of a
+//! render split with `render --part`, in `part`), and the tools for seeing and comparing,
+//! `photons`, `compare` and `sweep` (one file each, their labelled images in `montage`, the
+//! terminal progress in `progress`).
 //!
 //! A thin layer over foton-core: parse arguments (clap), load the scene, find the plugin, run
 //! it, write the image. Errors are turned into messages here, once. Everything host-only lives
@@ -9,14 +10,15 @@
 
 pub mod compare;
 pub mod montage;
+pub mod part;
 pub mod photons;
 mod progress;
 pub mod sweep;
 
 use clap::{Args, Parser, Subcommand};
 use foton_core::error::{Error, Result};
-use foton_core::film::{Film, check_output};
-use foton_core::integrator::{Integrator, RenderContext};
+use foton_core::film::{Film, ImageFormat, check_output, format_of};
+use foton_core::integrator::{Integrator, Part, RenderContext};
 use foton_core::plugin::{IntegratorPlugin, Registry, search_path};
 use foton_core::scene::Scene;
 pub use progress::TermProgress;
@@ -58,6 +60,17 @@ enum Command {
     Render(RenderArgs),
     /// Parse and validate a scene; list what it uses and any unused field.
     Check(CheckArgs),
+    /// Merge the parts of a render made with `foton render --part I/N` into its image.
+    ///
+    /// Checks first that the parts belong together (same scene content, integrator and
+    /// parameters, seed, number of parts and foton build; no part twice; none missing or
+    /// interrupted unless --partial), then adds their exact per-pixel sums one part at a time.
+    /// The merged image equals the render done in one process with the same seed, bit for
+    /// bit. Nothing is written if a check fails.
+    Merge(part::MergeArgs),
+    /// Write a Mitsuba 3 XML scene as the equivalent TOML scene (the same image for the same
+    /// seed); lists what --lenient left out.
+    Convert(ConvertArgs),
     /// List the plugins found on the plugin search path.
     Plugins(PluginArgs),
     /// Render a scene several times and report samples per second (a benchmark, not a test).
@@ -114,8 +127,16 @@ pub(crate) struct PluginArgs {
 
 #[derive(Args, Clone, Default)]
 pub(crate) struct SceneArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
     scene: PathBuf,
+    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (Mitsuba's -D;
+    /// repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed as warnings)
+    /// instead of refusing the scene.
+    #[arg(long)]
+    lenient: bool,
     /// Use this integrator plugin instead of the scene's render.integrator.
     #[arg(long)]
     integrator: Option<String>,
@@ -137,6 +158,21 @@ pub(crate) struct SceneArgs {
 }
 
 #[derive(Args)]
+struct ConvertArgs {
+    /// The Mitsuba 3 scene (.xml).
+    scene: PathBuf,
+    /// The TOML scene to write; default: <scene stem>.toml beside the scene.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// NAME=VALUE: set a <default name="NAME"> (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Leave out what foton cannot render yet (listed) instead of refusing the scene.
+    #[arg(long)]
+    lenient: bool,
+}
+
+#[derive(Args)]
 struct RenderArgs {
     #[command(flatten)]
     scene: SceneArgs,
@@ -153,6 +189,12 @@ struct RenderArgs {
     /// iterations (atomically), so that it can be watched as it converges.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
     checkpoint: Option<u64>,
+    /// Render the I-th (from 0) of N disjoint shares of the work and write a part file (.exr)
+    /// for `foton merge`: camera samples are split (path, photon, vpm: every part builds the
+    /// same photon maps), or iterations (sppm, radius_schedule = "global" only). Default
+    /// output: <scene stem>-part-I-of-N.exr beside the scene.
+    #[arg(long, value_name = "I/N", value_parser = part::parse_part)]
+    part: Option<Part>,
 }
 
 #[derive(Args)]
@@ -198,6 +240,8 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
     let result = match cli.command {
         Command::Render(a) => cmd_render(a, out, err),
         Command::Check(a) => cmd_check(a, out, err),
+        Command::Merge(a) => part::run(a, out, err),
+        Command::Convert(a) => cmd_convert(a, out, err),
         Command::Plugins(a) => cmd_plugins(a, out),
         Command::Bench(a) => cmd_bench(a, out, err),
         Command::Photons(a) => photons::run(a, out, err),
@@ -255,7 +299,31 @@ pub fn prepare(
     plugin_dirs: &[PathBuf],
     strict: bool,
 ) -> Result<Prepared> {
-    let scene = Scene::load(scene_path, overrides)?;
+    prepare_xml(scene_path, overrides, &[], false, plugin_dirs, strict)
+}
+
+/// [`prepare`] for the scene arguments of a command.
+pub(crate) fn prepare_args(a: &SceneArgs, overrides: &[String]) -> Result<Prepared> {
+    prepare_xml(
+        &a.scene,
+        overrides,
+        &a.defines,
+        a.lenient,
+        &a.plugins.plugin_dirs,
+        a.strict,
+    )
+}
+
+/// [`prepare`], with a Mitsuba XML scene's `-D` defines and `--lenient`.
+pub fn prepare_xml(
+    scene_path: &Path,
+    overrides: &[String],
+    defines: &[String],
+    lenient: bool,
+    plugin_dirs: &[PathBuf],
+    strict: bool,
+) -> Result<Prepared> {
+    let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
     prepare_scene(scene, &search_path(plugin_dirs), strict)
 }
 
@@ -319,12 +387,17 @@ fn beside_scene(scene: &Path, suffix: &str) -> PathBuf {
 
 /// Writes a file atomically: to a temporary name in the same folder, then renamed over `path`.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    write_atomic_with(path, |tmp| std::fs::write(tmp, bytes))
+}
+
+/// Writes a file atomically with `write`, which writes to the temporary path it is given.
+fn write_atomic_with(path: &Path, write: impl FnOnce(&Path) -> std::io::Result<()>) -> Result<()> {
     let name = path
         .file_name()
         .ok_or_else(|| Error::io(path, "not a file name"))?
         .to_string_lossy();
     let tmp = path.with_file_name(format!(".{name}.tmp-{}", std::process::id()));
-    std::fs::write(&tmp, bytes)
+    write(&tmp)
         .and_then(|()| std::fs::rename(&tmp, path))
         .map_err(|e| {
             let _ = std::fs::remove_file(&tmp);
@@ -342,16 +415,36 @@ pub fn render_prepared(
     threads: usize,
     progress: &TermProgress,
 ) -> Result<(Film, Duration)> {
+    render_part(p, threads, progress, Part::WHOLE)
+}
+
+/// Renders `part` of a prepared scene's work on `threads` threads.
+pub fn render_part(
+    p: &Prepared,
+    threads: usize,
+    progress: &TermProgress,
+    part: Part,
+) -> Result<(Film, Duration)> {
     let ctx = RenderContext {
-        threads,
-        cancel: &INTERRUPTED,
-        progress,
+        part,
+        ..RenderContext::new(threads, &INTERRUPTED, progress)
     };
     let start = Instant::now();
     let film = p
         .integrator
         .render(&p.scene, &ctx)
         .map_err(|e| blame_plugin(&p.plugin, e))?;
+    if film.part != part {
+        // A plugin that ignored the part rendered all of the work: merging such films would
+        // count it N times.
+        return Err(blame_plugin(
+            &p.plugin,
+            Error::Render(format!(
+                "asked for part {part}, it returned a film of part {}: this integrator cannot render in parts",
+                film.part
+            )),
+        ));
+    }
     Ok((film, start.elapsed()))
 }
 
@@ -369,17 +462,29 @@ pub fn render_with(p: &Prepared, ctx: &RenderContext<'_>) -> Result<(Film, Durat
 
 fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
-    let output = a
-        .output
-        .clone()
-        .unwrap_or_else(|| p.scene.film.output.clone());
+    let p = prepare_args(&a.scene, &overrides)?;
+    let output = match (&a.output, a.part) {
+        (Some(o), _) => o.clone(),
+        (None, Some(part)) => beside_scene(
+            &a.scene.scene,
+            &format!("part-{}-of-{}.exr", part.index, part.count),
+        ),
+        (None, None) => p.scene.film.output.clone(),
+    };
     check_output(&output)?;
+    if a.part.is_some() {
+        if format_of(&output)? != ImageFormat::Exr {
+            return Err(Error::Usage(format!(
+                "--part writes exact per-pixel sums, which only EXR can hold: name the output .exr, not {}",
+                output.display()
+            )));
+        }
+        if a.checkpoint.is_some() {
+            return Err(Error::Usage(
+                "--checkpoint and --part: a part's image is not the render's, merge the parts to see it".into(),
+            ));
+        }
+    }
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");
     }
@@ -389,7 +494,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
-    let (film, elapsed) = render_prepared(&p, threads, &progress)?;
+    let (film, elapsed) = render_part(&p, threads, &progress, a.part.unwrap_or(Part::WHOLE))?;
     if a.checkpoint.is_some() && progress.checkpoints.load(Ordering::Relaxed) == 0 {
         let _ = writeln!(
             err,
@@ -400,10 +505,23 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     for w in progress.take_warnings() {
         let _ = writeln!(err, "warning: {w}");
     }
-    film.write(&output, &p.scene.film.display())?;
+    let of_part = match a.part {
+        Some(part) => {
+            // The defines change an XML scene as overrides do.
+            let mut hashed = overrides.clone();
+            hashed.extend(a.scene.defines.iter().map(|d| format!("-D {d}")));
+            let info = part::PartInfo::of(&p.scene, &hashed, &p.integrator.describe(), &film)?;
+            part::write_part(&output, &film, &info, &[])?;
+            format!(", part {part}")
+        }
+        None => {
+            film.write(&output, &p.scene.film.display())?;
+            String::new()
+        }
+    };
     let _ = writeln!(
         out,
-        "{}: {}x{}, {} with {} -> {}",
+        "{}: {}x{}{of_part}, {} with {} -> {}",
         p.scene.file.display(),
         film.width,
         film.height,
@@ -458,7 +576,8 @@ fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
             film.iterations
         )
     } else {
-        let full = film.width as u64 * film.height as u64 * scene.render.spp as u64;
+        let share = film.part.share(scene.render.spp as u64);
+        let full = film.width as u64 * film.height as u64 * (share.end - share.start);
         format!(
             "wrote the image of the {} of {full} samples done so far",
             film.total_samples()
@@ -466,14 +585,47 @@ fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
     }
 }
 
+fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| a.scene.with_extension("toml"));
+    if output.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return Err(Error::Usage(format!(
+            "convert writes a TOML scene: name the output .toml, not {}",
+            output.display()
+        )));
+    }
+    let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    // Files are named relative to the scene; from another folder, by their full path.
+    let folder = |p: &Path| match p.parent() {
+        Some(d) if !d.as_os_str().is_empty() => std::fs::canonicalize(d).ok(),
+        _ => std::fs::canonicalize(".").ok(),
+    };
+    let base = folder(&a.scene).ok_or_else(|| Error::io(&a.scene, "cannot resolve its folder"))?;
+    if folder(&output).as_ref() != Some(&base) {
+        doc.absolutize_files(&base);
+    }
+    // The TOML must load: check it before writing.
+    Scene::from_document(doc.clone())?;
+    let header = format!(
+        "# Converted by `foton convert` from {}\n",
+        a.scene.display()
+    );
+    write_atomic(&output, (header + &doc.to_toml()).as_bytes())?;
+    for l in &report.left_out {
+        let _ = writeln!(err, "left out: {l}");
+    }
+    for n in &report.notes {
+        let _ = writeln!(err, "note: {n}");
+    }
+    let _ = writeln!(out, "{} -> {}", a.scene.display(), output.display());
+    Ok(0)
+}
+
 fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
+    let p = prepare_args(&a.scene, &overrides)?;
     let s = &p.scene;
     let _ = writeln!(out, "scene      {}", s.file.display());
     let _ = writeln!(out, "integrator {}", p.integrator.describe());

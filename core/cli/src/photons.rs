@@ -7,7 +7,7 @@
 //! budgets or classifications.
 
 use crate::{
-    INTERRUPTED, SceneArgs, TermProgress, beside_scene, prepare, scene_overrides, threads,
+    INTERRUPTED, SceneArgs, TermProgress, beside_scene, prepare_args, scene_overrides, threads,
 };
 use clap::Args;
 use foton_core::error::{Error, Result};
@@ -82,12 +82,7 @@ fn exposure(powers: &[Rgb]) -> f32 {
 
 pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let overrides = scene_overrides(&a.scene);
-    let p = prepare(
-        &a.scene.scene,
-        &overrides,
-        &a.scene.plugins.plugin_dirs,
-        a.scene.strict,
-    )?;
+    let p = prepare_args(&a.scene, &overrides)?;
     let scene = &p.scene;
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");
@@ -96,11 +91,7 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let progress = TermProgress::new(a.quiet);
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
-    let ctx = RenderContext {
-        threads,
-        cancel: &INTERRUPTED,
-        progress: &progress,
-    };
+    let ctx = RenderContext::new(threads, &INTERRUPTED, &progress);
     let name = p.integrator.name().to_string();
     let mut maps = p
         .integrator

@@ -2,15 +2,21 @@
 //! labelled grid. The first `--set` with several values runs along the columns, the second
 //! down the rows, further ones down the rows too (row-major, the earlier varying faster); a
 //! `--set` with one value applies to every cell.
+//!
+//! On a cluster the cells are an array job: `--cells` prints their number, `--cell I
+//! --cells-dir DIR` renders one into DIR/cell-I.exr (a part file of a whole render, with the
+//! sweep's signature and the cell's time), and `--assemble --cells-dir DIR` lays out the grid
+//! from those files, the same grid as one process makes but for the times.
 
 use crate::montage::{Tile, grid, render_image};
+use crate::part::{PartInfo, fnv_hex, read_part_attributes, read_part_film, write_part};
 use crate::threads;
 use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::check_output;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 
 /// More cells than this is almost certainly a typo in a value list.
@@ -46,6 +52,25 @@ pub(super) struct SweepArgs {
     /// No progress bar.
     #[arg(short, long)]
     quiet: bool,
+    /// Print the number of cells and do nothing else (to size an array job).
+    #[arg(long, conflicts_with_all = ["cell", "assemble"])]
+    cells: bool,
+    /// Render only cell I (from 0, in the grid's row-major order) into DIR/cell-I.exr
+    /// (--cells-dir): one task of an array job.
+    #[arg(
+        long,
+        value_name = "I",
+        requires = "cells_dir",
+        conflicts_with = "assemble"
+    )]
+    cell: Option<usize>,
+    /// Lay out the grid from the cells that --cell rendered into --cells-dir, rendering
+    /// nothing (the same --set arguments as the cells'; a cell from another sweep is refused).
+    #[arg(long, requires = "cells_dir")]
+    assemble: bool,
+    /// The folder of the cell files of --cell and --assemble (shared by the tasks).
+    #[arg(long, value_name = "DIR")]
+    cells_dir: Option<PathBuf>,
     #[command(flatten)]
     plugins: PluginArgs,
 }
@@ -162,14 +187,20 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             "the sweep has {cells} cells; at most {MAX_CELLS}"
         )));
     }
+    if a.cells {
+        let _ = writeln!(out, "{cells}");
+        return Ok(0);
+    }
+    if let Some(cell) = a.cell
+        && cell >= cells
+    {
+        return Err(Error::Usage(format!(
+            "--cell {cell}: the sweep has {cells} cells, numbered from 0"
+        )));
+    }
     let swept: Vec<&SweepSet> = sets.iter().filter(|s| s.values.len() > 1).collect();
     let names = short_names(&swept);
     let columns = swept.first().map_or(1, |s| s.values.len());
-    let output = a
-        .output
-        .clone()
-        .unwrap_or_else(|| beside_scene(&a.scene, "sweep.png"));
-    check_output(&output)?;
 
     let overrides_of = |cell: usize| {
         let choice = cell_choices(&sets, cell);
@@ -196,6 +227,67 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             .collect();
         (overrides, label)
     };
+    let signature = sweep_signature(&a)?;
+    if let Some(cell) = a.cell {
+        let dir = a.cells_dir.as_deref().expect("clap requires --cells-dir");
+        return render_cell(&a, cell, &overrides_of(cell), &signature, dir, out, err);
+    }
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| beside_scene(&a.scene, "sweep.png"));
+    check_output(&output)?;
+
+    if a.assemble {
+        let dir = a.cells_dir.as_deref().expect("clap requires --cells-dir");
+        let mut tiles = Vec::new();
+        let mut missing = Vec::new();
+        for cell in 0..cells {
+            let path = cell_path(dir, cell);
+            if !path.exists() {
+                missing.push(cell.to_string());
+                continue;
+            }
+            let attributes = read_part_attributes(&path)?;
+            let get = |key: &str| attributes.get(key).cloned().unwrap_or_default();
+            if get("foton.sweep") != signature || get("foton.cell") != cell.to_string() {
+                return Err(Error::Usage(format!(
+                    "{}: a cell of another sweep (other scene, --set values or flags) or of another cell",
+                    path.display()
+                )));
+            }
+            let info = crate::part::read_part_info(&path)?;
+            let film = read_part_film(&path, &info)?;
+            let (_, mut label) = overrides_of(cell);
+            let _ = writeln!(
+                out,
+                "[{}] {}: {}",
+                label.join(", "),
+                info.integrator,
+                get("foton.cellWork")
+            );
+            label.push(format!("{} s", get("foton.seconds")));
+            tiles.push(Tile {
+                image: render_image(&film, &info.display(), &output),
+                label,
+            });
+        }
+        if !missing.is_empty() {
+            return Err(Error::Usage(format!(
+                "missing cell(s) {} of {cells} in {}: render them with --cell I",
+                missing.join(", "),
+                dir.display()
+            )));
+        }
+        grid(&tiles, columns).write(&output)?;
+        let _ = writeln!(
+            out,
+            "{cells} cells ({columns} x {}) -> {}",
+            cells / columns,
+            output.display()
+        );
+        return Ok(0);
+    }
 
     // Every cell's scene and integrator are created first, so that a bad value fails before
     // any render; they are loaded again one at a time to render (a sweep over a large scene
@@ -232,11 +324,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             return Ok(130);
         }
         let secs = elapsed.as_secs_f64();
-        let work = if film.iterations > 0 {
-            format!("{} iterations", film.iterations)
-        } else {
-            format!("{} spp", p.scene.render.spp)
-        };
+        let work = cell_work(&film, &p);
         let _ = writeln!(
             out,
             "[{}] {}: {work} in {secs:.2} s",
@@ -259,6 +347,78 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
         columns,
         cells / columns,
         output.display()
+    );
+    Ok(0)
+}
+
+fn cell_work(film: &foton_core::film::Film, p: &crate::Prepared) -> String {
+    if film.iterations > 0 {
+        format!("{} iterations", film.iterations)
+    } else {
+        format!("{} spp", p.scene.render.spp)
+    }
+}
+
+fn cell_path(dir: &Path, cell: usize) -> PathBuf {
+    dir.join(format!("cell-{cell}.exr"))
+}
+
+/// What makes two sweeps the same: the scene file's bytes and every argument that changes the
+/// cells (the lists of values, the integrator, spp and seed).
+fn sweep_signature(a: &SweepArgs) -> Result<String> {
+    let scene = std::fs::read(&a.scene).map_err(|e| Error::io(&a.scene, e))?;
+    let mut fields: Vec<Vec<u8>> = vec![scene];
+    fields.extend(a.sets.iter().map(|s| s.as_bytes().to_vec()));
+    fields.push(format!("{:?} {:?} {:?}", a.integrator, a.spp, a.seed).into_bytes());
+    Ok(fnv_hex(&fields))
+}
+
+/// `--cell I`: renders one cell into its file in `dir`.
+fn render_cell(
+    a: &SweepArgs,
+    cell: usize,
+    (overrides, label): &(Vec<String>, Vec<String>),
+    signature: &str,
+    dir: &Path,
+    out: &mut dyn Write,
+    err: &mut dyn Write,
+) -> Result<u8> {
+    let path = cell_path(dir, cell);
+    check_output(&path)?;
+    let p = prepare(&a.scene, overrides, &a.plugins.plugin_dirs, a.strict)?;
+    for w in &p.warnings {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let progress = TermProgress::new(a.quiet);
+    let (film, elapsed) = render_prepared(&p, threads(a.threads), &progress)?;
+    for w in progress.take_warnings() {
+        let _ = writeln!(err, "warning: {w}");
+    }
+    if INTERRUPTED.load(Ordering::SeqCst) {
+        let _ = writeln!(err, "interrupted: nothing written");
+        return Ok(130);
+    }
+    let work = cell_work(&film, &p);
+    let info = PartInfo::of(&p.scene, overrides, &p.integrator.describe(), &film)?;
+    let secs = format!("{:.2}", elapsed.as_secs_f64());
+    write_part(
+        &path,
+        &film,
+        &info,
+        &[
+            ("foton.sweep", signature.to_string()),
+            ("foton.cell", cell.to_string()),
+            ("foton.cellWork", work.clone()),
+            ("foton.seconds", secs.clone()),
+        ],
+    )?;
+    let _ = writeln!(
+        out,
+        "[{}] {}: {work} in {secs} s -> {}",
+        label.join(", "),
+        p.integrator.describe(),
+        path.display()
     );
     Ok(0)
 }

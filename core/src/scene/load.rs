@@ -33,7 +33,14 @@ const SECTIONS: &[&str] = &[
     "lights",
     "scene",
 ];
-const MATERIAL_TYPES: &[&str] = &["diffuse", "mirror", "dielectric", "thindielectric", "null"];
+const MATERIAL_TYPES: &[&str] = &[
+    "diffuse",
+    "mirror",
+    "conductor",
+    "dielectric",
+    "thindielectric",
+    "null",
+];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
 const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
@@ -41,6 +48,7 @@ const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 /// Collects the bags of a load so that unused keys can be listed at the end.
 struct Loader {
     dir: PathBuf,
+    sources: Vec<PathBuf>,
     bags: Vec<Vec<(String, Location)>>,
     warnings: Vec<String>,
 }
@@ -62,11 +70,46 @@ impl Loader {
 impl Scene {
     /// Loads a scene file, applying `--set` style overrides first.
     pub fn load(path: &Path, overrides: &[String]) -> Result<Scene> {
-        let mut doc = Document::load(path)?;
+        Scene::load_with(path, overrides, &[], false)
+    }
+
+    /// Loads a scene file: TOML, or a Mitsuba 3 XML scene (`.xml`) whose `<default>`s
+    /// `defines` (`NAME=VALUE`, Mitsuba's `-D`) override and whose unsupported elements are
+    /// left out and listed among the warnings if `lenient`. `--set` style `overrides` apply
+    /// to the document in both cases (for XML: to the TOML it reads as).
+    pub fn load_with(
+        path: &Path,
+        overrides: &[String],
+        defines: &[String],
+        lenient: bool,
+    ) -> Result<Scene> {
+        let is_xml = path
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+        let (mut doc, report) = if is_xml {
+            if path.is_dir() {
+                return Err(crate::Error::io(path, "is a directory, not a scene file"));
+            }
+            let (doc, report) = super::mitsuba::read_xml(path, defines, lenient)?;
+            (doc, Some(report))
+        } else {
+            if let Some(d) = defines.first() {
+                return Err(crate::Error::Usage(format!(
+                    "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
+                )));
+            }
+            (Document::load(path)?, None)
+        };
         for o in overrides {
             doc.set(o)?;
         }
-        Scene::from_document(doc)
+        let mut scene = Scene::from_document(doc)?;
+        if let Some(report) = report {
+            scene.sources.extend(report.included);
+            let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
+            scene.warnings.extend(left_out.chain(report.notes));
+        }
+        Ok(scene)
     }
 
     pub fn from_document(doc: Document) -> Result<Scene> {
@@ -74,6 +117,7 @@ impl Scene {
         let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
         let mut ld = Loader {
             dir,
+            sources: Vec::new(),
             bags: Vec::new(),
             warnings: Vec::new(),
         };
@@ -192,6 +236,7 @@ impl Scene {
         let mut unused: Vec<(String, Location)> = ld.bags.into_iter().flatten().collect();
         unused.sort_by(|a, b| (a.1.line, &a.0).cmp(&(b.1.line, &b.0)));
         let warnings = ld.warnings;
+        let sources = ld.sources;
         Ok(Scene {
             file,
             render,
@@ -211,6 +256,7 @@ impl Scene {
             camera_medium,
             bounds: (lo, hi),
             document: doc,
+            sources,
             unused,
             warnings,
         })
@@ -505,6 +551,55 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                 }
                 Material::Mirror { reflectance }
             }
+            "conductor" => {
+                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let named = m.string_opt("material")?;
+                let (eta, k) = (m.rgb_opt("eta")?, m.rgb_opt("k")?);
+                match (named, eta, k) {
+                    (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
+                        return Err(m.error(
+                            "material",
+                            "give either a named `material` or `eta` and `k`, not both",
+                        ));
+                    }
+                    (None, Some(eta), Some(k)) => Material::Conductor {
+                        eta,
+                        k,
+                        specular_reflectance,
+                    },
+                    (None, Some(_), None) | (None, None, Some(_)) => {
+                        let missing = if m.has("eta") { "k" } else { "eta" };
+                        return Err(m.error(
+                            missing,
+                            "missing: a conductor's index of refraction needs both eta and k",
+                        ));
+                    }
+                    // Mitsuba's default: a perfect mirror.
+                    (None, None, None) | (Some("none"), None, None) => Material::Mirror {
+                        reflectance: specular_reflectance,
+                    },
+                    (Some(name), None, None) => {
+                        let (eta, k) = crate::material::conductor(name).ok_or_else(|| {
+                            let names: Vec<&str> = crate::material::CONDUCTORS
+                                .iter()
+                                .map(|(n, _, _)| *n)
+                                .collect();
+                            m.error(
+                                "material",
+                                format!(
+                                    "unknown conductor `{name}`; expected none or one of: {}",
+                                    names.join(", ")
+                                ),
+                            )
+                        })?;
+                        Material::Conductor {
+                            eta,
+                            k,
+                            specular_reflectance,
+                        }
+                    }
+                }
+            }
             "dielectric" | "thindielectric" => {
                 let ior = m.f32("ior", 1.5)?;
                 if ior <= 0.0 {
@@ -639,6 +734,27 @@ fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
     let Some(t) = s.table("transform")? else {
         return Ok(Mat4::IDENTITY);
     };
+    if let Some(m) = t.floats_opt("matrix", 16)? {
+        if let Some(other) = ["translate", "rotate", "scale"].iter().find(|k| t.has(k)) {
+            return Err(t.error(
+                other,
+                "a transform is either `matrix` or translate, rotate and scale, not both",
+            ));
+        }
+        // Row-major, as written (and as Mitsuba's <matrix value="..."/>).
+        let m = Mat4::from_cols_slice(&m).transpose();
+        if m.row(3) != glam::Vec4::W {
+            return Err(t.error(
+                "matrix",
+                "the last row must be [0, 0, 0, 1] (an affine transform)",
+            ));
+        }
+        if m.determinant() == 0.0 {
+            return Err(t.error("matrix", "is singular (it flattens the mesh)"));
+        }
+        ld.done(&t);
+        return Ok(m);
+    }
     let translate = t.vec3("translate", Vec3::ZERO)?;
     let scale = match t.node("scale").map(|n| &n.value) {
         None => Vec3::ONE,
@@ -706,7 +822,9 @@ fn read_shapes(
             "mesh" => {
                 let file = s.string_required("file")?;
                 let transform = read_transform(&s, ld)?;
-                let (tris, is_closed) = load_mesh(&s, &ld.dir.join(file), transform)?;
+                let path = ld.dir.join(file);
+                let (tris, is_closed) = load_mesh(&s, &path, transform)?;
+                ld.sources.push(path);
                 closed = is_closed;
                 tris
             }

@@ -5,6 +5,7 @@
 
 mod load;
 pub mod mesh;
+pub mod mitsuba;
 pub mod ply;
 mod visibility;
 mod volumes;
@@ -114,6 +115,8 @@ pub struct Scene {
     pub bounds: (Vec3, Vec3),
     /// The parsed document (integrators read their `[integrators.NAME]` table from it).
     pub document: Document,
+    /// The files the scene read besides its own (meshes), in the order it read them.
+    pub sources: Vec<PathBuf>,
     /// Keys that were present but never read by the loader (not counting `[integrators]`).
     pub unused: Vec<(String, Location)>,
     /// Non-fatal problems (reflectance above one, no lights...).

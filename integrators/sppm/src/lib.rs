@@ -80,7 +80,7 @@
 
 use foton_core::direct::Direct;
 use foton_core::direct::{Mis, Scatter, estimate_direct};
-use foton_core::film::Film;
+use foton_core::film::{Film, RadianceSum};
 use foton_core::integrator::{
     Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
 };
@@ -138,11 +138,13 @@ pub struct PixelStats {
     pub n: f64,
     /// Accumulated reflected flux tau.
     pub tau: DVec3,
-    /// Sum over iterations of the emission and shadow-ray direct light.
+    /// Sum over iterations of the emission and shadow-ray direct light (pixel schedule).
     pub ld: DVec3,
-    /// With the global schedule: the sum over iterations of each iteration's own photon
-    /// estimate of reflected radiance (`radius` is then the pixel's first radius r_1).
-    pub photon_sum: DVec3,
+    /// With the global schedule: the exact sum over iterations of each iteration's own
+    /// estimate (emission, direct light and reflected radiance from its photons), so that
+    /// iterations rendered in parts add up to the whole render (`radius` is then the pixel's
+    /// first radius r_1).
+    pub sum: RadianceSum,
 }
 
 impl PixelStats {
@@ -158,13 +160,13 @@ impl PixelStats {
         self.n = n_new;
     }
 
-    /// The pixel's radiance estimate after `iterations` iterations.
+    /// The pixel's radiance estimate after `iterations` iterations (pixel schedule).
     pub fn radiance(&self, iterations: u64) -> DVec3 {
         if iterations == 0 {
             return DVec3::ZERO;
         }
         let k = iterations as f64;
-        let mut l = (self.ld + self.photon_sum) / k;
+        let mut l = self.ld / k;
         if self.radius > 0.0 {
             l += self.tau / (k * PI * self.radius * self.radius);
         }
@@ -180,6 +182,16 @@ struct CameraSample {
     /// Emission and shadow-ray direct light, weighted by the path throughput.
     ld: Rgb,
     visible: Option<VisiblePoint>,
+}
+
+impl CameraSample {
+    /// How far along the camera path the visible point lies (infinite without one: such a
+    /// pixel gets the largest automatic radius).
+    fn distance(&self) -> f32 {
+        self.visible
+            .as_ref()
+            .map_or(f32::INFINITY, |vp| vp.distance)
+    }
 }
 
 impl Sppm {
@@ -282,12 +294,28 @@ fn pixel_angle(scene: &Scene) -> f32 {
     a.dot(b).clamp(-1.0, 1.0).acos()
 }
 
-fn film_of(stats: &[PixelStats], width: u32, height: u32, iterations: u64) -> Film {
+/// The image after `iterations` iterations: under the global schedule each pixel's exact sum
+/// of per-iteration estimates, one sample per iteration; under the pixel schedule the
+/// progressive estimate as one sample.
+fn film_of(
+    stats: &[PixelStats],
+    schedule: RadiusSchedule,
+    width: u32,
+    height: u32,
+    iterations: u64,
+) -> Film {
     let mut film = Film::new(width, height);
     for y in 0..height {
         for x in 0..width {
-            let l = stats[(y * width + x) as usize].radiance(iterations);
-            film.set_pixel(x, y, l.as_vec3());
+            let i = (y * width + x) as usize;
+            match schedule {
+                RadiusSchedule::Pixel => {
+                    film.set_pixel(x, y, stats[i].radiance(iterations).as_vec3())
+                }
+                RadiusSchedule::Global => {
+                    film.add_pixel(i, &stats[i].sum, iterations.min(u32::MAX as u64) as u32)
+                }
+            }
         }
     }
     film
@@ -296,25 +324,46 @@ fn film_of(stats: &[PixelStats], width: u32, height: u32, iterations: u64) -> Fi
 impl Integrator for Sppm {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
         let (width, height) = (scene.film.width, scene.film.height);
+        let global = self.schedule == RadiusSchedule::Global;
+        // The iterations to run: all of them, or this part's share.
+        let (first, last) = if ctx.part.is_whole() {
+            (0, self.iterations)
+        } else {
+            let Some(n) = self.iterations.filter(|_| self.time.is_none() && global) else {
+                return Err(Error::Render(format!(
+                    "part {}: sppm splits into parts only with radius_schedule = \"global\" and a \
+                     number of iterations (no time): under the pixel schedule each iteration's \
+                     radius depends on the photons of the iterations before it, so iterations \
+                     cannot be rendered apart",
+                    ctx.part
+                )));
+            };
+            let share = ctx.part.share(n);
+            (share.start, Some(share.end))
+        };
         let mut stats = vec![PixelStats::default(); width as usize * height as usize];
         let angle = pixel_angle(scene);
         let start = Instant::now();
-        let quiet = RenderContext {
-            threads: ctx.threads,
-            cancel: ctx.cancel,
-            progress: &NoProgress,
-        };
-        match (self.iterations, self.time) {
-            (Some(n), None) => ctx.progress.begin("iterations", n),
+        let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
+        match (last, self.time) {
+            (Some(n), None) => ctx.progress.begin("iterations", n - first),
             (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
             (None, None) => unreachable!("create() sets one"),
         }
-        let mut done = 0u64;
+        let mut done = first;
         let mut photons_total = 0u64;
         let mut rays = 0u64;
         let mut seconds_reported = 0u64;
+        if global && first > 0 {
+            // r_1 comes from the first iteration's camera sample: a part that starts later
+            // traces that camera pass for its radii alone.
+            let camera = with_pool(ctx.threads, || self.camera_pass(scene, 0, &mut rays))?;
+            for (st, cs) in stats.iter_mut().zip(&camera) {
+                st.radius = self.first_radius(scene, angle, cs.distance());
+            }
+        }
         loop {
-            if self.iterations.is_some_and(|n| done >= n)
+            if last.is_some_and(|n| done >= n)
                 || self
                     .time
                     .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
@@ -337,17 +386,17 @@ impl Integrator for Sppm {
                     .par_iter_mut()
                     .zip(camera.par_iter())
                     .for_each(|(st, cs)| {
-                        st.ld += cs.ld.as_dvec3();
-                        let global = self.schedule == RadiusSchedule::Global;
                         if global && done == 0 {
                             // r_1 from the first iteration's camera sample alone (a pixel
                             // without a visible point there gets the largest automatic one),
                             // so that every iteration's radius is a function of its number.
-                            let distance =
-                                cs.visible.as_ref().map_or(f32::INFINITY, |vp| vp.distance);
-                            st.radius = self.first_radius(scene, angle, distance);
+                            st.radius = self.first_radius(scene, angle, cs.distance());
                         }
                         let Some(vp) = &cs.visible else {
+                            match self.schedule {
+                                RadiusSchedule::Pixel => st.ld += cs.ld.as_dvec3(),
+                                RadiusSchedule::Global => st.sum.add(cs.ld),
+                            }
                             return;
                         };
                         if st.radius == 0.0 {
@@ -377,12 +426,18 @@ impl Integrator for Sppm {
                             phi += (f * photon.power() * w).as_dvec3();
                         });
                         let phi = phi * vp.beta.as_dvec3();
-                        if global {
-                            // This iteration's estimate of reflected radiance, tau / (pi r^2)
-                            // with its own radius; iterations are averaged.
-                            st.photon_sum += phi / disc as f64;
-                        } else {
-                            st.update(alpha, m, phi);
+                        match self.schedule {
+                            RadiusSchedule::Pixel => {
+                                st.ld += cs.ld.as_dvec3();
+                                st.update(alpha, m, phi);
+                            }
+                            RadiusSchedule::Global => {
+                                // This iteration's estimate: its direct light and reflected
+                                // radiance tau / (pi r^2) with its own radius; iterations
+                                // are averaged.
+                                let l = cs.ld.as_dvec3() + phi / disc as f64;
+                                st.sum.add_f64(l.to_array());
+                            }
                         }
                     })
             })?;
@@ -408,14 +463,17 @@ impl Integrator for Sppm {
                     seconds_reported = s;
                 }
             }
-            ctx.progress
-                .checkpoint(done, &|| film_of(&stats, width, height, done));
+            let kept = done - first;
+            ctx.progress.checkpoint(kept, &|| {
+                film_of(&stats, self.schedule, width, height, kept)
+            });
         }
         ctx.progress.finish();
-        let mut film = film_of(&stats, width, height, done);
+        let mut film = film_of(&stats, self.schedule, width, height, done - first);
+        film.part = ctx.part;
         film.rays = rays;
-        film.iterations = done;
-        film.iterations_planned = self.iterations.unwrap_or(0);
+        film.iterations = done - first;
+        film.iterations_planned = last.map_or(0, |n| n - first);
         film.photons = photons_total;
         Ok(film)
     }

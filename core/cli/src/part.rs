@@ -1,0 +1,521 @@
+//! Renders split into parts, and their merge: `foton render --part I/N` and `foton merge`.
+//!
+//! A part file is an OpenEXR image. Its `R`, `G`, `B` channels are the part's own image (any
+//! EXR viewer shows it); what the merge uses are the exact sums: per pixel the sample count
+//! `N` (u32) and, per colour channel, the film's fixed-point sum (an i128,
+//! [`RadianceSum`]) as four u32 words `sum.R.0` (least significant) to `sum.R.3`. Integer sums
+//! add associatively, so the merged sums, and the image made from them, are bit for bit those
+//! of the render done in one process. The header carries what decides whether parts belong
+//! together (attributes `foton.*`, below): the scene's content hash, the integrator with its
+//! parameters, the seed, the build of foton, the part I/N, and how much of its share the part
+//! did (an interrupted part says so).
+//!
+//! The merge reads every header first (small) and refuses a set of parts that do not belong
+//! together before it reads any pixels; then it adds the parts one at a time into one film,
+//! so its memory is one film and one part whatever the number of parts. Its output is written
+//! atomically, so a failed merge leaves nothing behind.
+
+use crate::write_atomic_with;
+use clap::Args;
+use exr::prelude::*;
+use foton_core::film::{DisplayTransform, Film, ImageFormat, RadianceSum, ToneMap, format_of};
+use foton_core::integrator::Part;
+use foton_core::scene::Scene;
+use foton_core::{Error, Result as FotonResult};
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// The version of the part file layout (attribute `foton.format`).
+pub const FORMAT: &str = "foton-part 1";
+
+const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// What a part file says about itself.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PartInfo {
+    pub part: Part,
+    /// The scene file as the render was given it (for messages).
+    pub scene: String,
+    /// [`scene_hash`] of the scene with its overrides.
+    pub scene_hash: String,
+    /// The integrator with its parameters in force (`Integrator::describe`).
+    pub integrator: String,
+    pub seed: u64,
+    /// `foton_core::BUILD_ID` of the foton that rendered it.
+    pub build: String,
+    pub width: u32,
+    pub height: u32,
+    /// What the work is counted in: `samples` (per pixel) or `iterations`.
+    pub work: String,
+    /// The units of work in this part's share, and how many it did (fewer: interrupted).
+    pub planned: u64,
+    pub done: u64,
+    /// The scene's display transform, for a merged PNG.
+    pub exposure: f32,
+    pub tonemap: String,
+}
+
+impl PartInfo {
+    /// The description of a part of `scene` that `film` holds.
+    pub fn of(
+        scene: &Scene,
+        overrides: &[String],
+        integrator: &str,
+        film: &Film,
+    ) -> FotonResult<PartInfo> {
+        let (work, planned, done) = if film.iterations > 0 || film.iterations_planned > 0 {
+            ("iterations", film.iterations_planned, film.iterations)
+        } else {
+            let share = film.part.share(scene.render.spp as u64);
+            let done = film.counts().iter().copied().min().unwrap_or(0) as u64;
+            ("samples", share.end - share.start, done)
+        };
+        let display = scene.film.display();
+        Ok(PartInfo {
+            part: film.part,
+            scene: scene.file.display().to_string(),
+            scene_hash: scene_hash(scene, overrides)?,
+            integrator: integrator.to_string(),
+            seed: scene.render.seed,
+            build: foton_core::BUILD_ID.to_string(),
+            width: film.width,
+            height: film.height,
+            work: work.into(),
+            planned,
+            done,
+            exposure: display.exposure,
+            tonemap: display.tonemap.name().into(),
+        })
+    }
+
+    fn attributes(&self) -> Vec<(&'static str, String)> {
+        vec![
+            ("foton.format", FORMAT.into()),
+            ("foton.part", self.part.to_string()),
+            ("foton.scene", self.scene.clone()),
+            ("foton.sceneHash", self.scene_hash.clone()),
+            ("foton.integrator", self.integrator.clone()),
+            ("foton.seed", self.seed.to_string()),
+            ("foton.build", self.build.clone()),
+            ("foton.work", self.work.clone()),
+            ("foton.planned", self.planned.to_string()),
+            ("foton.done", self.done.to_string()),
+            ("foton.exposure", self.exposure.to_string()),
+            ("foton.tonemap", self.tonemap.clone()),
+        ]
+    }
+
+    fn from_attributes(
+        path: &Path,
+        size: (usize, usize),
+        get: impl Fn(&str) -> Option<String>,
+    ) -> FotonResult<PartInfo> {
+        let format = get("foton.format").ok_or_else(|| {
+            Error::io(
+                path,
+                "not a foton part (no foton.format attribute): parts are written by `foton render --part I/N`",
+            )
+        })?;
+        if format != FORMAT {
+            return Err(Error::io(
+                path,
+                format!("a part in format `{format}`; this foton reads `{FORMAT}`"),
+            ));
+        }
+        let field = |key: &str| {
+            get(key).ok_or_else(|| Error::io(path, format!("damaged part: no {key} attribute")))
+        };
+        let number = |key: &str| -> FotonResult<u64> {
+            let text = field(key)?;
+            text.parse().map_err(|_| {
+                Error::io(
+                    path,
+                    format!("damaged part: {key} = `{text}` is not a number"),
+                )
+            })
+        };
+        let part_text = field("foton.part")?;
+        let part = parse_part(&part_text)
+            .map_err(|e| Error::io(path, format!("damaged part: foton.part: {e}")))?;
+        Ok(PartInfo {
+            part,
+            scene: field("foton.scene")?,
+            scene_hash: field("foton.sceneHash")?,
+            integrator: field("foton.integrator")?,
+            seed: number("foton.seed")?,
+            build: field("foton.build")?,
+            width: size.0 as u32,
+            height: size.1 as u32,
+            work: field("foton.work")?,
+            planned: number("foton.planned")?,
+            done: number("foton.done")?,
+            exposure: field("foton.exposure")?.parse().unwrap_or(0.0),
+            tonemap: field("foton.tonemap")?,
+        })
+    }
+
+    /// The scene's display transform, for a PNG of the part or of the merge.
+    pub fn display(&self) -> DisplayTransform {
+        DisplayTransform::new(
+            self.exposure,
+            ToneMap::from_name(&self.tonemap).unwrap_or_default(),
+        )
+    }
+}
+
+/// `I/N` with 0 <= I < N, as `--part` takes it.
+pub fn parse_part(text: &str) -> std::result::Result<Part, String> {
+    let bad = || format!("`{text}`: expected I/N with 0 <= I < N, e.g. 0/4 (parts count from 0)");
+    let (i, n) = text.split_once('/').ok_or_else(bad)?;
+    let (i, n) = (
+        i.trim().parse::<u32>().map_err(|_| bad())?,
+        n.trim().parse::<u32>().map_err(|_| bad())?,
+    );
+    Part::new(i, n).ok_or_else(bad)
+}
+
+/// FNV-1a, 64 bits: stable across Rust versions and machines (the parts of one render may be
+/// made by different processes on different hosts).
+struct Fnv(u64);
+
+impl Fnv {
+    fn new() -> Fnv {
+        Fnv(0xcbf2_9ce4_8422_2325)
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.0 ^= b as u64;
+            self.0 = self.0.wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    /// A field: its length first, so that ("ab", "c") and ("a", "bc") differ.
+    fn field(&mut self, bytes: &[u8]) {
+        self.write(&(bytes.len() as u64).to_le_bytes());
+        self.write(bytes);
+    }
+}
+
+/// The FNV-1a hash of `fields` (each prefixed by its length), in hex.
+pub fn fnv_hex(fields: &[Vec<u8>]) -> String {
+    let mut h = Fnv::new();
+    for f in fields {
+        h.field(f);
+    }
+    format!("{:016x}", h.0)
+}
+
+/// The scene's content hash: its file, the overrides it was loaded with, and every file it read
+/// (meshes), byte for byte. Two renders with the same hash render the same scene.
+pub fn scene_hash(scene: &Scene, overrides: &[String]) -> FotonResult<String> {
+    let mut h = Fnv::new();
+    let read = |path: &Path| std::fs::read(path).map_err(|e| Error::io(path, e));
+    h.field(&read(&scene.file)?);
+    h.write(&(overrides.len() as u64).to_le_bytes());
+    for o in overrides {
+        h.field(o.as_bytes());
+    }
+    for source in &scene.sources {
+        h.field(&read(source)?);
+    }
+    Ok(format!("{:016x}", h.0))
+}
+
+/// UTF-8 as the bytes of an EXR text attribute (which holds bytes).
+fn text(s: &str) -> Text {
+    Text::from_slice_unchecked(s.as_bytes())
+}
+
+fn exr_error(path: &Path, e: exr::error::Error) -> Error {
+    Error::io(path, format!("cannot read the part: {e}"))
+}
+
+/// Writes `film` (a part, or a whole render) as a part file, atomically, with `extra` header
+/// attributes besides those of `info`.
+pub fn write_part(
+    path: &Path,
+    film: &Film,
+    info: &PartInfo,
+    extra: &[(&str, String)],
+) -> FotonResult<()> {
+    if format_of(path)? != ImageFormat::Exr {
+        return Err(Error::io(
+            path,
+            "a part holds exact sums, which only EXR can store: name the output .exr",
+        ));
+    }
+    let pixels = film.pixels();
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::with_capacity(16);
+    for (c, name) in CHANNELS.iter().enumerate() {
+        let mean = pixels.iter().map(|p| p[c]).collect();
+        channels.push(AnyChannel::new(*name, FlatSamples::F32(mean)));
+        for word in 0..4 {
+            let words = film
+                .sums()
+                .iter()
+                .map(|s| (s.0[c] >> (32 * word)) as u32)
+                .collect();
+            channels.push(AnyChannel::new(
+                format!("sum.{name}.{word}").as_str(),
+                FlatSamples::U32(words),
+            ));
+        }
+    }
+    channels.push(AnyChannel::new(
+        "N",
+        FlatSamples::U32(film.counts().to_vec()),
+    ));
+    let layer = Layer::new(
+        (film.width as usize, film.height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    let mut image = Image::from_layer(layer);
+    for (key, value) in info.attributes().iter().chain(extra) {
+        image
+            .attributes
+            .other
+            .insert(text(key), AttributeValue::Text(text(value)));
+    }
+    write_atomic_with(path, |tmp| {
+        image
+            .write()
+            .to_file(tmp)
+            .map_err(|e| std::io::Error::other(e.to_string()))
+    })
+}
+
+/// The text attributes of an EXR's header and its size.
+fn read_header(path: &Path) -> FotonResult<(BTreeMap<String, String>, (usize, usize))> {
+    let meta = exr::meta::MetaData::read_from_file(path, true).map_err(|e| exr_error(path, e))?;
+    let header = meta
+        .headers
+        .first()
+        .ok_or_else(|| Error::io(path, "an EXR without any image"))?;
+    // Custom attributes come back as the layer's, whichever struct wrote them.
+    let attributes = header
+        .own_attributes
+        .other
+        .iter()
+        .chain(&header.shared_attributes.other)
+        .filter_map(|(key, value)| match value {
+            AttributeValue::Text(t) => Some((
+                String::from_utf8_lossy(key.bytes()).into_owned(),
+                String::from_utf8_lossy(t.bytes()).into_owned(),
+            )),
+            _ => None,
+        })
+        .collect();
+    Ok((attributes, (header.layer_size.0, header.layer_size.1)))
+}
+
+/// Every text attribute of a part file's header (those of [`PartInfo`] and the extra ones).
+pub fn read_part_attributes(path: &Path) -> FotonResult<BTreeMap<String, String>> {
+    Ok(read_header(path)?.0)
+}
+
+/// Reads the header of a part file.
+pub fn read_part_info(path: &Path) -> FotonResult<PartInfo> {
+    let (attributes, size) = read_header(path)?;
+    PartInfo::from_attributes(path, size, |key| attributes.get(key).cloned())
+}
+
+/// Reads a part file's sums and counts.
+pub fn read_part_film(path: &Path, info: &PartInfo) -> FotonResult<Film> {
+    let image = read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .first_valid_layer()
+        .all_attributes()
+        .pedantic()
+        .from_file(path)
+        .map_err(|e| exr_error(path, e))?;
+    let layer = &image.layer_data;
+    let n = info.width as usize * info.height as usize;
+    let channel = |name: &str| -> FotonResult<&Vec<u32>> {
+        let found = layer
+            .channel_data
+            .list
+            .iter()
+            .find(|c| c.name.bytes() == name.as_bytes())
+            .ok_or_else(|| Error::io(path, format!("damaged part: no channel {name}")))?;
+        match &found.sample_data {
+            FlatSamples::U32(v) if v.len() == n => Ok(v),
+            _ => Err(Error::io(
+                path,
+                format!("damaged part: channel {name} is not {n} u32 values"),
+            )),
+        }
+    };
+    let mut sums = vec![RadianceSum::ZERO; n];
+    for (c, name) in CHANNELS.iter().enumerate() {
+        for word in 0..4 {
+            let words = channel(&format!("sum.{name}.{word}"))?;
+            for (s, &w) in sums.iter_mut().zip(words) {
+                s.0[c] |= ((w as u128) << (32 * word)) as i128;
+            }
+        }
+    }
+    let counts = channel("N")?.clone();
+    Film::from_sums(info.width, info.height, sums, counts)
+        .ok_or_else(|| Error::io(path, "damaged part: channels of the wrong size"))
+}
+
+#[derive(Args)]
+pub(super) struct MergeArgs {
+    /// The part files (`foton render --part I/N -o part_I.exr`), in any order.
+    #[arg(required = true)]
+    parts: Vec<PathBuf>,
+    /// The merged image (.exr linear float32, or .png through the scene's exposure and
+    /// tonemap).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// Merge the parts that are there when some are missing or interrupted (the image then
+    /// has fewer samples; it says which parts it lacks).
+    #[arg(long)]
+    partial: bool,
+}
+
+/// `foton merge`: checks that the parts belong together, then adds them one at a time.
+pub(super) fn run(
+    a: MergeArgs,
+    out: &mut dyn std::io::Write,
+    err: &mut dyn std::io::Write,
+) -> FotonResult<u8> {
+    foton_core::film::check_output(&a.output)?;
+    let start = Instant::now();
+    let mut parts: BTreeMap<u32, (PathBuf, PartInfo)> = BTreeMap::new();
+    let mut first: Option<(PathBuf, PartInfo)> = None;
+    for path in &a.parts {
+        let info = read_part_info(path)?;
+        if let Some((first_path, f)) = &first {
+            belongs_with(path, &info, first_path, f)?;
+        } else {
+            first = Some((path.clone(), info.clone()));
+        }
+        if let Some((other, _)) = parts.get(&info.part.index) {
+            return Err(Error::Usage(format!(
+                "part {} is given twice: {} and {}",
+                info.part,
+                other.display(),
+                path.display()
+            )));
+        }
+        parts.insert(info.part.index, (path.clone(), info));
+    }
+    let (_, f) = first.expect("clap requires one part");
+    let count = f.part.count;
+    let missing: Vec<String> = (0..count)
+        .filter(|i| !parts.contains_key(i))
+        .map(|i| format!("{i}/{count}"))
+        .collect();
+    let interrupted: Vec<String> = parts
+        .values()
+        .filter(|(_, p)| p.done < p.planned)
+        .map(|(path, p)| {
+            format!(
+                "{} (part {}: {} of {} {})",
+                path.display(),
+                p.part,
+                p.done,
+                p.planned,
+                p.work
+            )
+        })
+        .collect();
+    if !a.partial {
+        if !missing.is_empty() {
+            return Err(Error::Usage(format!(
+                "missing part(s) {} of the {count} (given {}); render them, or merge what is there with --partial",
+                missing.join(", "),
+                parts.len()
+            )));
+        }
+        if !interrupted.is_empty() {
+            return Err(Error::Usage(format!(
+                "interrupted part(s): {}; render them again, or merge what is there with --partial",
+                interrupted.join(", ")
+            )));
+        }
+    }
+    let mut film = Film::new(f.width, f.height);
+    for (path, info) in parts.values() {
+        let part = read_part_film(path, info)?;
+        for (i, (sum, n)) in part.sums().iter().zip(part.counts()).enumerate() {
+            film.add_pixel(i, sum, *n);
+        }
+    }
+    film.write(&a.output, &f.display())?;
+    if !missing.is_empty() {
+        let _ = writeln!(
+            err,
+            "warning: --partial: merged without part(s) {}",
+            missing.join(", ")
+        );
+    }
+    if !interrupted.is_empty() {
+        let _ = writeln!(
+            err,
+            "warning: --partial: merged interrupted part(s): {}",
+            interrupted.join(", ")
+        );
+    }
+    let _ = writeln!(
+        out,
+        "{}: {} of {count} parts, {}x{}, {} with {} -> {} ({:.2} s)",
+        f.scene,
+        parts.len(),
+        f.width,
+        f.height,
+        parts.values().map(|(_, p)| p.done).sum::<u64>().to_string() + " " + &f.work,
+        f.integrator,
+        a.output.display(),
+        start.elapsed().as_secs_f64()
+    );
+    Ok(0)
+}
+
+/// Whether the part at `path` comes from the same render as the first part given.
+fn belongs_with(path: &Path, p: &PartInfo, first_path: &Path, f: &PartInfo) -> FotonResult<()> {
+    let differs = |what: &str, this: String, that: String| {
+        Err(Error::Usage(format!(
+            "{} is not a part of the same render as {}: {what} {this} (the other: {that})",
+            path.display(),
+            first_path.display()
+        )))
+    };
+    if p.integrator != f.integrator {
+        return differs("integrator", p.integrator.clone(), f.integrator.clone());
+    }
+    if p.seed != f.seed {
+        return differs("seed", p.seed.to_string(), f.seed.to_string());
+    }
+    if p.part.count != f.part.count {
+        return differs(
+            "number of parts",
+            p.part.count.to_string(),
+            f.part.count.to_string(),
+        );
+    }
+    if p.build != f.build {
+        return differs("foton build", p.build.clone(), f.build.clone());
+    }
+    if (p.width, p.height) != (f.width, f.height) {
+        return differs(
+            "size",
+            format!("{}x{}", p.width, p.height),
+            format!("{}x{}", f.width, f.height),
+        );
+    }
+    // Last: overrides of the seed or integrator change the hash too, and are named above.
+    if p.scene_hash != f.scene_hash {
+        return differs(
+            "another scene or other overrides: scene hash",
+            format!("{} of {}", p.scene_hash, p.scene),
+            format!("{} of {}", f.scene_hash, f.scene),
+        );
+    }
+    Ok(())
+}
