@@ -1,5 +1,6 @@
 //! Materials and their BSDFs. All work in world space around the geometric normal `ng`
-//! (the shape's own orientation); diffuse and mirror surfaces are two-sided.
+//! (the shape's own orientation); mirror surfaces are two-sided, diffuse ones unless made
+//! one-sided (Mitsuba's BSDFs are one-sided: black seen from behind).
 
 use crate::Rgb;
 use crate::sampling::{cosine_hemisphere, to_world};
@@ -8,8 +9,9 @@ use std::f32::consts::FRAC_1_PI;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
-    /// Lambertian: f = reflectance / pi.
-    Diffuse { reflectance: Rgb },
+    /// Lambertian: f = reflectance / pi; if not `twosided`, only on the side the geometric
+    /// normal points to (black from behind, as a Mitsuba BSDF not wrapped in `twosided`).
+    Diffuse { reflectance: Rgb, twosided: bool },
     /// Perfect specular reflection scaled by `reflectance`.
     Mirror { reflectance: Rgb },
     /// A smooth conductor (Mitsuba's `conductor`): specular reflection with the Fresnel
@@ -337,8 +339,11 @@ impl Material {
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3, ng: Vec3) -> Rgb {
         match *self {
-            Material::Diffuse { reflectance } => {
-                if wo.dot(ng) * wi.dot(ng) > 0.0 {
+            Material::Diffuse {
+                reflectance,
+                twosided,
+            } => {
+                if wo.dot(ng) * wi.dot(ng) > 0.0 && (twosided || wo.dot(ng) > 0.0) {
                     reflectance * FRAC_1_PI
                 } else {
                     Rgb::ZERO
@@ -352,7 +357,9 @@ impl Material {
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3, ng: Vec3) -> f32 {
         match *self {
-            Material::Diffuse { .. } if wo.dot(ng) * wi.dot(ng) > 0.0 => {
+            Material::Diffuse { twosided, .. }
+                if wo.dot(ng) * wi.dot(ng) > 0.0 && (twosided || wo.dot(ng) > 0.0) =>
+            {
                 wi.dot(ng).abs() * FRAC_1_PI
             }
             _ => 0.0,
@@ -376,7 +383,13 @@ impl Material {
         }
         let n = if cos_o > 0.0 { ng } else { -ng };
         match *self {
-            Material::Diffuse { reflectance } => {
+            Material::Diffuse {
+                reflectance,
+                twosided,
+            } => {
+                if !twosided && cos_o < 0.0 {
+                    return None;
+                }
                 let local = cosine_hemisphere(u);
                 if local.z <= 0.0 {
                     return None;

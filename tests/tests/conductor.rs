@@ -80,9 +80,18 @@ fn a_conductor_reflects_the_fresnel_reflectance_of_its_ior() {
 fn bad_conductors_are_clear_errors() {
     let dir = temp_dir("conductor-errors");
     for (material, needles) in [
-        ("material = \"gold\"", vec!["unknown conductor `gold`", "Au"]),
-        ("eta = [1, 1, 1]", vec!["`materials.metal.k`", "both eta and k"]),
-        ("material = \"Au\"\neta = [1, 1, 1]", vec!["either a named `material`"]),
+        (
+            "material = \"gold\"",
+            vec!["unknown conductor `gold`", "Au"],
+        ),
+        (
+            "eta = [1, 1, 1]",
+            vec!["`materials.metal.k`", "both eta and k"],
+        ),
+        (
+            "material = \"Au\"\neta = [1, 1, 1]",
+            vec!["either a named `material`"],
+        ),
     ] {
         let path = write(&dir, "s.toml", &scene("path", material));
         let run = foton_with_plugins(&["check", path.to_str().unwrap()]);

@@ -150,6 +150,7 @@ reflectance = [0.7, 0.7, 0.7]
 [materials.black]
 type = "diffuse"
 reflectance = [0, 0, 0]
+twosided = false
 [materials.glass]
 type = "dielectric"
 ior = 1.333
@@ -157,6 +158,7 @@ ior = 1.333
 type = "mirror"
 [materials.default]
 type = "diffuse"
+twosided = false
 
 # The floor: [-2, 2]^2 at y = 0, normal up.
 [[shapes]]
@@ -499,4 +501,37 @@ fn a_mesh_matrix_must_be_an_affine_placement() {
         ),
     );
     ok(&foton_with_plugins(&["check", s(&scene)]));
+}
+
+/// The tools take XML scenes and their defines: a sweep over an XML scene with -D.
+#[test]
+fn sweep_takes_an_xml_scene_and_its_defines() {
+    let dir = scene_folder("mitsuba-sweep");
+    let out = dir.join("grid.png");
+    let run = foton_with_plugins(&[
+        "sweep",
+        s(&dir.join("scene.xml")),
+        "-D",
+        "res=16",
+        "--set",
+        "render.spp=1,2",
+        "-q",
+        "-o",
+        s(&out),
+    ]);
+    ok(&run);
+    assert!(run.stdout.contains("2 cells (2 x 1)"), "{}", run.stdout);
+    // Without the define the film is 32 wide: the grid is wider.
+    let (w16, _, _) = read_image(&out).unwrap();
+    ok(&foton_with_plugins(&[
+        "sweep",
+        s(&dir.join("scene.xml")),
+        "--set",
+        "render.spp=1,2",
+        "-q",
+        "-o",
+        s(&out),
+    ]));
+    let (w32, _, _) = read_image(&out).unwrap();
+    assert!(w32 > w16, "{w32} vs {w16}");
 }

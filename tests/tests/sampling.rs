@@ -616,7 +616,10 @@ fn distribution1d_follows_its_pmf_and_never_draws_zero_weights() {
 #[test]
 fn diffuse_sampling_matches_its_pdf_on_both_sides() {
     let reflectance = Rgb::new(0.8, 0.5, 0.2);
-    let mat = Material::Diffuse { reflectance };
+    let mat = Material::Diffuse {
+        reflectance,
+        twosided: true,
+    };
     let ng = Vec3::new(0.3, -0.4, 0.866).normalize();
     let front = Vec3::new(0.5, 0.2, 0.8).normalize();
     let back = Vec3::new(-0.1, 0.7, -0.6).normalize();

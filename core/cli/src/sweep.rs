@@ -11,7 +11,7 @@
 use crate::montage::{Tile, grid, render_image};
 use crate::part::{PartInfo, fnv_hex, read_part_attributes, read_part_film, write_part};
 use crate::threads;
-use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare, render_prepared};
+use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare_xml, render_prepared};
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::check_output;
@@ -24,8 +24,14 @@ pub const MAX_CELLS: usize = 256;
 
 #[derive(Args)]
 pub(super) struct SweepArgs {
-    /// The scene file (TOML).
+    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
     scene: PathBuf,
+    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> in every cell (repeatable).
+    #[arg(short = 'D', value_name = "NAME=VALUE")]
+    defines: Vec<String>,
+    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed) instead of refusing.
+    #[arg(long)]
+    lenient: bool,
     /// KEY.PATH=VALUE[,VALUE...]: the values to sweep a scene value over (repeatable). Commas
     /// inside brackets, braces or quotes do not split: camera.position=[0,1,3],[0,1,4] is two
     /// values.
@@ -294,12 +300,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     // would not fit in memory many times over).
     let mut warned: Vec<String> = Vec::new();
     for cell in 0..cells {
-        let p = prepare(
-            &a.scene,
-            &overrides_of(cell).0,
-            &a.plugins.plugin_dirs,
-            a.strict,
-        )?;
+        let p = prepare_cell(&a, &overrides_of(cell).0)?;
         for w in &p.warnings {
             if !warned.contains(w) {
                 let _ = writeln!(err, "warning: {w}");
@@ -313,7 +314,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     let mut tiles = Vec::new();
     for cell in 0..cells {
         let (overrides, mut label) = overrides_of(cell);
-        let p = prepare(&a.scene, &overrides, &a.plugins.plugin_dirs, a.strict)?;
+        let p = prepare_cell(&a, &overrides)?;
         let progress = TermProgress::new(a.quiet);
         let (film, elapsed) = render_prepared(&p, threads, &progress)?;
         for w in progress.take_warnings() {
@@ -351,6 +352,17 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     Ok(0)
 }
 
+fn prepare_cell(a: &SweepArgs, overrides: &[String]) -> Result<crate::Prepared> {
+    prepare_xml(
+        &a.scene,
+        overrides,
+        &a.defines,
+        a.lenient,
+        &a.plugins.plugin_dirs,
+        a.strict,
+    )
+}
+
 fn cell_work(film: &foton_core::film::Film, p: &crate::Prepared) -> String {
     if film.iterations > 0 {
         format!("{} iterations", film.iterations)
@@ -369,6 +381,7 @@ fn sweep_signature(a: &SweepArgs) -> Result<String> {
     let scene = std::fs::read(&a.scene).map_err(|e| Error::io(&a.scene, e))?;
     let mut fields: Vec<Vec<u8>> = vec![scene];
     fields.extend(a.sets.iter().map(|s| s.as_bytes().to_vec()));
+    fields.extend(a.defines.iter().map(|d| format!("-D {d}").into_bytes()));
     fields.push(format!("{:?} {:?} {:?}", a.integrator, a.spp, a.seed).into_bytes());
     Ok(fnv_hex(&fields))
 }
@@ -385,7 +398,7 @@ fn render_cell(
 ) -> Result<u8> {
     let path = cell_path(dir, cell);
     check_output(&path)?;
-    let p = prepare(&a.scene, overrides, &a.plugins.plugin_dirs, a.strict)?;
+    let p = prepare_cell(a, overrides)?;
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");
     }

@@ -538,7 +538,11 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                         "is above 1: the material creates energy".into(),
                     );
                 }
-                Material::Diffuse { reflectance }
+                let twosided = m.bool("twosided", true)?;
+                Material::Diffuse {
+                    reflectance,
+                    twosided,
+                }
             }
             "mirror" => {
                 let reflectance = m.rgb("reflectance", Rgb::ONE)?;

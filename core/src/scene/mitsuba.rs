@@ -865,7 +865,6 @@ impl Reader {
         let mut put = |k: &str, v: Value| t.insert(k, at(v, line));
         match o.ty.as_str() {
             "twosided" => {
-                // foton's diffuse reflects on both sides already.
                 let inner = o
                     .props
                     .iter()
@@ -880,12 +879,25 @@ impl Reader {
                     inner.id = o.id.clone();
                 }
                 self.leftovers(&o)?;
-                return self.bsdf(inner);
+                let name = self.bsdf(inner)?;
+                // The same BSDF on both sides: diffuse's own switch (the others are two-sided
+                // or have no sides).
+                if let Some(Value::Table(t)) = name
+                    .as_deref()
+                    .and_then(|n| table_mut(&mut self.root, "materials").get_mut(n))
+                    .map(|n| &mut n.value)
+                    && t.get("twosided").is_some()
+                {
+                    t.insert("twosided", at(Value::Bool(true), line));
+                }
+                return Ok(name);
             }
             "diffuse" => {
                 put("type", Value::Str("diffuse".into()));
                 let c = o.color("reflectance", DVec3::splat(0.5))?;
                 t.insert("reflectance", vec3(c, line));
+                // Mitsuba's BSDFs are one-sided unless wrapped in `twosided`.
+                t.insert("twosided", at(Value::Bool(false), line));
             }
             "dielectric" | "thindielectric" => {
                 put("type", Value::Str(o.ty.clone()));
@@ -918,7 +930,9 @@ impl Reader {
                         t.insert("k", vec3(k, line));
                     }
                     _ => {
-                        return Err(o.error("a conductor needs both `eta` and `k`, or a `material`"));
+                        return Err(
+                            o.error("a conductor needs both `eta` and `k`, or a `material`")
+                        );
                     }
                 }
                 let c = o.color("specular_reflectance", DVec3::ONE)?;
@@ -1044,6 +1058,7 @@ impl Reader {
                 let name = format!("default_diffuse_{line}");
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("diffuse".into()), line));
+                t.insert("twosided", at(Value::Bool(false), line));
                 table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
                 name
             }
