@@ -324,7 +324,14 @@ pub fn prepare_xml(
     strict: bool,
 ) -> Result<Prepared> {
     let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
-    let registry = Registry::discover(&search_path(plugin_dirs));
+    prepare_scene(scene, &search_path(plugin_dirs), strict)
+}
+
+/// Creates a loaded scene's integrator from the plugins found in `search` (the whole search
+/// path, in order: [`search_path`]'s folders and any the caller adds after them, as the Python
+/// package does with its own plugin folder); as [`prepare`] does after loading.
+pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<Prepared> {
+    let registry = Registry::discover(search);
     let plugin = match registry.integrator(&scene.render.integrator) {
         Ok(p) => p.clone(),
         Err(e) => {
@@ -438,6 +445,18 @@ pub fn render_part(
             )),
         ));
     }
+    Ok((film, start.elapsed()))
+}
+
+/// Renders a prepared scene with the caller's context (its own cancel flag and progress, as
+/// the Python package's), as [`render_prepared`] does with the program's; returns the film and
+/// the time the render took.
+pub fn render_with(p: &Prepared, ctx: &RenderContext<'_>) -> Result<(Film, Duration)> {
+    let start = Instant::now();
+    let film = p
+        .integrator
+        .render(&p.scene, ctx)
+        .map_err(|e| blame_plugin(&p.plugin, e))?;
     Ok((film, start.elapsed()))
 }
 
