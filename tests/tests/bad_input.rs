@@ -1234,7 +1234,12 @@ fn some_shared_library() -> Option<PathBuf> {
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| {
             p.file_name().and_then(|n| n.to_str()).is_some_and(|n| {
-                n.starts_with(prefix) && n.ends_with(suffix) && !n.starts_with("libfoton")
+                // Not the Python extension (lib_foton.so, after a wheel build): it needs the
+                // interpreter's symbols and cannot be loaded by a program.
+                n.starts_with(prefix)
+                    && n.ends_with(suffix)
+                    && !n.starts_with("libfoton")
+                    && !n.starts_with("lib_foton")
             })
         })
         .collect();
