@@ -429,23 +429,7 @@ pub fn render_part(
         part,
         ..RenderContext::new(threads, &INTERRUPTED, progress)
     };
-    let start = Instant::now();
-    let film = p
-        .integrator
-        .render(&p.scene, &ctx)
-        .map_err(|e| blame_plugin(&p.plugin, e))?;
-    if film.part != part {
-        // A plugin that ignored the part rendered all of the work: merging such films would
-        // count it N times.
-        return Err(blame_plugin(
-            &p.plugin,
-            Error::Render(format!(
-                "asked for part {part}, it returned a film of part {}: this integrator cannot render in parts",
-                film.part
-            )),
-        ));
-    }
-    Ok((film, start.elapsed()))
+    render_with(p, &ctx)
 }
 
 /// Renders a prepared scene with the caller's context (its own cancel flag and progress, as
@@ -457,6 +441,17 @@ pub fn render_with(p: &Prepared, ctx: &RenderContext<'_>) -> Result<(Film, Durat
         .integrator
         .render(&p.scene, ctx)
         .map_err(|e| blame_plugin(&p.plugin, e))?;
+    if film.part != ctx.part {
+        // A plugin that ignored the part rendered all of the work: merging such films would
+        // count it N times.
+        return Err(blame_plugin(
+            &p.plugin,
+            Error::Render(format!(
+                "asked for part {}, it returned a film of part {}: this integrator cannot render in parts",
+                ctx.part, film.part
+            )),
+        ));
+    }
     Ok((film, start.elapsed()))
 }
 
