@@ -400,15 +400,21 @@ fn unsupported_and_bad_xml_is_a_clear_error() {
 
 /// The tutorials' two scenes, unchanged, from `../shared/scenes/mitsuba`: the Cornell box
 /// renders with path, photon and sppm, which agree in the mean over the image within their
-/// noise and bias (5%); the teapot with path (its `direct` integrator).
+/// noise and bias (5%); the teapot (direct light only) with path and sppm, which agree within
+/// 5% too. The folder is beside the repository in CI, which sets FOTON_REQUIRE_SHARED so that
+/// its absence fails there; a clone elsewhere says that it skips.
 #[test]
 fn the_shared_mitsuba_scenes_render_with_every_integrator() {
     let shared = repo_root().join("../shared/scenes/mitsuba");
-    assert!(
-        shared.join("cbox.xml").exists(),
-        "{} is missing",
-        shared.display()
-    );
+    if !shared.join("cbox.xml").exists() {
+        assert!(
+            std::env::var_os("FOTON_REQUIRE_SHARED").is_none(),
+            "{} is missing",
+            shared.display()
+        );
+        eprintln!("skipped: {} is not beside this clone", shared.display());
+        return;
+    }
     let dir = temp_dir("mitsuba-shared");
     let cbox = shared.join("cbox.xml");
     let small = ["-D", "res=32", "-D", "spp=64"];
@@ -450,13 +456,28 @@ fn the_shared_mitsuba_scenes_render_with_every_integrator() {
             );
         }
     }
-    let teapot = dir.join("teapot.exr");
-    ok(&render(
-        &shared.join("teapot.xml"),
-        &teapot,
-        &["-D", "res=32", "-D", "spp=4"],
-    ));
-    assert!(mean(&teapot)[0] > 0.0);
+    let teapot = shared.join("teapot.xml");
+    let (a, b) = (dir.join("teapot-path.exr"), dir.join("teapot-sppm.exr"));
+    let small = ["-D", "res=32", "-D", "spp=16"];
+    ok(&render(&teapot, &a, &small));
+    let mut args = small.to_vec();
+    args.extend([
+        "--integrator",
+        "sppm",
+        "--set",
+        "integrators.sppm.iterations=16",
+    ]);
+    ok(&render(&teapot, &b, &args));
+    let (ma, mb) = (mean(&a), mean(&b));
+    assert!(ma[0] > 0.01, "the teapot is black: {ma:?}");
+    for c in 0..3 {
+        assert!(
+            (mb[c] - ma[c]).abs() <= 0.05 * ma[c].max(1e-3),
+            "teapot channel {c}: sppm {} vs path {}",
+            mb[c],
+            ma[c]
+        );
+    }
 }
 
 /// The TOML mesh transform's `matrix` (what an XML `to_world` becomes): refused when it is
