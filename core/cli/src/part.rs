@@ -310,15 +310,17 @@ fn read_header(path: &Path) -> FotonResult<(BTreeMap<String, String>, (usize, us
     Ok((attributes, (header.layer_size.0, header.layer_size.1)))
 }
 
-/// Every text attribute of a part file's header (those of [`PartInfo`] and the extra ones).
-pub fn read_part_attributes(path: &Path) -> FotonResult<BTreeMap<String, String>> {
-    Ok(read_header(path)?.0)
+/// Reads the header of a part file: what [`PartInfo`] holds, and every text attribute (the
+/// extra ones a sweep's cell adds too).
+pub fn read_part_header(path: &Path) -> FotonResult<(PartInfo, BTreeMap<String, String>)> {
+    let (attributes, size) = read_header(path)?;
+    let info = PartInfo::from_attributes(path, size, |key| attributes.get(key).cloned())?;
+    Ok((info, attributes))
 }
 
 /// Reads the header of a part file.
 pub fn read_part_info(path: &Path) -> FotonResult<PartInfo> {
-    let (attributes, size) = read_header(path)?;
-    PartInfo::from_attributes(path, size, |key| attributes.get(key).cloned())
+    Ok(read_part_header(path)?.0)
 }
 
 /// Reads a part file's sums and counts.

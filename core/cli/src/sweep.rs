@@ -9,7 +9,7 @@
 //! from those files, the same grid as one process makes but for the times.
 
 use crate::montage::{Tile, grid, render_image};
-use crate::part::{PartInfo, fnv_hex, read_part_attributes, read_part_film, write_part};
+use crate::part::{PartInfo, fnv_hex, read_part_film, read_part_header, write_part};
 use crate::threads;
 use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare_xml, render_prepared};
 use clap::Args;
@@ -254,7 +254,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
                 missing.push(cell.to_string());
                 continue;
             }
-            let attributes = read_part_attributes(&path)?;
+            let (info, attributes) = read_part_header(&path)?;
             let get = |key: &str| attributes.get(key).cloned().unwrap_or_default();
             if get("foton.sweep") != signature || get("foton.cell") != cell.to_string() {
                 return Err(Error::Usage(format!(
@@ -262,7 +262,6 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
                     path.display()
                 )));
             }
-            let info = crate::part::read_part_info(&path)?;
             let film = read_part_film(&path, &info)?;
             let (_, mut label) = overrides_of(cell);
             let _ = writeln!(
