@@ -198,14 +198,9 @@ impl Light {
                 position,
                 intensity,
             } => {
-                let d = *position - x;
-                let dist2 = d.length_squared();
-                if dist2 == 0.0 {
-                    return None;
-                }
-                let dist = dist2.sqrt();
+                let (wi, dist, dist2) = towards(x, *position)?;
                 Some(LightSample {
-                    wi: d / dist,
+                    wi,
                     dist,
                     li: *intensity / dist2,
                     pdf: 1.0,
@@ -221,13 +216,7 @@ impl Light {
                 beam_width,
                 cutoff,
             } => {
-                let d = *position - x;
-                let dist2 = d.length_squared();
-                if dist2 == 0.0 {
-                    return None;
-                }
-                let dist = dist2.sqrt();
-                let wi = d / dist;
+                let (wi, dist, dist2) = towards(x, *position)?;
                 let falloff = spot_falloff(axis.dot(-wi), *beam_width, *cutoff);
                 Some(LightSample {
                     wi,
@@ -455,4 +444,16 @@ pub fn area_light(shapes: Vec<Shape>, radiance: Rgb, object: u32) -> Light {
         radiance,
         object,
     }
+}
+
+/// The direction from `x` to `p`, the distance and its square (a point light's 1/r^2); None
+/// when they coincide.
+fn towards(x: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
+    let d = p - x;
+    let dist2 = d.length_squared();
+    if dist2 == 0.0 {
+        return None;
+    }
+    let dist = dist2.sqrt();
+    Some((d / dist, dist, dist2))
 }
