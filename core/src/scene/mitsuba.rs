@@ -485,7 +485,7 @@ impl Reader {
                     };
                     Prop::Point(p)
                 }
-                "transform" => Prop::Transform(self.transform(c, file, cl, line_of)?),
+                "transform" => Prop::Transform(self.transform(c, file, line_of)?),
                 "ref" => {
                     let id = cget("id")?.ok_or_else(|| syntax(file, cl, "<ref> without id"))?;
                     Prop::Ref(id)
@@ -512,7 +512,6 @@ impl Reader {
         &self,
         n: roxmltree::Node<'_, '_>,
         file: &Path,
-        _line: u32,
         line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
     ) -> Result<DMat4> {
         let mut m = DMat4::IDENTITY;
