@@ -17,9 +17,9 @@
 //! path tracer, which counts what its next ray hits with the matching weight).
 
 use crate::Rgb;
+use crate::bsdf::Bsdf;
 use crate::error::Result;
 use crate::geometry::Hit;
-use crate::material::Material;
 use crate::medium::Phase;
 use crate::props::Properties;
 use crate::sampling::{Sampler, power_heuristic};
@@ -57,10 +57,7 @@ impl Direct {
 #[derive(Clone, Copy, Debug)]
 pub enum Scatter<'a> {
     /// A surface point and its BSDF.
-    Surface {
-        hit: &'a Hit,
-        material: &'a Material,
-    },
+    Surface { hit: &'a Hit, bsdf: &'a Bsdf },
     /// A point in a medium and its phase function.
     Medium { p: Vec3, phase: Phase },
 }
@@ -106,8 +103,8 @@ pub fn estimate_direct(
     }
     // The scattering function times the cosine, its sampling pdf, and the visibility.
     let (f, scatter_pdf, tr) = match at {
-        Scatter::Surface { hit, material } => {
-            let f = material.eval(wo, ls.wi, hit.ng);
+        Scatter::Surface { hit, bsdf } => {
+            let f = bsdf.eval(wo, ls.wi);
             if f == Rgb::ZERO {
                 return Rgb::ZERO;
             }
@@ -121,11 +118,11 @@ pub fn estimate_direct(
                 Rgb::ONE
             };
             let pdf = if mis == Mis::WithScatterSampling && !ls.delta {
-                material.pdf(wo, ls.wi, hit.ng)
+                bsdf.pdf(wo, ls.wi)
             } else {
                 0.0
             };
-            (f * ls.wi.dot(hit.ng).abs(), pdf, tr)
+            (f, pdf, tr)
         }
         Scatter::Medium { p, phase } => {
             *rays += 1;

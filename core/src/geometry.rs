@@ -1,6 +1,8 @@
-//! Rays and the three kinds of primitive: analytic spheres and parallelograms ("quads"), and
-//! triangles from meshes. Each primitive knows its orientation: the geometric normal is the
-//! outward normal for spheres, normalize(u x v) for quads and normalize(e1 x e2) for triangles.
+//! Rays and the four kinds of primitive: analytic spheres, parallelograms ("quads") and
+//! (elliptic) discs, and triangles from meshes. Each primitive knows its orientation: the
+//! geometric normal is the outward normal for spheres, normalize(u x v) for quads and discs and
+//! normalize(e1 x e2) for triangles. [`SurfacePoint`] adds what shading needs: the shading
+//! normal, texture coordinates and the tangent dp/du, with Mitsuba 3's parameterisations.
 
 use glam::{Vec2, Vec3};
 use obvhs::aabb::Aabb;
@@ -54,6 +56,42 @@ pub enum Shape {
         e1: Vec3,
         e2: Vec3,
     },
+    /// center + a u + b v with a^2 + b^2 <= 1 (a circle when u and v are orthogonal and of
+    /// equal length: Mitsuba's `disk` under any affine `to_world`). `w` and `normal` as for
+    /// a quad.
+    Disk {
+        center: Vec3,
+        u: Vec3,
+        v: Vec3,
+        w: Vec3,
+        normal: Vec3,
+    },
+}
+
+/// What a mesh file gives a triangle besides its corners: vertex normals and texture
+/// coordinates, in the order of the triangle's corners (p0, p0 + e1, p0 + e2).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TriangleAttrs {
+    pub normals: Option<[Vec3; 3]>,
+    pub uvs: Option<[Vec2; 3]>,
+}
+
+/// No [`TriangleAttrs`] for a primitive.
+pub const NO_ATTRS: u32 = u32::MAX;
+
+/// A point on a surface with what shading needs there.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    pub p: Vec3,
+    /// Unit geometric normal, the primitive's own orientation.
+    pub ng: Vec3,
+    /// Unit shading normal (the interpolated vertex normal of a smooth mesh; else `ng`), on
+    /// the side of `ng`.
+    pub ns: Vec3,
+    /// Texture coordinates.
+    pub uv: Vec2,
+    /// Tangent dp/du (zero where the parameterisation gives none): orients anisotropic BSDFs.
+    pub dpdu: Vec3,
 }
 
 /// A shape instance in the scene: geometry plus the index of the scene object it belongs to
@@ -62,6 +100,8 @@ pub enum Shape {
 pub struct Primitive {
     pub shape: Shape,
     pub object: u32,
+    /// Index of the triangle's [`TriangleAttrs`] in the scene, or [`NO_ATTRS`].
+    pub attrs: u32,
 }
 
 /// A ray-surface intersection.
@@ -86,6 +126,27 @@ impl Shape {
         }
     }
 
+    pub fn disk(center: Vec3, u: Vec3, v: Vec3) -> Shape {
+        let n = u.cross(v);
+        Shape::Disk {
+            center,
+            u,
+            v,
+            w: n / n.dot(n),
+            normal: n.normalize(),
+        }
+    }
+
+    /// Turns the surface's normal the other way (Mitsuba's `flip_normals`), keeping its
+    /// texture coordinates. Spheres are not flipped (they have no orientation field).
+    pub fn flip(&mut self) {
+        match self {
+            Shape::Quad { normal, .. } | Shape::Disk { normal, .. } => *normal = -*normal,
+            Shape::Triangle { e1, e2, .. } => std::mem::swap(e1, e2),
+            Shape::Sphere { .. } => {}
+        }
+    }
+
     pub fn aabb(&self) -> Aabb {
         let (lo, hi) = match *self {
             Shape::Sphere { center, radius } => {
@@ -96,6 +157,11 @@ impl Shape {
                 bounds(&pts)
             }
             Shape::Triangle { p0, e1, e2 } => bounds(&[p0, p0 + e1, p0 + e2]),
+            Shape::Disk { center, u, v, .. } => {
+                // The ellipse's extent along each axis: sqrt(u_i^2 + v_i^2).
+                let half = (u * u + v * v).map(f32::sqrt);
+                (center - half, center + half)
+            }
         };
         // Pad flat boxes: an axis-aligned quad has zero thickness.
         let pad = Vec3::splat(1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element()));
@@ -107,6 +173,7 @@ impl Shape {
             Shape::Sphere { radius, .. } => 4.0 * std::f32::consts::PI * radius * radius,
             Shape::Quad { u, v, .. } => u.cross(v).length(),
             Shape::Triangle { e1, e2, .. } => 0.5 * e1.cross(e2).length(),
+            Shape::Disk { u, v, .. } => std::f32::consts::PI * u.cross(v).length(),
         }
     }
 
@@ -182,6 +249,26 @@ impl Shape {
                 let t = e2.dot(qvec) * inv;
                 (t > 0.0 && t < tmax).then_some(t)
             }
+            Shape::Disk {
+                center,
+                u,
+                v,
+                w,
+                normal,
+            } => {
+                let denom = normal.dot(ray.dir);
+                if denom.abs() < 1e-12 {
+                    return None;
+                }
+                let t = normal.dot(center - ray.origin) / denom;
+                if !(t > 0.0 && t < tmax) {
+                    return None;
+                }
+                let q = ray.at(t) - center;
+                let a = w.dot(q.cross(v));
+                let b = w.dot(u.cross(q));
+                (a * a + b * b <= 1.0).then_some(t)
+            }
         }
     }
 
@@ -192,6 +279,91 @@ impl Shape {
             Shape::Sphere { center, .. } => (p - center).normalize(),
             Shape::Quad { normal, .. } => normal,
             Shape::Triangle { e1, e2, .. } => e1.cross(e2).normalize(),
+            Shape::Disk { normal, .. } => normal,
+        }
+    }
+
+    /// The surface at `p` (a point on it): Mitsuba 3's texture coordinates and tangents
+    /// (sphere: u = phi / 2 pi, v = theta / pi; rectangle: the corner coordinates in [0, 1]^2;
+    /// disk: u = r, v = phi / 2 pi; triangle: interpolated, else the barycentrics (b1, b2)),
+    /// and the shading normal from a triangle's vertex normals.
+    pub fn surface(&self, p: Vec3, attrs: Option<&TriangleAttrs>) -> SurfacePoint {
+        let ng = self.normal(p);
+        let (uv, dpdu, ns) = match *self {
+            Shape::Sphere { center, radius } => {
+                let d = (p - center) / radius;
+                let mut phi = d.y.atan2(d.x);
+                if phi < 0.0 {
+                    phi += 2.0 * std::f32::consts::PI;
+                }
+                let theta = d.z.clamp(-1.0, 1.0).acos();
+                let uv = Vec2::new(
+                    phi * (0.5 * std::f32::consts::FRAC_1_PI),
+                    theta * std::f32::consts::FRAC_1_PI,
+                );
+                let dpdu = Vec3::new(-d.y, d.x, 0.0) * (2.0 * std::f32::consts::PI * radius);
+                (uv, dpdu, ng)
+            }
+            Shape::Quad {
+                origin, u, v, w, ..
+            } => {
+                let q = p - origin;
+                (Vec2::new(w.dot(q.cross(v)), w.dot(u.cross(q))), u, ng)
+            }
+            Shape::Disk {
+                center, u, v, w, ..
+            } => {
+                let q = p - center;
+                let (a, b) = (w.dot(q.cross(v)), w.dot(u.cross(q)));
+                let mut phi = b.atan2(a);
+                if phi < 0.0 {
+                    phi += 2.0 * std::f32::consts::PI;
+                }
+                let r = (a * a + b * b).sqrt();
+                // d p / d r along the radius, as Mitsuba's disk (u = r).
+                let dpdu = if r > 0.0 { (a * u + b * v) / r } else { u };
+                (
+                    Vec2::new(r, phi * (0.5 * std::f32::consts::FRAC_1_PI)),
+                    dpdu,
+                    ng,
+                )
+            }
+            Shape::Triangle { p0, e1, e2 } => {
+                let n = e1.cross(e2);
+                let q = p - p0;
+                let inv = 1.0 / n.dot(n);
+                let b1 = q.cross(e2).dot(n) * inv;
+                let b2 = e1.cross(q).dot(n) * inv;
+                let b0 = 1.0 - b1 - b2;
+                let mut uv = Vec2::new(b1, b2);
+                let mut dpdu = Vec3::ZERO;
+                let mut ns = ng;
+                if let Some(a) = attrs {
+                    if let Some(t) = a.uvs {
+                        uv = b0 * t[0] + b1 * t[1] + b2 * t[2];
+                        // Solve e1 = du1 dpdu + dv1 dpdv, e2 = du2 dpdu + dv2 dpdv.
+                        let (d1, d2) = (t[1] - t[0], t[2] - t[0]);
+                        let det = d1.x * d2.y - d1.y * d2.x;
+                        if det.abs() > 1e-20 {
+                            dpdu = (d2.y * e1 - d1.y * e2) / det;
+                        }
+                    }
+                    if let Some(nv) = a.normals {
+                        let n = b0 * nv[0] + b1 * nv[1] + b2 * nv[2];
+                        if n.length_squared() > 0.0 {
+                            ns = n.normalize();
+                        }
+                    }
+                }
+                (uv, dpdu, ns)
+            }
+        };
+        SurfacePoint {
+            p,
+            ng,
+            ns,
+            uv,
+            dpdu,
         }
     }
 
@@ -213,6 +385,16 @@ impl Shape {
             Shape::Triangle { p0, e1, e2 } => {
                 let (b1, b2) = crate::sampling::uniform_triangle(u);
                 (p0 + b1 * e1 + b2 * e2, e1.cross(e2).normalize())
+            }
+            Shape::Disk {
+                center,
+                u: eu,
+                v: ev,
+                normal,
+                ..
+            } => {
+                let d = crate::sampling::concentric_disc(u);
+                (center + d.x * eu + d.y * ev, normal)
             }
         }
     }

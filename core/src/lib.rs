@@ -2,15 +2,15 @@
 //!
 //! One module per concept, named as in the literature: [`scene`] (the scene and its queries,
 //! loading, meshes, volumes, visibility), [`geometry`] and [`accel`] (the BVH), [`material`]
-//! (BSDFs), [`light`], [`camera`], [`film`], [`sampling`], [`medium`], [`kernel`]
+//! and [`bsdf`], [`light`], [`camera`], [`film`], [`sampling`], [`medium`], [`kernel`]
 //! (density-estimation kernels), [`integrator`] (the plugin interface), [`render`] (the shared
 //! parallel image loop) and [`plugin`] (declaring and loading plugins). Nothing host-only lives
 //! here: the `foton` program and its tools are the crate in `cli/`, the photon machinery of
 //! the photon-mapping plugins is `integrators/photonmap`.
 
 pub mod accel;
+pub mod bsdf;
 pub mod camera;
-
 pub mod direct;
 pub mod error;
 pub mod film;

@@ -1,11 +1,11 @@
-//! Materials and their BSDFs. All work in world space around the geometric normal `ng`
-//! (the shape's own orientation); mirror surfaces are two-sided, diffuse ones unless made
-//! one-sided (Mitsuba's BSDFs are one-sided: black seen from behind).
+//! Materials: what a scene says a surface is made of. At a surface point a material gives
+//! its BSDF ([`Material::bsdf`], see [`crate::bsdf`]); mirror surfaces are two-sided, diffuse
+//! ones unless made one-sided (Mitsuba's BSDFs are one-sided: black seen from behind).
 
 use crate::Rgb;
-use crate::sampling::{cosine_hemisphere, to_world};
-use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
+use crate::bsdf::{Bsdf, Frame, Lobe};
+use crate::geometry::SurfacePoint;
+use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
@@ -40,16 +40,6 @@ pub enum Material {
 pub enum TransportMode {
     Radiance,
     Importance,
-}
-
-#[derive(Clone, Copy, Debug)]
-pub struct BsdfSample {
-    pub wi: Vec3,
-    /// f |cos theta_i| / pdf: what the path throughput is multiplied by.
-    pub weight: Rgb,
-    /// For delta lobes the probability of having chosen that lobe.
-    pub pdf: f32,
-    pub delta: bool,
 }
 
 /// Unpolarised Fresnel reflectance of a dielectric interface. `cos_i` >= 0 is the cosine on
@@ -319,8 +309,7 @@ pub fn refract(wo: Vec3, n: Vec3, eta: f32) -> Option<Vec3> {
 }
 
 impl Material {
-    /// True when the BSDF is a sum of Dirac deltas (mirror, smooth glass): it cannot be
-    /// evaluated for a given pair of directions, only sampled. Photons are never stored there.
+    /// True when the material scatters only in Dirac deltas (mirror, smooth glass).
     pub fn is_delta(&self) -> bool {
         matches!(
             self,
@@ -335,142 +324,36 @@ impl Material {
         matches!(self, Material::Null)
     }
 
-    /// BSDF value f(wo, wi) (without the cosine). Zero for delta materials.
+    /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
     #[inline]
-    pub fn eval(&self, wo: Vec3, wi: Vec3, ng: Vec3) -> Rgb {
-        match *self {
+    pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
+        let lobe = match *self {
             Material::Diffuse {
                 reflectance,
                 twosided,
-            } => {
-                if wo.dot(ng) * wi.dot(ng) > 0.0 && (twosided || wo.dot(ng) > 0.0) {
-                    reflectance * FRAC_1_PI
-                } else {
-                    Rgb::ZERO
-                }
-            }
-            _ => Rgb::ZERO,
-        }
-    }
-
-    /// Solid-angle pdf with which `sample` produces wi (zero for delta materials).
-    #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3, ng: Vec3) -> f32 {
-        match *self {
-            Material::Diffuse { twosided, .. }
-                if wo.dot(ng) * wi.dot(ng) > 0.0 && (twosided || wo.dot(ng) > 0.0) =>
-            {
-                wi.dot(ng).abs() * FRAC_1_PI
-            }
-            _ => 0.0,
-        }
-    }
-
-    /// Samples an incident direction for the outgoing direction `wo`. `u` chooses a direction
-    /// within a lobe, `uc` chooses between lobes (reflection or refraction).
-    #[inline]
-    pub fn sample(
-        &self,
-        wo: Vec3,
-        ng: Vec3,
-        u: Vec2,
-        uc: f32,
-        mode: TransportMode,
-    ) -> Option<BsdfSample> {
-        let cos_o = wo.dot(ng);
-        if cos_o == 0.0 {
-            return None;
-        }
-        let n = if cos_o > 0.0 { ng } else { -ng };
-        match *self {
-            Material::Diffuse {
+            } => Lobe::Diffuse {
                 reflectance,
                 twosided,
-            } => {
-                if !twosided && cos_o < 0.0 {
-                    return None;
-                }
-                let local = cosine_hemisphere(u);
-                if local.z <= 0.0 {
-                    return None;
-                }
-                Some(BsdfSample {
-                    wi: to_world(local, n),
-                    weight: reflectance,
-                    pdf: local.z * FRAC_1_PI,
-                    delta: false,
-                })
-            }
-            Material::Mirror { reflectance } => Some(BsdfSample {
-                wi: reflect(wo, n),
-                weight: reflectance,
-                pdf: 1.0,
-                delta: true,
-            }),
+            },
+            Material::Mirror { reflectance } => Lobe::Mirror { reflectance },
             Material::Conductor {
                 eta,
                 k,
                 specular_reflectance,
-            } => {
-                let c = cos_o.abs();
-                let f = Rgb::new(
-                    fresnel_conductor(c, eta.x, k.x),
-                    fresnel_conductor(c, eta.y, k.y),
-                    fresnel_conductor(c, eta.z, k.z),
-                );
-                Some(BsdfSample {
-                    wi: reflect(wo, n),
-                    weight: specular_reflectance * f,
-                    pdf: 1.0,
-                    delta: true,
-                })
-            }
-            Material::Dielectric { ior } => {
-                let eta = if cos_o > 0.0 { ior } else { 1.0 / ior };
-                let f = fresnel_dielectric(cos_o.abs(), eta);
-                if uc < f {
-                    return Some(BsdfSample {
-                        wi: reflect(wo, n),
-                        weight: Rgb::ONE,
-                        pdf: f,
-                        delta: true,
-                    });
-                }
-                let wi = refract(wo, n, eta)?;
-                let scale = match mode {
-                    TransportMode::Radiance => 1.0 / (eta * eta),
-                    TransportMode::Importance => 1.0,
-                };
-                Some(BsdfSample {
-                    wi,
-                    weight: Rgb::splat(scale),
-                    pdf: 1.0 - f,
-                    delta: true,
-                })
-            }
-            Material::ThinDielectric { ior } => {
-                // Air-glass-air: the same reflectance from either side; the infinite series of
-                // reflections inside the sheet sums to R' = R + T^2 R / (1 - R^2) = 2R / (1 + R).
-                let r = fresnel_dielectric(cos_o.abs(), ior);
-                let r = 2.0 * r / (1.0 + r);
-                if uc < r {
-                    return Some(BsdfSample {
-                        wi: reflect(wo, n),
-                        weight: Rgb::ONE,
-                        pdf: r,
-                        delta: true,
-                    });
-                }
-                // Straight through: the two refractions undo each other (no 1/eta^2 either).
-                Some(BsdfSample {
-                    wi: -wo,
-                    weight: Rgb::ONE,
-                    pdf: 1.0 - r,
-                    delta: true,
-                })
-            }
-            Material::Null => None,
-        }
+            } => Lobe::Conductor {
+                eta,
+                k,
+                specular_reflectance,
+            },
+            Material::Dielectric { ior } => Lobe::Dielectric { ior },
+            Material::ThinDielectric { ior } => Lobe::ThinDielectric { ior },
+            Material::Null => return None,
+        };
+        Some(Bsdf {
+            lobe,
+            frame: Frame::from_normal_tangent(sp.ns, sp.dpdu),
+            ng: sp.ng,
+        })
     }
 }
 

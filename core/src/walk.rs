@@ -17,10 +17,14 @@
 //! with no loop to limit.
 
 use crate::Rgb;
+use crate::bsdf::Bsdf;
+use crate::direct::{Mis, Scatter, estimate_direct};
+use crate::error::Result;
 use crate::geometry::{Hit, Ray, offset_origin};
-use crate::material::{Material, TransportMode};
+use crate::material::TransportMode;
 use crate::medium::Medium;
-use crate::sampling::Sampler;
+use crate::props::Properties;
+use crate::sampling::{Sampler, power_heuristic};
 use crate::scene::Scene;
 use glam::Vec3;
 
@@ -37,13 +41,17 @@ pub struct RayWalk {
     /// How far the ray's origin lies past the null boundary it just crossed, along the ray.
     gap: f32,
     crossings: u32,
+    /// Emitting surfaces are passed through, as null boundaries are, until the ray first
+    /// scatters: a camera ray with `hide_emitters` (Mitsuba's: directly seen emitters are
+    /// skipped, what lies behind them is seen).
+    skip_emitters: bool,
 }
 
 /// What a walk's ray met at the end of a segment ([`RayWalk::reach`]).
 #[derive(Clone, Copy, Debug)]
 pub enum Reached {
-    /// A surface that scatters, with its material.
-    Surface(Material),
+    /// A surface that scatters, with its BSDF there.
+    Surface(Bsdf),
     /// A null boundary, crossed: trace the next segment.
     Crossed,
     /// A null boundary past the crossing limit: the ray is ended.
@@ -98,6 +106,16 @@ impl RayWalk {
             medium,
             gap: 0.0,
             crossings: 0,
+            skip_emitters: false,
+        }
+    }
+
+    /// A camera ray's walk: from the camera's medium, passing through emitters until it first
+    /// scatters if the scene hides them (`[render] hide_emitters`).
+    pub fn camera(scene: &Scene, ray: Ray) -> Self {
+        RayWalk {
+            skip_emitters: scene.render.hide_emitters,
+            ..RayWalk::new(ray, scene.camera_medium)
         }
     }
 
@@ -132,12 +150,12 @@ impl RayWalk {
     }
 
     /// What the ray met at `hit`, the end of the last segment: a surface that scatters (its
-    /// material), or a null boundary, which is crossed ([`RayWalk::cross`]).
+    /// BSDF), or a null boundary (or a hidden emitter), which is crossed ([`RayWalk::cross`]).
     #[inline]
     pub fn reach(&mut self, scene: &Scene, hit: &Hit) -> Reached {
-        let material = *scene.material(hit);
-        if !material.is_null() {
-            Reached::Surface(material)
+        let hidden = self.skip_emitters && scene.object(hit).light.is_some();
+        if !hidden && let Some(bsdf) = scene.bsdf(hit) {
+            Reached::Surface(bsdf)
         } else if self.cross(scene, hit) {
             Reached::Crossed
         } else {
@@ -153,6 +171,7 @@ impl RayWalk {
         self.ray = Ray::new(offset_origin(hit.p, hit.ng, wi), wi);
         self.gap = 0.0;
         self.crossings = 0;
+        self.skip_emitters = false;
     }
 
     /// Goes on from a scattering event at `x` in a medium, in direction `wi`.
@@ -161,6 +180,7 @@ impl RayWalk {
         self.ray = Ray::new(x, wi);
         self.gap = 0.0;
         self.crossings = 0;
+        self.skip_emitters = false;
     }
 }
 
@@ -185,18 +205,19 @@ pub fn first_surface(
     }
 }
 
-/// The first non-delta point of a camera path.
+/// The first point of a camera path where radiance is estimated (the first non-delta, non-
+/// glossy one: see [`walk_to_diffuse`]).
 #[derive(Clone, Copy, Debug)]
 pub struct VisiblePoint {
     pub hit: Hit,
-    pub material: Material,
+    pub bsdf: Bsdf,
     /// Direction towards the camera (along the path).
     pub wo: Vec3,
     /// Surface normal on the side `wo` is on.
     pub n: Vec3,
-    /// Throughput of the delta bounces and media before it.
+    /// Throughput of the bounces and media before it.
     pub beta: Rgb,
-    /// Delta bounces before it: photons gathered here may have at most max_depth - bounces
+    /// Bounces (delta or glossy) before it: photons gathered here may have at most max_depth - bounces
     /// scattering events.
     pub bounces: u32,
     /// Length of the path from the camera (for the pixel's footprint).
@@ -222,24 +243,69 @@ pub struct CameraPath {
 pub trait InMedium: FnMut(&Segment, &dyn Medium, u32, &mut Sampler, &mut u64) -> Rgb {}
 impl<F: FnMut(&Segment, &dyn Medium, u32, &mut Sampler, &mut u64) -> Rgb> InMedium for F {}
 
-/// Follows a camera ray through null boundaries and at most `max_depth` delta bounces
-/// (sampling reflection or refraction in radiance mode) to its first non-delta surface. On
-/// each segment through a medium, `in_medium` gives the in-scattered radiance and the
+/// How a camera walk treats the surfaces it meets.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraWalk {
+    /// Bounces the walk may take (the scene's `max_depth`).
+    pub max_depth: u32,
+    /// Lobes with a roughness (microfacet alpha) below this are continued through by sampling
+    /// instead of being estimated from photons (0: only delta lobes are).
+    pub glossy_roughness: f32,
+}
+
+impl CameraWalk {
+    /// The photon integrators' shared parameter `glossy_roughness` (default
+    /// [`GLOSSY_ROUGHNESS`]), with the scene's `max_depth`.
+    pub fn read(props: &Properties<'_>, scene: &Scene) -> Result<CameraWalk> {
+        let glossy_roughness = props.f32("glossy_roughness", GLOSSY_ROUGHNESS)?;
+        if glossy_roughness < 0.0 || glossy_roughness.is_nan() {
+            return Err(props.error(
+                "glossy_roughness",
+                format!("must be zero or positive, found {glossy_roughness}"),
+            ));
+        }
+        Ok(CameraWalk {
+            max_depth: scene.render.max_depth,
+            glossy_roughness,
+        })
+    }
+}
+
+/// Default `glossy_roughness`: microfacet lobes with alpha below one half (most glossy
+/// materials) are sampled; rougher ones, nearly diffuse, are estimated from photons.
+pub const GLOSSY_ROUGHNESS: f32 = 0.5;
+
+/// Follows a camera ray through null boundaries, delta and glossy bounces (at most
+/// `max_depth`) to its first point whose radiance is estimated from photons: a surface whose
+/// BSDF is neither delta nor glossy. This is the photon integrators' method for glossy
+/// surfaces seen from the camera (Mitsuba 0.6's photon mapper's): a lobe rougher than
+/// `glossy_roughness` is estimated from the photons there; a smoother one, whose reflection
+/// a density estimate would blur, is continued through by sampling it, with next-event
+/// estimation at the glossy vertex and the emission the sampled ray meets weighted against it
+/// (the power heuristic). A BSDF that mixes a delta part with a non-delta one (a smooth
+/// plastic) picks one by its sampling probabilities: the delta part is continued through, the
+/// other estimated here, each weighted by one over its probability.
+///
+/// On each segment through a medium, `in_medium` gives the in-scattered radiance and the
 /// throughput is then multiplied by the segment's transmittance (so that surfaces behind it
 /// are seen through it).
 pub fn walk_to_diffuse(
     scene: &Scene,
     ray: Ray,
-    max_depth: u32,
+    how: CameraWalk,
     sampler: &mut Sampler,
     rays: &mut u64,
     mut in_medium: impl InMedium,
 ) -> CameraPath {
-    let mut walk = RayWalk::new(ray, scene.camera_medium);
+    let mut walk = RayWalk::camera(scene, ray);
     let mut emitted = Rgb::ZERO;
     let mut beta = Rgb::ONE;
     let mut bounces = 0u32;
     let mut distance = 0.0;
+    // The last bounce's solid-angle pdf and point, if it was glossy (MIS for the emission its
+    // ray meets); None after the camera or a delta bounce.
+    let mut glossy_from: Option<(f32, Vec3)> = None;
+    let hidden = scene.render.hide_emitters;
     loop {
         let seg = walk.segment(scene, rays);
         if let Some(m) = seg.interacting_medium(scene) {
@@ -250,33 +316,74 @@ pub fn walk_to_diffuse(
             }
         }
         let Some(hit) = seg.hit else {
-            if let Some((_, le)) = scene.escaped(seg.ray.dir) {
-                emitted += beta * le;
+            if let Some((light_id, le)) = scene.escaped(seg.ray.dir)
+                && !(hidden && bounces == 0)
+            {
+                let w = match glossy_from {
+                    None => 1.0,
+                    Some((pdf, p)) => {
+                        let light = &scene.lights[light_id as usize];
+                        let pdf_light = scene.light_pmf(light_id as usize)
+                            * light.pdf_li(p, p + seg.ray.dir, Vec3::ZERO);
+                        power_heuristic(pdf, pdf_light)
+                    }
+                };
+                emitted += beta * le * w;
             }
             break;
         };
         distance += hit.p.distance(seg.ray.origin);
-        let material = match walk.reach(scene, &hit) {
-            Reached::Surface(material) => material,
+        let bsdf = match walk.reach(scene, &hit) {
+            Reached::Surface(bsdf) => bsdf,
             Reached::Crossed => continue,
             Reached::Ended => break,
         };
         let wo = -seg.ray.dir;
-        if let Some((_, light)) = scene.area_light(&hit) {
-            emitted += beta * light.emitted(hit.ng, wo);
+        if let Some((light_id, light)) = scene.area_light(&hit) {
+            let le = light.emitted(hit.ng, wo);
+            if le != Rgb::ZERO {
+                let w = match glossy_from {
+                    None => 1.0,
+                    Some((pdf, p)) => {
+                        let pdf_light =
+                            scene.light_pmf(light_id as usize) * light.pdf_li(p, hit.p, hit.ng);
+                        power_heuristic(pdf, pdf_light)
+                    }
+                };
+                emitted += beta * le * w;
+            }
         }
-        if bounces >= max_depth {
+        if bounces >= how.max_depth {
             break;
         }
-        if material.is_delta() {
+        let glossy = bsdf.is_delta() || bsdf.roughness() < how.glossy_roughness;
+        if glossy && !bsdf.is_delta() {
+            let at = Scatter::Surface {
+                hit: &hit,
+                bsdf: &bsdf,
+            };
+            let mis = Mis::WithScatterSampling;
+            emitted += beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
+        }
+        let p_delta = if glossy {
+            0.0
+        } else {
+            bsdf.delta_probability(wo)
+        };
+        if glossy || p_delta > 0.0 {
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
                 break;
             };
-            beta *= bs.weight;
-            bounces += 1;
-            walk.scatter_at_surface(scene, &hit, bs.wi);
-            continue;
+            if glossy || bs.delta {
+                beta *= bs.weight;
+                bounces += 1;
+                glossy_from = (!bs.delta).then_some((bs.pdf, hit.p));
+                walk.scatter_at_surface(scene, &hit, bs.wi);
+                continue;
+            }
+            // The non-delta part was picked: estimated here, for both parts' share.
+            beta /= 1.0 - p_delta;
         }
         let n = if hit.ng.dot(wo) > 0.0 {
             hit.ng
@@ -287,7 +394,7 @@ pub fn walk_to_diffuse(
             emitted,
             visible: Some(VisiblePoint {
                 hit,
-                material,
+                bsdf,
                 wo,
                 n,
                 beta,
@@ -308,11 +415,9 @@ pub fn walk_to_diffuse(
 pub fn trace_to_diffuse(
     scene: &Scene,
     ray: Ray,
-    max_depth: u32,
+    how: CameraWalk,
     sampler: &mut Sampler,
     rays: &mut u64,
 ) -> CameraPath {
-    walk_to_diffuse(scene, ray, max_depth, sampler, rays, |_, _, _, _, _| {
-        Rgb::ZERO
-    })
+    walk_to_diffuse(scene, ray, how, sampler, rays, |_, _, _, _, _| Rgb::ZERO)
 }

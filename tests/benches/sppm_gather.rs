@@ -14,7 +14,7 @@
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
-use foton_core::walk::trace_to_diffuse;
+use foton_core::walk::{CameraWalk, GLOSSY_ROUGHNESS, trace_to_diffuse};
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::repo_root;
@@ -52,7 +52,10 @@ fn main() {
             let path = trace_to_diffuse(
                 &scene,
                 scene.camera.generate_ray(film),
-                16,
+                CameraWalk {
+                    max_depth: 16,
+                    glossy_roughness: GLOSSY_ROUGHNESS,
+                },
                 &mut s,
                 &mut rays,
             );

@@ -330,7 +330,7 @@ fn unknown_shape_type_lists_the_types() {
         "type = \"sphere\"",
         "type = \"cube\"",
         "shapes[0].type",
-        &["unknown shape type \"cube\"", "sphere, quad, mesh"],
+        &["unknown shape type \"cube\"", "sphere, quad, disk, mesh"],
     );
 }
 
@@ -341,7 +341,7 @@ fn missing_shape_type_lists_the_types() {
     scene.check_fails(
         "[[shapes]]",
         "shapes[0].type",
-        &["missing", "sphere, quad, mesh"],
+        &["missing", "sphere, quad, disk, mesh"],
     );
 }
 

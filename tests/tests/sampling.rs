@@ -11,7 +11,8 @@
 //! All random numbers come from `Rng::new(&[seed])`, so every run draws the same samples.
 
 use foton_core::Rgb;
-use foton_core::geometry::Shape;
+use foton_core::bsdf::Bsdf;
+use foton_core::geometry::{Shape, SurfacePoint};
 use foton_core::kernel::{BUILTIN_KERNELS, NormalizedKernel, builtin};
 use foton_core::light::{Light, area_light};
 use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
@@ -613,6 +614,18 @@ fn distribution1d_follows_its_pmf_and_never_draws_zero_weights() {
 // Materials
 // ---------------------------------------------------------------------------------------------
 
+/// The BSDF of `mat` on a flat surface with normal `ng` (no shading normal, no texture).
+fn flat(mat: Material, ng: Vec3) -> Bsdf {
+    let sp = SurfacePoint {
+        p: Vec3::ZERO,
+        ng,
+        ns: ng,
+        uv: glam::Vec2::ZERO,
+        dpdu: Vec3::ZERO,
+    };
+    mat.bsdf(&sp).expect("a material that scatters")
+}
+
 #[test]
 fn diffuse_sampling_matches_its_pdf_on_both_sides() {
     let reflectance = Rgb::new(0.8, 0.5, 0.2);
@@ -628,7 +641,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
         // The whole sphere around ng: samples on the wrong side land in empty cells.
         let grid = SphereGrid::full_sphere(d(ng), 20, 20);
         let mut rng = Rng::new(&[10, k as u64]);
-        let pdf = |w: DVec3| mat.pdf(wo, w.as_vec3(), ng) as f64;
+        let pdf = |w: DVec3| flat(mat, ng).pdf(wo, w.as_vec3()) as f64;
         let integral = check_directions(
             &format!("diffuse, wo on the {side}"),
             &grid,
@@ -641,7 +654,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                 } else {
                     TransportMode::Importance
                 };
-                let s = mat.sample(wo, ng, rng.next_2d(), rng.next_f32(), mode)?;
+                let s = flat(mat, ng).sample(wo, rng.next_2d(), rng.next_f32(), mode)?;
                 assert!(!s.delta);
                 assert_close("|wi|", s.wi.length() as f64, 1.0, 1e-5);
                 assert!(
@@ -649,7 +662,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                     "wi = {} is on the other side from wo = {wo}",
                     s.wi
                 );
-                let pdf = mat.pdf(wo, s.wi, ng);
+                let pdf = flat(mat, ng).pdf(wo, s.wi);
                 assert_close("sample pdf vs pdf()", s.pdf as f64, pdf as f64, 1e-6);
                 assert!(
                     rgb_close(s.weight, reflectance, 1e-6),
@@ -657,7 +670,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                     s.weight
                 );
                 if pdf > 1e-3 {
-                    let fcos = mat.eval(wo, s.wi, ng) * s.wi.dot(ng).abs();
+                    let fcos = flat(mat, ng).eval(wo, s.wi);
                     assert!(
                         rgb_close(fcos / pdf, s.weight, 1e-4),
                         "f cos / pdf = {} but weight = {}",
@@ -757,8 +770,8 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
             } else {
                 TransportMode::Importance
             };
-            let s = mat
-                .sample(wo, ng, rng.next_2d(), rng.next_f32(), mode)
+            let s = flat(mat, ng)
+                .sample(wo, rng.next_2d(), rng.next_f32(), mode)
                 .unwrap_or_else(|| panic!("{name}: no sample"));
             assert!(s.delta, "{name}: not a delta lobe");
             let wi = d(s.wi);
@@ -839,14 +852,8 @@ fn dielectric_totally_reflects_beyond_the_critical_angle() {
         assert!(refract(wo, n, (n_t / n_o) as f32).is_none());
         let mut rng = Rng::new(&[21, k as u64]);
         for _ in 0..10_000 {
-            let s = mat
-                .sample(
-                    wo,
-                    ng,
-                    rng.next_2d(),
-                    rng.next_f32(),
-                    TransportMode::Radiance,
-                )
+            let s = flat(mat, ng)
+                .sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)
                 .unwrap();
             let mirror = 2.0 * d(wo).dot(d(n)) * d(n) - d(wo);
             assert!(
@@ -876,8 +883,8 @@ fn mirror_reflects_exactly() {
         } else {
             TransportMode::Importance
         };
-        let s = mat
-            .sample(wo, ng, rng.next_2d(), rng.next_f32(), mode)
+        let s = flat(mat, ng)
+            .sample(wo, rng.next_2d(), rng.next_f32(), mode)
             .unwrap();
         let (wo64, n64) = (d(wo), d(ng));
         let mirror = 2.0 * wo64.dot(n64) * n64 - wo64;
@@ -888,8 +895,8 @@ fn mirror_reflects_exactly() {
         );
         assert_close("cos in = cos out", d(s.wi).dot(n64), wo64.dot(n64), 1e-5);
         assert!(s.delta && s.pdf == 1.0 && s.weight == reflectance);
-        assert_eq!(mat.eval(wo, s.wi, ng), Rgb::ZERO);
-        assert_eq!(mat.pdf(wo, s.wi, ng), 0.0);
+        assert_eq!(flat(mat, ng).eval(wo, s.wi), Rgb::ZERO);
+        assert_eq!(flat(mat, ng).pdf(wo, s.wi), 0.0);
     }
 }
 
@@ -947,6 +954,16 @@ fn hit(shape: &Shape, x: DVec3, w: DVec3) -> Option<(f64, DVec3, DVec3)> {
             let (t, a, b, n) = plane(d(p0), d(e1), d(e2))?;
             (a >= 0.0 && b >= 0.0 && a + b <= 1.0).then(|| (t, x + w * t, n))
         }
+        Shape::Disk {
+            center,
+            u,
+            v,
+            normal,
+            ..
+        } => {
+            let (t, a, b, _) = plane(d(center), d(u), d(v))?;
+            (a * a + b * b <= 1.0).then(|| (t, x + w * t, d(normal)))
+        }
     }
 }
 
@@ -956,6 +973,7 @@ fn shape_area(shape: &Shape) -> f64 {
         Shape::Sphere { radius, .. } => 4.0 * PI * (radius as f64).powi(2),
         Shape::Quad { u, v, .. } => d(u).cross(d(v)).length(),
         Shape::Triangle { e1, e2, .. } => 0.5 * d(e1).cross(d(e2)).length(),
+        Shape::Disk { u, v, .. } => PI * d(u).cross(d(v)).length(),
     }
 }
 
@@ -986,6 +1004,16 @@ fn on_shape(shape: &Shape, p: DVec3, tol: f64) -> Option<DVec3> {
         Shape::Triangle { p0, e1, e2 } => {
             let (a, b, n) = plane(d(p0), d(e1), d(e2))?;
             (a >= -tol && b >= -tol && a + b <= 1.0 + tol).then_some(n)
+        }
+        Shape::Disk {
+            center,
+            u,
+            v,
+            normal,
+            ..
+        } => {
+            let (a, b, _) = plane(d(center), d(u), d(v))?;
+            (a * a + b * b <= 1.0 + tol).then_some(d(normal))
         }
     }
 }
@@ -1020,6 +1048,10 @@ fn vertices(shape: &Shape) -> Vec<DVec3> {
             vec![o, o + u, o + v, o + u + v]
         }
         Shape::Triangle { p0, e1, e2 } => vec![d(p0), d(p0 + e1), d(p0 + e2)],
+        Shape::Disk { center, u, v, .. } => {
+            let (c, u, v) = (d(center), d(u), d(v));
+            vec![c + u, c - u, c + v, c - v]
+        }
         Shape::Sphere { .. } => unreachable!(),
     }
 }

@@ -3,7 +3,7 @@
 //! Every table is read through a [`Properties`] bag, so every error names file, line, key path
 //! and what was expected, and every key that was never read is reported as unused.
 
-use super::mesh::load_mesh;
+use super::mesh::{MeshOptions, load_mesh};
 use super::volumes::{locate_medium, medium_interfaces};
 use super::{BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene};
 use crate::Rgb;
@@ -11,7 +11,7 @@ use crate::accel::Accel;
 use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::filter::{Filter, FilterSampler};
-use crate::geometry::{Primitive, Shape};
+use crate::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
 use crate::light::{Light, area_light};
 use crate::material::Material;
 use crate::medium::{Homogeneous, Phase};
@@ -41,7 +41,7 @@ const MATERIAL_TYPES: &[&str] = &[
     "thindielectric",
     "null",
 ];
-const SHAPE_TYPES: &[&str] = &["sphere", "quad", "mesh"];
+const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
 const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
@@ -140,6 +140,7 @@ impl Scene {
 
         let mut objects = Vec::new();
         let mut prims = Vec::new();
+        let mut triangle_attrs = Vec::new();
         let mut lights = Vec::new();
         read_shapes(
             &root,
@@ -148,7 +149,7 @@ impl Scene {
             &material_index,
             &medium_index,
             &mut objects,
-            &mut prims,
+            (&mut prims, &mut triangle_attrs),
             &mut lights,
         )?;
         read_point_lights(&root, &mut ld, &mut lights)?;
@@ -249,6 +250,7 @@ impl Scene {
             light_distribution,
             environment,
             accel,
+            triangle_attrs,
             medium,
             interfaces,
             volumes,
@@ -297,6 +299,7 @@ fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings>
         spp,
         seed: t.u64("seed", 0)?,
         max_depth: t.u32("max_depth", 16)?,
+        hide_emitters: t.bool("hide_emitters", false)?,
     };
     ld.done(&t);
     Ok(settings)
@@ -792,7 +795,7 @@ fn read_shapes(
     materials: &Index,
     media: &Index,
     objects: &mut Vec<Object>,
-    prims: &mut Vec<Primitive>,
+    (prims, triangle_attrs): (&mut Vec<Primitive>, &mut Vec<TriangleAttrs>),
     lights: &mut Vec<Light>,
 ) -> Result<()> {
     for s in array_of_tables(root, "shapes")? {
@@ -803,7 +806,9 @@ fn read_shapes(
             )
         })?;
         let mut closed = ty == "sphere";
-        let shapes = match ty {
+        let flip = s.bool("flip_normals", false)?;
+        let mut attrs = Vec::new();
+        let mut shapes = match ty {
             "sphere" => {
                 let center = s.vec3_required("center")?;
                 let radius = s.f32_required("radius")?;
@@ -823,14 +828,45 @@ fn read_shapes(
                 }
                 vec![Shape::quad(origin, u, v)]
             }
+            "disk" => {
+                let center = s.vec3_required("center")?;
+                // Either the two semi-axes (an ellipse; Mitsuba's disk under its to_world, which
+                // also fixes where the angle of its texture coordinates starts) or a circle.
+                let (u, v) = if s.has("u") || s.has("v") {
+                    (s.vec3_required("u")?, s.vec3_required("v")?)
+                } else {
+                    let normal = s.vec3_required("normal")?;
+                    let radius = s.f32_required("radius")?;
+                    if radius <= 0.0 {
+                        return Err(s.error("radius", format!("must be positive, found {radius}")));
+                    }
+                    if normal.length_squared() == 0.0 {
+                        return Err(s.error("normal", "must not be the zero vector"));
+                    }
+                    let f = crate::bsdf::Frame::from_normal(normal.normalize());
+                    (f.s * radius, f.t * radius)
+                };
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(
+                        s.error("v", "u and v are parallel or zero: the disk has zero area")
+                    );
+                }
+                vec![Shape::disk(center, u, v)]
+            }
             "mesh" => {
                 let file = s.string_required("file")?;
                 let transform = read_transform(&s, ld)?;
+                let options = MeshOptions {
+                    face_normals: s.bool("face_normals", false)?,
+                    flip_tex_coords: s.bool("flip_tex_coords", true)?,
+                    flip_normals: flip,
+                };
                 let path = ld.dir.join(file);
-                let (tris, is_closed) = load_mesh(&s, &path, transform)?;
+                let mesh = load_mesh(&s, &path, transform, options)?;
                 ld.sources.push(path);
-                closed = is_closed;
-                tris
+                closed = mesh.closed;
+                attrs = mesh.attrs;
+                mesh.triangles
             }
             other => {
                 return Err(s.error(
@@ -842,6 +878,18 @@ fn read_shapes(
                 ));
             }
         };
+        if flip {
+            match ty {
+                "sphere" => {
+                    return Err(s.error(
+                        "flip_normals",
+                        "a sphere cannot be turned inside out yet (a mesh, quad or disk can)",
+                    ));
+                }
+                "mesh" => {} // the mesh reader reversed its triangles
+                _ => shapes.iter_mut().for_each(Shape::flip),
+            }
+        }
         let material_name = s.string_required("material")?;
         let material = *materials
             .get(material_name)
@@ -882,7 +930,18 @@ fn read_shapes(
             interior,
             closed,
         });
-        prims.extend(shapes.into_iter().map(|shape| Primitive { shape, object }));
+        let first_attrs = triangle_attrs.len() as u32;
+        let with_attrs = !attrs.is_empty();
+        triangle_attrs.extend(attrs);
+        prims.extend(shapes.into_iter().enumerate().map(|(i, shape)| Primitive {
+            shape,
+            object,
+            attrs: if with_attrs {
+                first_attrs + i as u32
+            } else {
+                NO_ATTRS
+            },
+        }));
         ld.done(&s);
     }
     Ok(())

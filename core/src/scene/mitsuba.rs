@@ -49,17 +49,9 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         bsdfs: HashMap::new(),
         media: HashMap::new(),
         anonymous: 0,
-        smooth_meshes: Vec::new(),
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text, true)?;
-    if !r.smooth_meshes.is_empty() {
-        r.report.notes.push(format!(
-            "{}: the meshes of lines {} are shaded with their face normals (Mitsuba interpolates vertex normals unless face_normals = true; foton: not yet)",
-            path.display(),
-            r.smooth_meshes.join(", ")
-        ));
-    }
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
         root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
@@ -247,8 +239,6 @@ struct Reader {
     /// Medium ids to their names in `[media]`.
     media: HashMap<String, String>,
     anonymous: usize,
-    /// Lines of the meshes Mitsuba would shade with smooth normals.
-    smooth_meshes: Vec<String>,
 }
 
 /// Mitsuba's named indices of refraction (its documentation's table).
@@ -711,7 +701,8 @@ impl Reader {
             o.take(ignored);
         }
         if o.boolean("hide_emitters", false)? {
-            self.unsupported(&o, "hide_emitters = true is not supported yet")?;
+            table_mut(&mut self.root, "render")
+                .insert("hide_emitters", at(Value::Bool(true), line));
         }
         self.leftovers(&o)
     }
@@ -733,8 +724,34 @@ impl Reader {
                 "a sensor to_world that mirrors the image is not supported",
             )?;
         }
-        let fov = o.float("fov", 45.0)?;
-        let fov_axis = o.string("fov_axis")?.unwrap_or_else(|| "x".into());
+        let has_fov = o.props.iter().any(|(n, _, _)| n == "fov");
+        let (fov, fov_axis) = if has_fov {
+            if o.props.iter().any(|(n, _, _)| n == "focal_length") {
+                return Err(o.error("give either `fov` or `focal_length`, not both"));
+            }
+            let fov = o.float("fov", 45.0)?;
+            (fov, o.string("fov_axis")?.unwrap_or_else(|| "x".into()))
+        } else {
+            // Mitsuba's default: a focal length on 35 mm film (36 x 24 mm), whose diagonal
+            // field of view is 2 atan(43.27 / 2f).
+            let f = o.string("focal_length")?.unwrap_or_else(|| "50mm".into());
+            let mm: f64 = f
+                .strip_suffix("mm")
+                .unwrap_or(&f)
+                .trim()
+                .parse()
+                .ok()
+                .filter(|x: &f64| *x > 0.0)
+                .ok_or_else(|| {
+                    o.error(format!(
+                        "`focal_length` = {f:?}: expected a positive length in millimetres, such as \"50mm\""
+                    ))
+                })?;
+            let diagonal = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt();
+            let fov = 2.0 * (diagonal / (2.0 * mm)).atan().to_degrees();
+            o.take("fov_axis");
+            (fov, "diagonal".to_string())
+        };
         // A pinhole: the clip planes and focus distance change nothing foton renders.
         for ignored in ["near_clip", "far_clip", "focus_distance"] {
             o.take(ignored);
@@ -1062,9 +1079,7 @@ impl Reader {
                 name
             }
         };
-        if o.boolean("flip_normals", false)? {
-            self.unsupported(&o, "flip_normals is not supported yet")?;
-        }
+        let flip_normals = o.boolean("flip_normals", false)?;
         let mut shapes: Vec<Table> = Vec::new();
         let quad = |origin: DVec3, u: DVec3, v: DVec3| {
             let mut t = Table::default();
@@ -1074,17 +1089,19 @@ impl Reader {
             t.insert("v", vec3(v, line));
             t
         };
-        // A shape's normal is its transformed normal: a mirroring to_world swaps the edges
-        // so that u x v still points that way.
+        // A shape's normal is its transformed normal, M^-T n; u x v = det(M) M^-T (x x y)
+        // points the other way under a mirroring to_world: flipped back (which keeps the
+        // texture coordinates, as swapping the edges would not).
         let mirrored = m.determinant() < 0.0;
+        let flip = mirrored != flip_normals;
         let rectangle = |corner: DVec3, a: DVec3, b: DVec3| {
             let origin = m.transform_point3(corner);
             let (u, v) = (m.transform_vector3(a), m.transform_vector3(b));
-            if mirrored {
-                quad(origin, v, u)
-            } else {
-                quad(origin, u, v)
+            let mut t = quad(origin, u, v);
+            if flip {
+                t.insert("flip_normals", at(Value::Bool(true), line));
             }
+            t
         };
         match o.ty.as_str() {
             "obj" | "ply" => {
@@ -1095,12 +1112,17 @@ impl Reader {
                 let rel = path
                     .strip_prefix(&self.dir)
                     .map_or(path.clone(), Path::to_path_buf);
-                if !o.boolean("face_normals", false)? {
-                    // foton shades with face normals, which face_normals asks for.
-                    self.smooth_meshes.push(format!("{}", o.line));
-                }
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("mesh".into()), line));
+                if o.boolean("face_normals", false)? {
+                    t.insert("face_normals", at(Value::Bool(true), line));
+                }
+                if o.ty == "obj" && !o.boolean("flip_tex_coords", true)? {
+                    t.insert("flip_tex_coords", at(Value::Bool(false), line));
+                }
+                if flip_normals {
+                    t.insert("flip_normals", at(Value::Bool(true), line));
+                }
                 t.insert(
                     "file",
                     at(Value::Str(rel.to_string_lossy().into_owned()), line),
@@ -1113,6 +1135,21 @@ impl Reader {
                         .collect();
                     tr.insert("matrix", at(Value::Array(rows), line));
                     t.insert("transform", at(Value::Table(tr), line));
+                }
+                shapes.push(t);
+            }
+            "sphere" if flip_normals => {
+                o.props.clear();
+                return self.unsupported(&o, "a sphere with flip_normals is not supported yet");
+            }
+            "disk" => {
+                let mut t = Table::default();
+                t.insert("type", at(Value::Str("disk".into()), line));
+                t.insert("center", vec3(m.transform_point3(DVec3::ZERO), line));
+                t.insert("u", vec3(m.transform_vector3(DVec3::X), line));
+                t.insert("v", vec3(m.transform_vector3(DVec3::Y), line));
+                if flip {
+                    t.insert("flip_normals", at(Value::Bool(true), line));
                 }
                 shapes.push(t);
             }

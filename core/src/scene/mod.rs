@@ -15,10 +15,11 @@ use volumes::Volume;
 
 use crate::Rgb;
 use crate::accel::Accel;
+use crate::bsdf::Bsdf;
 use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::film::{DisplayTransform, ToneMap};
-use crate::geometry::{Hit, Primitive, Ray};
+use crate::geometry::{Hit, Primitive, Ray, SurfacePoint, TriangleAttrs};
 use crate::light::Light;
 use crate::material::Material;
 use crate::medium::Medium;
@@ -37,6 +38,9 @@ pub struct RenderSettings {
     pub seed: u64,
     /// Scattering events, pbrt style: 0 = emitters seen directly, 1 = direct lighting.
     pub max_depth: u32,
+    /// Emitters (area lights, the environment) are not seen directly by the camera: camera
+    /// rays pass through them until they first scatter (Mitsuba's `hide_emitters`).
+    pub hide_emitters: bool,
 }
 
 #[derive(Clone, Debug)]
@@ -99,6 +103,8 @@ pub struct Scene {
     /// The environment light (`constant`), seen by rays that leave the scene.
     pub environment: Option<u32>,
     pub accel: Accel,
+    /// Vertex normals and texture coordinates of mesh triangles (`Primitive::attrs`).
+    pub triangle_attrs: Vec<TriangleAttrs>,
     /// The medium filling free space, if any.
     pub medium: Option<u32>,
     /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
@@ -171,6 +177,27 @@ impl Scene {
     #[inline]
     pub fn material(&self, hit: &Hit) -> &Material {
         &self.materials[self.object(hit).material as usize].value
+    }
+
+    /// The surface at a hit: shading normal, texture coordinates, tangent.
+    #[inline]
+    pub fn surface(&self, hit: &Hit) -> SurfacePoint {
+        let prim = self.primitive(hit);
+        let attrs = self.triangle_attrs.get(prim.attrs as usize);
+        let mut sp = prim.shape.surface(hit.p, attrs);
+        // The hit's normal is the one every other query used: keep it exact.
+        sp.ng = hit.ng;
+        sp
+    }
+
+    /// The BSDF at a hit (None on a null boundary, which does not scatter).
+    #[inline]
+    pub fn bsdf(&self, hit: &Hit) -> Option<Bsdf> {
+        let material = self.material(hit);
+        if material.is_null() {
+            return None;
+        }
+        material.bsdf(&self.surface(hit))
     }
 
     /// The area light a hit lies on, if its object emits.

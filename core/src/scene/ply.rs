@@ -6,7 +6,7 @@
 //! same triangles. Errors are plain text; the caller adds the file and the scene key.
 
 use super::mesh::RawMesh;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Scalar {
@@ -251,23 +251,61 @@ fn parse_header(data: &[u8]) -> Result<Header, String> {
 /// Where the mesh's data is among the elements' properties.
 struct Layout {
     vertex: usize,
-    xyz: [usize; 3],
+    /// Per property of the vertex element: which of [`FIELDS`] it holds, if any.
+    slots: Vec<Option<usize>>,
+    has_normals: bool,
+    has_uvs: bool,
     face: usize,
     indices: usize,
+}
+
+/// The vertex fields read: position, normal, texture coordinates (slots 0-2, 3-5, 6-7).
+const FIELDS: usize = 8;
+
+/// The names a vertex property may have for each field, as Mitsuba 3 reads them (texture
+/// coordinates as `u`/`v`, `s`/`t` or `texture_u`/`texture_v`).
+fn field_of(name: &str) -> Option<usize> {
+    Some(match name {
+        "x" => 0,
+        "y" => 1,
+        "z" => 2,
+        "nx" => 3,
+        "ny" => 4,
+        "nz" => 5,
+        "u" | "s" | "texture_u" => 6,
+        "v" | "t" | "texture_v" => 7,
+        _ => return None,
+    })
 }
 
 fn layout(elements: &[Element]) -> Result<Layout, String> {
     let find = |name: &str| elements.iter().position(|e| e.name == name);
     let vertex = find("vertex").ok_or("the PLY file has no `vertex` element")?;
-    let mut xyz = [0; 3];
-    for (slot, axis) in xyz.iter_mut().zip(["x", "y", "z"]) {
-        let props = &elements[vertex].properties;
-        *slot = props.iter().position(|p| p.name == axis).ok_or_else(|| {
-            format!("the `vertex` element has no `{axis}` property (vertices need x, y and z)")
-        })?;
-        if matches!(props[*slot].kind, Kind::List { .. }) {
+    let props = &elements[vertex].properties;
+    let mut slots = vec![None; props.len()];
+    let mut seen = [false; FIELDS];
+    for (p, property) in props.iter().enumerate() {
+        let Some(f) = field_of(&property.name) else {
+            continue;
+        };
+        if matches!(property.kind, Kind::List { .. }) {
+            if f < 3 {
+                return Err(format!(
+                    "the vertex property `{}` is a list; expected a number",
+                    property.name
+                ));
+            }
+            continue;
+        }
+        if !seen[f] {
+            seen[f] = true;
+            slots[p] = Some(f);
+        }
+    }
+    for (f, axis) in ["x", "y", "z"].iter().enumerate() {
+        if !seen[f] {
             return Err(format!(
-                "the vertex property `{axis}` is a list; expected a number"
+                "the `vertex` element has no `{axis}` property (vertices need x, y and z)"
             ));
         }
     }
@@ -288,7 +326,9 @@ fn layout(elements: &[Element]) -> Result<Layout, String> {
     }
     Ok(Layout {
         vertex,
-        xyz,
+        slots,
+        has_normals: seen[3] && seen[4] && seen[5],
+        has_uvs: seen[6] && seen[7],
         face,
         indices,
     })
@@ -297,11 +337,24 @@ fn layout(elements: &[Element]) -> Result<Layout, String> {
 /// Accumulates the positions and fan-triangulated faces as the elements are read.
 struct Builder {
     positions: Vec<Vec3>,
+    normals: Vec<Vec3>,
+    uvs: Vec<Vec2>,
     triangles: Vec<[u32; 3]>,
     polygon: Vec<u32>,
 }
 
 impl Builder {
+    /// A vertex is read: its fields in [`FIELDS`] order.
+    fn vertex(&mut self, layout: &Layout, v: &[f32; FIELDS]) {
+        self.positions.push(Vec3::new(v[0], v[1], v[2]));
+        if layout.has_normals {
+            self.normals.push(Vec3::new(v[3], v[4], v[5]));
+        }
+        if layout.has_uvs {
+            self.uvs.push(Vec2::new(v[6], v[7]));
+        }
+    }
+
     /// Face `face` is done: `polygon` holds its indices.
     fn end_face(&mut self, face: usize) -> Result<(), String> {
         let p = &self.polygon;
@@ -350,6 +403,8 @@ pub fn parse(data: &[u8]) -> Result<RawMesh, String> {
     // exists (a record is at least one byte, or two characters in ascii).
     let mut b = Builder {
         positions: Vec::with_capacity(vertices.min(body.len())),
+        normals: Vec::new(),
+        uvs: Vec::new(),
         triangles: Vec::with_capacity(faces.min(body.len())),
         polygon: Vec::new(),
     };
@@ -357,10 +412,25 @@ pub fn parse(data: &[u8]) -> Result<RawMesh, String> {
         Format::Ascii => parse_ascii(body, &header.elements, &layout, &mut b)?,
         Format::Binary { big } => parse_binary(body, big, &header.elements, &layout, &mut b)?,
     }
+    // Normals and texture coordinates belong to the vertices: indexed as the positions are.
+    let normal_triangles = if b.normals.is_empty() {
+        Vec::new()
+    } else {
+        b.triangles.clone()
+    };
+    let uv_triangles = if b.uvs.is_empty() {
+        Vec::new()
+    } else {
+        b.triangles.clone()
+    };
     Ok(RawMesh {
         positions: b.positions,
         triangles: b.triangles,
         first_index: 0,
+        normals: b.normals,
+        normal_triangles,
+        uvs: b.uvs,
+        uv_triangles,
     })
 }
 
@@ -379,7 +449,7 @@ fn parse_ascii(
     let mut tokens = text.split_ascii_whitespace();
     for (e, element) in elements.iter().enumerate() {
         for record in 0..element.count {
-            let mut xyz = Vec3::ZERO;
+            let mut fields = [0.0f32; FIELDS];
             for (p, property) in element.properties.iter().enumerate() {
                 let mut value = |ty: Scalar| -> Result<f64, String> {
                     let token = tokens.next().ok_or_else(|| truncated(element, record))?;
@@ -394,9 +464,9 @@ fn parse_ascii(
                     Kind::Scalar(ty) => {
                         let v = value(ty)?;
                         if e == layout.vertex
-                            && let Some(axis) = layout.xyz.iter().position(|&i| i == p)
+                            && let Some(f) = layout.slots[p]
                         {
-                            xyz[axis] = v as f32;
+                            fields[f] = v as f32;
                         }
                     }
                     Kind::List { count, item } => {
@@ -421,7 +491,7 @@ fn parse_ascii(
                 }
             }
             if e == layout.vertex {
-                b.positions.push(xyz);
+                b.vertex(layout, &fields);
             }
         }
     }
@@ -450,30 +520,32 @@ fn parse_binary(
             let bytes = &body[pos..pos + size * element.count];
             pos += bytes.len();
             if e == layout.vertex {
-                let mut offsets = [(0, Scalar::F32); 3];
-                for (slot, &p) in offsets.iter_mut().zip(&layout.xyz) {
-                    let offset: usize = element.properties[..p]
-                        .iter()
-                        .map(|q| match q.kind {
-                            Kind::Scalar(t) => t.size(),
-                            Kind::List { .. } => unreachable!("fixed-size records"),
-                        })
-                        .sum();
-                    let Kind::Scalar(ty) = element.properties[p].kind else {
-                        unreachable!("layout() checked that x, y, z are scalars")
+                // (field, byte offset, type) of each property read.
+                let mut wanted = Vec::new();
+                let mut offset = 0;
+                for (p, q) in element.properties.iter().enumerate() {
+                    let Kind::Scalar(ty) = q.kind else {
+                        unreachable!("fixed-size records have no lists")
                     };
-                    *slot = (offset, ty);
+                    if let Some(f) = layout.slots[p] {
+                        wanted.push((f, offset, ty));
+                    }
+                    offset += ty.size();
                 }
-                b.positions.extend(bytes.chunks_exact(size).map(|r| {
-                    let get = |(o, t): (usize, Scalar)| t.read(&r[o..], big) as f32;
-                    Vec3::new(get(offsets[0]), get(offsets[1]), get(offsets[2]))
-                }));
+                b.positions.reserve(element.count);
+                for r in bytes.chunks_exact(size) {
+                    let mut fields = [0.0f32; FIELDS];
+                    for &(f, o, ty) in &wanted {
+                        fields[f] = ty.read(&r[o..], big) as f32;
+                    }
+                    b.vertex(layout, &fields);
+                }
             }
             continue;
         }
         // Records with lists: walk them property by property.
         for record in 0..element.count {
-            let mut xyz = Vec3::ZERO;
+            let mut fields = [0.0f32; FIELDS];
             for (p, property) in element.properties.iter().enumerate() {
                 let mut take = |ty: Scalar| -> Result<f64, String> {
                     let bytes = body
@@ -486,9 +558,9 @@ fn parse_binary(
                     Kind::Scalar(ty) => {
                         let v = take(ty)?;
                         if e == layout.vertex
-                            && let Some(axis) = layout.xyz.iter().position(|&i| i == p)
+                            && let Some(f) = layout.slots[p]
                         {
-                            xyz[axis] = v as f32;
+                            fields[f] = v as f32;
                         }
                     }
                     Kind::List { count, item } => {
@@ -517,7 +589,7 @@ fn parse_binary(
                 }
             }
             if e == layout.vertex {
-                b.positions.push(xyz);
+                b.vertex(layout, &fields);
             }
         }
     }

@@ -174,6 +174,8 @@ fn distance_to(shape: &Shape, p: Vec3) -> f32 {
             .min(segment(origin, v))
             .min(segment(origin + u, v))
             .min(segment(origin + v, u)),
+        // Never closed either; the distance to its plane is a lower bound.
+        Shape::Disk { center, normal, .. } => (p - center).dot(normal).abs(),
     }
 }
 
@@ -207,6 +209,7 @@ fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
             normal,
             ..
         }) => origin + 0.5 * (u + v) - normal * 1e-3,
+        Some(Shape::Disk { center, normal, .. }) => center - normal * 1e-3,
         None => Vec3::ZERO,
     }
 }

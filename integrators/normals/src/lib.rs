@@ -2,8 +2,8 @@
 //!
 //! The minimal example integrator plugin of docs/plugins.md, and a quick look at a scene's
 //! geometry and orientation. Each camera ray is followed to the first surface whose material
-//! is not `null` (null boundaries are crossed); the pixel is the unit geometric normal `n` there
-//! mapped to a colour, `n * 0.5 + 0.5` (x to red, y to green, z to blue), and black when the
+//! is not `null` (null boundaries are crossed); the pixel is the unit shading normal `n` there
+//! (the geometric one, but on smooth meshes, where it is interpolated) mapped to a colour, `n * 0.5 + 0.5` (x to red, y to green, z to blue), and black when the
 //! ray hits nothing. The walk is core's `foton_core::walk::first_surface` (the crossing loop
 //! every integrator shares): past `MAX_NULL_CROSSINGS` null boundaries in a row the ray is
 //! given up, and the pixel is black.
@@ -43,8 +43,9 @@ impl Normals {
         let Some((hit, _)) = first_surface(scene, ray, scene.camera_medium, rays) else {
             return Rgb::ZERO;
         };
-        let mut n = hit.ng;
-        if self.flip_to_camera && n.dot(ray.dir) > 0.0 {
+        // The shading normal (interpolated on smooth meshes), as a renderer's normal pass.
+        let mut n = scene.surface(&hit).ns;
+        if self.flip_to_camera && hit.ng.dot(ray.dir) > 0.0 {
             n = -n;
         }
         n * 0.5 + Rgb::splat(0.5)

@@ -77,7 +77,7 @@ impl PathTracer {
         let mut prev_pdf = 0.0f32;
         let mut prev_p = ray.origin;
         // The ray, the medium it travels in and the null boundaries it crosses.
-        let mut walk = RayWalk::new(ray, scene.camera_medium);
+        let mut walk = RayWalk::camera(scene, ray);
         // Spectral MIS over the whole path, chosen at the first medium the path meets.
         let mut hero: Option<HeroChannel> = None;
 
@@ -127,7 +127,9 @@ impl PathTracer {
 
             let Some(hit) = seg.hit else {
                 // ---- The environment, weighted against light sampling as an emitter ----
-                if let Some((light_id, le)) = scene.escaped(seg.ray.dir) {
+                if let Some((light_id, le)) = scene.escaped(seg.ray.dir)
+                    && !(depth == 0 && scene.render.hide_emitters)
+                {
                     if specular {
                         radiance += beta * le;
                     } else {
@@ -139,8 +141,8 @@ impl PathTracer {
                 }
                 break;
             };
-            let material = match walk.reach(scene, &hit) {
-                Reached::Surface(material) => material,
+            let bsdf = match walk.reach(scene, &hit) {
+                Reached::Surface(bsdf) => bsdf,
                 Reached::Crossed => continue,
                 Reached::Ended => break,
             };
@@ -164,10 +166,10 @@ impl PathTracer {
             }
 
             // ---- Emitter sampling ----
-            if !material.is_delta() {
+            if !bsdf.is_delta() {
                 let at = Scatter::Surface {
                     hit: &hit,
-                    material: &material,
+                    bsdf: &bsdf,
                 };
                 let mis = Mis::WithScatterSampling;
                 radiance += beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
@@ -175,7 +177,7 @@ impl PathTracer {
 
             // ---- BSDF sampling ----
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
                 break;
             };
             beta *= bs.weight;

@@ -14,6 +14,7 @@
 //! | `direct`          | string  | `nee` (shadow rays) or `photons` (first-hit photons)           | `nee`    |
 //! | `final_gather`    | bool    | indirect light by gather rays that look the maps up            | false    |
 //! | `gather_rays`     | integer | gather rays per camera sample, >= 1 (used with `final_gather`) | 32       |
+//! | `glossy_roughness`| float   | glossy lobes smoother than this (microfacet alpha) are followed by sampling, not estimated (see below) | 0.5 |
 //!
 //! `[render] max_depth` bounds the scattering events of a whole light path, as in the path
 //! tracer: a photon's surface hits plus the camera path's delta bounces (each photon records
@@ -62,17 +63,18 @@
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
 
+use foton_core::bsdf::Bsdf;
 use foton_core::direct::Direct;
 use foton_core::film::Film;
 use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::material::{Material, TransportMode};
+use foton_core::material::TransportMode;
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
-use foton_core::walk::{first_surface, trace_to_diffuse};
+use foton_core::walk::{CameraWalk, first_surface, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
 use foton_photonmap::map::Estimate;
 use foton_photonmap::surface::{Budgets, SurfaceMaps, trace_surface_photons};
@@ -87,13 +89,15 @@ pub struct PhotonMapper {
     pub final_gather: bool,
     pub gather_rays: u32,
     pub max_depth: u32,
+    /// How camera paths (and gather rays) treat glossy surfaces.
+    pub camera: CameraWalk,
 }
 
 /// A diffuse point reached by a camera ray: where it is, what it is, where the ray came from.
 #[derive(Clone, Copy)]
 struct Vertex<'a> {
     hit: &'a Hit,
-    material: &'a Material,
+    bsdf: &'a Bsdf,
     wo: Vec3,
     /// Delta bounces of the camera path before this vertex.
     bounces: u32,
@@ -145,7 +149,7 @@ impl PhotonMapper {
     ) -> Rgb {
         let Vertex {
             hit,
-            material,
+            bsdf,
             wo,
             bounces,
         } = *v;
@@ -155,7 +159,7 @@ impl PhotonMapper {
         let mut sum = Rgb::ZERO;
         for _ in 0..self.gather_rays {
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = material.sample(wo, hit.ng, u, uc, TransportMode::Radiance) else {
+            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
                 continue;
             };
             let mut beta = bs.weight;
@@ -164,19 +168,36 @@ impl PhotonMapper {
                 let Some((y, arrived)) = first_surface(scene, ray, None, rays) else {
                     break;
                 };
-                let m = *scene.material(&y);
-                let wo_y = -arrived.ray.dir;
-                if !m.is_delta() {
-                    let depth = budget - b;
-                    sum += beta * maps.reflected_by_all(&self.estimate(), &m, &y, wo_y, depth);
-                    break;
-                }
-                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-                let Some(bs) = m.sample(wo_y, y.ng, u, uc, TransportMode::Radiance) else {
+                let Some(m) = scene.bsdf(&y) else {
                     break;
                 };
-                beta *= bs.weight;
-                ray = Ray::new(offset_origin(y.p, y.ng, bs.wi), bs.wi);
+                let wo_y = -arrived.ray.dir;
+                // A delta part (all of a mirror, the coat of a smooth plastic) is followed;
+                // the rest is the maps' estimate, each weighted by one over its probability.
+                let p_delta = if m.is_delta() {
+                    1.0
+                } else {
+                    m.delta_probability(wo_y)
+                };
+                let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+                let sampled = if p_delta > 0.0 {
+                    m.sample(wo_y, u, uc, TransportMode::Radiance)
+                } else {
+                    None
+                };
+                match sampled {
+                    Some(bs) if bs.delta => {
+                        beta *= bs.weight;
+                        ray = Ray::new(offset_origin(y.p, y.ng, bs.wi), bs.wi);
+                    }
+                    _ if m.is_delta() => break,
+                    _ => {
+                        let depth = budget - b;
+                        let l = maps.reflected_by_all(&self.estimate(), &m, &y, wo_y, depth);
+                        sum += beta * l / (1.0 - p_delta);
+                        break;
+                    }
+                }
             }
         }
         sum / self.gather_rays as f32
@@ -192,7 +213,7 @@ impl PhotonMapper {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let path = trace_to_diffuse(scene, ray, self.max_depth, sampler, rays);
+        let path = trace_to_diffuse(scene, ray, self.camera, sampler, rays);
         let Some(vp) = path.visible else {
             return path.emitted;
         };
@@ -212,7 +233,7 @@ impl PhotonMapper {
         if self.final_gather {
             let vertex = Vertex {
                 hit: &vp.hit,
-                material: &vp.material,
+                bsdf: &vp.bsdf,
                 wo: vp.wo,
                 bounces: vp.bounces,
             };
@@ -249,6 +270,7 @@ impl Integrator for PhotonMapper {
             Parameter::str("direct", self.direct.name()),
             Parameter::bool("final_gather", self.final_gather),
             Parameter::int("gather_rays", self.gather_rays),
+            Parameter::float("glossy_roughness", self.camera.glossy_roughness),
         ]);
         p
     }
@@ -349,6 +371,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         final_gather,
         gather_rays,
         max_depth: scene.render.max_depth,
+        camera: CameraWalk::read(props, scene)?,
     }))
 }
 

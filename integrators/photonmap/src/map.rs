@@ -10,9 +10,9 @@
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
 use foton_core::Rgb;
+use foton_core::bsdf::{Bsdf, Lobe};
 use foton_core::geometry::Hit;
 use foton_core::kernel::NormalizedKernel;
-use foton_core::material::Material;
 use foton_core::medium::Phase;
 use glam::Vec3;
 
@@ -547,15 +547,15 @@ impl PhotonMap {
         )
     }
 
-    /// Radiance reflected towards `wo` by `material` at `hit` (`n`: the normal on the side
+    /// Radiance reflected towards `wo` by `bsdf` at `hit` (`n`: the normal on the side
     /// looked at) from the photons of at most `max_depth` scattering events: the surface
-    /// estimate every photon integrator makes, with the BSDF evaluated per photon. Uses this
-    /// thread's scratch buffer.
+    /// estimate every photon integrator makes, with the BSDF evaluated per photon
+    /// (`Bsdf::eval_density`). Uses this thread's scratch buffer.
     #[allow(clippy::too_many_arguments)]
     pub fn reflected(
         &self,
         estimate: &Estimate<'_>,
-        material: &Material,
+        bsdf: &Bsdf,
         hit: &Hit,
         wo: Vec3,
         n: Vec3,
@@ -565,14 +565,17 @@ impl PhotonMap {
             return Rgb::ZERO;
         }
         with_scratch(|scratch| {
-            if let Material::Diffuse { .. } = material {
-                // A Lambertian BSDF is the same for every photon of the disc (each arrived on
-                // the side looked at): f once, outside the sum, and no direction to decode.
-                let f = material.eval(wo, n, hit.ng);
+            if let Lobe::Diffuse { .. } = bsdf.lobe
+                && bsdf.frame.n == bsdf.ng
+            {
+                // A Lambertian BSDF without a shading normal is the same for every photon of
+                // the disc (each arrived on the side looked at): f once, outside the sum, and
+                // no direction to decode.
+                let f = bsdf.eval_density(wo, n);
                 return f * self.radiance(hit.p, n, max_depth, estimate, scratch, |_| Rgb::ONE);
             }
             self.radiance(hit.p, n, max_depth, estimate, scratch, |wi| {
-                material.eval(wo, wi, hit.ng)
+                bsdf.eval_density(wo, wi)
             })
         })
     }

@@ -11,11 +11,11 @@
 
 use crate::map::{Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
+use foton_core::bsdf::Bsdf;
 use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
 use foton_core::error::{Error, Result};
 use foton_core::geometry::Hit;
 use foton_core::integrator::RenderContext;
-use foton_core::material::Material;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::VisiblePoint;
@@ -131,21 +131,17 @@ impl SurfaceMaps {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
-        let (hit, material, wo, n) = (&vp.hit, &vp.material, vp.wo, vp.n);
+        let (hit, bsdf, wo, n) = (&vp.hit, &vp.bsdf, vp.wo, vp.n);
         let mut l = match (direct, &self.direct) {
-            (Direct::Photons, Some(map)) => map.reflected(estimate, material, hit, wo, n, depth),
+            (Direct::Photons, Some(map)) => map.reflected(estimate, bsdf, hit, wo, n, depth),
             _ => {
-                let at = Scatter::Surface { hit, material };
+                let at = Scatter::Surface { hit, bsdf };
                 estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
             }
         };
-        l += self
-            .caustic
-            .reflected(estimate, material, hit, wo, n, depth);
+        l += self.caustic.reflected(estimate, bsdf, hit, wo, n, depth);
         if indirect {
-            l += self
-                .indirect
-                .reflected(estimate, material, hit, wo, n, depth);
+            l += self.indirect.reflected(estimate, bsdf, hit, wo, n, depth);
         }
         l
     }
@@ -155,7 +151,7 @@ impl SurfaceMaps {
     pub fn reflected_by_all(
         &self,
         estimate: &Estimate<'_>,
-        material: &Material,
+        bsdf: &Bsdf,
         hit: &Hit,
         wo: Vec3,
         depth: u32,
@@ -165,14 +161,10 @@ impl SurfaceMaps {
         } else {
             -hit.ng
         };
-        let mut l = self
-            .caustic
-            .reflected(estimate, material, hit, wo, n, depth)
-            + self
-                .indirect
-                .reflected(estimate, material, hit, wo, n, depth);
+        let mut l = self.caustic.reflected(estimate, bsdf, hit, wo, n, depth)
+            + self.indirect.reflected(estimate, bsdf, hit, wo, n, depth);
         if let Some(direct) = &self.direct {
-            l += direct.reflected(estimate, material, hit, wo, n, depth);
+            l += direct.reflected(estimate, bsdf, hit, wo, n, depth);
         }
         l
     }

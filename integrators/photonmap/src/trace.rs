@@ -173,14 +173,14 @@ pub fn trace_one(
         let Some(hit) = seg.hit else {
             return;
         };
-        let material = match walk.reach(scene, &hit) {
-            Reached::Surface(material) => material,
+        let bsdf = match walk.reach(scene, &hit) {
+            Reached::Surface(bsdf) => bsdf,
             Reached::Crossed => continue,
             Reached::Ended => return,
         };
         hits += 1;
         let wi = -seg.ray.dir;
-        if !material.is_delta() {
+        if !bsdf.is_delta() {
             let n = if hit.ng.dot(wi) > 0.0 {
                 hit.ng
             } else {
@@ -200,7 +200,7 @@ pub fn trace_one(
             return;
         }
         let (u, uc) = (rng.next_2d(), rng.next_f32());
-        let Some(bs) = material.sample(wi, hit.ng, u, uc, TransportMode::Importance) else {
+        let Some(bs) = bsdf.sample(wi, u, uc, TransportMode::Importance) else {
             return;
         };
         // Russian roulette on the scattering weight (the reflectance for a Lambertian

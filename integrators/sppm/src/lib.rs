@@ -89,7 +89,7 @@ use foton_core::props::Properties;
 use foton_core::render::with_pool;
 use foton_core::sampling::{Rng, splitmix64};
 use foton_core::scene::Scene;
-use foton_core::walk::{VisiblePoint, trace_to_diffuse};
+use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
 use foton_photonmap::map::{DISC_THICKNESS, PhotonMap};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
@@ -108,6 +108,8 @@ pub struct Sppm {
     pub kernel: NormalizedKernel,
     pub direct: Direct,
     pub max_depth: u32,
+    /// How camera paths treat glossy surfaces.
+    pub camera: CameraWalk,
     pub schedule: RadiusSchedule,
 }
 
@@ -208,18 +210,13 @@ impl Sppm {
                         let mut sampler = Rng::new(&[seed, STREAM_CAMERA, pixel, iteration]);
                         let film = scene.film.filter.film_position(x, y, sampler.next_2d());
                         let ray = scene.camera.generate_ray(film);
-                        let path = trace_to_diffuse(
-                            scene,
-                            ray,
-                            self.max_depth,
-                            &mut sampler,
-                            &mut row_rays,
-                        );
+                        let path =
+                            trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
                         let mut ld = path.emitted;
                         if let (Some(vp), Direct::ShadowRays) = (&path.visible, self.direct) {
                             let at = Scatter::Surface {
                                 hit: &vp.hit,
-                                material: &vp.material,
+                                bsdf: &vp.bsdf,
                             };
                             ld += vp.beta
                                 * estimate_direct(
@@ -421,7 +418,7 @@ impl Integrator for Sppm {
                                 return; // too long, another surface, or its other side
                             }
                             let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;
-                            let f = vp.material.eval(vp.wo, photon.wi(), vp.hit.ng);
+                            let f = vp.bsdf.eval_density(vp.wo, photon.wi());
                             m += w as f64;
                             phi += (f * photon.power() * w).as_dvec3();
                         });
@@ -508,6 +505,10 @@ impl Integrator for Sppm {
                 RadiusSchedule::Global => "global",
             },
         ));
+        p.push(Parameter::float(
+            "glossy_roughness",
+            self.camera.glossy_roughness,
+        ));
         p
     }
 
@@ -592,6 +593,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         kernel,
         direct,
         max_depth: scene.render.max_depth,
+        camera: CameraWalk::read(props, scene)?,
         schedule,
     }))
 }

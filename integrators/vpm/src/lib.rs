@@ -86,7 +86,7 @@ use foton_core::props::Properties;
 use foton_core::render::{render_pixels, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
-use foton_core::walk::{Segment, walk_to_diffuse};
+use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
 use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
@@ -114,6 +114,8 @@ pub struct Vpm {
     pub direct: Direct,
     pub estimate: VolumeEstimate,
     pub max_depth: u32,
+    /// How camera paths treat glossy surfaces.
+    pub camera: CameraWalk,
 }
 
 pub struct Maps {
@@ -370,7 +372,7 @@ impl Vpm {
         let path = walk_to_diffuse(
             scene,
             ray,
-            self.max_depth,
+            self.camera,
             sampler,
             rays,
             |seg: &Segment, m: &dyn Medium, bounces: u32, sampler: &mut Sampler, rays: &mut u64| {
@@ -432,6 +434,7 @@ impl Integrator for Vpm {
                     VolumeEstimate::Beam => "beam",
                 },
             ),
+            Parameter::float("glossy_roughness", self.camera.glossy_roughness),
         ]);
         p
     }
@@ -524,6 +527,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         direct,
         estimate,
         max_depth: scene.render.max_depth,
+        camera: CameraWalk::read(props, scene)?,
     }))
 }
 

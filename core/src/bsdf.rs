@@ -1,0 +1,397 @@
+//! The BSDF at a surface point (pbrt-v4's `BSDF`): a material's lobe with its textures looked
+//! up there, in the local shading frame (z the shading normal, x along dp/du), with the
+//! geometric normal kept for the corrections shading normals need.
+//!
+//! Conventions (Mitsuba 3's): both directions point away from the surface, `wo` towards the
+//! viewer (or where a photon came from), `wi` the other one; `eval` is f(wo, wi) |cos theta_i|
+//! with theta_i measured from the shading normal; one-sided lobes are black when either
+//! direction lies below the shading frame.
+//!
+//! **Shading normals and photons.** Radiance and flux obey different scattering equations
+//! once the shading normal differs from the geometric one (Veach 1997, section 5.3): a photon
+//! (importance mode) scattered from `wo` to `wi` is weighted by f |wo.ns| |wi.ng| / |wo.ng|
+//! instead of f |wi.ns|, and a photon arriving along `wi` with flux Phi gives a density
+//! estimate f |wi.ns| / |wi.ng| Phi / A ([`Bsdf::eval_density`]). Both reduce to the usual
+//! forms where ns = ng.
+
+use crate::Rgb;
+use crate::material::{TransportMode, fresnel_conductor, fresnel_dielectric};
+use crate::sampling::{basis, cosine_hemisphere};
+use glam::{Vec2, Vec3};
+use std::f32::consts::FRAC_1_PI;
+
+/// An orthonormal frame: `n` the normal, `s` and `t` the tangents.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frame {
+    pub s: Vec3,
+    pub t: Vec3,
+    pub n: Vec3,
+}
+
+impl Frame {
+    /// Any frame around `n` (unit).
+    #[inline]
+    pub fn from_normal(n: Vec3) -> Frame {
+        let (s, t) = basis(n);
+        Frame { s, t, n }
+    }
+
+    /// The frame around `n` whose `s` is `dpdu` made orthogonal to `n` (Gram-Schmidt, as
+    /// Mitsuba orients its shading frame); any frame if `dpdu` is (nearly) along `n`.
+    #[inline]
+    pub fn from_normal_tangent(n: Vec3, dpdu: Vec3) -> Frame {
+        let s = dpdu - n * n.dot(dpdu);
+        let len2 = s.length_squared();
+        // A tangent within about 0.06 degrees of the normal orients nothing reliably.
+        if len2 <= 1e-6 * dpdu.length_squared() || len2.is_nan() {
+            return Frame::from_normal(n);
+        }
+        let s = s / len2.sqrt();
+        // Once more: the first subtraction loses digits when dpdu is nearly along n.
+        let s = (s - n * n.dot(s)).normalize();
+        Frame {
+            s,
+            t: n.cross(s),
+            n,
+        }
+    }
+
+    #[inline]
+    pub fn to_local(&self, v: Vec3) -> Vec3 {
+        Vec3::new(v.dot(self.s), v.dot(self.t), v.dot(self.n))
+    }
+
+    #[inline]
+    pub fn to_world(&self, v: Vec3) -> Vec3 {
+        self.s * v.x + self.t * v.y + self.n * v.z
+    }
+}
+
+/// A sampled direction of a BSDF (world space).
+#[derive(Clone, Copy, Debug)]
+pub struct BsdfSample {
+    pub wi: Vec3,
+    /// f |cos theta_i| / pdf (importance mode: with the shading-normal correction): what the
+    /// path throughput is multiplied by.
+    pub weight: Rgb,
+    /// Solid-angle pdf; for a delta lobe the probability of having chosen it.
+    pub pdf: f32,
+    pub delta: bool,
+}
+
+/// A sampled direction in the local frame.
+#[derive(Clone, Copy, Debug)]
+pub struct LocalSample {
+    pub wi: Vec3,
+    pub weight: Rgb,
+    pub pdf: f32,
+    pub delta: bool,
+}
+
+/// A material's scattering at one point, its textures resolved (see [`crate::material`] for
+/// the meaning of each).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Lobe {
+    Diffuse {
+        reflectance: Rgb,
+        twosided: bool,
+    },
+    Mirror {
+        reflectance: Rgb,
+    },
+    Conductor {
+        eta: Rgb,
+        k: Rgb,
+        specular_reflectance: Rgb,
+    },
+    Dielectric {
+        ior: f32,
+    },
+    ThinDielectric {
+        ior: f32,
+    },
+}
+
+#[inline]
+fn reflect_local(w: Vec3) -> Vec3 {
+    Vec3::new(-w.x, -w.y, w.z)
+}
+
+impl Lobe {
+    /// True when the lobe is a sum of Dirac deltas (mirror, smooth glass): it cannot be
+    /// evaluated for a given pair of directions, only sampled.
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        !matches!(self, Lobe::Diffuse { .. })
+    }
+
+    /// f(wo, wi) |cos theta_i| (zero for delta lobes).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        match *self {
+            Lobe::Diffuse {
+                reflectance,
+                twosided,
+            } => {
+                if wo.z * wi.z > 0.0 && (twosided || wo.z > 0.0) {
+                    reflectance * (FRAC_1_PI * wi.z.abs())
+                } else {
+                    Rgb::ZERO
+                }
+            }
+            _ => Rgb::ZERO,
+        }
+    }
+
+    /// Solid-angle pdf with which `sample` produces wi (zero for delta lobes).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match *self {
+            Lobe::Diffuse { twosided, .. } if wo.z * wi.z > 0.0 && (twosided || wo.z > 0.0) => {
+                wi.z.abs() * FRAC_1_PI
+            }
+            _ => 0.0,
+        }
+    }
+
+    /// Samples wi for `wo`: `u` within a lobe, `uc` between lobes (reflection or refraction).
+    #[inline]
+    pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
+        let cos_o = wo.z;
+        if cos_o == 0.0 {
+            return None;
+        }
+        let delta = |wi: Vec3, weight: Rgb, pdf: f32| {
+            Some(LocalSample {
+                wi,
+                weight,
+                pdf,
+                delta: true,
+            })
+        };
+        match *self {
+            Lobe::Diffuse {
+                reflectance,
+                twosided,
+            } => {
+                if !twosided && cos_o < 0.0 {
+                    return None;
+                }
+                let mut wi = cosine_hemisphere(u);
+                if wi.z <= 0.0 {
+                    return None;
+                }
+                let pdf = wi.z * FRAC_1_PI;
+                if cos_o < 0.0 {
+                    wi.z = -wi.z;
+                }
+                Some(LocalSample {
+                    wi,
+                    weight: reflectance,
+                    pdf,
+                    delta: false,
+                })
+            }
+            Lobe::Mirror { reflectance } => delta(reflect_local(wo), reflectance, 1.0),
+            Lobe::Conductor {
+                eta,
+                k,
+                specular_reflectance,
+            } => {
+                let c = cos_o.abs();
+                let f = Rgb::new(
+                    fresnel_conductor(c, eta.x, k.x),
+                    fresnel_conductor(c, eta.y, k.y),
+                    fresnel_conductor(c, eta.z, k.z),
+                );
+                delta(reflect_local(wo), specular_reflectance * f, 1.0)
+            }
+            Lobe::Dielectric { ior } => {
+                let eta = if cos_o > 0.0 { ior } else { 1.0 / ior };
+                let f = fresnel_dielectric(cos_o.abs(), eta);
+                if uc < f {
+                    return delta(reflect_local(wo), Rgb::ONE, f);
+                }
+                let n = if cos_o > 0.0 { Vec3::Z } else { Vec3::NEG_Z };
+                let wi = crate::material::refract(wo, n, eta)?;
+                let scale = match mode {
+                    TransportMode::Radiance => 1.0 / (eta * eta),
+                    TransportMode::Importance => 1.0,
+                };
+                delta(wi, Rgb::splat(scale), 1.0 - f)
+            }
+            Lobe::ThinDielectric { ior } => {
+                // Air-glass-air: the same reflectance from either side; the infinite series of
+                // reflections inside the sheet sums to R' = R + T^2 R / (1 - R^2) = 2R / (1 + R).
+                let r = fresnel_dielectric(cos_o.abs(), ior);
+                let r = 2.0 * r / (1.0 + r);
+                if uc < r {
+                    return delta(reflect_local(wo), Rgb::ONE, r);
+                }
+                // Straight through: the two refractions undo each other (no 1/eta^2 either).
+                delta(-wo, Rgb::ONE, 1.0 - r)
+            }
+        }
+    }
+
+    /// How rough the lobe's non-delta part is: 0 for delta lobes, infinite for diffuse ones
+    /// (a microfacet lobe gives its alpha). Camera paths of the photon integrators continue
+    /// through lobes below their `glossy_roughness` by sampling.
+    #[inline]
+    pub fn roughness(&self) -> f32 {
+        match self {
+            Lobe::Diffuse { .. } => f32::INFINITY,
+            _ => 0.0,
+        }
+    }
+
+    /// The probability that `sample` picks a delta part for `wo`, for lobes that mix a delta
+    /// part with a non-delta one (0 for the others).
+    #[inline]
+    pub fn delta_probability(&self, _wo: Vec3) -> f32 {
+        0.0
+    }
+}
+
+/// The BSDF at a surface point.
+#[derive(Clone, Copy, Debug)]
+pub struct Bsdf {
+    pub lobe: Lobe,
+    /// The shading frame (its `n` is the shading normal).
+    pub frame: Frame,
+    /// The unit geometric normal (the primitive's orientation).
+    pub ng: Vec3,
+}
+
+impl Bsdf {
+    /// True when every part is a delta (mirror, smooth glass): photons are never stored there.
+    #[inline]
+    pub fn is_delta(&self) -> bool {
+        self.lobe.is_delta()
+    }
+
+    /// f(wo, wi) |cos theta_i| (radiance: the cosine from the shading normal).
+    #[inline]
+    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        self.lobe
+            .eval(self.frame.to_local(wo), self.frame.to_local(wi))
+    }
+
+    /// What a photon arriving along `wi` with unit flux gives the radiance towards `wo`, per
+    /// unit area: f(wo, wi) |wi.ns| / |wi.ng| (f alone without shading normals).
+    #[inline]
+    pub fn eval_density(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let cos_g = wi.dot(self.ng).abs();
+        if cos_g == 0.0 {
+            return Rgb::ZERO;
+        }
+        self.eval(wo, wi) / cos_g
+    }
+
+    /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        self.lobe
+            .pdf(self.frame.to_local(wo), self.frame.to_local(wi))
+    }
+
+    /// Samples `wi` for `wo` (see [`Lobe::sample`]); in importance mode the weight carries the
+    /// shading-normal correction (module comment).
+    #[inline]
+    pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<BsdfSample> {
+        let s = self.lobe.sample(self.frame.to_local(wo), u, uc, mode)?;
+        let wi = self.frame.to_world(s.wi);
+        let mut weight = s.weight;
+        if mode == TransportMode::Importance && self.frame.n != self.ng {
+            let (cos_o_g, cos_i_s) = (wo.dot(self.ng).abs(), s.wi.z.abs());
+            if cos_o_g == 0.0 || cos_i_s == 0.0 {
+                return None;
+            }
+            weight *= (wo.dot(self.frame.n).abs() * wi.dot(self.ng).abs()) / (cos_o_g * cos_i_s);
+        }
+        Some(BsdfSample {
+            wi,
+            weight,
+            pdf: s.pdf,
+            delta: s.delta,
+        })
+    }
+
+    /// See [`Lobe::roughness`].
+    #[inline]
+    pub fn roughness(&self) -> f32 {
+        self.lobe.roughness()
+    }
+
+    /// See [`Lobe::delta_probability`].
+    #[inline]
+    pub fn delta_probability(&self, wo: Vec3) -> f32 {
+        self.lobe.delta_probability(self.frame.to_local(wo))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn frames_are_orthonormal_and_invert() {
+        let n = Vec3::new(0.3, -0.5, 0.8).normalize();
+        for f in [
+            Frame::from_normal(n),
+            Frame::from_normal_tangent(n, Vec3::new(1.0, 2.0, 0.5)),
+            Frame::from_normal_tangent(n, n * 3.0),
+        ] {
+            assert!((f.s.dot(f.t)).abs() < 1e-6 && (f.s.dot(f.n)).abs() < 1e-6);
+            assert!((f.s.length() - 1.0).abs() < 1e-6 && (f.t.length() - 1.0).abs() < 1e-6);
+            // Right-handed: s x t = n.
+            assert!((f.s.cross(f.t) - f.n).length() < 1e-5);
+            let v = Vec3::new(0.2, 0.7, -0.4);
+            assert!((f.to_world(f.to_local(v)) - v).length() < 1e-6);
+        }
+        let f = Frame::from_normal_tangent(Vec3::Z, Vec3::new(2.0, 0.0, 1.0));
+        assert!((f.s - Vec3::X).length() < 1e-6);
+    }
+
+    #[test]
+    fn shading_correction_only_where_normals_differ() {
+        let lobe = Lobe::Diffuse {
+            reflectance: Rgb::splat(0.5),
+            twosided: true,
+        };
+        let ng = Vec3::Z;
+        let flat = Bsdf {
+            lobe,
+            frame: Frame::from_normal(ng),
+            ng,
+        };
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let (u, uc) = (Vec2::new(0.3, 0.7), 0.5);
+        let a = flat.sample(wo, u, uc, TransportMode::Radiance).unwrap();
+        let b = flat.sample(wo, u, uc, TransportMode::Importance).unwrap();
+        assert_eq!(a.weight, b.weight);
+        // A tilted shading normal: radiance weight f |wi.ns| / pdf = rho; importance weight
+        // rho |wo.ns| |wi.ng| / (|wo.ng| |wi.ns|).
+        let ns = Vec3::new(0.2, 0.0, 1.0).normalize();
+        let tilted = Bsdf {
+            lobe,
+            frame: Frame::from_normal(ns),
+            ng,
+        };
+        let r = tilted.sample(wo, u, uc, TransportMode::Radiance).unwrap();
+        let i = tilted.sample(wo, u, uc, TransportMode::Importance).unwrap();
+        assert!((r.weight - Rgb::splat(0.5)).length() < 1e-6);
+        let expected =
+            0.5 * wo.dot(ns).abs() * i.wi.dot(ng).abs() / (wo.dot(ng).abs() * i.wi.dot(ns).abs());
+        assert!(
+            (i.weight.x - expected).abs() < 1e-5,
+            "{} {expected}",
+            i.weight.x
+        );
+        // The density estimate's factor.
+        let wi = Vec3::new(-0.3, 0.1, 0.9).normalize();
+        let d = tilted.eval_density(wo, wi);
+        let want = 0.5 * FRAC_1_PI * wi.dot(ns) / wi.dot(ng);
+        assert!((d.x - want).abs() < 1e-6);
+    }
+}
