@@ -21,6 +21,7 @@ pub mod kernel;
 pub mod light;
 pub mod material;
 pub mod medium;
+pub mod microfacet;
 pub mod plugin;
 pub mod props;
 pub mod render;
