@@ -16,6 +16,7 @@ pub mod error;
 pub mod film;
 pub mod filter;
 pub mod geometry;
+pub mod glossy;
 pub mod integrator;
 pub mod kernel;
 pub mod light;
