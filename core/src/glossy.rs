@@ -18,6 +18,7 @@ use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::sampling::cosine_hemisphere;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
+use std::sync::Mutex;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalSample {
@@ -34,6 +35,12 @@ pub struct LocalSample {
 #[inline]
 fn positive(x: f32) -> bool {
     x > 0.0 && x.is_finite()
+}
+
+/// True for a finite direction strictly above the surface (one-sided lobes).
+#[inline]
+fn above(v: Vec3) -> bool {
+    v.z > 0.0 && v.is_finite()
 }
 
 /// Mirror reflection of `v` about the microfacet normal `m`.
@@ -122,7 +129,7 @@ impl RoughConductor {
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return Rgb::ZERO;
         }
         let h = (wo + wi).normalize_or_zero();
@@ -136,7 +143,7 @@ impl RoughConductor {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize_or_zero();
-        if wo.z <= 0.0 || wi.z <= 0.0 || wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
+        if !above(wo) || !above(wi) || wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
             return 0.0;
         }
         // D_wo(h) / (4 wi.h), with wo.h = wi.h.
@@ -144,7 +151,7 @@ impl RoughConductor {
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, _uc: f32, _mode: TransportMode) -> Option<LocalSample> {
-        if wo.z <= 0.0 {
+        if !above(wo) {
             return None;
         }
         let (m, pdf_m) = self.distribution.sample(wo, u);
@@ -201,7 +208,7 @@ impl RoughDielectric {
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
         let (cos_o, cos_i) = (wo.z, wi.z);
-        if cos_o == 0.0 || !positive(self.eta) {
+        if cos_o == 0.0 || !wo.is_finite() || !wi.is_finite() || !positive(self.eta) {
             return Rgb::ZERO;
         }
         let reflect = cos_o * cos_i > 0.0;
@@ -238,7 +245,7 @@ impl RoughDielectric {
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (cos_o, cos_i) = (wo.z, wi.z);
-        if cos_o == 0.0 || !positive(self.eta) {
+        if cos_o == 0.0 || !wo.is_finite() || !wi.is_finite() || !positive(self.eta) {
             return 0.0;
         }
         let reflect = cos_o * cos_i > 0.0;
@@ -268,7 +275,7 @@ impl RoughDielectric {
 
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
         let cos_o = wo.z;
-        if cos_o == 0.0 || !positive(self.eta) {
+        if cos_o == 0.0 || !wo.is_finite() || !positive(self.eta) {
             return None;
         }
         let md = &self.distribution;
@@ -367,7 +374,7 @@ impl Plastic {
 
     /// The diffuse part only (the delta coat is not a function).
     pub fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return Rgb::ZERO;
         }
         let f_o = fresnel_dielectric(wo.z, self.eta);
@@ -376,7 +383,7 @@ impl Plastic {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return 0.0;
         }
         let f_o = fresnel_dielectric(wo.z, self.eta);
@@ -384,7 +391,7 @@ impl Plastic {
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, _mode: TransportMode) -> Option<LocalSample> {
-        if wo.z <= 0.0 {
+        if !above(wo) {
             return None;
         }
         let f_o = fresnel_dielectric(wo.z, self.eta);
@@ -429,11 +436,7 @@ pub const ROUGH_TRANSMITTANCE_RES: usize = 64;
 /// internal diffuse reflectance. Isotropic only, as in Mitsuba (which rejects anisotropic
 /// roughness); Beckmann or GGX. One-sided.
 ///
-/// Built by [`RoughPlastic::new`], which integrates the coat's transmittance and internal
-/// reflectance once, exactly as Mitsuba does: T at 64 cosines in [1e-6, 1] (linearly spaced)
-/// by a 32 x 32 Gauss-Legendre rule over the visible-normal sample space, E[G1(wt, m) (1 - F)];
-/// R_int as 2 x the mean over the same cosines of cos E[G1(wr, m) F] with eta inverted, by a
-/// 128 x 128 rule.
+/// Built by [`RoughPlastic::new`], which gets the coat's tables from [`Coat::get`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RoughPlastic {
     pub distribution: Microfacet,
@@ -441,22 +444,45 @@ pub struct RoughPlastic {
     pub diffuse_reflectance: Rgb,
     pub specular_reflectance: Rgb,
     pub nonlinear: bool,
-    external_transmittance: [f32; ROUGH_TRANSMITTANCE_RES],
-    internal_reflectance: f32,
+    coat: &'static Coat,
 }
 
-impl RoughPlastic {
+/// What the rough plastic's diffuse part needs to know of its rough dielectric coat,
+/// integrated once as Mitsuba does: T at 64 cosines in [1e-6, 1] (linearly spaced) by a
+/// 32 x 32 Gauss-Legendre rule over the visible-normal sample space, E[G1(wt, m) (1 - F)];
+/// R_int as 2 x the mean over the same cosines of cos E[G1(wr, m) F] with eta inverted, by a
+/// 128 x 128 rule (Mitsuba's rule sizes: 32 when the relative index exceeds 1, else 128).
+#[derive(Debug, PartialEq)]
+pub struct Coat {
+    pub external_transmittance: [f32; ROUGH_TRANSMITTANCE_RES],
+    pub internal_reflectance: f32,
+}
+
+impl Coat {
+    /// The coat of a distribution and relative index. Coats are interned for the life of the
+    /// program: the lobe stays a small `Copy` value, and identical coats (most materials of a
+    /// scene share a few) are integrated once (about 0.1 s for GGX, 0.03 s for Beckmann).
     /// `eta` must be positive and differ from 1 (Mitsuba rejects equal indices); otherwise the
-    /// coat is treated as absent (T = 1, R_int = 0).
-    pub fn new(
-        kind: MicrofacetKind,
-        alpha: f32,
-        eta: f32,
-        diffuse_reflectance: Rgb,
-        specular_reflectance: Rgb,
-        nonlinear: bool,
-    ) -> Self {
-        let distribution = Microfacet::isotropic(kind, alpha);
+    /// coat is taken as absent (T = 1, R_int = 0).
+    pub fn get(distribution: Microfacet, eta: f32) -> &'static Coat {
+        type Key = (MicrofacetKind, u32, u32, u32);
+        static COATS: Mutex<Vec<(Key, &'static Coat)>> = Mutex::new(Vec::new());
+        let key = (
+            distribution.kind,
+            distribution.alpha_u.to_bits(),
+            distribution.alpha_v.to_bits(),
+            eta.to_bits(),
+        );
+        let mut coats = COATS.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some((_, coat)) = coats.iter().find(|(k, _)| *k == key) {
+            return coat;
+        }
+        let coat: &'static Coat = Box::leak(Box::new(Coat::integrate(&distribution, eta)));
+        coats.push((key, coat));
+        coat
+    }
+
+    fn integrate(distribution: &Microfacet, eta: f32) -> Coat {
         let mut external_transmittance = [1.0; ROUGH_TRANSMITTANCE_RES];
         let mut internal_reflectance = 0.0;
         if eta > 0.0 && eta != 1.0 && eta.is_finite() {
@@ -467,19 +493,35 @@ impl RoughPlastic {
             let mut sum_r = 0.0f64;
             for (t, mu) in external_transmittance.iter_mut().zip(cosines) {
                 let w = Vec3::new((1.0 - mu * mu).sqrt(), 0.0, mu);
-                *t = coat_transmittance(&distribution, w, eta, &rule_t) as f32;
-                sum_r += coat_reflectance(&distribution, w, 1.0 / eta, &rule_r) * mu as f64;
+                *t = coat_transmittance(distribution, w, eta, &rule_t) as f32;
+                sum_r += coat_reflectance(distribution, w, 1.0 / eta, &rule_r) * mu as f64;
             }
             internal_reflectance = (2.0 * sum_r / ROUGH_TRANSMITTANCE_RES as f64) as f32;
         }
+        Coat {
+            external_transmittance,
+            internal_reflectance,
+        }
+    }
+}
+
+impl RoughPlastic {
+    pub fn new(
+        kind: MicrofacetKind,
+        alpha: f32,
+        eta: f32,
+        diffuse_reflectance: Rgb,
+        specular_reflectance: Rgb,
+        nonlinear: bool,
+    ) -> Self {
+        let distribution = Microfacet::isotropic(kind, alpha);
         RoughPlastic {
             distribution,
             eta,
             diffuse_reflectance,
             specular_reflectance,
             nonlinear,
-            external_transmittance,
-            internal_reflectance,
+            coat: Coat::get(distribution, eta),
         }
     }
 
@@ -491,16 +533,14 @@ impl RoughPlastic {
     pub fn external_transmittance(&self, cos: f32) -> f32 {
         let x = cos.clamp(0.0, 1.0) * (ROUGH_TRANSMITTANCE_RES - 1) as f32;
         let i = (x as usize).min(ROUGH_TRANSMITTANCE_RES - 2);
-        let (t0, t1) = (
-            self.external_transmittance[i],
-            self.external_transmittance[i + 1],
-        );
+        let table = &self.coat.external_transmittance;
+        let (t0, t1) = (table[i], table[i + 1]);
         t0 + (t1 - t0) * (x - i as f32)
     }
 
     /// The coat's diffuse reflectance seen from inside, R_int.
     pub fn internal_reflectance(&self) -> f32 {
-        self.internal_reflectance
+        self.coat.internal_reflectance
     }
 
     fn prob_specular(&self, t_o: f32) -> f32 {
@@ -509,7 +549,7 @@ impl RoughPlastic {
     }
 
     pub fn eval(&self, wo: Vec3, wi: Vec3, _mode: TransportMode) -> Rgb {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return Rgb::ZERO;
         }
         let md = &self.distribution;
@@ -519,9 +559,9 @@ impl RoughPlastic {
 
         let rho = self.diffuse_reflectance;
         let internal = if self.nonlinear {
-            rho * self.internal_reflectance
+            rho * self.coat.internal_reflectance
         } else {
-            Rgb::splat(self.internal_reflectance)
+            Rgb::splat(self.coat.internal_reflectance)
         };
         let t_o = self.external_transmittance(wo.z);
         let t_i = self.external_transmittance(wi.z);
@@ -531,7 +571,7 @@ impl RoughPlastic {
     }
 
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if wo.z <= 0.0 || wi.z <= 0.0 {
+        if !above(wo) || !above(wi) {
             return 0.0;
         }
         let p_spec = self.prob_specular(self.external_transmittance(wo.z));
@@ -546,7 +586,7 @@ impl RoughPlastic {
     }
 
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
-        if wo.z <= 0.0 {
+        if !above(wo) {
             return None;
         }
         let p_spec = self.prob_specular(self.external_transmittance(wo.z));
@@ -607,21 +647,15 @@ fn gauss_legendre_unit(n: usize) -> Vec<(f32, f64)> {
 /// `eta` and not masked on the way out: E over visible normals of F G1(reflected, m)
 /// (Mitsuba's `eval_reflectance`).
 fn coat_reflectance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> f64 {
+    let nodes: Vec<f32> = rule.iter().map(|r| r.0).collect();
     let mut sum = 0.0;
-    for &(x, wx) in rule {
-        for &(y, wy) in rule {
-            let (m, pdf) = md.sample(w, Vec2::new(x, y));
-            if pdf <= 0.0 {
-                continue;
-            }
-            let r = reflect(w, m);
-            if r.z <= 0.0 {
-                continue;
-            }
+    md.for_each_normal_on_grid(w, &nodes, |i, j, m| {
+        let r = reflect(w, m);
+        if r.z > 0.0 {
             let (f, ..) = fresnel(w.dot(m), eta);
-            sum += wx * wy * (f * md.smith_g1(r, m)) as f64;
+            sum += rule[i].1 * rule[j].1 * (f * md.smith_g1(r, m)) as f64;
         }
-    }
+    });
     sum
 }
 
@@ -629,20 +663,611 @@ fn coat_reflectance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> 
 /// index `eta` and not masked on the other side: E over visible normals of (1 - F)
 /// G1(refracted, m) (Mitsuba's `eval_transmittance`).
 fn coat_transmittance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> f64 {
+    let nodes: Vec<f32> = rule.iter().map(|r| r.0).collect();
     let mut sum = 0.0;
-    for &(x, wx) in rule {
-        for &(y, wy) in rule {
-            let (m, pdf) = md.sample(w, Vec2::new(x, y));
-            if pdf <= 0.0 {
-                continue;
+    md.for_each_normal_on_grid(w, &nodes, |i, j, m| {
+        let (f, cos_t, _, eta_ti) = fresnel(w.dot(m), eta);
+        let t = refract(w, m, cos_t, eta_ti);
+        if t.z * w.z < 0.0 {
+            sum += rule[i].1 * rule[j].1 * ((1.0 - f) * md.smith_g1(t, m)) as f64;
+        }
+    });
+    sum
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::microfacet::chi2::{self, Outcome};
+    use crate::sampling::{Rng, uniform_sphere};
+    use std::f64::consts::PI;
+
+    const BECKMANN: MicrofacetKind = MicrofacetKind::Beckmann;
+    const GGX: MicrofacetKind = MicrofacetKind::Ggx;
+
+    /// Distributions of the sampling tests: narrow, anisotropic both ways, wide.
+    const DISTRIBUTIONS: [(MicrofacetKind, f32, f32); 4] = [
+        (BECKMANN, 0.1, 0.1),
+        (BECKMANN, 0.15, 0.6),
+        (GGX, 0.4, 0.4),
+        (GGX, 0.6, 0.15),
+    ];
+    /// Viewing directions above the surface: normal, oblique (off-axis in phi), grazing.
+    fn views() -> [Vec3; 3] {
+        [
+            Vec3::new(0.0, 0.0, 1.0),
+            Vec3::new(0.5, -0.4, 0.75).normalize(),
+            Vec3::new(-0.7, 0.7, 0.08).normalize(),
+        ]
+    }
+    /// Viewing directions of the dielectric from inside: oblique, and beyond the critical
+    /// angle (total internal reflection on most microfacets).
+    fn inside_views() -> [Vec3; 2] {
+        [
+            Vec3::new(0.3, 0.2, -0.9).normalize(),
+            Vec3::new(0.2, -0.85, -0.5).normalize(),
+        ]
+    }
+    const ROUGH_PLASTICS: [(MicrofacetKind, f32); 2] = [(BECKMANN, 0.1), (GGX, 0.4)];
+    const PLASTICS: [(f32, bool); 2] = [(1.5, false), (1.9, true)];
+
+    /// All chi-square tests of this module, for the Sidak correction.
+    const GOF_TESTS: usize = DISTRIBUTIONS.len() * 3 // conductor
+        + DISTRIBUTIONS.len() * 5 // dielectric, 3 views outside and 2 inside
+        + PLASTICS.len() * 3
+        + ROUGH_PLASTICS.len() * 3;
+    const N_SAMPLES: usize = 150_000;
+
+    /// One lobe, whichever it is, for the tests that go over all of them.
+    #[derive(Clone, Copy, Debug)]
+    enum Lobe {
+        Conductor(RoughConductor),
+        Dielectric(RoughDielectric),
+        Plastic(Plastic),
+        RoughPlastic(RoughPlastic),
+    }
+
+    impl Lobe {
+        fn eval(&self, wo: Vec3, wi: Vec3, mode: TransportMode) -> Rgb {
+            match self {
+                Lobe::Conductor(b) => b.eval(wo, wi, mode),
+                Lobe::Dielectric(b) => b.eval(wo, wi, mode),
+                Lobe::Plastic(b) => b.eval(wo, wi, mode),
+                Lobe::RoughPlastic(b) => b.eval(wo, wi, mode),
             }
-            let (f, cos_t, _, eta_ti) = fresnel(w.dot(m), eta);
-            let t = refract(w, m, cos_t, eta_ti);
-            if t.z * w.z >= 0.0 {
-                continue;
+        }
+        fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+            match self {
+                Lobe::Conductor(b) => b.pdf(wo, wi),
+                Lobe::Dielectric(b) => b.pdf(wo, wi),
+                Lobe::Plastic(b) => b.pdf(wo, wi),
+                Lobe::RoughPlastic(b) => b.pdf(wo, wi),
             }
-            sum += wx * wy * ((1.0 - f) * md.smith_g1(t, m)) as f64;
+        }
+        fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
+            match self {
+                Lobe::Conductor(b) => b.sample(wo, u, uc, mode),
+                Lobe::Dielectric(b) => b.sample(wo, u, uc, mode),
+                Lobe::Plastic(b) => b.sample(wo, u, uc, mode),
+                Lobe::RoughPlastic(b) => b.sample(wo, u, uc, mode),
+            }
+        }
+        /// The density of `sample`, exact: `pdf` with the microfacet part rescaled by the
+        /// exact over the fitted Beckmann G1(wo) (see `chi2::g1_correction`).
+        fn exact_pdf(&self, wo: Vec3, wi: Vec3) -> f64 {
+            let up = wo * wo.z.signum();
+            match self {
+                Lobe::Conductor(b) => {
+                    b.pdf(wo, wi) as f64 * chi2::g1_correction(&b.distribution, up)
+                }
+                Lobe::Dielectric(b) => {
+                    b.pdf(wo, wi) as f64 * chi2::g1_correction(&b.distribution, up)
+                }
+                Lobe::Plastic(b) => b.pdf(wo, wi) as f64,
+                Lobe::RoughPlastic(b) => {
+                    if !above(wo) || !above(wi) {
+                        return 0.0;
+                    }
+                    let p = b.prob_specular(b.external_transmittance(wo.z)) as f64;
+                    p * b.specular_pdf(wo, wi) as f64 * chi2::g1_correction(&b.distribution, up)
+                        + (1.0 - p) * wi.z as f64 / PI
+                }
+            }
         }
     }
-    sum
+
+    fn conductor(kind: MicrofacetKind, au: f32, av: f32) -> RoughConductor {
+        RoughConductor {
+            distribution: Microfacet::new(kind, au, av),
+            eta: Rgb::new(0.2, 0.9, 1.1),
+            k: Rgb::new(3.9, 2.4, 2.1),
+            specular_reflectance: Rgb::new(0.9, 0.8, 0.7),
+        }
+    }
+
+    fn dielectric(kind: MicrofacetKind, au: f32, av: f32, eta: f32) -> RoughDielectric {
+        RoughDielectric {
+            distribution: Microfacet::new(kind, au, av),
+            eta,
+            specular_reflectance: Rgb::ONE,
+            specular_transmittance: Rgb::ONE,
+        }
+    }
+
+    fn plastic(eta: f32, nonlinear: bool) -> Plastic {
+        Plastic {
+            eta,
+            diffuse_reflectance: Rgb::new(0.5, 0.3, 0.2),
+            specular_reflectance: Rgb::new(1.0, 0.9, 0.8),
+            nonlinear,
+        }
+    }
+
+    fn rough_plastic(kind: MicrofacetKind, alpha: f32) -> RoughPlastic {
+        RoughPlastic::new(
+            kind,
+            alpha,
+            1.5,
+            Rgb::new(0.5, 0.3, 0.2),
+            Rgb::new(1.0, 0.9, 0.8),
+            false,
+        )
+    }
+
+    /// Every lobe of the sampling tests with the views it is tested from.
+    fn cases() -> Vec<(Lobe, Vec<Vec3>)> {
+        let mut v = Vec::new();
+        for (kind, au, av) in DISTRIBUTIONS {
+            v.push((Lobe::Conductor(conductor(kind, au, av)), views().to_vec()));
+        }
+        for (kind, au, av) in DISTRIBUTIONS {
+            let mut w = views().to_vec();
+            w.extend(inside_views());
+            v.push((Lobe::Dielectric(dielectric(kind, au, av, 1.5)), w));
+        }
+        for (eta, nonlinear) in PLASTICS {
+            v.push((Lobe::Plastic(plastic(eta, nonlinear)), views().to_vec()));
+        }
+        for (kind, alpha) in ROUGH_PLASTICS {
+            v.push((
+                Lobe::RoughPlastic(rough_plastic(kind, alpha)),
+                views().to_vec(),
+            ));
+        }
+        v
+    }
+
+    fn gof(lobe: Lobe, wo: Vec3, seed: u64) {
+        chi2::assert_fits(
+            &format!("{lobe:?} wo {wo}"),
+            N_SAMPLES,
+            seed,
+            |rng: &mut Rng| {
+                let u = rng.next_2d();
+                match lobe.sample(wo, u, rng.next_f32(), TransportMode::Radiance) {
+                    Some(s) if !s.delta => Outcome::Dir(s.wi),
+                    _ => Outcome::Other,
+                }
+            },
+            &|wi| lobe.exact_pdf(wo, wi),
+            chi2::sidak(GOF_TESTS),
+        );
+    }
+
+    // The chi-square tests are split by lobe so that they run in parallel.
+
+    #[test]
+    fn conductor_samples_follow_its_pdf() {
+        for (i, (lobe, views)) in cases().into_iter().enumerate() {
+            if let Lobe::Conductor(_) = lobe {
+                for (j, wo) in views.into_iter().enumerate() {
+                    gof(lobe, wo, (100 * i + j) as u64);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn dielectric_samples_follow_its_pdf() {
+        for (i, (lobe, views)) in cases().into_iter().enumerate() {
+            if let Lobe::Dielectric(_) = lobe {
+                for (j, wo) in views.into_iter().enumerate() {
+                    gof(lobe, wo, (100 * i + j) as u64);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn plastic_samples_follow_their_pdf() {
+        for (i, (lobe, views)) in cases().into_iter().enumerate() {
+            if let Lobe::Plastic(_) | Lobe::RoughPlastic(_) = lobe {
+                for (j, wo) in views.into_iter().enumerate() {
+                    gof(lobe, wo, (100 * i + j) as u64);
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn sample_weight_is_eval_over_pdf() {
+        let mut rng = Rng::new(&[7]);
+        for (lobe, _) in cases() {
+            let two_sided = matches!(lobe, Lobe::Dielectric(_));
+            for _ in 0..2000 {
+                let mut wo = uniform_sphere(rng.next_2d());
+                if !two_sided {
+                    wo.z = wo.z.abs();
+                }
+                let (u, uc) = (rng.next_2d(), rng.next_f32());
+                for mode in [TransportMode::Radiance, TransportMode::Importance] {
+                    let Some(s) = lobe.sample(wo, u, uc, mode) else {
+                        continue;
+                    };
+                    assert!(
+                        s.pdf > 0.0 && s.weight.is_finite() && s.weight.min_element() >= 0.0,
+                        "{lobe:?}: {s:?}"
+                    );
+                    if s.delta {
+                        continue;
+                    }
+                    let (f, pdf) = (lobe.eval(wo, s.wi, mode), lobe.pdf(wo, s.wi));
+                    let tol = 2e-3 * (1.0 + s.weight.max_element());
+                    assert!(
+                        (s.pdf - pdf).abs() <= 2e-3 * pdf,
+                        "{lobe:?} wo {wo}: sample pdf {} vs pdf {pdf}",
+                        s.pdf
+                    );
+                    assert!(
+                        (s.weight - f / pdf).abs().max_element() <= tol,
+                        "{lobe:?} wo {wo} wi {}: weight {} vs eval / pdf {}",
+                        s.wi,
+                        s.weight,
+                        f / pdf
+                    );
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn conductor_is_reciprocal() {
+        let mut rng = Rng::new(&[8]);
+        for (kind, au, av) in DISTRIBUTIONS {
+            let b = conductor(kind, au, av);
+            for _ in 0..1000 {
+                let mut wo = uniform_sphere(rng.next_2d());
+                let mut wi = uniform_sphere(rng.next_2d());
+                wo.z = wo.z.abs();
+                wi.z = wi.z.abs();
+                let m = TransportMode::Radiance;
+                let a = b.eval(wo, wi, m) / wi.z;
+                let c = b.eval(wi, wo, m) / wo.z;
+                assert!(
+                    (a - c).abs().max_element() <= 1e-4 * a.max_element() + 1e-6,
+                    "{b:?}: {a} vs {c}"
+                );
+            }
+        }
+    }
+
+    /// Directional albedo, the integral of eval over wi, estimated by the mean sample weight
+    /// (delta lobes included), with its standard error.
+    fn albedo(lobe: &Lobe, wo: Vec3, mode: TransportMode, n: usize, seed: u64) -> (Rgb, f32) {
+        let mut rng = Rng::new(&[seed]);
+        let (mut sum, mut sum2) = (Rgb::ZERO, 0.0f64);
+        for _ in 0..n {
+            let u = rng.next_2d();
+            if let Some(s) = lobe.sample(wo, u, rng.next_f32(), mode) {
+                sum += s.weight;
+                sum2 += (s.weight.max_element() as f64).powi(2);
+            }
+        }
+        let mean = sum / n as f32;
+        let var = sum2 / n as f64 - (mean.max_element() as f64).powi(2);
+        (mean, (var.max(0.0) / n as f64).sqrt() as f32)
+    }
+
+    const ALPHAS: [f32; 5] = [0.01, 0.05, 0.2, 0.5, 1.0];
+
+    #[test]
+    fn conductor_conserves_energy_and_tends_to_the_smooth_one() {
+        for kind in [BECKMANN, GGX] {
+            for alpha in ALPHAS {
+                // eta = 0, k = 1 (Mitsuba's defaults) reflects everything: F = 1.
+                let white = Lobe::Conductor(RoughConductor {
+                    distribution: Microfacet::isotropic(kind, alpha),
+                    eta: Rgb::ZERO,
+                    k: Rgb::ONE,
+                    specular_reflectance: Rgb::ONE,
+                });
+                for wo in views() {
+                    let (a, se) = albedo(&white, wo, TransportMode::Radiance, 40_000, 1);
+                    assert!(
+                        a.max_element() <= 1.0 + 4.0 * se + 1e-3,
+                        "{white:?} {wo}: {a}"
+                    );
+                    if alpha == 0.01 && wo.z > 0.5 {
+                        assert!(a.min_element() > 0.99, "{white:?} {wo}: {a}");
+                    }
+                }
+            }
+            // Gold, nearly smooth: the smooth conductor's Fresnel reflectance.
+            let (eta, k) = crate::material::conductor("Au").unwrap();
+            let gold = RoughConductor {
+                distribution: Microfacet::isotropic(kind, 0.01),
+                eta,
+                k,
+                specular_reflectance: Rgb::ONE,
+            };
+            let wo = views()[1];
+            let (a, _) = albedo(
+                &Lobe::Conductor(gold),
+                wo,
+                TransportMode::Radiance,
+                20_000,
+                2,
+            );
+            let smooth = gold.fresnel(wo.z);
+            assert!((a - smooth).abs().max_element() < 0.01, "{a} vs {smooth}");
+        }
+    }
+
+    #[test]
+    fn dielectric_conserves_energy_and_tends_to_the_smooth_one() {
+        for kind in [BECKMANN, GGX] {
+            for alpha in ALPHAS {
+                for eta in [1.5, 1.0 / 1.33] {
+                    let lobe = Lobe::Dielectric(dielectric(kind, alpha, alpha, eta));
+                    for wo in views().into_iter().chain(inside_views()) {
+                        let (a, se) = albedo(&lobe, wo, TransportMode::Importance, 40_000, 3);
+                        assert!(
+                            a.max_element() <= 1.0 + 4.0 * se + 1e-3,
+                            "{lobe:?} {wo}: {a}"
+                        );
+                        if alpha == 0.01 && wo.z.abs() > 0.5 {
+                            assert!(a.min_element() > 0.99, "{lobe:?} {wo}: {a}");
+                            // Radiance: the transmitted part scaled by 1 / eta^2 (relative
+                            // to the side of wo), as the smooth dielectric does.
+                            let (r, _) = albedo(&lobe, wo, TransportMode::Radiance, 40_000, 4);
+                            let eta_o = if wo.z > 0.0 { eta } else { 1.0 / eta };
+                            let f = fresnel_dielectric(wo.z.abs(), eta_o);
+                            let smooth = f + (1.0 - f) / (eta_o * eta_o);
+                            assert!(
+                                (r.x - smooth).abs() < 0.01 * smooth,
+                                "{lobe:?} {wo}: {r} vs {smooth}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
+
+    /// Fresnel reflectance of a dielectric in f64, written out from Snell's law.
+    fn fresnel64(cos_i: f64, eta: f64) -> f64 {
+        let sin2_t = (1.0 - cos_i * cos_i) / (eta * eta);
+        if sin2_t >= 1.0 {
+            return 1.0;
+        }
+        let cos_t = (1.0 - sin2_t).sqrt();
+        let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+        let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+        0.5 * (rs * rs + rp * rp)
+    }
+
+    /// Fdr = 2 int_0^1 F(mu) mu dmu, by Simpson's rule.
+    fn fdr_exact(eta: f64) -> f64 {
+        let n = 20_000;
+        let h = 1.0 / n as f64;
+        let f = |mu: f64| 2.0 * fresnel64(mu, eta) * mu;
+        let mut s = f(0.0) + f(1.0);
+        for i in 1..n {
+            s += f(i as f64 * h) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        s * h / 3.0
+    }
+
+    #[test]
+    fn fresnel_diffuse_reflectance_fits_the_integral() {
+        for eta in [1.2f32, 1.5, 1.9, 1.0 / 1.2, 1.0 / 1.5, 1.0 / 1.9] {
+            let (fit, exact) = (
+                fresnel_diffuse_reflectance(eta) as f64,
+                fdr_exact(eta as f64),
+            );
+            assert!(
+                (fit - exact).abs() < 0.01 * exact,
+                "{eta}: {fit} vs {exact}"
+            );
+        }
+    }
+
+    #[test]
+    fn plastic_eval_matches_the_formula() {
+        let mut rng = Rng::new(&[9]);
+        for (eta, nonlinear) in [(1.5f32, false), (1.5, true), (1.9, false)] {
+            let b = plastic(eta, nonlinear);
+            let e = eta as f64;
+            let fdr_int = fdr_exact(1.0 / e);
+            for _ in 0..20 {
+                let mut wo = uniform_sphere(rng.next_2d());
+                let mut wi = uniform_sphere(rng.next_2d());
+                wo.z = wo.z.abs();
+                wi.z = wi.z.abs();
+                let got = b.eval(wo, wi, TransportMode::Radiance);
+                for c in 0..3 {
+                    let rho = b.diffuse_reflectance[c] as f64;
+                    let internal = if nonlinear { rho * fdr_int } else { fdr_int };
+                    let (co, ci) = (wo.z as f64, wi.z as f64);
+                    let want = rho / (1.0 - internal)
+                        * (1.0 - fresnel64(co, e))
+                        * (1.0 - fresnel64(ci, e))
+                        / (e * e * PI)
+                        * ci;
+                    // Fdr from the fits, within 1% of the integral.
+                    assert!(
+                        (got[c] as f64 - want).abs() <= 0.01 * want + 1e-7,
+                        "{b:?}: {} vs {want}",
+                        got[c]
+                    );
+                }
+            }
+            // The coat and below: one-sided.
+            assert_eq!(
+                b.eval(-Vec3::Z, Vec3::Z, TransportMode::Radiance),
+                Rgb::ZERO
+            );
+            assert_eq!(
+                b.eval(Vec3::Z, -Vec3::Z, TransportMode::Radiance),
+                Rgb::ZERO
+            );
+        }
+    }
+
+    #[test]
+    fn plastics_conserve_energy() {
+        for nonlinear in [false, true] {
+            for eta in [1.3f32, 1.5, 1.9] {
+                let white = Plastic {
+                    eta,
+                    diffuse_reflectance: Rgb::ONE,
+                    specular_reflectance: Rgb::ONE,
+                    nonlinear,
+                };
+                let mut lobes = vec![Lobe::Plastic(white)];
+                for kind in [BECKMANN, GGX] {
+                    for alpha in [0.05, 0.3, 0.8] {
+                        lobes.push(Lobe::RoughPlastic(RoughPlastic::new(
+                            kind,
+                            alpha,
+                            eta,
+                            Rgb::ONE,
+                            Rgb::ONE,
+                            nonlinear,
+                        )));
+                    }
+                }
+                for lobe in lobes {
+                    for wo in views() {
+                        let (a, se) = albedo(&lobe, wo, TransportMode::Radiance, 40_000, 5);
+                        // The Fdr fits are within about 1% of the integral they stand for.
+                        assert!(a.max_element() <= 1.01 + 4.0 * se, "{lobe:?} {wo}: {a}");
+                    }
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn rough_coat_tends_to_the_smooth_one() {
+        for kind in [BECKMANN, GGX] {
+            let b = RoughPlastic::new(kind, 0.01, 1.5, Rgb::ONE, Rgb::ONE, false);
+            for cos in [1.0f32, 0.7, 0.3] {
+                let t = b.external_transmittance(cos) as f64;
+                let smooth = 1.0 - fresnel64(cos as f64, 1.5);
+                assert!((t - smooth).abs() < 2e-3, "{cos}: {t} vs {smooth}");
+            }
+            // Mitsuba's mean over 64 cosines is a coarse quadrature of 2 int F mu dmu.
+            let (r, smooth) = (b.internal_reflectance() as f64, fdr_exact(1.0 / 1.5));
+            assert!((r - smooth).abs() < 0.02 * smooth, "{r} vs {smooth}");
+        }
+    }
+
+    /// Values computed with mitsuba 3.9.1 (`scalar_rgb`, `mi.load_dict` of the plugin named
+    /// with `int_ior` 1.5 and `ext_ior` 1.0, si.wi = wo, eval/pdf at wi; directions
+    /// normalised in f32).
+    #[test]
+    #[allow(clippy::excessive_precision)] // Mitsuba's values as printed
+    fn matches_mitsuba_3_9_1() {
+        let n = |x: f32, y: f32, z: f32| Vec3::new(x, y, z).normalize();
+        let metal = |kind, au, av| RoughConductor {
+            distribution: Microfacet::new(kind, au, av),
+            eta: Rgb::new(0.2, 0.9, 1.1),
+            k: Rgb::new(3.9, 2.4, 2.1),
+            specular_reflectance: Rgb::ONE,
+        };
+        let red = Rgb::new(0.5, 0.3, 0.2);
+        let (a, b, c) = (n(0.3, 0.2, 0.93), n(-0.4, -0.1, 0.91), n(0.8, 0.2, 0.3));
+        let d = n(-0.6, -0.1, 0.5);
+        /// (lobe, wo, wi, eval in Radiance mode, in Importance mode, pdf).
+        type Case = (Lobe, Vec3, Vec3, [f32; 3], [f32; 3], f32);
+        #[rustfmt::skip]
+        let cases: [Case; 9] = [
+            (Lobe::Conductor(metal(GGX, 0.3, 0.3)), a, b,
+             [0.798_209_4, 0.516_357, 0.420_422_2], [0.798_209_4, 0.516_357, 0.420_422_2], 0.842_452_05),
+            (Lobe::Conductor(metal(BECKMANN, 0.1, 0.3)), n(0.5, 0.0, 0.866), n(-0.45, 0.1, 0.887),
+             [2.614_171, 1.691_253, 1.378_187_8], [2.614_171, 1.691_253, 1.378_187_8], 2.746_974),
+            (Lobe::Dielectric(dielectric(GGX, 0.2, 0.2, 1.5)), a, b,
+             [0.066_089_88; 3], [0.066_089_88; 3], 0.066_225_28),
+            (Lobe::Dielectric(dielectric(GGX, 0.2, 0.2, 1.5)), a, n(-0.2, -0.1, -0.97),
+             [17.241_796; 3], [38.794_037; 3], 38.814_644),
+            (Lobe::Dielectric(dielectric(BECKMANN, 0.3, 0.3, 1.5)), n(0.2, 0.1, -0.97), n(-0.3, -0.2, 0.93),
+             [22.354_83; 3], [9.935_481; 3], 9.935_481),
+            (Lobe::Plastic(Plastic { eta: 1.5, diffuse_reflectance: red, specular_reflectance: Rgb::ONE, nonlinear: false }), a, d,
+             [0.100_626_08, 0.060_375_65, 0.040_250_435], [0.100_626_08, 0.060_375_65, 0.040_250_435], 0.179_492_03),
+            (Lobe::Plastic(Plastic { eta: 1.5, diffuse_reflectance: red, specular_reflectance: Rgb::ONE, nonlinear: true }), c, d,
+             [0.049_944_922, 0.025_609_938, 0.015_916_23], [0.049_944_922, 0.025_609_938, 0.015_916_23], 0.124_810_35),
+            (Lobe::RoughPlastic(RoughPlastic::new(BECKMANN, 0.2, 1.5, red, Rgb::ONE, false)), a, b,
+             [0.210_431_29, 0.156_394_99, 0.129_376_83], [0.210_431_29, 0.156_394_99, 0.129_376_83], 0.468_084_4),
+            (Lobe::RoughPlastic(RoughPlastic::new(GGX, 0.3, 1.5, red, Rgb::ONE, true)), c, d,
+             [0.154_053_81, 0.134_249_24, 0.125_690_88], [0.154_053_81, 0.134_249_24, 0.125_690_88], 0.598_558_07),
+        ];
+        for (lobe, wo, wi, radiance, importance, pdf) in cases {
+            let r = lobe.eval(wo, wi, TransportMode::Radiance);
+            let i = lobe.eval(wo, wi, TransportMode::Importance);
+            let p = lobe.pdf(wo, wi);
+            let close = |x: f32, y: f32| (x - y).abs() <= 1e-4 * y.abs();
+            for ch in 0..3 {
+                assert!(
+                    close(r[ch], radiance[ch]),
+                    "{lobe:?}: radiance {r} vs {radiance:?}"
+                );
+                assert!(
+                    close(i[ch], importance[ch]),
+                    "{lobe:?}: importance {i} vs {importance:?}"
+                );
+            }
+            assert!(close(p, pdf), "{lobe:?}: pdf {p} vs {pdf}");
+        }
+    }
+
+    #[test]
+    fn odd_input_gives_zero_not_nan() {
+        let odd = [
+            Vec3::ZERO,
+            Vec3::X,
+            Vec3::splat(f32::NAN),
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(1.0, 0.0, 1e-8),
+        ];
+        let mut lobes: Vec<Lobe> = cases().into_iter().map(|(l, _)| l).collect();
+        lobes.push(Lobe::Dielectric(dielectric(GGX, 0.3, 0.3, 1.0)));
+        lobes.push(Lobe::Dielectric(dielectric(GGX, 0.3, 0.3, 0.0)));
+        lobes.push(Lobe::Conductor(conductor(GGX, 0.0, 0.0)));
+        for lobe in lobes {
+            for &wo in odd.iter().chain(&[Vec3::Z, -Vec3::Z]) {
+                for &wi in odd.iter().chain(&[Vec3::Z, -Vec3::Z]) {
+                    for mode in [TransportMode::Radiance, TransportMode::Importance] {
+                        let f = lobe.eval(wo, wi, mode);
+                        assert!(
+                            f.is_finite() && f.min_element() >= 0.0,
+                            "{lobe:?} {wo} {wi}: {f}"
+                        );
+                    }
+                    let p = lobe.pdf(wo, wi);
+                    assert!(p.is_finite() && p >= 0.0, "{lobe:?} {wo} {wi}: {p}");
+                }
+                for u in [Vec2::ZERO, Vec2::ONE, Vec2::new(0.5, 0.999_999_9)] {
+                    for uc in [0.0, 0.999_999_9] {
+                        if let Some(s) = lobe.sample(wo, u, uc, TransportMode::Radiance) {
+                            assert!(
+                                s.wi.is_finite() && s.weight.is_finite() && s.pdf > 0.0,
+                                "{lobe:?} {wo}: {s:?}"
+                            );
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
