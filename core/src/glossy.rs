@@ -11,6 +11,11 @@
 //! The conductor and the plastics are one-sided (black when wo.z <= 0 or wi.z <= 0); the
 //! rough dielectric is two-sided: wo below the surface means the viewer is inside, and the
 //! relative index of refraction is inverted.
+//!
+//! Directions are unit vectors. Where Mitsuba's `sample` returns a sample of zero weight (the
+//! sampled direction on the wrong side of the surface), `sample` returns None here. The
+//! indices `eta` are relative (interior over exterior): Mitsuba's `int_ior` / `ext_ior`, whose
+//! default exterior is air, 1.000277, not 1.
 
 use crate::Rgb;
 use crate::material::{TransportMode, fresnel_conductor, fresnel_dielectric};
