@@ -15,6 +15,7 @@
 //! forms where ns = ng.
 
 use crate::Rgb;
+use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
 use crate::material::{TransportMode, fresnel_conductor, fresnel_dielectric};
 use crate::sampling::{basis, cosine_hemisphere};
 use glam::{Vec2, Vec3};
@@ -80,7 +81,7 @@ pub struct BsdfSample {
 }
 
 /// A sampled direction in the local frame.
-#[derive(Clone, Copy, Debug)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct LocalSample {
     pub wi: Vec3,
     pub weight: Rgb,
@@ -110,6 +111,10 @@ pub enum Lobe {
     ThinDielectric {
         ior: f32,
     },
+    RoughConductor(RoughConductor),
+    RoughDielectric(RoughDielectric),
+    Plastic(Plastic),
+    RoughPlastic(RoughPlastic),
 }
 
 #[inline]
@@ -122,7 +127,13 @@ impl Lobe {
     /// evaluated for a given pair of directions, only sampled.
     #[inline]
     pub fn is_delta(&self) -> bool {
-        !matches!(self, Lobe::Diffuse { .. })
+        matches!(
+            self,
+            Lobe::Mirror { .. }
+                | Lobe::Conductor { .. }
+                | Lobe::Dielectric { .. }
+                | Lobe::ThinDielectric { .. }
+        )
     }
 
     /// f(wo, wi) |cos theta_i| (zero for delta lobes).
@@ -139,6 +150,10 @@ impl Lobe {
                     Rgb::ZERO
                 }
             }
+            Lobe::RoughConductor(l) => l.eval(wo, wi, TransportMode::Radiance),
+            Lobe::RoughDielectric(l) => l.eval(wo, wi, TransportMode::Radiance),
+            Lobe::Plastic(l) => l.eval(wo, wi, TransportMode::Radiance),
+            Lobe::RoughPlastic(l) => l.eval(wo, wi, TransportMode::Radiance),
             _ => Rgb::ZERO,
         }
     }
@@ -150,6 +165,10 @@ impl Lobe {
             Lobe::Diffuse { twosided, .. } if wo.z * wi.z > 0.0 && (twosided || wo.z > 0.0) => {
                 wi.z.abs() * FRAC_1_PI
             }
+            Lobe::RoughConductor(l) => l.pdf(wo, wi),
+            Lobe::RoughDielectric(l) => l.pdf(wo, wi),
+            Lobe::Plastic(l) => l.pdf(wo, wi),
+            Lobe::RoughPlastic(l) => l.pdf(wo, wi),
             _ => 0.0,
         }
     }
@@ -231,6 +250,10 @@ impl Lobe {
                 // Straight through: the two refractions undo each other (no 1/eta^2 either).
                 delta(-wo, Rgb::ONE, 1.0 - r)
             }
+            Lobe::RoughConductor(l) => l.sample(wo, u, uc, mode),
+            Lobe::RoughDielectric(l) => l.sample(wo, u, uc, mode),
+            Lobe::Plastic(l) => l.sample(wo, u, uc, mode),
+            Lobe::RoughPlastic(l) => l.sample(wo, u, uc, mode),
         }
     }
 
@@ -240,16 +263,31 @@ impl Lobe {
     #[inline]
     pub fn roughness(&self) -> f32 {
         match self {
-            Lobe::Diffuse { .. } => f32::INFINITY,
+            // A smooth plastic's non-delta part is its diffuse base.
+            Lobe::Diffuse { .. } | Lobe::Plastic(_) => f32::INFINITY,
+            Lobe::RoughConductor(l) => l.roughness(),
+            Lobe::RoughDielectric(l) => l.roughness(),
+            Lobe::RoughPlastic(l) => l.roughness(),
             _ => 0.0,
         }
+    }
+
+    /// Whether a non-delta part transmits light through the surface (a rough dielectric).
+    /// Camera paths follow such lobes by sampling whatever their roughness: a surface
+    /// estimate gathers the photons of one side only.
+    #[inline]
+    pub fn transmits(&self) -> bool {
+        matches!(self, Lobe::RoughDielectric(_))
     }
 
     /// The probability that `sample` picks a delta part for `wo`, for lobes that mix a delta
     /// part with a non-delta one (0 for the others).
     #[inline]
-    pub fn delta_probability(&self, _wo: Vec3) -> f32 {
-        0.0
+    pub fn delta_probability(&self, wo: Vec3) -> f32 {
+        match self {
+            Lobe::Plastic(l) => l.delta_probability(wo),
+            _ => 0.0,
+        }
     }
 }
 
@@ -261,6 +299,9 @@ pub struct Bsdf {
     pub frame: Frame,
     /// The unit geometric normal (the primitive's orientation).
     pub ng: Vec3,
+    /// A one-sided lobe seen from below acts as seen from above (Mitsuba's `twosided`): both
+    /// directions are mirrored to the upper side.
+    pub twosided: bool,
 }
 
 impl Bsdf {
@@ -270,11 +311,23 @@ impl Bsdf {
         self.lobe.is_delta()
     }
 
+    /// `wo` and `wi` in the local frame, both mirrored to the upper side for a two-sided
+    /// BSDF seen from below.
+    #[inline]
+    fn local(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+        let (mut wo, mut wi) = (self.frame.to_local(wo), self.frame.to_local(wi));
+        if self.twosided && wo.z < 0.0 {
+            wo.z = -wo.z;
+            wi.z = -wi.z;
+        }
+        (wo, wi)
+    }
+
     /// f(wo, wi) |cos theta_i| (radiance: the cosine from the shading normal).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        self.lobe
-            .eval(self.frame.to_local(wo), self.frame.to_local(wi))
+        let (wo, wi) = self.local(wo, wi);
+        self.lobe.eval(wo, wi)
     }
 
     /// What a photon arriving along `wi` with unit flux gives the radiance towards `wo`, per
@@ -291,15 +344,23 @@ impl Bsdf {
     /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        self.lobe
-            .pdf(self.frame.to_local(wo), self.frame.to_local(wi))
+        let (wo, wi) = self.local(wo, wi);
+        self.lobe.pdf(wo, wi)
     }
 
     /// Samples `wi` for `wo` (see [`Lobe::sample`]); in importance mode the weight carries the
     /// shading-normal correction (module comment).
     #[inline]
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<BsdfSample> {
-        let s = self.lobe.sample(self.frame.to_local(wo), u, uc, mode)?;
+        let mut local_wo = self.frame.to_local(wo);
+        let below = self.twosided && local_wo.z < 0.0;
+        if below {
+            local_wo.z = -local_wo.z;
+        }
+        let mut s = self.lobe.sample(local_wo, u, uc, mode)?;
+        if below {
+            s.wi.z = -s.wi.z;
+        }
         let wi = self.frame.to_world(s.wi);
         let mut weight = s.weight;
         if mode == TransportMode::Importance && self.frame.n != self.ng {
@@ -326,7 +387,8 @@ impl Bsdf {
     /// See [`Lobe::delta_probability`].
     #[inline]
     pub fn delta_probability(&self, wo: Vec3) -> f32 {
-        self.lobe.delta_probability(self.frame.to_local(wo))
+        let (wo, _) = self.local(wo, wo);
+        self.lobe.delta_probability(wo)
     }
 }
 
@@ -364,6 +426,7 @@ mod tests {
             lobe,
             frame: Frame::from_normal(ng),
             ng,
+            twosided: false,
         };
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let (u, uc) = (Vec2::new(0.3, 0.7), 0.5);
@@ -377,6 +440,7 @@ mod tests {
             lobe,
             frame: Frame::from_normal(ns),
             ng,
+            twosided: false,
         };
         let r = tilted.sample(wo, u, uc, TransportMode::Radiance).unwrap();
         let i = tilted.sample(wo, u, uc, TransportMode::Importance).unwrap();

@@ -25,16 +25,7 @@ use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 use std::sync::Mutex;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LocalSample {
-    pub wi: Vec3,
-    /// f |cos theta_i| / pdf: what the path throughput is multiplied by.
-    pub weight: Rgb,
-    /// Solid-angle pdf times the probability of the chosen lobe; for a delta lobe only that
-    /// probability.
-    pub pdf: f32,
-    pub delta: bool,
-}
+pub use crate::bsdf::LocalSample;
 
 /// True for a finite positive number (false for NaN).
 #[inline]
@@ -369,6 +360,14 @@ impl Plastic {
             Rgb::splat(fdr)
         };
         rho / (Rgb::ONE - internal)
+    }
+
+    /// The probability that `sample` picks the delta coat for `wo`.
+    pub fn delta_probability(&self, wo: Vec3) -> f32 {
+        if !above(wo) {
+            return 0.0;
+        }
+        self.prob_specular(fresnel_dielectric(wo.z, self.eta))
     }
 
     /// Probability of sampling the delta coat for this wo (cos_o > 0).

@@ -5,6 +5,7 @@
 use crate::Rgb;
 use crate::bsdf::{Bsdf, Frame, Lobe};
 use crate::geometry::SurfacePoint;
+use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -29,6 +30,18 @@ pub enum Material {
     /// straight through, with the Fresnel reflectance of the sheet's two faces and their
     /// interreflections, R' = 2R / (1 + R). It bounds no volume.
     ThinDielectric { ior: f32 },
+    /// Microfacet reflection off a conductor (Mitsuba's `roughconductor`).
+    RoughConductor {
+        lobe: RoughConductor,
+        twosided: bool,
+    },
+    /// Microfacet reflection and refraction at a dielectric interface (Mitsuba's
+    /// `roughdielectric`; two-sided by nature).
+    RoughDielectric { lobe: RoughDielectric },
+    /// A diffuse base under a smooth dielectric coat (Mitsuba's `plastic`).
+    Plastic { lobe: Plastic, twosided: bool },
+    /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
+    RoughPlastic { lobe: RoughPlastic, twosided: bool },
     /// An invisible boundary (of a medium): rays cross it without scattering.
     Null,
 }
@@ -347,12 +360,23 @@ impl Material {
             },
             Material::Dielectric { ior } => Lobe::Dielectric { ior },
             Material::ThinDielectric { ior } => Lobe::ThinDielectric { ior },
+            Material::RoughConductor { lobe, .. } => Lobe::RoughConductor(lobe),
+            Material::RoughDielectric { lobe } => Lobe::RoughDielectric(lobe),
+            Material::Plastic { lobe, .. } => Lobe::Plastic(lobe),
+            Material::RoughPlastic { lobe, .. } => Lobe::RoughPlastic(lobe),
             Material::Null => return None,
+        };
+        let twosided = match *self {
+            Material::RoughConductor { twosided, .. }
+            | Material::Plastic { twosided, .. }
+            | Material::RoughPlastic { twosided, .. } => twosided,
+            _ => false,
         };
         Some(Bsdf {
             lobe,
             frame: Frame::from_normal_tangent(sp.ns, sp.dpdu),
             ng: sp.ng,
+            twosided,
         })
     }
 }

@@ -282,7 +282,8 @@ pub const GLOSSY_ROUGHNESS: f32 = 0.5;
 /// `glossy_roughness` is estimated from the photons there; a smoother one, whose reflection
 /// a density estimate would blur, is continued through by sampling it, with next-event
 /// estimation at the glossy vertex and the emission the sampled ray meets weighted against it
-/// (the power heuristic). A BSDF that mixes a delta part with a non-delta one (a smooth
+/// (the power heuristic). Lobes that transmit (rough glass) are always continued through: a
+/// surface estimate sees the photons of one side only. A BSDF that mixes a delta part with a non-delta one (a smooth
 /// plastic) picks one by its sampling probabilities: the delta part is continued through, the
 /// other estimated here, each weighted by one over its probability.
 ///
@@ -356,7 +357,8 @@ pub fn walk_to_diffuse(
         if bounces >= how.max_depth {
             break;
         }
-        let glossy = bsdf.is_delta() || bsdf.roughness() < how.glossy_roughness;
+        let glossy =
+            bsdf.is_delta() || bsdf.lobe.transmits() || bsdf.roughness() < how.glossy_roughness;
         if glossy && !bsdf.is_delta() {
             let at = Scatter::Surface {
                 hit: &hit,

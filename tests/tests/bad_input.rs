@@ -350,11 +350,11 @@ fn unknown_material_type_lists_the_types() {
     assert_bad_value(
         "unknown-material",
         "type = \"diffuse\"",
-        "type = \"plastic\"",
+        "type = \"velvet\"",
         "materials.white.type",
         &[
-            "unknown material type \"plastic\"",
-            "diffuse, mirror, conductor, dielectric, thindielectric, null",
+            "unknown material type \"velvet\"",
+            "diffuse, mirror, conductor, roughconductor, dielectric, thindielectric, roughdielectric, plastic, roughplastic, null",
         ],
     );
 }

@@ -12,9 +12,11 @@ use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::filter::{Filter, FilterSampler};
 use crate::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
+use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
 use crate::light::{Light, area_light};
 use crate::material::Material;
 use crate::medium::{Homogeneous, Phase};
+use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::sampling::Distribution1D;
 use crate::value::{Document, Value};
@@ -37,8 +39,12 @@ const MATERIAL_TYPES: &[&str] = &[
     "diffuse",
     "mirror",
     "conductor",
+    "roughconductor",
     "dielectric",
     "thindielectric",
+    "roughdielectric",
+    "plastic",
+    "roughplastic",
     "null",
 ];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
@@ -560,58 +566,81 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
             }
             "conductor" => {
                 let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
-                let named = m.string_opt("material")?;
-                let (eta, k) = (m.rgb_opt("eta")?, m.rgb_opt("k")?);
-                match (named, eta, k) {
-                    (Some(_), Some(_), _) | (Some(_), _, Some(_)) => {
-                        return Err(m.error(
-                            "material",
-                            "give either a named `material` or `eta` and `k`, not both",
-                        ));
-                    }
-                    (None, Some(eta), Some(k)) => Material::Conductor {
+                match read_conductor_ior(&m)? {
+                    Some((eta, k)) => Material::Conductor {
                         eta,
                         k,
                         specular_reflectance,
                     },
-                    (None, Some(_), None) | (None, None, Some(_)) => {
-                        let missing = if m.has("eta") { "k" } else { "eta" };
-                        return Err(m.error(
-                            missing,
-                            "missing: a conductor's index of refraction needs both eta and k",
-                        ));
-                    }
                     // Mitsuba's default: a perfect mirror.
-                    (None, None, None) | (Some("none"), None, None) => Material::Mirror {
+                    None => Material::Mirror {
                         reflectance: specular_reflectance,
                     },
-                    (Some(name), None, None) => {
-                        let (eta, k) = crate::material::conductor(name).ok_or_else(|| {
-                            let names: Vec<&str> = crate::material::CONDUCTORS
-                                .iter()
-                                .map(|(n, _, _)| *n)
-                                .collect();
-                            m.error(
-                                "material",
-                                format!(
-                                    "unknown conductor `{name}`; expected none or one of: {}",
-                                    names.join(", ")
-                                ),
-                            )
-                        })?;
-                        Material::Conductor {
+                }
+            }
+            "roughconductor" => {
+                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                // No named material and no eta, k: a perfect (rough) mirror, F = 1.
+                let (eta, k) = read_conductor_ior(&m)?.unwrap_or((Rgb::ZERO, Rgb::ZERO));
+                Material::RoughConductor {
+                    lobe: RoughConductor {
+                        distribution: read_microfacet(&m, true)?,
+                        eta,
+                        k,
+                        specular_reflectance,
+                    },
+                    twosided: m.bool("twosided", true)?,
+                }
+            }
+            "roughdielectric" => Material::RoughDielectric {
+                lobe: RoughDielectric {
+                    distribution: read_microfacet(&m, true)?,
+                    eta: read_ior(&m, 1.5)?,
+                    specular_reflectance: m.rgb("specular_reflectance", Rgb::ONE)?,
+                    specular_transmittance: m.rgb("specular_transmittance", Rgb::ONE)?,
+                },
+            },
+            "plastic" | "roughplastic" => {
+                // Mitsuba's default: polypropylene in air.
+                let eta = read_ior(&m, 1.49 / 1.000277)?;
+                let diffuse_reflectance = m.rgb("diffuse_reflectance", Rgb::splat(0.5))?;
+                if diffuse_reflectance.max_element() > 1.0 {
+                    ld.warn(
+                        &m,
+                        "diffuse_reflectance",
+                        "is above 1: the material creates energy".into(),
+                    );
+                }
+                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let nonlinear = m.bool("nonlinear", false)?;
+                let twosided = m.bool("twosided", true)?;
+                if ty == "plastic" {
+                    Material::Plastic {
+                        lobe: Plastic {
                             eta,
-                            k,
+                            diffuse_reflectance,
                             specular_reflectance,
-                        }
+                            nonlinear,
+                        },
+                        twosided,
+                    }
+                } else {
+                    let d = read_microfacet(&m, false)?;
+                    Material::RoughPlastic {
+                        lobe: RoughPlastic::new(
+                            d.kind,
+                            d.alpha_u,
+                            eta,
+                            diffuse_reflectance,
+                            specular_reflectance,
+                            nonlinear,
+                        ),
+                        twosided,
                     }
                 }
             }
             "dielectric" | "thindielectric" => {
-                let ior = m.f32("ior", 1.5)?;
-                if ior <= 0.0 {
-                    return Err(m.error("ior", format!("must be positive, found {ior}")));
-                }
+                let ior = read_ior(&m, 1.5)?;
                 if ty == "dielectric" {
                     Material::Dielectric { ior }
                 } else {
@@ -638,6 +667,95 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
     }
     ld.done(&all);
     Ok((out, index))
+}
+
+/// A conductor's complex index of refraction: a named `material` (Mitsuba's names; `none`: a
+/// perfect mirror) or `eta` and `k`. None: a perfect mirror.
+fn read_conductor_ior(m: &Properties<'_>) -> Result<Option<(Rgb, Rgb)>> {
+    let named = m.string_opt("material")?;
+    let (eta, k) = (m.rgb_opt("eta")?, m.rgb_opt("k")?);
+    match (named, eta, k) {
+        (Some(_), Some(_), _) | (Some(_), _, Some(_)) => Err(m.error(
+            "material",
+            "give either a named `material` or `eta` and `k`, not both",
+        )),
+        (None, Some(eta), Some(k)) => Ok(Some((eta, k))),
+        (None, Some(_), None) | (None, None, Some(_)) => {
+            let missing = if m.has("eta") { "k" } else { "eta" };
+            Err(m.error(
+                missing,
+                "missing: a conductor's index of refraction needs both eta and k",
+            ))
+        }
+        (None, None, None) | (Some("none"), None, None) => Ok(None),
+        (Some(name), None, None) => {
+            let found = crate::material::conductor(name).ok_or_else(|| {
+                let names: Vec<&str> = crate::material::CONDUCTORS
+                    .iter()
+                    .map(|(n, _, _)| *n)
+                    .collect();
+                m.error(
+                    "material",
+                    format!(
+                        "unknown conductor `{name}`; expected none or one of: {}",
+                        names.join(", ")
+                    ),
+                )
+            })?;
+            Ok(Some(found))
+        }
+    }
+}
+
+/// A relative index of refraction `ior` (inside over outside), positive.
+fn read_ior(m: &Properties<'_>, default: f32) -> Result<f32> {
+    let ior = m.f32("ior", default)?;
+    if ior <= 0.0 || !ior.is_finite() {
+        return Err(m.error("ior", format!("must be positive, found {ior}")));
+    }
+    Ok(ior)
+}
+
+/// A microfacet distribution: `distribution` (`beckmann`, Mitsuba's default, or `ggx`) and
+/// `alpha` (default 0.1), or `alpha_u` and `alpha_v` where `anisotropic` lobes are allowed.
+fn read_microfacet(m: &Properties<'_>, anisotropic: bool) -> Result<Microfacet> {
+    let kind = match m.string("distribution", "beckmann")? {
+        "beckmann" => MicrofacetKind::Beckmann,
+        "ggx" => MicrofacetKind::Ggx,
+        other => {
+            return Err(m.error(
+                "distribution",
+                format!("unknown distribution {other:?}; expected beckmann or ggx"),
+            ));
+        }
+    };
+    let positive = |key: &str, x: f32| {
+        if x > 0.0 && x.is_finite() {
+            Ok(x)
+        } else {
+            Err(m.error(key, format!("must be positive, found {x}")))
+        }
+    };
+    if m.has("alpha_u") || m.has("alpha_v") {
+        if !anisotropic {
+            return Err(m.error(
+                if m.has("alpha_u") {
+                    "alpha_u"
+                } else {
+                    "alpha_v"
+                },
+                "this material's roughness is isotropic: give `alpha`",
+            ));
+        }
+        if m.has("alpha") {
+            return Err(m.error("alpha", "give either `alpha` or `alpha_u` and `alpha_v`"));
+        }
+        let u = positive("alpha_u", m.f32_required("alpha_u")?)?;
+        let v = positive("alpha_v", m.f32_required("alpha_v")?)?;
+        return Ok(Microfacet::new(kind, u, v));
+    }
+    let alpha = positive("alpha", m.f32("alpha", 0.1)?)?;
+    Ok(Microfacet::isotropic(kind, alpha))
 }
 
 fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<BoxedMedium>>, Index)> {

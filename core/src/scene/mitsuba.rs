@@ -926,8 +926,13 @@ impl Reader {
                     }
                 }
             }
-            "conductor" => {
-                put("type", Value::Str("conductor".into()));
+            "conductor" | "roughconductor" => {
+                put("type", Value::Str(o.ty.clone()));
+                if o.ty == "roughconductor" {
+                    self.microfacet(&mut o, &mut t, true)?;
+                    // Mitsuba's BSDFs are one-sided unless wrapped in `twosided`.
+                    t.insert("twosided", at(Value::Bool(false), line));
+                }
                 let material = o.string("material")?;
                 let (eta, k) = (o.take("eta"), o.take("k"));
                 match (eta, k) {
@@ -954,6 +959,33 @@ impl Reader {
                 let c = o.color("specular_reflectance", DVec3::ONE)?;
                 t.insert("specular_reflectance", vec3(c, line));
             }
+            "roughdielectric" => {
+                put("type", Value::Str("roughdielectric".into()));
+                self.microfacet(&mut o, &mut t, true)?;
+                let int = self.ior(&mut o, "int_ior", 1.5046)?;
+                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
+                t.insert("ior", at(Value::Float(int / ext), line));
+                for k in ["specular_reflectance", "specular_transmittance"] {
+                    let c = o.color(k, DVec3::ONE)?;
+                    t.insert(k, vec3(c, line));
+                }
+            }
+            "plastic" | "roughplastic" => {
+                put("type", Value::Str(o.ty.clone()));
+                if o.ty == "roughplastic" {
+                    self.microfacet(&mut o, &mut t, false)?;
+                }
+                let int = self.ior(&mut o, "int_ior", 1.49)?;
+                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
+                t.insert("ior", at(Value::Float(int / ext), line));
+                let c = o.color("diffuse_reflectance", DVec3::splat(0.5))?;
+                t.insert("diffuse_reflectance", vec3(c, line));
+                let c = o.color("specular_reflectance", DVec3::ONE)?;
+                t.insert("specular_reflectance", vec3(c, line));
+                let nonlinear = o.boolean("nonlinear", false)?;
+                t.insert("nonlinear", at(Value::Bool(nonlinear), line));
+                t.insert("twosided", at(Value::Bool(false), line));
+            }
             "null" => put("type", Value::Str("null".into())),
             _ => {
                 o.props.clear();
@@ -968,6 +1000,34 @@ impl Reader {
         }
         table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
         Ok(Some(name))
+    }
+
+    /// A microfacet BSDF's `distribution` and `alpha` (or, if `anisotropic`, `alpha_u` and
+    /// `alpha_v`), Mitsuba's defaults written out. Visible-normal sampling is foton's only
+    /// sampling: `sample_visible` changes noise, not the image.
+    fn microfacet(&mut self, o: &mut Obj, t: &mut Table, anisotropic: bool) -> Result<()> {
+        let line = o.line;
+        let distribution = o
+            .string("distribution")?
+            .unwrap_or_else(|| "beckmann".into());
+        if distribution != "beckmann" && distribution != "ggx" {
+            return Err(o.error(format!(
+                "`distribution`: unknown {distribution:?}; expected beckmann or ggx"
+            )));
+        }
+        t.insert("distribution", at(Value::Str(distribution), line));
+        o.take("sample_visible");
+        let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
+        if anisotropic && (has(o, "alpha_u") || has(o, "alpha_v")) {
+            let u = o.float("alpha_u", 0.1)?;
+            let v = o.float("alpha_v", 0.1)?;
+            t.insert("alpha_u", at(Value::Float(u), line));
+            t.insert("alpha_v", at(Value::Float(v), line));
+        } else {
+            let a = o.float("alpha", 0.1)?;
+            t.insert("alpha", at(Value::Float(a), line));
+        }
+        Ok(())
     }
 
     fn ior(&mut self, o: &mut Obj, name: &str, default: f64) -> Result<f64> {
