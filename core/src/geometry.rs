@@ -440,6 +440,71 @@ mod tests {
     }
 
     #[test]
+    fn surface_coordinates_follow_mitsuba() {
+        // Sphere: u = phi / 2 pi from +x towards +y, v = theta / pi from +z.
+        let s = Shape::Sphere {
+            center: Vec3::new(1.0, 2.0, 3.0),
+            radius: 2.0,
+        };
+        let at = |d: Vec3| s.surface(Vec3::new(1.0, 2.0, 3.0) + 2.0 * d, None);
+        let sp = at(Vec3::Y);
+        assert!((sp.uv - Vec2::new(0.25, 0.5)).length() < 1e-6, "{}", sp.uv);
+        assert!(sp.dpdu.normalize().dot(Vec3::NEG_X) > 0.999);
+        assert!((at(Vec3::Z).uv.y).abs() < 1e-6 && (at(-Vec3::Z).uv.y - 1.0).abs() < 1e-6);
+        assert!((at(Vec3::NEG_Y).uv.x - 0.75).abs() < 1e-6);
+        // Quad: the corner coordinates (Mitsuba's rectangle: (x + 1) / 2, (y + 1) / 2).
+        let q = Shape::quad(
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 4.0, 0.0),
+        );
+        let sp = q.surface(Vec3::new(0.5, 3.0, 0.0), None);
+        assert!((sp.uv - Vec2::new(0.25, 0.75)).length() < 1e-6);
+        assert_eq!(sp.ns, sp.ng);
+        // Disk: u = r, v = phi / 2 pi from its u axis towards v; area pi |u x v|.
+        let d = Shape::disk(
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.0),
+        );
+        let sp = d.surface(Vec3::new(0.0, 0.5, 0.0), None);
+        assert!((sp.uv - Vec2::new(0.5, 0.25)).length() < 1e-6, "{}", sp.uv);
+        assert!((d.area() - 2.0 * std::f32::consts::PI).abs() < 1e-5);
+        let ray = Ray::new(Vec3::new(1.9, 0.0, 1.0), Vec3::NEG_Z);
+        assert!(d.intersect(&ray, f32::INFINITY).is_some());
+        let ray = Ray::new(Vec3::new(1.5, 0.8, 1.0), Vec3::NEG_Z);
+        assert!(
+            d.intersect(&ray, f32::INFINITY).is_none(),
+            "outside the ellipse"
+        );
+        // Triangle: barycentrics without attributes; interpolated uvs, normals and dp/du
+        // with them.
+        let t = Shape::Triangle {
+            p0: Vec3::ZERO,
+            e1: Vec3::X,
+            e2: Vec3::Y,
+        };
+        let p = Vec3::new(0.25, 0.5, 0.0);
+        assert!((t.surface(p, None).uv - Vec2::new(0.25, 0.5)).length() < 1e-6);
+        let attrs = TriangleAttrs {
+            normals: Some([Vec3::Z, Vec3::Z, Vec3::new(1.0, 0.0, 1.0).normalize()]),
+            uvs: Some([Vec2::ZERO, Vec2::new(0.0, 2.0), Vec2::new(2.0, 0.0)]),
+        };
+        let sp = t.surface(p, Some(&attrs));
+        assert!((sp.uv - Vec2::new(1.0, 0.5)).length() < 1e-6, "{}", sp.uv);
+        // u grows along e2 (uv (2, 0) at p0 + e2): dp/du = e2 / 2.
+        assert!(
+            (sp.dpdu - Vec3::new(0.0, 0.5, 0.0)).length() < 1e-6,
+            "{}",
+            sp.dpdu
+        );
+        let n = (0.25 * Vec3::Z + 0.25 * Vec3::Z + 0.5 * Vec3::new(1.0, 0.0, 1.0).normalize())
+            .normalize();
+        assert!((sp.ns - n).length() < 1e-6);
+        assert_eq!(sp.ng, Vec3::Z);
+    }
+
+    #[test]
     fn triangle_hit() {
         let t = Shape::Triangle {
             p0: Vec3::ZERO,

@@ -583,3 +583,113 @@ fn compare_takes_an_xml_scene_and_its_defines() {
     let (w, _, _) = read_image(&dir.join("cmp-path.exr")).unwrap();
     assert_eq!(w, 16);
 }
+
+/// The glossy BSDFs, disks, flip_normals, hide_emitters and the sensor's default field of view
+/// read from XML with Mitsuba's meanings: eta = int_ior / ext_ior (air 1.000277 by default,
+/// named indices), Beckmann and alpha 0.1 by default, one-sided unless `twosided`; a disk's
+/// axes from its to_world; the field of view of a 50 mm lens on 35 mm film along the
+/// diagonal.
+#[test]
+fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
+    use foton_core::material::Material;
+    use foton_core::microfacet::MicrofacetKind;
+    let dir = scene_folder("mitsuba-glossy");
+    let text = r#"<scene version="3.0.0">
+    <integrator type="path"><boolean name="hide_emitters" value="true"/></integrator>
+    <sensor type="perspective">
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="30"/><integer name="height" value="20"/></film>
+    </sensor>
+    <bsdf type="roughconductor" id="a">
+        <string name="material" value="Au"/><string name="distribution" value="ggx"/>
+        <float name="alpha_u" value="0.05"/><float name="alpha_v" value="0.3"/>
+    </bsdf>
+    <bsdf type="twosided" id="b"><bsdf type="roughplastic"><float name="int_ior" value="1.6"/></bsdf></bsdf>
+    <bsdf type="roughdielectric" id="c"><string name="int_ior" value="water"/><float name="ext_ior" value="1.2"/></bsdf>
+    <bsdf type="plastic" id="d"><rgb name="diffuse_reflectance" value="0.1, 0.2, 0.3"/><boolean name="nonlinear" value="true"/></bsdf>
+    <shape type="sphere"><ref id="a"/></shape>
+    <shape type="sphere"><point name="center" x="3" y="0" z="0"/><ref id="b"/></shape>
+    <shape type="sphere"><point name="center" x="6" y="0" z="0"/><ref id="c"/></shape>
+    <shape type="disk">
+        <transform name="to_world"><scale x="2" y="0.5" z="1"/><translate y="-3"/></transform>
+        <boolean name="flip_normals" value="true"/><ref id="d"/>
+    </shape>
+    <emitter type="constant"/>
+</scene>
+"#;
+    let xml = write(&dir, "glossy.xml", text);
+    let scene = foton_core::scene::Scene::load_with(&xml, &[], &[], false).unwrap();
+    assert!(scene.render.hide_emitters);
+    // 50 mm on 35 mm film: a diagonal field of view of 2 atan(43.27 / 100) = 46.8 degrees.
+    let toml = dir.join("glossy.toml");
+    ok(&foton(&["convert", s(&xml), "-o", s(&toml)]));
+    let converted = std::fs::read_to_string(&toml).unwrap();
+    assert!(converted.contains("fov_axis = \"diagonal\""), "{converted}");
+    assert!(converted.contains("fov = 46.79"), "{converted}");
+    let material = |i: usize| scene.materials[scene.objects[i].material as usize].value;
+    let Material::RoughConductor { lobe, twosided } = material(0) else {
+        panic!("{:?}", material(0))
+    };
+    assert!(!twosided);
+    assert_eq!(lobe.distribution.kind, MicrofacetKind::Ggx);
+    assert_eq!(
+        (lobe.distribution.alpha_u, lobe.distribution.alpha_v),
+        (0.05, 0.3)
+    );
+    assert_eq!(
+        (lobe.eta, lobe.k),
+        foton_core::material::conductor("Au").unwrap()
+    );
+    let Material::RoughPlastic { lobe, twosided } = material(1) else {
+        panic!("{:?}", material(1))
+    };
+    assert!(twosided);
+    assert_eq!(lobe.distribution.kind, MicrofacetKind::Beckmann);
+    assert_eq!(lobe.distribution.alpha_u, 0.1);
+    assert!((lobe.eta - 1.6 / 1.000277).abs() < 1e-6);
+    let Material::RoughDielectric { lobe } = material(2) else {
+        panic!("{:?}", material(2))
+    };
+    assert!((lobe.eta - 1.333 / 1.2).abs() < 1e-6, "{}", lobe.eta);
+    let Material::Plastic { lobe, twosided } = material(3) else {
+        panic!("{:?}", material(3))
+    };
+    assert!(!twosided && lobe.nonlinear);
+    assert_eq!(
+        lobe.diffuse_reflectance,
+        foton_core::Rgb::new(0.1, 0.2, 0.3)
+    );
+    assert!((lobe.eta - 1.49 / 1.000277).abs() < 1e-6);
+    // The disk: an ellipse of semi-axes 2 and 0.5 at y = -3, turned to face -z.
+    let disk = scene
+        .accel
+        .primitives()
+        .iter()
+        .find(|p| p.object == 3)
+        .unwrap()
+        .shape;
+    let foton_core::geometry::Shape::Disk {
+        center,
+        u,
+        v,
+        normal,
+        ..
+    } = disk
+    else {
+        panic!("{disk:?}")
+    };
+    assert_eq!(
+        (center, u, v),
+        (
+            glam::Vec3::new(0.0, -3.0, 0.0),
+            glam::Vec3::X * 2.0,
+            glam::Vec3::Y * 0.5
+        )
+    );
+    assert_eq!(normal, glam::Vec3::NEG_Z);
+    // The converted TOML renders the same image.
+    let (a, b) = (dir.join("a.exr"), dir.join("b.exr"));
+    ok(&render(&xml, &a, &["--spp", "2"]));
+    ok(&render(&toml, &b, &["--spp", "2"]));
+    assert_eq!(std::fs::read(&a).unwrap(), std::fs::read(&b).unwrap());
+}
