@@ -14,7 +14,7 @@
 //! | `direct`          | string  | `nee` (shadow rays) or `photons` (first-hit photons)           | `nee`    |
 //! | `final_gather`    | bool    | indirect light by gather rays that look the maps up            | false    |
 //! | `gather_rays`     | integer | gather rays per camera sample, >= 1 (used with `final_gather`) | 32       |
-//! | `glossy_roughness`| float   | glossy lobes smoother than this (microfacet alpha) are followed by sampling, not estimated (see below) | 0.5 |
+//! | `glossy_roughness`| float   | glossy lobes smoother than this (microfacet alpha) are followed by sampling, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
 //!
 //! `[render] max_depth` bounds the scattering events of a whole light path, as in the path
 //! tracer: a photon's surface hits plus the camera path's delta bounces (each photon records

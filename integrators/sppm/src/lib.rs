@@ -14,6 +14,7 @@
 //! | `cone_c`                | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1     |
 //! | `direct`                | string  | `nee` (shadow rays) or `photons`                          | `nee`   |
 //! | `radius_schedule`       | string  | `pixel` (each pixel's radius from its photon statistics) or `global` (from the iteration number alone, below) | `pixel` |
+//! | `glossy_roughness`      | float   | glossy lobes smoother than this (microfacet alpha) are followed by the camera pass, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
 //!
 //! **Global radius schedule** (`radius_schedule = "global"`, Knaus and Zwicker 2011,
 //! "Progressive photon mapping: a probabilistic approach"): iteration i gathers with

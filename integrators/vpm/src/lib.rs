@@ -18,6 +18,7 @@
 //! | `cone_c`            | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1      |
 //! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
 //! | `estimate`          | string  | `march` (ray marching) or `beam` (beam radiance estimate)  | `march` |
+//! | `glossy_roughness`  | float   | glossy lobes smoother than this (microfacet alpha) are followed by the camera walk, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
 //! medium scattering events alike), as in the path tracer. `[render] spp` camera samples. A
