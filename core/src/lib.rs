@@ -26,6 +26,7 @@ pub mod props;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod texture;
 pub mod value;
 pub mod walk;
 
