@@ -12,6 +12,7 @@ pub mod accel;
 pub mod camera;
 
 pub mod direct;
+pub mod envmap;
 pub mod error;
 pub mod film;
 pub mod filter;
