@@ -52,7 +52,7 @@ impl EnvironmentMap {
     /// `to_world`, which must be a rotation or a mirror, possibly uniformly scaled (the
     /// translation is irrelevant to directions). Negative texels are taken as zero.
     pub fn new(bitmap: &Bitmap, scale: f32, to_world: Mat3) -> Result<EnvironmentMap, String> {
-        if !(scale >= 0.0 && scale.is_finite()) {
+        if scale < 0.0 || !scale.is_finite() {
             return Err(format!(
                 "the scale must be finite and non-negative, found {scale}"
             ));
@@ -66,7 +66,8 @@ impl EnvironmentMap {
                 .all(|e| e.abs() <= 1e-4 * s2);
         if !orthogonal {
             return Err(
-                "an environment map's transform must be a rotation (or a mirror), possibly uniformly scaled"
+                "an environment map's transform must be a rotation (or a mirror), \
+                 possibly uniformly scaled"
                     .into(),
             );
         }

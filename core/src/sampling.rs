@@ -263,7 +263,7 @@ impl Distribution2D {
     /// A point of [0, 1)^2 and its density (with respect to area on the square); None when
     /// every weight is zero.
     pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
-        if !(self.total() > 0.0) {
+        if self.total() <= 0.0 {
             return None;
         }
         let (y, pdf_y, row) = self.marginal.sample_continuous(u.y);
@@ -273,7 +273,8 @@ impl Distribution2D {
 
     /// The density at `p` of [0, 1]^2 (0 outside).
     pub fn pdf(&self, p: Vec2) -> f32 {
-        if !(self.total() > 0.0 && (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y)) {
+        let inside = (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y);
+        if self.total() <= 0.0 || !inside {
             return 0.0;
         }
         let (nu, nv) = (self.conditional[0].len(), self.conditional.len());

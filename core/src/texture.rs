@@ -526,7 +526,8 @@ mod tests {
         let dir = temp_dir("wrap");
         write_png(&dir);
         let with = |extra: &str| {
-            read(&dir, &format!("[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nfilter_type = \"nearest\"\n{extra}")).unwrap()
+            let head = "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nfilter_type = \"nearest\"";
+            read(&dir, &format!("{head}\n{extra}\n")).unwrap()
         };
         let clamp = with("wrap_mode = \"clamp\"");
         assert_eq!(clamp.eval(Vec2::new(-5.0, 0.2)), linear(0));

@@ -196,3 +196,71 @@ fn envmap_errors_name_the_key_and_the_file() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Mitsuba's `<emitter type="envmap">` reads as the TOML envmap: the file relative to the
+/// XML's folder, `scale`, and `to_world` turning the map (+z of the map onto +x here).
+#[test]
+fn the_xml_envmap_is_the_toml_envmap() {
+    let dir = temp_dir("envmap-xml");
+    // 4 x 3 texels, each its own colour.
+    let texels: Vec<f32> = (0..12)
+        .flat_map(|i| [i as f32, 1.0 + (i % 3) as f32, 0.5])
+        .collect();
+    image::Rgb32FImage::from_raw(4, 3, texels)
+        .unwrap()
+        .save(dir.join("sky.exr"))
+        .unwrap();
+    let xml = write(
+        &dir,
+        "scene.xml",
+        r#"<scene version="3.0.0">
+    <sensor type="perspective">
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+    </sensor>
+    <emitter type="envmap">
+        <string name="filename" value="sky.exr"/>
+        <float name="scale" value="2"/>
+        <transform name="to_world"><rotate y="1" angle="90"/></transform>
+    </emitter>
+</scene>"#,
+    );
+    let toml = write(
+        &dir,
+        "scene.toml",
+        r#"
+[camera]
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+
+[[lights]]
+type = "envmap"
+filename = "sky.exr"
+scale = 2.0
+to_world = { rotate = { axis = [0, 1, 0], degrees = 90 } }
+"#,
+    );
+    let from_xml = Scene::load(&xml, &[]).unwrap();
+    let from_toml = Scene::load(&toml, &[]).unwrap();
+    let (a, b) = (&from_xml.lights[0], &from_toml.lights[0]);
+    for d in [
+        Vec3::X,
+        Vec3::Y,
+        -Vec3::Z,
+        Vec3::new(0.3, -0.5, 0.8).normalize(),
+    ] {
+        let (la, lb) = (a.environment(d), b.environment(d));
+        assert!(
+            (la - lb).abs().max_element() < 1e-5,
+            "{d}: {la} against {lb}"
+        );
+    }
+    // The map's +z, the image's centre (between columns 1 and 2 of the middle row: texels 5
+    // and 6), turned onto +x, times the scale.
+    let centre = a.environment(Vec3::X);
+    let want = Vec3::new(5.5, 2.0, 0.5) * 2.0;
+    assert!(
+        (centre - want).abs().max_element() < 1e-4,
+        "{centre} against {want}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
