@@ -12,6 +12,7 @@ pub mod accel;
 pub mod bsdf;
 pub mod camera;
 pub mod direct;
+pub mod envmap;
 pub mod error;
 pub mod film;
 pub mod filter;
@@ -28,6 +29,7 @@ pub mod props;
 pub mod render;
 pub mod sampling;
 pub mod scene;
+pub mod texture;
 pub mod value;
 pub mod walk;
 

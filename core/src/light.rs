@@ -1,12 +1,14 @@
-//! Lights: point lights, spot lights and area lights (any emissive shape). An area light emits
-//! radiance `radiance` on the side its geometric normal points to, and nothing on the other
-//! side.
+//! Lights: point lights, spot lights and area lights (any emissive shape), and lights at
+//! infinity (directional, constant and environment-mapped). An area light emits radiance
+//! `radiance` on the side its geometric normal points to, and nothing on the other side.
 
 use crate::Rgb;
+use crate::envmap::EnvironmentMap;
 use crate::geometry::Shape;
 use crate::sampling::{Distribution1D, to_world, uniform_cone};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub enum Light {
@@ -43,6 +45,13 @@ pub enum Light {
     /// sphere facing their direction (`centre`, `radius`, set once the scene is loaded).
     Constant {
         radiance: Rgb,
+        centre: Vec3,
+        radius: f32,
+    },
+    /// Radiance from every direction at infinity read from a latitude-longitude image
+    /// (Mitsuba's `envmap`), sampled by its luminance; like `Constant` otherwise.
+    Envmap {
+        map: Arc<EnvironmentMap>,
         centre: Vec3,
         radius: f32,
     },
@@ -161,6 +170,8 @@ impl Light {
             Light::Constant {
                 radiance, radius, ..
             } => *radiance * (4.0 * PI * PI * radius * radius),
+            // pi R^2 times the integral of L over the sphere (pbrt's ImageInfiniteLight).
+            Light::Envmap { map, radius, .. } => map.integral() * (PI * radius * radius),
             Light::Area { area, radiance, .. } => PI * *area * *radiance,
         }
     }
@@ -172,11 +183,18 @@ impl Light {
         )
     }
 
+    /// Whether rays that leave the scene see this light (a constant or an environment map:
+    /// a scene has at most one).
+    pub fn is_environment(&self) -> bool {
+        matches!(self, Light::Constant { .. } | Light::Envmap { .. })
+    }
+
     /// For a light at infinity: the scene's bounding sphere, which its power (the flux
     /// through the sphere's disc) and its photons' origins need. Other lights ignore it.
     pub fn fit_to_scene(&mut self, scene_centre: Vec3, scene_radius: f32) {
-        if let Light::Directional { centre, radius, .. } | Light::Constant { centre, radius, .. } =
-            self
+        if let Light::Directional { centre, radius, .. }
+        | Light::Constant { centre, radius, .. }
+        | Light::Envmap { centre, radius, .. } = self
         {
             *centre = scene_centre;
             *radius = scene_radius;
@@ -187,7 +205,10 @@ impl Light {
     pub fn position(&self) -> Option<Vec3> {
         match self {
             Light::Point { position, .. } | Light::Spot { position, .. } => Some(*position),
-            Light::Directional { .. } | Light::Constant { .. } | Light::Area { .. } => None,
+            Light::Directional { .. }
+            | Light::Constant { .. }
+            | Light::Envmap { .. }
+            | Light::Area { .. } => None,
         }
     }
 
@@ -248,6 +269,18 @@ impl Light {
                 let mut ls = sample_at_infinity(x, wi, *centre, *radius);
                 ls.li = *radiance;
                 ls.pdf = crate::sampling::UNIFORM_SPHERE_PDF;
+                ls.delta = false;
+                Some(ls)
+            }
+            Light::Envmap {
+                map,
+                centre,
+                radius,
+            } => {
+                let (wi, li, pdf) = map.sample(u)?;
+                let mut ls = sample_at_infinity(x, wi, *centre, *radius);
+                ls.li = li;
+                ls.pdf = pdf;
                 ls.delta = false;
                 Some(ls)
             }
@@ -318,6 +351,8 @@ impl Light {
         match self {
             Light::Point { .. } | Light::Spot { .. } | Light::Directional { .. } => 0.0,
             Light::Constant { .. } => crate::sampling::UNIFORM_SPHERE_PDF,
+            // The direction is all that counts: `p` is any point along it from `x`.
+            Light::Envmap { map, .. } => map.pdf((p - x).normalize_or_zero()),
             Light::Area { shapes, area, .. } => {
                 if let Shape::Sphere { center, radius } = shapes[0]
                     && shapes.len() == 1
@@ -338,9 +373,10 @@ impl Light {
     /// Radiance arriving from infinitely far along -`dir` (a ray travelling along `dir` that
     /// leaves the scene): an environment light's, zero for the others.
     #[inline]
-    pub fn environment(&self, _dir: Vec3) -> Rgb {
+    pub fn environment(&self, dir: Vec3) -> Rgb {
         match self {
             Light::Constant { radiance, .. } => *radiance,
+            Light::Envmap { map, .. } => map.eval(dir),
             _ => Rgb::ZERO,
         }
     }
@@ -409,6 +445,24 @@ impl Light {
                     dir,
                     n: Vec3::ZERO,
                     flux: *radiance * (4.0 * PI * PI * radius * radius),
+                }
+            }
+            Light::Envmap {
+                map,
+                centre,
+                radius,
+            } => {
+                // A direction by the map's density, then a uniform point of the disc facing
+                // it: L / (pdf_dir / (pi R^2)) (pbrt's ImageInfiniteLight::SampleLe).
+                let (dir, flux) = match map.sample(u_dir) {
+                    Some((wi, li, pdf)) => (-wi, li * (PI * radius * radius / pdf)),
+                    None => (-Vec3::Z, Rgb::ZERO),
+                };
+                EmittedRay {
+                    origin: disc_origin(dir, *centre, *radius, u_pos),
+                    dir,
+                    n: Vec3::ZERO,
+                    flux,
                 }
             }
             Light::Area {

@@ -213,6 +213,75 @@ impl Distribution1D {
         }
         (i, self.pmf[i])
     }
+
+    /// A point of [0, 1) with density proportional to the weights, each weight spread evenly
+    /// over its cell of width 1/len: (the point, its density, the cell).
+    pub fn sample_continuous(&self, u: f32) -> (f32, f32, usize) {
+        let (i, pmf) = self.sample(u);
+        let below = if i == 0 { 0.0 } else { self.cdf[i - 1] };
+        // Where u falls within the cell's share of the cdf (0 if u landed in a skipped one).
+        let offset = if pmf > 0.0 {
+            ((u - below) / pmf).clamp(0.0, ONE_MINUS_EPSILON)
+        } else {
+            0.0
+        };
+        let n = self.len() as f32;
+        (((i as f32 + offset) / n).min(ONE_MINUS_EPSILON), pmf * n, i)
+    }
+}
+
+/// The largest f32 below 1.
+pub const ONE_MINUS_EPSILON: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// A piecewise-constant density on [0, 1)^2 over an `nu` x `nv` grid of cells, proportional
+/// to the cells' weights: a marginal distribution over the rows, a conditional one over the
+/// cells of each row (pbrt's `PiecewiseConstant2D`).
+#[derive(Clone, Debug, Default)]
+pub struct Distribution2D {
+    conditional: Vec<Distribution1D>,
+    marginal: Distribution1D,
+}
+
+impl Distribution2D {
+    /// `weights` row by row: `weights[v * nu + u]`, `nv` rows of `nu` cells.
+    pub fn new(weights: &[f32], nu: usize, nv: usize) -> Self {
+        assert_eq!(weights.len(), nu * nv, "a grid of {nu} x {nv} weights");
+        let conditional: Vec<Distribution1D> =
+            weights.chunks(nu).map(Distribution1D::new).collect();
+        let row_totals: Vec<f32> = conditional.iter().map(Distribution1D::total).collect();
+        Distribution2D {
+            marginal: Distribution1D::new(&row_totals),
+            conditional,
+        }
+    }
+
+    /// Sum of the weights.
+    pub fn total(&self) -> f32 {
+        self.marginal.total()
+    }
+
+    /// A point of [0, 1)^2 and its density (with respect to area on the square); None when
+    /// every weight is zero.
+    pub fn sample(&self, u: Vec2) -> Option<(Vec2, f32)> {
+        if self.total() <= 0.0 {
+            return None;
+        }
+        let (y, pdf_y, row) = self.marginal.sample_continuous(u.y);
+        let (x, pdf_x, _) = self.conditional[row].sample_continuous(u.x);
+        Some((Vec2::new(x, y), pdf_x * pdf_y))
+    }
+
+    /// The density at `p` of [0, 1]^2 (0 outside).
+    pub fn pdf(&self, p: Vec2) -> f32 {
+        let inside = (0.0..=1.0).contains(&p.x) && (0.0..=1.0).contains(&p.y);
+        if self.total() <= 0.0 || !inside {
+            return 0.0;
+        }
+        let (nu, nv) = (self.conditional[0].len(), self.conditional.len());
+        let row = ((p.y * nv as f32) as usize).min(nv - 1);
+        let col = ((p.x * nu as f32) as usize).min(nu - 1);
+        self.marginal.pmf(row) * self.conditional[row].pmf(col) * (nu * nv) as f32
+    }
 }
 
 #[cfg(test)]
@@ -228,6 +297,36 @@ mod tests {
             assert!(p > 0.0);
         }
         assert_eq!(d.sample(0.9999).0, 3);
+    }
+
+    #[test]
+    fn distribution2d_density_is_the_normalised_weights() {
+        let w = [0.0, 1.0, 2.0, 0.0, 0.0, 0.0, 3.0, 0.5, 4.0];
+        let d = Distribution2D::new(&w, 3, 3);
+        let total: f32 = w.iter().sum();
+        let mut rng = Rng::new(&[3]);
+        let mut counts = [0u32; 9];
+        let n = 90_000;
+        for _ in 0..n {
+            let (p, pdf) = d.sample(rng.next_2d()).unwrap();
+            let cell = (p.y * 3.0) as usize * 3 + (p.x * 3.0) as usize;
+            assert!(w[cell] > 0.0, "sampled a cell of zero weight");
+            assert!((pdf - w[cell] / total * 9.0).abs() < 1e-5);
+            assert!((d.pdf(p) - pdf).abs() < 1e-5);
+            counts[cell] += 1;
+        }
+        for (c, w) in counts.iter().zip(w) {
+            let want = w / total * n as f32;
+            assert!(
+                (*c as f32 - want).abs() < 5.0 * want.sqrt().max(1.0),
+                "{c} vs {want}"
+            );
+        }
+        assert!(
+            Distribution2D::new(&[0.0; 4], 2, 2)
+                .sample(Vec2::splat(0.5))
+                .is_none()
+        );
     }
 
     #[test]

@@ -274,8 +274,9 @@ fn find_renamed(
 }
 
 impl Document {
-    /// Makes the relative `file` of every shape and the film's `output` absolute against
-    /// `base` (for a document written into another folder than the one it was read from).
+    /// Makes the relative `file` of every shape, the `filename` of every light (an envmap's
+    /// image) and the film's `output` absolute against `base` (for a document written into
+    /// another folder than the one it was read from).
     pub fn absolutize_files(&mut self, base: &Path) {
         let fix = |node: &mut Node| {
             if let Value::Str(s) = &mut node.value
@@ -284,16 +285,18 @@ impl Document {
                 *s = base.join(&*s).to_string_lossy().into_owned();
             }
         };
-        if let Some(Node {
-            value: Value::Array(shapes),
-            ..
-        }) = self.root.get_mut("shapes")
-        {
-            for shape in shapes {
-                if let Value::Table(t) = &mut shape.value
-                    && let Some(file) = t.get_mut("file")
-                {
-                    fix(file);
+        for (array, key) in [("shapes", "file"), ("lights", "filename")] {
+            if let Some(Node {
+                value: Value::Array(items),
+                ..
+            }) = self.root.get_mut(array)
+            {
+                for item in items {
+                    if let Value::Table(t) = &mut item.value
+                        && let Some(file) = t.get_mut(key)
+                    {
+                        fix(file);
+                    }
                 }
             }
         }

@@ -12,15 +12,18 @@
 
 use foton_core::Rgb;
 use foton_core::bsdf::Bsdf;
+use foton_core::envmap::EnvironmentMap;
 use foton_core::geometry::{Shape, SurfacePoint};
 use foton_core::kernel::{BUILTIN_KERNELS, NormalizedKernel, builtin};
 use foton_core::light::{Light, area_light};
 use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
 use foton_core::medium::{Homogeneous, Medium, Phase, channel};
 use foton_core::sampling::{self, Distribution1D, Rng};
+use foton_core::texture::Bitmap;
 use foton_tests::stats::{self, Gof, assert_close, assert_rel, chi2_gof, chi2_sf, ln_gamma};
-use glam::{DVec3, Vec2, Vec3};
+use glam::{DVec3, Mat3, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
+use std::sync::Arc;
 
 // ---------------------------------------------------------------------------------------------
 // Statistics
@@ -36,6 +39,7 @@ const NUM_GOF_TESTS: usize = 7 // uniform_sphere, cosine_hemisphere, 3 x uniform
     + DIELECTRIC_CASES.len() // binomial reflect/refract frequencies
     + 3 // sample_li: quad, sphere from outside, triangles
     + 7 // sample_emission: positions and directions of 3 area lights, point light directions
+    + 2 // environment map: sample_li, sample_emission directions
     + PHASES.len()
     + FREE_FLIGHT_CASES.len();
 
@@ -1466,6 +1470,132 @@ fn point_light_emission_is_uniform_with_its_power() {
             Some(d(e.dir))
         },
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// The environment map
+// ---------------------------------------------------------------------------------------------
+
+/// A 16 x 8 map, turned away from the axes: a dim sky, a brighter ground with a red column
+/// and a small bright sun (a texel and its neighbour).
+fn envmap_light() -> (Light, Mat3) {
+    let (w, h) = (16, 8);
+    let mut texels = Vec::with_capacity(w * h);
+    for j in 0..h {
+        for i in 0..w {
+            texels.push(if i == 3 {
+                Rgb::new(1.5, 0.0, 0.0)
+            } else if j < h / 2 {
+                Rgb::new(0.2, 0.3, 0.6)
+            } else {
+                Rgb::new(0.5, 0.4, 0.3)
+            });
+        }
+    }
+    texels[2 * w + 9] = Rgb::new(300.0, 250.0, 200.0);
+    texels[2 * w + 10] = Rgb::new(100.0, 80.0, 60.0);
+    let to_world = Mat3::from_axis_angle(Vec3::new(1.0, 0.5, -0.3).normalize(), 0.7);
+    let bitmap = Bitmap::new(w, h, texels).unwrap();
+    let map = EnvironmentMap::new(&bitmap, 1.5, to_world).unwrap();
+    let light = Light::Envmap {
+        map: Arc::new(map),
+        centre: Vec3::new(0.1, 0.2, 0.3),
+        radius: 2.0,
+    };
+    (light, to_world)
+}
+
+/// A grid in theta about the map's pole, whose sin(theta) cancels the 1/sin(theta) of the
+/// map's density.
+fn envmap_grid(to_world: Mat3) -> SphereGrid {
+    SphereGrid::new(
+        d(to_world * Vec3::Y),
+        Polar::Theta,
+        uniform_edges(0.0, PI, 16),
+        32,
+    )
+}
+
+#[test]
+fn envmap_sample_li_matches_pdf_li() {
+    let (light, to_world) = envmap_light();
+    let x = Vec3::new(0.3, -0.2, 0.5);
+    let pdf = |w: DVec3| light.pdf_li(x, x + w.as_vec3(), Vec3::ZERO) as f64;
+    let mut rng = Rng::new(&[51]);
+    let n = 1_000_000;
+    // The density is piecewise constant: a direction within rounding of a cell's edge (x + wi
+    // - x is not quite wi) may find the neighbour's.
+    let mut mismatches = 0;
+    let integral = check_directions(
+        "envmap sample_li",
+        &envmap_grid(to_world),
+        n,
+        0.0,
+        &pdf,
+        &mut || {
+            let ls = light.sample_li(x, rng.next_2d(), rng.next_f32())?;
+            assert!(!ls.delta);
+            if ((ls.pdf as f64 - pdf(d(ls.wi))) / pdf(d(ls.wi))).abs() > 1e-3 {
+                mismatches += 1;
+            }
+            let le = light.environment(ls.wi);
+            assert!(rgb_close(ls.li, le, 1e-3), "{} against {le}", ls.li);
+            assert!(ls.dist > 0.0 && (ls.p - (x + ls.wi * ls.dist)).length() < 1e-3);
+            Some(d(ls.wi))
+        },
+    );
+    assert_close("integral of the envmap's pdf_li", integral, 1.0, 2e-3);
+    assert!(
+        mismatches <= n / 10_000,
+        "{mismatches} samples whose pdf is not pdf_li's"
+    );
+}
+
+#[test]
+fn envmap_emission_follows_its_pdf_with_its_power() {
+    let (light, to_world) = envmap_light();
+    let Light::Envmap { centre, radius, .. } = light else {
+        unreachable!()
+    };
+    let pdf = |w: DVec3| light.pdf_li(Vec3::ZERO, -w.as_vec3(), Vec3::ZERO) as f64;
+    let mut rng = Rng::new(&[52]);
+    let n = 1_000_000;
+    let mut flux = DVec3::ZERO;
+    let mut flux2 = DVec3::ZERO;
+    check_directions(
+        "envmap emission directions",
+        &envmap_grid(to_world),
+        n,
+        0.0,
+        &pdf,
+        &mut || {
+            let e = light.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+            // From the disc of the bounding sphere facing the photon's direction, outside it.
+            let o = e.origin - centre;
+            assert_close(
+                "origin behind the centre",
+                o.dot(e.dir) as f64,
+                -radius as f64,
+                1e-4,
+            );
+            assert!((o - o.dot(e.dir) * e.dir).length() <= radius * 1.0001);
+            flux += e.flux.as_dvec3();
+            flux2 += (e.flux * e.flux).as_dvec3();
+            Some(d(e.dir))
+        },
+    );
+    // The mean flux is the power, within 4 standard errors.
+    let mean = flux / n as f64;
+    let se = ((flux2 / n as f64 - mean * mean) / n as f64)
+        .max(DVec3::ZERO)
+        .sqrt();
+    let power = light.power().as_dvec3();
+    for c in 0..3 {
+        assert!(
+            (mean[c] - power[c]).abs() < 4.0 * se[c] + 1e-6 * power[c],
+            "mean flux {mean} against power {power} (se {se})"
+        );
+    }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -666,10 +666,7 @@ fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
             "directional",
             count(|l| matches!(l, Light::Directional { .. })),
         ),
-        (
-            "environment",
-            count(|l| matches!(l, Light::Constant { .. })),
-        ),
+        ("environment", count(Light::is_environment)),
         ("area", count(|l| matches!(l, Light::Area { .. }))),
     ];
     let listed: Vec<String> = kinds

@@ -48,7 +48,7 @@ const MATERIAL_TYPES: &[&str] = &[
     "null",
 ];
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
-const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant"];
+const LIGHT_TYPES: &[&str] = &["point", "spot", "directional", "constant", "envmap"];
 const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
 /// Collects the bags of a load so that unused keys can be listed at the end.
@@ -202,7 +202,7 @@ impl Scene {
         }
         let environment = lights
             .iter()
-            .position(|l| matches!(l, Light::Constant { .. }))
+            .position(Light::is_environment)
             .map(|i| i as u32);
         let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
         let light_distribution = Distribution1D::new(&powers);
@@ -367,6 +367,29 @@ fn read_directional(l: &Properties<'_>) -> Result<Light> {
     Ok(Light::Directional {
         direction: direction.normalize(),
         irradiance,
+        centre: Vec3::ZERO,
+        radius: 0.0,
+    })
+}
+
+/// A `type = "envmap"` light (Mitsuba's `envmap`): the latitude-longitude image `filename`
+/// (OpenEXR or Radiance HDR, linear; PNG or JPEG, sRGB-decoded), its radiance times `scale`
+/// (default 1), turned by `to_world` (a transform table; only its rotation counts).
+fn read_envmap(l: &Properties<'_>, ld: &mut Loader) -> Result<Light> {
+    let file = l.string_required("filename")?;
+    let scale = l.f32("scale", 1.0)?;
+    if scale < 0.0 {
+        return Err(l.error("scale", format!("must be non-negative, found {scale}")));
+    }
+    let to_world = read_transform_at(l, "to_world", ld)?;
+    let path = ld.dir.join(file);
+    let bitmap = crate::texture::Bitmap::load(&path, false)
+        .map_err(|e| l.error("filename", e.to_string()))?;
+    ld.sources.push(path);
+    let map = crate::envmap::EnvironmentMap::new(&bitmap, scale, glam::Mat3::from_mat4(to_world))
+        .map_err(|e| l.error("to_world", e))?;
+    Ok(Light::Envmap {
+        map: std::sync::Arc::new(map),
         centre: Vec3::ZERO,
         radius: 0.0,
     })
@@ -856,7 +879,12 @@ fn array_of_tables<'a>(root: &Properties<'a>, key: &str) -> Result<Vec<Propertie
 }
 
 fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
-    let Some(t) = s.table("transform")? else {
+    read_transform_at(s, "transform", ld)
+}
+
+/// The transform table `key` of `s` (`matrix`, or translate, rotate and scale).
+fn read_transform_at(s: &Properties<'_>, key: &str, ld: &mut Loader) -> Result<Mat4> {
+    let Some(t) = s.table(key)? else {
         return Ok(Mat4::IDENTITY);
     };
     if let Some(m) = t.floats_opt("matrix", 16)? {
@@ -1086,18 +1114,23 @@ fn read_point_lights(
                 ),
             ));
         }
-        if ty == "constant" {
-            if lights.iter().any(|l| matches!(l, Light::Constant { .. })) {
+        if ty == "constant" || ty == "envmap" {
+            if lights.iter().any(Light::is_environment) {
                 return Err(l.error(
                     "type",
-                    "a scene has at most one constant (environment) light",
+                    "a scene has at most one environment light (constant or envmap)",
                 ));
             }
-            lights.push(Light::Constant {
-                radiance: l.rgb("radiance", Rgb::ONE)?,
-                centre: Vec3::ZERO,
-                radius: 0.0,
-            });
+            let light = if ty == "envmap" {
+                read_envmap(&l, ld)?
+            } else {
+                Light::Constant {
+                    radiance: l.rgb("radiance", Rgb::ONE)?,
+                    centre: Vec3::ZERO,
+                    radius: 0.0,
+                }
+            };
+            lights.push(light);
             ld.done(&l);
             continue;
         }

@@ -1322,6 +1322,31 @@ impl Reader {
                 let l = o.color("radiance", DVec3::ONE)?;
                 t.insert("radiance", vec3(l, line));
             }
+            "envmap" => {
+                let file = o
+                    .string("filename")?
+                    .ok_or_else(|| o.error("missing `filename`"))?;
+                let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
+                let rel = path
+                    .strip_prefix(&self.dir)
+                    .map_or(path.clone(), Path::to_path_buf);
+                t.insert(
+                    "filename",
+                    at(Value::Str(rel.to_string_lossy().into_owned()), line),
+                );
+                t.insert("scale", at(Value::Float(o.float("scale", 1.0)?), line));
+                if m != DMat4::IDENTITY {
+                    let rows: Vec<Node> = (0..4)
+                        .flat_map(|r| m.row(r).to_array())
+                        .map(|x| at(Value::Float(x), line))
+                        .collect();
+                    let mut tr = Table::default();
+                    tr.insert("matrix", at(Value::Array(rows), line));
+                    t.insert("to_world", at(Value::Table(tr), line));
+                }
+                // Compensation changes only the noise.
+                o.take("mis_compensation");
+            }
             _ => {
                 o.props.clear();
                 return self.unsupported(&o, "this emitter is not supported yet");
