@@ -1,9 +1,14 @@
 //! Loading a large binary PLY mesh (a benchmark, not a test): a 708x708 grid bent into a
 //! sphere, 1,002,528 triangles, written as binary little-endian with normals and uv (as
 //! scanners and exporters write them). Prints the seconds of the parse alone (bytes to
-//! positions and triangles) and of `Scene::load` (read, parse, transform, closedness, BVH).
+//! positions, triangles, normals and uv), of `Scene::load` (read, parse, transform,
+//! closedness, BVH) and of its largest parts; then loads the same mesh written without normals
+//! and uv, with and without `face_normals`, which shows what computing vertex normals costs.
 //!
 //!   cargo bench -p foton-tests --bench ply_load
+//!
+//! With FOTON_PLY_KEEP=1 the files stay where it prints, for other renderers to load
+//! (tests/benches/ply_load_mitsuba.py times Mitsuba 3 on them).
 
 use foton_core::accel::Accel;
 use foton_core::geometry::Primitive;
@@ -13,14 +18,21 @@ use foton_core::scene::ply;
 use foton_tests::{temp_dir, write};
 use glam::Vec3;
 use std::f32::consts::PI;
+use std::path::Path;
 use std::time::Instant;
 
 /// Vertices per side of the grid; (N - 1)^2 quads of two triangles.
 const N: usize = 709;
 
-fn sphere_ply() -> Vec<u8> {
+/// The sphere as a binary PLY; `attributes`: with normals and uv.
+fn sphere_ply(attributes: bool) -> Vec<u8> {
+    let extra = if attributes {
+        "property float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\n"
+    } else {
+        ""
+    };
     let mut out = format!(
-        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nproperty float nx\nproperty float ny\nproperty float nz\nproperty float u\nproperty float v\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        "ply\nformat binary_little_endian 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\n{extra}element face {}\nproperty list uchar int vertex_indices\nend_header\n",
         N * N,
         2 * (N - 1) * (N - 1)
     )
@@ -35,7 +47,10 @@ fn sphere_ply() -> Vec<u8> {
                 theta.cos(),
                 theta.sin() * phi.sin(),
             ];
-            for x in n.iter().chain(&n).chain(&[u, v]) {
+            let uv = [u, v];
+            let attrs = if attributes { &n[..] } else { &[] };
+            let uv = if attributes { &uv[..] } else { &[] };
+            for x in n.iter().chain(attrs).chain(uv) {
                 out.extend_from_slice(&x.to_le_bytes());
             }
         }
@@ -55,8 +70,47 @@ fn sphere_ply() -> Vec<u8> {
     out
 }
 
+/// A scene of the mesh file `mesh` (in the scene's folder) alone.
+fn scene_toml(mesh: &str, face_normals: bool) -> String {
+    format!(
+        r#"
+[render]
+integrator = "path"
+[film]
+width = 16
+height = 16
+[camera]
+position = [0, 0, 4]
+look_at = [0, 0, 0]
+fov = 40
+[materials.white]
+type = "diffuse"
+reflectance = [0.5, 0.5, 0.5]
+[[shapes]]
+type = "mesh"
+file = "{mesh}"
+material = "white"
+face_normals = {face_normals}
+[[lights]]
+type = "point"
+position = [0, 3, 3]
+intensity = [1, 1, 1]
+"#
+    )
+}
+
+/// `Scene::load` of `scene`, and its seconds.
+fn load(scene: &Path) -> (Scene, f64) {
+    let start = Instant::now();
+    let loaded = Scene::load(scene, &[]).unwrap();
+    let seconds = start.elapsed().as_secs_f64();
+    assert_eq!(loaded.accel.primitives().len(), 2 * (N - 1) * (N - 1));
+    (loaded, seconds)
+}
+
 fn main() {
-    let bytes = sphere_ply();
+    let keep = std::env::var_os("FOTON_PLY_KEEP").is_some();
+    let bytes = sphere_ply(true);
     let dir = temp_dir("ply-bench");
     let mesh = dir.join("sphere.ply");
     std::fs::write(&mesh, &bytes).unwrap();
@@ -73,37 +127,8 @@ fn main() {
     assert_eq!(raw.triangles.len(), 2 * (N - 1) * (N - 1));
     println!("parse:              {parse:.3} s");
 
-    let scene = write(
-        &dir,
-        "scene.toml",
-        r#"
-[render]
-integrator = "path"
-[film]
-width = 16
-height = 16
-[camera]
-position = [0, 0, 4]
-look_at = [0, 0, 0]
-fov = 40
-[materials.white]
-type = "diffuse"
-reflectance = [0.5, 0.5, 0.5]
-[[shapes]]
-type = "mesh"
-file = "sphere.ply"
-material = "white"
-[[lights]]
-type = "point"
-position = [0, 3, 3]
-intensity = [1, 1, 1]
-"#,
-    );
-    let start = Instant::now();
-    let loaded = Scene::load(&scene, &[]).unwrap();
-    let load = start.elapsed().as_secs_f64();
-    assert_eq!(loaded.accel.primitives().len(), 2 * (N - 1) * (N - 1));
-    println!("Scene::load + BVH:  {load:.3} s");
+    let (loaded, total) = load(&write(&dir, "scene.toml", &scene_toml("sphere.ply", false)));
+    println!("Scene::load + BVH:  {total:.3} s");
 
     // Where the load's time goes: the two largest parts, timed alone.
     let corners: Vec<[Vec3; 3]> = raw
@@ -113,17 +138,41 @@ intensity = [1, 1, 1]
         .collect();
     let start = Instant::now();
     assert!(!is_closed(&corners), "the sphere is open at its poles");
-    println!(
-        "  of which is_closed: {:.3} s",
-        start.elapsed().as_secs_f64()
-    );
+    let closed = start.elapsed().as_secs_f64();
+    println!("  of which is_closed: {closed:.3} s");
     let prims: Vec<Primitive> = loaded.accel.primitives().to_vec();
+    drop(loaded);
     let start = Instant::now();
     let accel = Accel::build(prims);
+    let bvh = start.elapsed().as_secs_f64();
+    println!("  of which BVH build: {bvh:.3} s");
     println!(
-        "  of which BVH build: {:.3} s",
-        start.elapsed().as_secs_f64()
+        "  the rest (read, parse, transform, attributes): {:.3} s",
+        total - closed - bvh
     );
-    assert_eq!(accel.primitives().len(), loaded.accel.primitives().len());
-    let _ = std::fs::remove_dir_all(&dir);
+    drop(accel);
+
+    // Without normals in the file the loader computes them, unless face_normals.
+    let plain = sphere_ply(false);
+    std::fs::write(dir.join("sphere-plain.ply"), &plain).unwrap();
+    let (_, computed) = load(&write(
+        &dir,
+        "plain.toml",
+        &scene_toml("sphere-plain.ply", false),
+    ));
+    let (_, faceted) = load(&write(
+        &dir,
+        "plain-faceted.toml",
+        &scene_toml("sphere-plain.ply", true),
+    ));
+    println!(
+        "without normals and uv ({:.1} MB): Scene::load {computed:.3} s, with face_normals {faceted:.3} s",
+        plain.len() as f64 / 1e6
+    );
+
+    if keep {
+        println!("kept: {} and sphere-plain.ply", mesh.display());
+    } else {
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 }

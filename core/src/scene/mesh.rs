@@ -6,7 +6,7 @@ use crate::error::Result;
 use crate::geometry::{Shape, TriangleAttrs};
 use crate::props::Properties;
 use glam::{Mat3, Mat4, Vec2, Vec3};
-use std::collections::HashMap;
+use rayon::prelude::*;
 use std::io::Read;
 use std::path::Path;
 
@@ -307,32 +307,83 @@ fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
 /// exactly one triangle and its reverse by exactly one other. Needed for `interior`: inside
 /// and outside must be well defined. Vertices are matched by position (+0 and -0 alike).
 pub fn is_closed(tris: &[[Vec3; 3]]) -> bool {
-    type Vertex = (u32, u32, u32);
-    // Adding +0.0 turns -0.0 into +0.0.
-    let key = |p: Vec3| -> Vertex {
-        let p = p + Vec3::ZERO;
-        (p.x.to_bits(), p.y.to_bits(), p.z.to_bits())
-    };
-    let mut directed: HashMap<(Vertex, Vertex), u32> = HashMap::new();
-    for v in tris {
-        for i in 0..3 {
-            *directed
-                .entry((key(v[i]), key(v[(i + 1) % 3])))
-                .or_default() += 1;
-        }
+    // Sorting instead of a hash map keyed by pairs of positions, which at a million triangles
+    // took longer than the BVH build: positions get ids by a sort, directed edges become u64s
+    // sorted by their first vertex, and each edge's reverse is looked up among the edges
+    // leaving its second vertex.
+    if tris.is_empty() {
+        return false;
     }
-    !directed.is_empty()
-        && directed
-            .iter()
-            .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+    let corners = 3 * tris.len();
+    // Corners and position ids are numbered in 32 bits; more than 1.4 billion triangles would
+    // not fit in memory anyway.
+    assert!(
+        u32::try_from(corners).is_ok(),
+        "is_closed: too many triangles"
+    );
+    // The position's bits above, its corner's number below. Adding +0.0 turns -0.0 into +0.0.
+    let mut keyed = vec![0u128; corners];
+    keyed
+        .par_chunks_mut(3)
+        .zip(tris)
+        .enumerate()
+        .for_each(|(t, (out, v))| {
+            for (k, (slot, &p)) in out.iter_mut().zip(v).enumerate() {
+                let p = p + Vec3::ZERO;
+                let bits = (p.x.to_bits() as u128) << 64
+                    | (p.y.to_bits() as u128) << 32
+                    | p.z.to_bits() as u128;
+                *slot = bits << 32 | (3 * t + k) as u128;
+            }
+        });
+    keyed.par_sort_unstable();
+    let mut id = vec![0u32; corners];
+    let mut next = 0u32;
+    for (i, &c) in keyed.iter().enumerate() {
+        if i > 0 && c >> 32 != keyed[i - 1] >> 32 {
+            next += 1;
+        }
+        id[c as u32 as usize] = next;
+    }
+    let positions = next as usize + 1;
+    drop(keyed);
+    let mut edges = vec![0u64; corners];
+    edges
+        .par_chunks_mut(3)
+        .zip(id.par_chunks_exact(3))
+        .for_each(|(out, t)| {
+            for k in 0..3 {
+                out[k] = (t[k] as u64) << 32 | t[(k + 1) % 3] as u64;
+            }
+        });
+    drop(id);
+    edges.par_sort_unstable();
+    if edges.windows(2).any(|w| w[0] == w[1]) {
+        return false;
+    }
+    // The edges leaving position a are edges[first[a]..first[a + 1]], sorted.
+    let mut first = vec![0u32; positions + 1];
+    for &e in &edges {
+        first[(e >> 32) as usize + 1] += 1;
+    }
+    for a in 0..positions {
+        first[a + 1] += first[a];
+    }
+    edges.par_iter().all(|&e| {
+        let b = (e & 0xffff_ffff) as usize;
+        edges[first[b] as usize..first[b + 1] as usize]
+            .binary_search(&e.rotate_left(32))
+            .is_ok()
+    })
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::collections::HashMap;
 
-    #[test]
-    fn cube_is_closed_and_open_box_is_not() {
+    /// A unit cube of 12 outward-facing triangles.
+    fn cube() -> Vec<[Vec3; 3]> {
         let c = |x: f32, y: f32, z: f32| Vec3::new(x, y, z);
         let quads = [
             (c(0., 0., 0.), c(0., 1., 0.), c(1., 0., 0.)),
@@ -347,8 +398,117 @@ mod tests {
             tris.push([o, o + u, o + u + v]);
             tris.push([o, o + u + v, o + v]);
         }
+        tris
+    }
+
+    /// The definition, written the slow and obvious way (is_closed before it was sorted).
+    fn closed_by_definition(tris: &[[Vec3; 3]]) -> bool {
+        type Vertex = (u32, u32, u32);
+        let key = |p: Vec3| -> Vertex {
+            let p = p + Vec3::ZERO;
+            (p.x.to_bits(), p.y.to_bits(), p.z.to_bits())
+        };
+        let mut directed: HashMap<(Vertex, Vertex), u32> = HashMap::new();
+        for v in tris {
+            for i in 0..3 {
+                *directed
+                    .entry((key(v[i]), key(v[(i + 1) % 3])))
+                    .or_default() += 1;
+            }
+        }
+        !directed.is_empty()
+            && directed
+                .iter()
+                .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+    }
+
+    #[test]
+    fn cube_is_closed_and_open_box_is_not() {
+        let mut tris = cube();
         assert!(is_closed(&tris));
         tris.pop();
         assert!(!is_closed(&tris));
+        assert!(!is_closed(&[]));
+    }
+
+    #[test]
+    fn a_duplicated_triangle_is_not_closed() {
+        let mut tris = cube();
+        tris.push(tris[3]);
+        assert!(!is_closed(&tris));
+        // Whereas a triangle and its reverse satisfy the definition, which is about edges.
+        let t = tris[0];
+        assert!(is_closed(&[t, [t[0], t[2], t[1]]]));
+    }
+
+    #[test]
+    fn one_flipped_triangle_is_not_closed() {
+        for f in 0..12 {
+            let mut tris = cube();
+            tris[f].swap(1, 2);
+            assert!(!is_closed(&tris), "triangle {f} flipped");
+        }
+    }
+
+    #[test]
+    fn minus_zero_matches_plus_zero() {
+        let mut tris = cube();
+        // The same corners, written with -0.0 in some triangles only.
+        for t in tris.iter_mut().step_by(2) {
+            for p in t.iter_mut() {
+                *p = Vec3::select(p.cmpeq(Vec3::ZERO), Vec3::splat(-0.0), *p);
+            }
+        }
+        assert!(
+            tris.iter()
+                .flatten()
+                .any(|p| p.x.to_bits() == (-0.0f32).to_bits())
+        );
+        assert!(is_closed(&tris));
+    }
+
+    #[test]
+    fn agrees_with_the_definition_on_random_triangle_sets() {
+        // Triangles over a few grid points, so that edges coincide often; some sets are
+        // cubes with triangles removed, flipped or repeated.
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        let mut seen = [0; 2];
+        for _ in 0..2000 {
+            let tris: Vec<[Vec3; 3]> = if next(2) == 0 {
+                let mut tris = cube();
+                match next(4) {
+                    0 => {}
+                    1 => {
+                        tris.remove(next(12) as usize);
+                    }
+                    2 => tris[next(12) as usize].swap(0, 1),
+                    _ => tris.push(tris[next(12) as usize]),
+                }
+                tris
+            } else {
+                let point = |i: u64| {
+                    let s = if i & 8 != 0 { -0.0 } else { 0.0 };
+                    Vec3::new(
+                        (i & 1) as f32 + s,
+                        ((i >> 1) & 1) as f32,
+                        (i >> 2 & 1) as f32,
+                    )
+                };
+                let n = 1 + next(6) as usize;
+                (0..n)
+                    .map(|_| [point(next(16)), point(next(16)), point(next(16))])
+                    .collect()
+            };
+            let expected = closed_by_definition(&tris);
+            assert_eq!(is_closed(&tris), expected, "{tris:?}");
+            seen[expected as usize] += 1;
+        }
+        assert!(seen[0] > 100 && seen[1] > 100, "{seen:?}");
     }
 }
