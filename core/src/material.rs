@@ -6,22 +6,29 @@ use crate::Rgb;
 use crate::bsdf::{Bsdf, Frame, Lobe};
 use crate::geometry::SurfacePoint;
 use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
+use crate::texture::Texture;
 use glam::Vec3;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// A material. Colours marked "texture" are [`Texture`]s (a constant, an image or a
+/// checkerboard over the surface's uv); the lobe structs hold the rest, their textured fields
+/// being set at each surface point.
+#[derive(Clone, Debug)]
 pub enum Material {
-    /// Lambertian: f = reflectance / pi; if not `twosided`, only on the side the geometric
+    /// Lambertian: f = reflectance / pi (texture); if not `twosided`, only on the side the
     /// normal points to (black from behind, as a Mitsuba BSDF not wrapped in `twosided`).
-    Diffuse { reflectance: Rgb, twosided: bool },
-    /// Perfect specular reflection scaled by `reflectance`.
-    Mirror { reflectance: Rgb },
+    Diffuse {
+        reflectance: Texture,
+        twosided: bool,
+    },
+    /// Perfect specular reflection scaled by `reflectance` (texture).
+    Mirror { reflectance: Texture },
     /// A smooth conductor (Mitsuba's `conductor`): specular reflection with the Fresnel
     /// reflectance of the complex index of refraction eta + i k (per channel, relative to the
-    /// outside), scaled by `specular_reflectance`.
+    /// outside), scaled by `specular_reflectance` (texture).
     Conductor {
         eta: Rgb,
         k: Rgb,
-        specular_reflectance: Rgb,
+        specular_reflectance: Texture,
     },
     /// Smooth dielectric interface with Fresnel reflection and refraction; `ior` is the index
     /// of the side the normal points away from (inside), relative to the outside.
@@ -33,15 +40,30 @@ pub enum Material {
     /// Microfacet reflection off a conductor (Mitsuba's `roughconductor`).
     RoughConductor {
         lobe: RoughConductor,
+        specular_reflectance: Texture,
         twosided: bool,
     },
     /// Microfacet reflection and refraction at a dielectric interface (Mitsuba's
     /// `roughdielectric`; two-sided by nature).
-    RoughDielectric { lobe: RoughDielectric },
+    RoughDielectric {
+        lobe: RoughDielectric,
+        specular_reflectance: Texture,
+        specular_transmittance: Texture,
+    },
     /// A diffuse base under a smooth dielectric coat (Mitsuba's `plastic`).
-    Plastic { lobe: Plastic, twosided: bool },
+    Plastic {
+        lobe: Plastic,
+        diffuse_reflectance: Texture,
+        specular_reflectance: Texture,
+        twosided: bool,
+    },
     /// A diffuse base under a rough dielectric coat (Mitsuba's `roughplastic`).
-    RoughPlastic { lobe: RoughPlastic, twosided: bool },
+    RoughPlastic {
+        lobe: RoughPlastic,
+        diffuse_reflectance: Texture,
+        specular_reflectance: Texture,
+        twosided: bool,
+    },
     /// An invisible boundary (of a medium): rays cross it without scattering.
     Null,
 }
@@ -340,30 +362,67 @@ impl Material {
     /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
     #[inline]
     pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
-        let lobe = match *self {
+        let at = |t: &Texture| t.eval(sp.uv);
+        let lobe = match self {
             Material::Diffuse {
                 reflectance,
                 twosided,
             } => Lobe::Diffuse {
-                reflectance,
-                twosided,
+                reflectance: at(reflectance),
+                twosided: *twosided,
             },
-            Material::Mirror { reflectance } => Lobe::Mirror { reflectance },
+            Material::Mirror { reflectance } => Lobe::Mirror {
+                reflectance: at(reflectance),
+            },
             Material::Conductor {
                 eta,
                 k,
                 specular_reflectance,
             } => Lobe::Conductor {
-                eta,
-                k,
-                specular_reflectance,
+                eta: *eta,
+                k: *k,
+                specular_reflectance: at(specular_reflectance),
             },
-            Material::Dielectric { ior } => Lobe::Dielectric { ior },
-            Material::ThinDielectric { ior } => Lobe::ThinDielectric { ior },
-            Material::RoughConductor { lobe, .. } => Lobe::RoughConductor(lobe),
-            Material::RoughDielectric { lobe } => Lobe::RoughDielectric(lobe),
-            Material::Plastic { lobe, .. } => Lobe::Plastic(lobe),
-            Material::RoughPlastic { lobe, .. } => Lobe::RoughPlastic(lobe),
+            Material::Dielectric { ior } => Lobe::Dielectric { ior: *ior },
+            Material::ThinDielectric { ior } => Lobe::ThinDielectric { ior: *ior },
+            Material::RoughConductor {
+                lobe,
+                specular_reflectance,
+                ..
+            } => Lobe::RoughConductor(RoughConductor {
+                specular_reflectance: at(specular_reflectance),
+                ..*lobe
+            }),
+            Material::RoughDielectric {
+                lobe,
+                specular_reflectance,
+                specular_transmittance,
+            } => Lobe::RoughDielectric(RoughDielectric {
+                specular_reflectance: at(specular_reflectance),
+                specular_transmittance: at(specular_transmittance),
+                ..*lobe
+            }),
+            Material::Plastic {
+                lobe,
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            } => Lobe::Plastic(Plastic {
+                diffuse_reflectance: at(diffuse_reflectance),
+                specular_reflectance: at(specular_reflectance),
+                ..*lobe
+            }),
+            Material::RoughPlastic {
+                lobe,
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            } => {
+                let mut l = *lobe;
+                l.diffuse_reflectance = at(diffuse_reflectance);
+                l.specular_reflectance = at(specular_reflectance);
+                Lobe::RoughPlastic(l)
+            }
             Material::Null => return None,
         };
         let twosided = match *self {

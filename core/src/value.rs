@@ -275,8 +275,8 @@ fn find_renamed(
 
 impl Document {
     /// Makes the relative `file` of every shape, the `filename` of every light (an envmap's
-    /// image) and the film's `output` absolute against `base` (for a document written into
-    /// another folder than the one it was read from).
+    /// image) and of every material's texture, and the film's `output` absolute against `base`
+    /// (for a document written into another folder than the one it was read from).
     pub fn absolutize_files(&mut self, base: &Path) {
         let fix = |node: &mut Node| {
             if let Value::Str(s) = &mut node.value
@@ -296,6 +296,24 @@ impl Document {
                         && let Some(file) = t.get_mut(key)
                     {
                         fix(file);
+                    }
+                }
+            }
+        }
+        // A texture is an inline table with a `filename`, as a material's field.
+        if let Some(Node {
+            value: Value::Table(materials),
+            ..
+        }) = self.root.get_mut("materials")
+        {
+            for (_, material) in materials.0.iter_mut() {
+                if let Value::Table(fields) = &mut material.value {
+                    for (_, field) in fields.0.iter_mut() {
+                        if let Value::Table(texture) = &mut field.value
+                            && let Some(file) = texture.get_mut("filename")
+                        {
+                            fix(file);
+                        }
                     }
                 }
             }

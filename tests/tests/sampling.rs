@@ -20,6 +20,7 @@ use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract}
 use foton_core::medium::{Homogeneous, Medium, Phase, channel};
 use foton_core::sampling::{self, Distribution1D, Rng};
 use foton_core::texture::Bitmap;
+use foton_core::texture::Texture;
 use foton_tests::stats::{self, Gof, assert_close, assert_rel, chi2_gof, chi2_sf, ln_gamma};
 use glam::{DVec3, Mat3, Vec2, Vec3};
 use std::f64::consts::{PI, TAU};
@@ -619,7 +620,7 @@ fn distribution1d_follows_its_pmf_and_never_draws_zero_weights() {
 // ---------------------------------------------------------------------------------------------
 
 /// The BSDF of `mat` on a flat surface with normal `ng` (no shading normal, no texture).
-fn flat(mat: Material, ng: Vec3) -> Bsdf {
+fn flat(mat: &Material, ng: Vec3) -> Bsdf {
     let sp = SurfacePoint {
         p: Vec3::ZERO,
         ng,
@@ -634,7 +635,7 @@ fn flat(mat: Material, ng: Vec3) -> Bsdf {
 fn diffuse_sampling_matches_its_pdf_on_both_sides() {
     let reflectance = Rgb::new(0.8, 0.5, 0.2);
     let mat = Material::Diffuse {
-        reflectance,
+        reflectance: Texture::Constant(reflectance),
         twosided: true,
     };
     let ng = Vec3::new(0.3, -0.4, 0.866).normalize();
@@ -645,7 +646,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
         // The whole sphere around ng: samples on the wrong side land in empty cells.
         let grid = SphereGrid::full_sphere(d(ng), 20, 20);
         let mut rng = Rng::new(&[10, k as u64]);
-        let pdf = |w: DVec3| flat(mat, ng).pdf(wo, w.as_vec3()) as f64;
+        let pdf = |w: DVec3| flat(&mat, ng).pdf(wo, w.as_vec3()) as f64;
         let integral = check_directions(
             &format!("diffuse, wo on the {side}"),
             &grid,
@@ -658,7 +659,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                 } else {
                     TransportMode::Importance
                 };
-                let s = flat(mat, ng).sample(wo, rng.next_2d(), rng.next_f32(), mode)?;
+                let s = flat(&mat, ng).sample(wo, rng.next_2d(), rng.next_f32(), mode)?;
                 assert!(!s.delta);
                 assert_close("|wi|", s.wi.length() as f64, 1.0, 1e-5);
                 assert!(
@@ -666,7 +667,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                     "wi = {} is on the other side from wo = {wo}",
                     s.wi
                 );
-                let pdf = flat(mat, ng).pdf(wo, s.wi);
+                let pdf = flat(&mat, ng).pdf(wo, s.wi);
                 assert_close("sample pdf vs pdf()", s.pdf as f64, pdf as f64, 1e-6);
                 assert!(
                     rgb_close(s.weight, reflectance, 1e-6),
@@ -674,7 +675,7 @@ fn diffuse_sampling_matches_its_pdf_on_both_sides() {
                     s.weight
                 );
                 if pdf > 1e-3 {
-                    let fcos = flat(mat, ng).eval(wo, s.wi);
+                    let fcos = flat(&mat, ng).eval(wo, s.wi);
                     assert!(
                         rgb_close(fcos / pdf, s.weight, 1e-4),
                         "f cos / pdf = {} but weight = {}",
@@ -774,7 +775,7 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
             } else {
                 TransportMode::Importance
             };
-            let s = flat(mat, ng)
+            let s = flat(&mat, ng)
                 .sample(wo, rng.next_2d(), rng.next_f32(), mode)
                 .unwrap_or_else(|| panic!("{name}: no sample"));
             assert!(s.delta, "{name}: not a delta lobe");
@@ -856,7 +857,7 @@ fn dielectric_totally_reflects_beyond_the_critical_angle() {
         assert!(refract(wo, n, (n_t / n_o) as f32).is_none());
         let mut rng = Rng::new(&[21, k as u64]);
         for _ in 0..10_000 {
-            let s = flat(mat, ng)
+            let s = flat(&mat, ng)
                 .sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)
                 .unwrap();
             let mirror = 2.0 * d(wo).dot(d(n)) * d(n) - d(wo);
@@ -874,7 +875,9 @@ fn dielectric_totally_reflects_beyond_the_critical_angle() {
 #[test]
 fn mirror_reflects_exactly() {
     let reflectance = Rgb::new(0.9, 0.6, 0.3);
-    let mat = Material::Mirror { reflectance };
+    let mat = Material::Mirror {
+        reflectance: Texture::Constant(reflectance),
+    };
     let mut rng = Rng::new(&[22]);
     for _ in 0..100_000 {
         let ng = sampling::uniform_sphere(rng.next_2d());
@@ -887,7 +890,7 @@ fn mirror_reflects_exactly() {
         } else {
             TransportMode::Importance
         };
-        let s = flat(mat, ng)
+        let s = flat(&mat, ng)
             .sample(wo, rng.next_2d(), rng.next_f32(), mode)
             .unwrap();
         let (wo64, n64) = (d(wo), d(ng));
@@ -899,8 +902,8 @@ fn mirror_reflects_exactly() {
         );
         assert_close("cos in = cos out", d(s.wi).dot(n64), wo64.dot(n64), 1e-5);
         assert!(s.delta && s.pdf == 1.0 && s.weight == reflectance);
-        assert_eq!(flat(mat, ng).eval(wo, s.wi), Rgb::ZERO);
-        assert_eq!(flat(mat, ng).pdf(wo, s.wi), 0.0);
+        assert_eq!(flat(&mat, ng).eval(wo, s.wi), Rgb::ZERO);
+        assert_eq!(flat(&mat, ng).pdf(wo, s.wi), 0.0);
     }
 }
 

@@ -19,6 +19,7 @@ use crate::medium::{Homogeneous, Phase};
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::sampling::Distribution1D;
+use crate::texture::Texture;
 use crate::value::{Document, Value};
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
@@ -560,35 +561,27 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                 format!("missing; expected one of: {}", MATERIAL_TYPES.join(", ")),
             )
         })?;
+        // A colour that may be a texture; a reflectance above 1 is warned about.
+        let mut texture = |key: &str, default: Rgb, reflectance: bool| -> Result<Texture> {
+            let (t, bag) = Texture::read_param(&m, key, default, &ld.dir)?;
+            if let Some(bag) = bag {
+                ld.done(&bag);
+            }
+            if reflectance && t.max().max_element() > 1.0 {
+                ld.warn(&m, key, "is above 1: the material creates energy".into());
+            }
+            Ok(t)
+        };
         let material = match ty {
-            "diffuse" => {
-                let reflectance = m.rgb("reflectance", Rgb::splat(0.5))?;
-                if reflectance.max_element() > 1.0 {
-                    ld.warn(
-                        &m,
-                        "reflectance",
-                        "is above 1: the material creates energy".into(),
-                    );
-                }
-                let twosided = m.bool("twosided", true)?;
-                Material::Diffuse {
-                    reflectance,
-                    twosided,
-                }
-            }
-            "mirror" => {
-                let reflectance = m.rgb("reflectance", Rgb::ONE)?;
-                if reflectance.max_element() > 1.0 {
-                    ld.warn(
-                        &m,
-                        "reflectance",
-                        "is above 1: the material creates energy".into(),
-                    );
-                }
-                Material::Mirror { reflectance }
-            }
+            "diffuse" => Material::Diffuse {
+                reflectance: texture("reflectance", Rgb::splat(0.5), true)?,
+                twosided: m.bool("twosided", true)?,
+            },
+            "mirror" => Material::Mirror {
+                reflectance: texture("reflectance", Rgb::ONE, true)?,
+            },
             "conductor" => {
-                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let specular_reflectance = texture("specular_reflectance", Rgb::ONE, false)?;
                 match read_conductor_ior(&m)? {
                     Some((eta, k)) => Material::Conductor {
                         eta,
@@ -602,7 +595,7 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                 }
             }
             "roughconductor" => {
-                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let specular_reflectance = texture("specular_reflectance", Rgb::ONE, false)?;
                 // No named material and no eta, k: a perfect (rough) mirror, F = 1.
                 let (eta, k) = read_conductor_ior(&m)?.unwrap_or((Rgb::ZERO, Rgb::ZERO));
                 Material::RoughConductor {
@@ -610,8 +603,9 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                         distribution: read_microfacet(&m, true)?,
                         eta,
                         k,
-                        specular_reflectance,
+                        specular_reflectance: Rgb::ONE,
                     },
+                    specular_reflectance,
                     twosided: m.bool("twosided", true)?,
                 }
             }
@@ -619,45 +613,41 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
                 lobe: RoughDielectric {
                     distribution: read_microfacet(&m, true)?,
                     eta: read_ior(&m, 1.5)?,
-                    specular_reflectance: m.rgb("specular_reflectance", Rgb::ONE)?,
-                    specular_transmittance: m.rgb("specular_transmittance", Rgb::ONE)?,
+                    specular_reflectance: Rgb::ONE,
+                    specular_transmittance: Rgb::ONE,
                 },
+                specular_reflectance: texture("specular_reflectance", Rgb::ONE, false)?,
+                specular_transmittance: texture("specular_transmittance", Rgb::ONE, false)?,
             },
             "plastic" | "roughplastic" => {
                 // Mitsuba's default: polypropylene in air.
                 let eta = read_ior(&m, 1.49 / 1.000277)?;
-                let diffuse_reflectance = m.rgb("diffuse_reflectance", Rgb::splat(0.5))?;
-                if diffuse_reflectance.max_element() > 1.0 {
-                    ld.warn(
-                        &m,
-                        "diffuse_reflectance",
-                        "is above 1: the material creates energy".into(),
-                    );
-                }
-                let specular_reflectance = m.rgb("specular_reflectance", Rgb::ONE)?;
+                let diffuse_reflectance = texture("diffuse_reflectance", Rgb::splat(0.5), true)?;
+                let specular_reflectance = texture("specular_reflectance", Rgb::ONE, false)?;
                 let nonlinear = m.bool("nonlinear", false)?;
                 let twosided = m.bool("twosided", true)?;
+                // The lobes' colours are set at each point from the textures.
+                let (diffuse, specular) = (Rgb::splat(0.5), Rgb::ONE);
                 if ty == "plastic" {
                     Material::Plastic {
                         lobe: Plastic {
                             eta,
-                            diffuse_reflectance,
-                            specular_reflectance,
+                            diffuse_reflectance: diffuse,
+                            specular_reflectance: specular,
                             nonlinear,
                         },
+                        diffuse_reflectance,
+                        specular_reflectance,
                         twosided,
                     }
                 } else {
                     let d = read_microfacet(&m, false)?;
                     Material::RoughPlastic {
                         lobe: RoughPlastic::new(
-                            d.kind,
-                            d.alpha_u,
-                            eta,
-                            diffuse_reflectance,
-                            specular_reflectance,
-                            nonlinear,
+                            d.kind, d.alpha_u, eta, diffuse, specular, nonlinear,
                         ),
+                        diffuse_reflectance,
+                        specular_reflectance,
                         twosided,
                     }
                 }

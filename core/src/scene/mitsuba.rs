@@ -47,6 +47,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         shapes: Vec::new(),
         lights: Vec::new(),
         bsdfs: HashMap::new(),
+        textures: HashMap::new(),
         media: HashMap::new(),
         anonymous: 0,
     };
@@ -236,6 +237,8 @@ struct Reader {
     lights: Vec<Node>,
     /// BSDF ids to their material names in `[materials]`.
     bsdfs: HashMap<String, String>,
+    /// Top-level `<texture id="...">`s, as the inline tables a material field takes.
+    textures: HashMap<String, Table>,
     /// Medium ids to their names in `[media]`.
     media: HashMap<String, String>,
     anonymous: usize,
@@ -598,7 +601,7 @@ impl Reader {
         Ok(m)
     }
 
-    fn top_level(&mut self, mut obj: Obj) -> Result<()> {
+    fn top_level(&mut self, obj: Obj) -> Result<()> {
         match obj.tag.as_str() {
             "integrator" => self.integrator(obj),
             "sensor" => self.sensor(obj),
@@ -607,8 +610,14 @@ impl Reader {
             "shape" => self.shape(obj),
             "emitter" => self.emitter(obj),
             "texture" => {
-                obj.props.clear();
-                self.unsupported(&obj, "textures are not supported yet")
+                let id = obj.id.clone();
+                let Some(t) = self.texture_table(obj)? else {
+                    return Ok(());
+                };
+                if let Some(id) = id {
+                    self.textures.insert(id, t);
+                }
+                Ok(())
             }
             other => Err(obj.error(format!("<{other}> is not a top-level element of a scene"))),
         }
@@ -910,8 +919,10 @@ impl Reader {
             }
             "diffuse" => {
                 put("type", Value::Str("diffuse".into()));
-                let c = o.color("reflectance", DVec3::splat(0.5))?;
-                t.insert("reflectance", vec3(c, line));
+                let Some(c) = self.texture(&mut o, "reflectance", DVec3::splat(0.5))? else {
+                    return Ok(None);
+                };
+                t.insert("reflectance", c);
                 // Mitsuba's BSDFs are one-sided unless wrapped in `twosided`.
                 t.insert("twosided", at(Value::Bool(false), line));
             }
@@ -956,8 +967,10 @@ impl Reader {
                         );
                     }
                 }
-                let c = o.color("specular_reflectance", DVec3::ONE)?;
-                t.insert("specular_reflectance", vec3(c, line));
+                let Some(c) = self.texture(&mut o, "specular_reflectance", DVec3::ONE)? else {
+                    return Ok(None);
+                };
+                t.insert("specular_reflectance", c);
             }
             "roughdielectric" => {
                 put("type", Value::Str("roughdielectric".into()));
@@ -966,8 +979,10 @@ impl Reader {
                 let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
                 t.insert("ior", at(Value::Float(int / ext), line));
                 for k in ["specular_reflectance", "specular_transmittance"] {
-                    let c = o.color(k, DVec3::ONE)?;
-                    t.insert(k, vec3(c, line));
+                    let Some(c) = self.texture(&mut o, k, DVec3::ONE)? else {
+                        return Ok(None);
+                    };
+                    t.insert(k, c);
                 }
             }
             "plastic" | "roughplastic" => {
@@ -978,10 +993,12 @@ impl Reader {
                 let int = self.ior(&mut o, "int_ior", 1.49)?;
                 let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
                 t.insert("ior", at(Value::Float(int / ext), line));
-                let c = o.color("diffuse_reflectance", DVec3::splat(0.5))?;
-                t.insert("diffuse_reflectance", vec3(c, line));
-                let c = o.color("specular_reflectance", DVec3::ONE)?;
-                t.insert("specular_reflectance", vec3(c, line));
+                for (k, default) in [("diffuse_reflectance", 0.5), ("specular_reflectance", 1.0)] {
+                    let Some(c) = self.texture(&mut o, k, DVec3::splat(default))? else {
+                        return Ok(None);
+                    };
+                    t.insert(k, c);
+                }
                 let nonlinear = o.boolean("nonlinear", false)?;
                 t.insert("nonlinear", at(Value::Bool(nonlinear), line));
                 t.insert("twosided", at(Value::Bool(false), line));
@@ -1000,6 +1017,87 @@ impl Reader {
         }
         table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
         Ok(Some(name))
+    }
+
+    /// A colour parameter that may be a texture (`<texture name="...">` inside, or a `<ref>` to
+    /// a top-level one): an RGB array or the texture's inline table for the TOML material.
+    /// None: a texture left out (lenient).
+    fn texture(&mut self, o: &mut Obj, name: &str, default: DVec3) -> Result<Option<Node>> {
+        let line = o.line;
+        match o.take(name) {
+            Some((Prop::Object(t), _)) if t.tag == "texture" => {
+                Ok(self.texture_table(t)?.map(|t| at(Value::Table(t), line)))
+            }
+            Some((Prop::Ref(id), l)) => match self.textures.get(&id) {
+                Some(t) => Ok(Some(at(Value::Table(t.clone()), line))),
+                None => Err(o.error(format!(
+                    "`{name}`: line {l}: no texture with id `{id}` before it"
+                ))),
+            },
+            Some((p, l)) => {
+                o.props.push((name.to_string(), p, l));
+                Ok(Some(vec3(o.color(name, default)?, line)))
+            }
+            None => Ok(Some(vec3(default, line))),
+        }
+    }
+
+    /// A `<texture>` as the inline table foton's materials take (docs/scene-format.md):
+    /// Mitsuba's `bitmap` (filename, raw, filter_type, wrap_mode, to_uv) and `checkerboard`
+    /// (color0, color1, to_uv). None: left out (lenient).
+    fn texture_table(&mut self, mut o: Obj) -> Result<Option<Table>> {
+        let line = o.line;
+        let mut t = Table::default();
+        t.insert("type", at(Value::Str(o.ty.clone()), line));
+        match o.ty.as_str() {
+            "bitmap" => {
+                let file = o
+                    .string("filename")?
+                    .ok_or_else(|| o.error("missing `filename`"))?;
+                let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
+                let rel = path
+                    .strip_prefix(&self.dir)
+                    .map_or(path.clone(), Path::to_path_buf);
+                t.insert(
+                    "filename",
+                    at(Value::Str(rel.to_string_lossy().into_owned()), line),
+                );
+                if o.boolean("raw", false)? {
+                    t.insert("raw", at(Value::Bool(true), line));
+                }
+                for key in ["filter_type", "wrap_mode"] {
+                    if let Some(v) = o.string(key)? {
+                        t.insert(key, at(Value::Str(v), line));
+                    }
+                }
+                // Storage format and value clamping change nothing foton renders.
+                o.take("format");
+                o.take("accel");
+            }
+            "checkerboard" => {
+                for (key, default) in [("color0", 0.4), ("color1", 0.2)] {
+                    let c = o.color(key, DVec3::splat(default))?;
+                    t.insert(key, vec3(c, line));
+                }
+            }
+            _ => {
+                o.props.clear();
+                self.unsupported(&o, "this texture is not supported yet")?;
+                return Ok(None);
+            }
+        }
+        let m = o.transform("to_uv")?;
+        if m != DMat4::IDENTITY {
+            let mut tr = Table::default();
+            let rows: Vec<Node> = (0..4)
+                .flat_map(|r| m.row(r).to_array())
+                .map(|x| at(Value::Float(x), line))
+                .collect();
+            tr.insert("matrix", at(Value::Array(rows), line));
+            t.insert("to_uv", at(Value::Table(tr), line));
+        }
+        self.leftovers(&o)?;
+        Ok(Some(t))
     }
 
     /// A microfacet BSDF's `distribution` and `alpha` (or, if `anisotropic`, `alpha_u` and

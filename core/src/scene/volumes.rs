@@ -229,7 +229,12 @@ pub(super) fn medium_interfaces(
     for (i, o) in objects.iter().enumerate() {
         let m = &materials[o.material as usize].value;
         if o.closed
-            && (o.interior.is_some() || m.is_null() || matches!(m, Material::Dielectric { .. }))
+            && (o.interior.is_some()
+                || m.is_null()
+                || matches!(
+                    m,
+                    Material::Dielectric { .. } | Material::RoughDielectric { .. }
+                ))
         {
             index[i] = Some(volumes.len());
             volumes.push(Volume {
