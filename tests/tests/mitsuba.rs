@@ -758,3 +758,48 @@ fn the_showroom_renders_alike_with_every_integrator() {
         assert!(rel < 0.03, "{name}: mean {} against {mean}", film.mean());
     }
 }
+
+/// A shape's `exterior` medium: the medium filling free space when nothing else says so (as
+/// a fog scene written for Mitsuba declares it on its shapes), accepted when it is the
+/// camera's medium or another shape's interior, and an error otherwise.
+#[test]
+fn a_shapes_exterior_medium_is_the_medium_around_it() {
+    let dir = scene_folder("mitsuba-exterior");
+    let scene = |sensor_medium: &str, exterior: &str| {
+        format!(
+            r#"<scene version="3.0.0">
+    <medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.1"/></medium>
+    <medium type="homogeneous" id="smoke"><rgb name="sigma_t" value="0.5"/></medium>
+    <sensor type="perspective">
+        <float name="fov" value="30"/>
+        <transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+        {sensor_medium}
+    </sensor>
+    <shape type="sphere"><bsdf type="dielectric"/><ref name="exterior" id="{exterior}"/></shape>
+    <emitter type="point"><point name="position" x="0" y="3" z="3"/></emitter>
+</scene>
+"#
+        )
+    };
+    let load = |text: &str| {
+        let xml = write(&dir, "scene.xml", text);
+        foton_core::scene::Scene::load_with(&xml, &[], &[], false)
+    };
+    let s = load(&scene("", "fog")).unwrap();
+    assert_eq!(
+        s.medium.map(|m| s.media[m as usize].name.as_str()),
+        Some("fog")
+    );
+    assert_eq!(s.camera_medium, s.medium);
+    let s = load(&scene("<ref name=\"medium\" id=\"fog\"/>", "fog")).unwrap();
+    assert!(s.medium.is_some());
+    let err = load(&scene("<ref name=\"medium\" id=\"fog\"/>", "smoke"))
+        .err()
+        .expect("an exterior unlike the medium around the shape")
+        .to_string();
+    assert!(
+        err.contains("scene.xml:") && err.contains("exterior"),
+        "{err}"
+    );
+}

@@ -49,10 +49,12 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         bsdfs: HashMap::new(),
         textures: HashMap::new(),
         media: HashMap::new(),
+        exteriors: Vec::new(),
         anonymous: 0,
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text, true)?;
+    r.check_exteriors()?;
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
         root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
@@ -237,6 +239,9 @@ struct Reader {
     lights: Vec<Node>,
     /// BSDF ids to their material names in `[materials]`.
     bsdfs: HashMap<String, String>,
+    /// The `exterior` media shapes declared (medium name, line): foton infers a shape's
+    /// outside from the volumes around it, so these are checked against that at the end.
+    exteriors: Vec<(String, u32)>,
     /// Top-level `<texture id="...">`s, as the inline tables a material field takes.
     textures: HashMap<String, Table>,
     /// Medium ids to their names in `[media]`.
@@ -599,6 +604,55 @@ impl Reader {
             m = step * m;
         }
         Ok(m)
+    }
+
+    /// A shape's `exterior` is what foton infers from where it lies: the medium filling free
+    /// space (`[scene] medium`, which the sensor's medium or the first exterior sets), or
+    /// the interior of another shape around it. An exterior that is neither cannot be
+    /// rendered as written.
+    fn check_exteriors(&mut self) -> Result<()> {
+        if self.exteriors.is_empty() {
+            return Ok(());
+        }
+        let interiors: Vec<String> = self
+            .shapes
+            .iter()
+            .filter_map(|s| match &s.value {
+                Value::Table(t) => match t.get("interior").map(|n| &n.value) {
+                    Some(Value::Str(m)) => Some(m.clone()),
+                    _ => None,
+                },
+                _ => None,
+            })
+            .collect();
+        let scene_medium = |root: &Table| match root.get("scene").map(|n| &n.value) {
+            Some(Value::Table(t)) => match t.get("medium").map(|n| &n.value) {
+                Some(Value::Str(m)) => Some(m.clone()),
+                _ => None,
+            },
+            _ => None,
+        };
+        for (medium, line) in std::mem::take(&mut self.exteriors) {
+            match scene_medium(&self.root) {
+                Some(m) if m == medium => {}
+                None if !interiors.contains(&medium) => {
+                    table_mut(&mut self.root, "scene")
+                        .insert("medium", at(Value::Str(medium), line));
+                }
+                _ if interiors.contains(&medium) => {}
+                _ => {
+                    let message = format!(
+                        "{}:{line}: a shape's `exterior` medium that is neither the medium around the camera nor the interior of another shape is not supported (foton infers a shape's outside from the volumes around it)",
+                        self.file.display()
+                    );
+                    if !self.lenient {
+                        return Err(Error::Usage(message));
+                    }
+                    self.report.left_out.push(message);
+                }
+            }
+        }
+        Ok(())
     }
 
     fn top_level(&mut self, obj: Obj) -> Result<()> {
@@ -1221,6 +1275,16 @@ impl Reader {
                     interior = Some(self.media.get(&id).cloned().ok_or_else(|| {
                         o.error(format!("line {l}: no medium with id `{id}` before it"))
                     })?)
+                }
+                Prop::Object(med) if med.tag == "medium" && name == "exterior" => {
+                    let m = self.medium(med)?;
+                    self.exteriors.push((m, l));
+                }
+                Prop::Ref(id) if name == "exterior" => {
+                    let m = self.media.get(&id).cloned().ok_or_else(|| {
+                        o.error(format!("line {l}: no medium with id `{id}` before it"))
+                    })?;
+                    self.exteriors.push((m, l));
                 }
                 other => o.props.push((name, other, l)),
             }
