@@ -186,6 +186,11 @@ global_photons = 200000
 caustic_photons = 100000
 k = 30
 
+[integrators.vpm]
+global_photons = 200000
+caustic_photons = 100000
+k = 30
+
 [integrators.sppm]
 iterations = 64
 photons_per_iteration = 20000
@@ -194,8 +199,8 @@ photons_per_iteration = 20000
         )
 }
 
-/// `photon` and `sppm` (with glossy surfaces followed by sampling, and with them estimated
-/// from photons) agree with the path tracer by blocks. Tolerance: 10% per block for the photon
+/// `photon`, `vpm` and `sppm` (with glossy surfaces followed by sampling, and, for sppm, with
+/// them estimated from photons) agree with the path tracer by blocks. Tolerance: 10% per block for the photon
 /// maps' blur and bias (the glass sphere's caustic, the edges of the spheres' shadows), 4
 /// standard errors of the pixel noise, and a floor for dark blocks.
 #[test]
@@ -210,6 +215,7 @@ fn photon_integrators_agree_with_path_on_glossy_materials() {
     };
     for (name, integrator, spp, extra) in [
         ("photon", "photon", 16, ""),
+        ("vpm", "vpm", 16, ""),
         ("sppm", "sppm", 1, ""),
         (
             "sppm, glossy estimated from photons",

@@ -281,13 +281,14 @@ fn triangles(
 fn vertex_normals(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Vec3> {
     let mut sum = vec![Vec3::ZERO; positions.len()];
     for face in triangles {
-        let Some(p) = face
-            .iter()
-            .map(|&i| positions.get(i as usize).copied())
-            .collect::<Option<Vec<_>>>()
-        else {
+        let (Some(&a), Some(&b), Some(&c)) = (
+            positions.get(face[0] as usize),
+            positions.get(face[1] as usize),
+            positions.get(face[2] as usize),
+        ) else {
             continue; // reported by the caller
         };
+        let p = [a, b, c];
         let n = (p[1] - p[0]).cross(p[2] - p[0]);
         if n.length_squared() == 0.0 {
             continue;
