@@ -38,9 +38,11 @@ pub fn offset_origin(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
 
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
+    /// The normal points outward, or inward if `inward` (Mitsuba's `flip_normals`).
     Sphere {
         center: Vec3,
         radius: f32,
+        inward: bool,
     },
     /// origin + s u + t v, s, t in [0, 1]. `w` = n / (n . n) with n = u x v (for the
     /// barycentric-style coordinates of a hit), `normal` = normalize(n).
@@ -137,19 +139,28 @@ impl Shape {
         }
     }
 
+    /// A sphere with its normal outward.
+    pub fn sphere(center: Vec3, radius: f32) -> Shape {
+        Shape::Sphere {
+            center,
+            radius,
+            inward: false,
+        }
+    }
+
     /// Turns the surface's normal the other way (Mitsuba's `flip_normals`), keeping its
-    /// texture coordinates. Spheres are not flipped (they have no orientation field).
+    /// texture coordinates.
     pub fn flip(&mut self) {
         match self {
             Shape::Quad { normal, .. } | Shape::Disk { normal, .. } => *normal = -*normal,
             Shape::Triangle { e1, e2, .. } => std::mem::swap(e1, e2),
-            Shape::Sphere { .. } => {}
+            Shape::Sphere { inward, .. } => *inward = !*inward,
         }
     }
 
     pub fn aabb(&self) -> Aabb {
         let (lo, hi) = match *self {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere { center, radius, .. } => {
                 (center - Vec3::splat(radius), center + Vec3::splat(radius))
             }
             Shape::Quad { origin, u, v, .. } => {
@@ -181,7 +192,7 @@ impl Shape {
     #[inline]
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<f32> {
         match *self {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere { center, radius, .. } => {
                 // Numerically careful form (Ray Tracing Gems ch. 7): avoids cancellation for
                 // distant or small spheres.
                 let f = ray.origin - center;
@@ -276,7 +287,10 @@ impl Shape {
     #[inline]
     pub fn normal(&self, p: Vec3) -> Vec3 {
         match *self {
-            Shape::Sphere { center, .. } => (p - center).normalize(),
+            Shape::Sphere { center, inward, .. } => {
+                let n = (p - center).normalize();
+                if inward { -n } else { n }
+            }
             Shape::Quad { normal, .. } => normal,
             Shape::Triangle { e1, e2, .. } => e1.cross(e2).normalize(),
             Shape::Disk { normal, .. } => normal,
@@ -290,7 +304,7 @@ impl Shape {
     pub fn surface(&self, p: Vec3, attrs: Option<&TriangleAttrs>) -> SurfacePoint {
         let ng = self.normal(p);
         let (uv, dpdu, ns) = match *self {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere { center, radius, .. } => {
                 let d = (p - center) / radius;
                 let mut phi = d.y.atan2(d.x);
                 if phi < 0.0 {
@@ -371,9 +385,13 @@ impl Shape {
     #[inline]
     pub fn sample_area(&self, u: Vec2) -> (Vec3, Vec3) {
         match *self {
-            Shape::Sphere { center, radius } => {
+            Shape::Sphere {
+                center,
+                radius,
+                inward,
+            } => {
                 let d = crate::sampling::uniform_sphere(u);
-                (center + radius * d, d)
+                (center + radius * d, if inward { -d } else { d })
             }
             Shape::Quad {
                 origin,
@@ -429,10 +447,7 @@ mod tests {
 
     #[test]
     fn sphere_hits_from_outside_and_inside() {
-        let s = Shape::Sphere {
-            center: Vec3::ZERO,
-            radius: 1.0,
-        };
+        let s = Shape::sphere(Vec3::ZERO, 1.0);
         let r = Ray::new(Vec3::new(0.0, 0.0, 5.0), Vec3::NEG_Z);
         assert!((s.intersect(&r, f32::INFINITY).unwrap() - 4.0).abs() < 1e-5);
         let inside = Ray::new(Vec3::ZERO, Vec3::X);
@@ -442,10 +457,7 @@ mod tests {
     #[test]
     fn surface_coordinates_follow_mitsuba() {
         // Sphere: u = phi / 2 pi from +x towards +y, v = theta / pi from +z.
-        let s = Shape::Sphere {
-            center: Vec3::new(1.0, 2.0, 3.0),
-            radius: 2.0,
-        };
+        let s = Shape::sphere(Vec3::new(1.0, 2.0, 3.0), 2.0);
         let at = |d: Vec3| s.surface(Vec3::new(1.0, 2.0, 3.0) + 2.0 * d, None);
         let sp = at(Vec3::Y);
         assert!((sp.uv - Vec2::new(0.25, 0.5)).length() < 1e-6, "{}", sp.uv);

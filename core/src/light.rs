@@ -293,7 +293,11 @@ impl Light {
             } => {
                 let (i, _) = by_area.sample(uc);
                 let shape = &shapes[i];
-                if let Shape::Sphere { center, radius } = *shape
+                if let Shape::Sphere {
+                    center,
+                    radius,
+                    inward,
+                } = *shape
                     && shapes.len() == 1
                     && let Some(cos_max) = sphere_cone(center, radius, x)
                 {
@@ -301,11 +305,13 @@ impl Light {
                     // Sphere::Sample(ctx)): every sample sees the emitting side.
                     let axis = (center - x).normalize();
                     let wi = to_world(uniform_cone(u, cos_max), axis);
-                    let t = Shape::Sphere { center, radius }
+                    let t = shape
                         .intersect(&crate::geometry::Ray::new(x, wi), f32::INFINITY)
                         .unwrap_or_else(|| (center - x).dot(wi));
                     let p = x + wi * t;
-                    let n = (p - center).normalize();
+                    let outward = (p - center).normalize();
+                    // A sphere turned inside out is dark from outside.
+                    let n = if inward { -outward } else { outward };
                     return Some(LightSample {
                         wi,
                         dist: t,
@@ -354,7 +360,7 @@ impl Light {
             // The direction is all that counts: `p` is any point along it from `x`.
             Light::Envmap { map, .. } => map.pdf((p - x).normalize_or_zero()),
             Light::Area { shapes, area, .. } => {
-                if let Shape::Sphere { center, radius } = shapes[0]
+                if let Shape::Sphere { center, radius, .. } = shapes[0]
                     && shapes.len() == 1
                     && let Some(cos_max) = sphere_cone(center, radius, x)
                 {

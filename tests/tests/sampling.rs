@@ -934,7 +934,7 @@ fn hit(shape: &Shape, x: DVec3, w: DVec3) -> Option<(f64, DVec3, DVec3)> {
         ))
     };
     match *shape {
-        Shape::Sphere { center, radius } => {
+        Shape::Sphere { center, radius, .. } => {
             let (c, r) = (d(center), radius as f64);
             let f = x - c;
             let b = f.dot(w);
@@ -1000,7 +1000,7 @@ fn on_shape(shape: &Shape, p: DVec3, tol: f64) -> Option<DVec3> {
         })
     };
     match *shape {
-        Shape::Sphere { center, radius } => {
+        Shape::Sphere { center, radius, .. } => {
             let r = p - d(center);
             ((r.length() - radius as f64).abs() <= tol).then(|| r.normalize())
         }
@@ -1145,10 +1145,7 @@ fn quad_light() -> (Light, Vec<Shape>, Rgb) {
 }
 
 fn sphere_light() -> (Light, Vec<Shape>, Rgb) {
-    let sphere = Shape::Sphere {
-        center: Vec3::new(0.3, -0.2, 2.5),
-        radius: 0.6,
-    };
+    let sphere = Shape::sphere(Vec3::new(0.3, -0.2, 2.5), 0.6);
     let radiance = Rgb::new(1.0, 4.0, 2.0);
     (
         area_light(vec![sphere], radiance, 1),
@@ -1210,7 +1207,7 @@ fn quad_light_sample_li_matches_pdf_li() {
 #[test]
 fn sphere_light_seen_from_outside_samples_its_cone() {
     let (light, shapes, radiance) = sphere_light();
-    let Shape::Sphere { center, radius } = shapes[0] else {
+    let Shape::Sphere { center, radius, .. } = shapes[0] else {
         unreachable!()
     };
     let x = Vec3::new(0.0, 0.1, 0.0);

@@ -92,7 +92,7 @@ fn a_disk_light_gives_the_irradiance_of_its_formula() {
 }
 
 #[test]
-fn flip_normals_turns_meshes_and_quads_over_but_not_spheres() {
+fn flip_normals_turns_meshes_quads_and_spheres_over() {
     let dir = temp_dir("flip-normals");
     // One triangle, wound to face +y: flipped, it faces -y.
     let obj = write(&dir, "tri.obj", "v -1 0 -1\nv 0 0 1\nv 1 0 -1\nf 1 2 3\n");
@@ -131,17 +131,82 @@ fn flip_normals_turns_meshes_and_quads_over_but_not_spheres() {
             );
         }
     }
-    let text = format!(
-        "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\nflip_normals = true\n"
-    );
-    let path = write(&dir, "sphere.toml", &text);
+    // A sphere turned inside out: its normal points to the centre; it cannot hold a medium.
+    let sphere = |extra: &str| {
+        format!(
+            "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[media.fog]\ntype = \"homogeneous\"\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.1, 0.1, 0.1]\n\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\nflip_normals = true\n{extra}"
+        )
+    };
+    let scene = Scene::load(&write(&dir, "sphere.toml", &sphere("")), &[]).unwrap();
+    let ray = foton_core::geometry::Ray::new(glam::Vec3::new(0.0, 0.0, 3.0), glam::Vec3::NEG_Z);
+    let hit = scene.intersect(&ray, f32::INFINITY).unwrap();
+    assert!((hit.ng - glam::Vec3::NEG_Z).length() < 1e-6, "{}", hit.ng);
+    let path = write(&dir, "sphere.toml", &sphere("interior = \"fog\""));
     let run = foton_with_plugins(&["check", path.to_str().unwrap()]);
     assert_eq!(run.code, 1);
     assert!(
-        run.stderr.contains("shapes[0].flip_normals") && run.stderr.contains("sphere"),
+        run.stderr.contains("shapes[0].flip_normals") && run.stderr.contains("inside out"),
         "{}",
         run.stderr
     );
+}
+
+/// An emissive sphere turned inside out lights what is inside it and nothing outside: a
+/// two-sided diffuse square at the centre of a dome of radiance L (a furnace from inside)
+/// shows rho L, and the same dome seen from outside is black.
+#[test]
+fn an_inside_out_sphere_emits_inwards() {
+    let scene = |integrator: &str, camera_z: f32| {
+        header(integrator, 64, 4, 8, 8)
+            + &format!(
+                r#"
+[camera]
+position = [0, 0, {camera_z}]
+look_at = [0, 0, 0]
+fov = 10
+
+[materials.grey]
+type = "diffuse"
+reflectance = [0.6, 0.6, 0.6]
+
+[materials.black]
+type = "diffuse"
+reflectance = [0, 0, 0]
+
+[[shapes]]
+type = "quad"
+origin = [-0.5, -0.5, 0]
+u = [1, 0, 0]
+v = [0, 1, 0]
+material = "grey"
+
+[[shapes]]
+type = "sphere"
+center = [0, 0, 0]
+radius = 5
+material = "black"
+emission = [2, 2, 2]
+flip_normals = true
+
+[integrators.photon]
+global_photons = 200000
+caustic_photons = 0
+direct = "photons"
+k = 200
+"#
+            )
+    };
+    // path: light samples on the dome from inside; photon: photons it emits inwards.
+    for (integrator, tol) in [("path", 0.01), ("photon", 0.05)] {
+        let inside = render_toml("dome-inside", &scene(integrator, 3.0), &[], 2);
+        let (m, se) = region_mean(&inside, 2, 2, 6, 6);
+        assert!(
+            (m.x - 1.2).abs() < 4.0 * se.x + tol * 1.2,
+            "{integrator}: rho L = 1.2 inside the dome: {m}"
+        );
+    }
+    let outside = render_toml("dome-outside", &scene("path", 8.0), &[], 2);
+    assert_eq!(outside.mean(), Rgb::ZERO, "the dome is dark from outside");
 }
 
 /// `hide_emitters`: the camera does not see emitters directly (an area light in front of it is

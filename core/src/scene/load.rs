@@ -951,7 +951,7 @@ fn read_shapes(
                 if radius <= 0.0 {
                     return Err(s.error("radius", format!("must be positive, found {radius}")));
                 }
-                vec![Shape::Sphere { center, radius }]
+                vec![Shape::sphere(center, radius)]
             }
             "quad" => {
                 let origin = s.vec3_required("origin")?;
@@ -1015,15 +1015,15 @@ fn read_shapes(
             }
         };
         if flip {
-            match ty {
-                "sphere" => {
-                    return Err(s.error(
-                        "flip_normals",
-                        "a sphere cannot be turned inside out yet (a mesh, quad or disk can)",
-                    ));
-                }
-                "mesh" => {} // the mesh reader reversed its triangles
-                _ => shapes.iter_mut().for_each(Shape::flip),
+            if ty == "sphere" && s.has("interior") {
+                return Err(s.error(
+                    "flip_normals",
+                    "a sphere turned inside out cannot hold an interior medium (its inside would be all of space outside it)",
+                ));
+            }
+            if ty != "mesh" {
+                // The mesh reader reversed its triangles itself.
+                shapes.iter_mut().for_each(Shape::flip);
             }
         }
         let material_name = s.string_required("material")?;

@@ -1360,10 +1360,6 @@ impl Reader {
                 }
                 shapes.push(t);
             }
-            "sphere" if flip_normals => {
-                o.props.clear();
-                return self.unsupported(&o, "a sphere with flip_normals is not supported yet");
-            }
             "disk" => {
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("disk".into()), line));
@@ -1400,6 +1396,9 @@ impl Reader {
                 t.insert("type", at(Value::Str("sphere".into()), line));
                 t.insert("center", vec3(m.transform_point3(center), line));
                 t.insert("radius", at(Value::Float(radius * s), line));
+                if flip_normals {
+                    t.insert("flip_normals", at(Value::Bool(true), line));
+                }
                 shapes.push(t);
             }
             "rectangle" => shapes.push(rectangle(

@@ -187,7 +187,7 @@ const MAX_COLLECTED_CROSSINGS: usize = 16;
 /// quad or triangle.
 fn segment_crossings(shape: &Shape, ray: &Ray, tmax: f32) -> [Option<f32>; 2] {
     match *shape {
-        Shape::Sphere { center, radius } => {
+        Shape::Sphere { center, radius, .. } => {
             // As Shape::intersect (Ray Tracing Gems ch. 7), keeping both roots.
             let f = ray.origin - center;
             let b = -f.dot(ray.dir);

@@ -155,7 +155,7 @@ fn distance_to(shape: &Shape, p: Vec3) -> f32 {
         p.distance(a + s * e)
     };
     match *shape {
-        Shape::Sphere { center, radius } => (p.distance(center) - radius).abs(),
+        Shape::Sphere { center, radius, .. } => (p.distance(center) - radius).abs(),
         Shape::Triangle { p0, e1, e2 } => {
             // The nearest point is inside the triangle (the projection) or on an edge.
             let n = e1.cross(e2);
