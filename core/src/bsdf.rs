@@ -341,6 +341,14 @@ impl Bsdf {
         self.eval(wo, wi) / cos_g
     }
 
+    /// [`Bsdf::eval`] and [`Bsdf::pdf`] together (next-event estimation wants both), the
+    /// directions taken to the local frame once.
+    #[inline]
+    pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        let (wo, wi) = self.local(wo, wi);
+        (self.lobe.eval(wo, wi), self.lobe.pdf(wo, wi))
+    }
+
     /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {

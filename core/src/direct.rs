@@ -104,7 +104,7 @@ pub fn estimate_direct(
     // The scattering function times the cosine, its sampling pdf, and the visibility.
     let (f, scatter_pdf, tr) = match at {
         Scatter::Surface { hit, bsdf } => {
-            let f = bsdf.eval(wo, ls.wi);
+            let (f, pdf) = bsdf.eval_pdf(wo, ls.wi);
             if f == Rgb::ZERO {
                 return Rgb::ZERO;
             }
@@ -118,7 +118,7 @@ pub fn estimate_direct(
                 Rgb::ONE
             };
             let pdf = if mis == Mis::WithScatterSampling && !ls.delta {
-                bsdf.pdf(wo, ls.wi)
+                pdf
             } else {
                 0.0
             };

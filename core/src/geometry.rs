@@ -302,7 +302,37 @@ impl Shape {
     /// disk: u = r, v = phi / 2 pi; triangle: interpolated, else the barycentrics (b1, b2)),
     /// and the shading normal from a triangle's vertex normals.
     pub fn surface(&self, p: Vec3, attrs: Option<&TriangleAttrs>) -> SurfacePoint {
+        self.surface_with(p, attrs, true)
+    }
+
+    /// [`Shape::surface`], with the texture coordinates and the tangent (zero) left out
+    /// unless `coordinates`: most materials need neither, and a sphere's cost an atan2 and an
+    /// acos per hit.
+    #[inline]
+    pub fn surface_with(
+        &self,
+        p: Vec3,
+        attrs: Option<&TriangleAttrs>,
+        coordinates: bool,
+    ) -> SurfacePoint {
         let ng = self.normal(p);
+        if !coordinates
+            && !matches!(
+                attrs,
+                Some(TriangleAttrs {
+                    normals: Some(_),
+                    ..
+                })
+            )
+        {
+            return SurfacePoint {
+                p,
+                ng,
+                ns: ng,
+                uv: Vec2::ZERO,
+                dpdu: Vec3::ZERO,
+            };
+        }
         let (uv, dpdu, ns) = match *self {
             Shape::Sphere { center, radius, .. } => {
                 let d = (p - center) / radius;

@@ -359,6 +359,47 @@ impl Material {
         matches!(self, Material::Null)
     }
 
+    /// Whether the BSDF depends on the surface's texture coordinates or tangent: a texture
+    /// that varies, or an anisotropic lobe.
+    #[inline]
+    pub fn needs_coordinates(&self) -> bool {
+        let varies = |t: &Texture| !t.is_constant();
+        match self {
+            Material::Diffuse { reflectance, .. } | Material::Mirror { reflectance } => {
+                varies(reflectance)
+            }
+            Material::Conductor {
+                specular_reflectance,
+                ..
+            } => varies(specular_reflectance),
+            Material::RoughConductor {
+                lobe,
+                specular_reflectance,
+                ..
+            } => !lobe.distribution.is_isotropic() || varies(specular_reflectance),
+            Material::RoughDielectric {
+                lobe,
+                specular_reflectance,
+                specular_transmittance,
+            } => {
+                !lobe.distribution.is_isotropic()
+                    || varies(specular_reflectance)
+                    || varies(specular_transmittance)
+            }
+            Material::Plastic {
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            }
+            | Material::RoughPlastic {
+                diffuse_reflectance,
+                specular_reflectance,
+                ..
+            } => varies(diffuse_reflectance) || varies(specular_reflectance),
+            Material::Dielectric { .. } | Material::ThinDielectric { .. } | Material::Null => false,
+        }
+    }
+
     /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
     #[inline]
     pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
@@ -433,7 +474,12 @@ impl Material {
         };
         Some(Bsdf {
             lobe,
-            frame: Frame::from_normal_tangent(sp.ns, sp.dpdu),
+            // Without a tangent (not needed, or none), any frame: isotropic lobes do not care.
+            frame: if sp.dpdu == Vec3::ZERO {
+                Frame::from_normal(sp.ns)
+            } else {
+                Frame::from_normal_tangent(sp.ns, sp.dpdu)
+            },
             ng: sp.ng,
             twosided,
         })

@@ -197,7 +197,13 @@ impl Scene {
         if material.is_null() {
             return None;
         }
-        material.bsdf(&self.surface(hit))
+        let prim = self.primitive(hit);
+        let attrs = self.triangle_attrs.get(prim.attrs as usize);
+        let mut sp = prim
+            .shape
+            .surface_with(hit.p, attrs, material.needs_coordinates());
+        sp.ng = hit.ng;
+        material.bsdf(&sp)
     }
 
     /// The area light a hit lies on, if its object emits.
