@@ -96,6 +96,17 @@ fn table_mut<'t>(t: &'t mut Table, key: &str) -> &'t mut Table {
     }
 }
 
+/// A transform as the TOML `{ matrix = [16 numbers, row-major] }` table.
+fn matrix_table(m: DMat4, line: u32) -> Node {
+    let rows: Vec<Node> = (0..4)
+        .flat_map(|r| m.row(r).to_array())
+        .map(|x| at(Value::Float(x), line))
+        .collect();
+    let mut t = Table::default();
+    t.insert("matrix", at(Value::Array(rows), line));
+    at(Value::Table(t), line)
+}
+
 fn vec3(v: DVec3, line: u32) -> Node {
     at(
         Value::Array(
@@ -1096,6 +1107,19 @@ impl Reader {
         }
     }
 
+    /// The element's required `filename`, relative to the XML file, as the TOML document's
+    /// path (relative to the main scene's folder, or absolute).
+    fn filename(&self, o: &mut Obj) -> Result<Node> {
+        let file = o
+            .string("filename")?
+            .ok_or_else(|| o.error("missing `filename`"))?;
+        let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
+        let rel = path
+            .strip_prefix(&self.dir)
+            .map_or(path.clone(), Path::to_path_buf);
+        Ok(at(Value::Str(rel.to_string_lossy().into_owned()), o.line))
+    }
+
     /// A `<texture>` as the inline table foton's materials take (docs/scene-format.md):
     /// Mitsuba's `bitmap` (filename, raw, filter_type, wrap_mode, to_uv) and `checkerboard`
     /// (color0, color1, to_uv). None: left out (lenient).
@@ -1105,17 +1129,7 @@ impl Reader {
         t.insert("type", at(Value::Str(o.ty.clone()), line));
         match o.ty.as_str() {
             "bitmap" => {
-                let file = o
-                    .string("filename")?
-                    .ok_or_else(|| o.error("missing `filename`"))?;
-                let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
-                let rel = path
-                    .strip_prefix(&self.dir)
-                    .map_or(path.clone(), Path::to_path_buf);
-                t.insert(
-                    "filename",
-                    at(Value::Str(rel.to_string_lossy().into_owned()), line),
-                );
+                t.insert("filename", self.filename(&mut o)?);
                 if o.boolean("raw", false)? {
                     t.insert("raw", at(Value::Bool(true), line));
                 }
@@ -1142,13 +1156,7 @@ impl Reader {
         }
         let m = o.transform("to_uv")?;
         if m != DMat4::IDENTITY {
-            let mut tr = Table::default();
-            let rows: Vec<Node> = (0..4)
-                .flat_map(|r| m.row(r).to_array())
-                .map(|x| at(Value::Float(x), line))
-                .collect();
-            tr.insert("matrix", at(Value::Array(rows), line));
-            t.insert("to_uv", at(Value::Table(tr), line));
+            t.insert("to_uv", matrix_table(m, line));
         }
         self.leftovers(&o)?;
         Ok(Some(t))
@@ -1327,13 +1335,7 @@ impl Reader {
         };
         match o.ty.as_str() {
             "obj" | "ply" => {
-                let file = o
-                    .string("filename")?
-                    .ok_or_else(|| o.error("missing `filename`"))?;
-                let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
-                let rel = path
-                    .strip_prefix(&self.dir)
-                    .map_or(path.clone(), Path::to_path_buf);
+                let file = self.filename(&mut o)?;
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("mesh".into()), line));
                 if o.boolean("face_normals", false)? {
@@ -1345,18 +1347,9 @@ impl Reader {
                 if flip_normals {
                     t.insert("flip_normals", at(Value::Bool(true), line));
                 }
-                t.insert(
-                    "file",
-                    at(Value::Str(rel.to_string_lossy().into_owned()), line),
-                );
+                t.insert("file", file);
                 if m != DMat4::IDENTITY {
-                    let mut tr = Table::default();
-                    let rows: Vec<Node> = (0..4)
-                        .flat_map(|r| m.row(r).to_array())
-                        .map(|x| at(Value::Float(x), line))
-                        .collect();
-                    tr.insert("matrix", at(Value::Array(rows), line));
-                    t.insert("transform", at(Value::Table(tr), line));
+                    t.insert("transform", matrix_table(m, line));
                 }
                 shapes.push(t);
             }
@@ -1484,26 +1477,10 @@ impl Reader {
                 t.insert("radiance", vec3(l, line));
             }
             "envmap" => {
-                let file = o
-                    .string("filename")?
-                    .ok_or_else(|| o.error("missing `filename`"))?;
-                let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
-                let rel = path
-                    .strip_prefix(&self.dir)
-                    .map_or(path.clone(), Path::to_path_buf);
-                t.insert(
-                    "filename",
-                    at(Value::Str(rel.to_string_lossy().into_owned()), line),
-                );
+                t.insert("filename", self.filename(&mut o)?);
                 t.insert("scale", at(Value::Float(o.float("scale", 1.0)?), line));
                 if m != DMat4::IDENTITY {
-                    let rows: Vec<Node> = (0..4)
-                        .flat_map(|r| m.row(r).to_array())
-                        .map(|x| at(Value::Float(x), line))
-                        .collect();
-                    let mut tr = Table::default();
-                    tr.insert("matrix", at(Value::Array(rows), line));
-                    t.insert("to_world", at(Value::Table(tr), line));
+                    t.insert("to_world", matrix_table(m, line));
                 }
                 // Compensation changes only the noise.
                 o.take("mis_compensation");
