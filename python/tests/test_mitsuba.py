@@ -53,7 +53,8 @@ XML = """<scene version="3.0.0">
 </scene>
 """
 DIFFUSE = '<bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.2, 0.2"/></bsdf>'
-ROUGH = '<bsdf type="roughplastic"><float name="alpha" value="0.1"/></bsdf>'
+# A BSDF foton does not read (yet).
+UNREAD = '<bsdf type="principled"><float name="roughness" value="0.1"/></bsdf>'
 
 
 def xml_scene(tmp_path, bsdf=DIFFUSE):
@@ -83,15 +84,15 @@ def test_xml_defaults_and_overrides(tmp_path):
 
 
 def test_xml_lenient(tmp_path):
-    xml = xml_scene(tmp_path, ROUGH)
+    xml = xml_scene(tmp_path, UNREAD)
     with pytest.raises(foton.SceneError) as e:
         foton.load(xml)
     assert e.value.file == str(xml)
-    assert XML.replace("SPHERE_BSDF", ROUGH).splitlines()[e.value.line - 1].strip().startswith(
-        '<bsdf type="roughplastic">'
+    assert XML.replace("SPHERE_BSDF", UNREAD).splitlines()[e.value.line - 1].strip().startswith(
+        '<bsdf type="principled">'
     )
     assert "not supported yet" in e.value.reason and "--lenient" in e.value.reason
-    with pytest.warns(foton.FotonWarning, match="left out: .*roughplastic"):
+    with pytest.warns(foton.FotonWarning, match="left out: .*principled"):
         scene = foton.load(xml, lenient=True, **{"render.spp": 1})
     assert scene.render(progress=False).any()
 
