@@ -302,20 +302,21 @@ impl Shape {
     /// disk: u = r, v = phi / 2 pi; triangle: interpolated, else the barycentrics (b1, b2)),
     /// and the shading normal from a triangle's vertex normals.
     pub fn surface(&self, p: Vec3, attrs: Option<&TriangleAttrs>) -> SurfacePoint {
-        self.surface_with(p, attrs, true)
+        self.surface_at(p, self.normal(p), attrs, true)
     }
 
-    /// [`Shape::surface`], with the texture coordinates and the tangent (zero) left out
-    /// unless `coordinates`: most materials need neither, and a sphere's cost an atan2 and an
-    /// acos per hit.
+    /// [`Shape::surface`] at a point whose geometric normal `ng` is known (a hit's: not
+    /// computed again), with the texture coordinates and the tangent (zero) left out unless
+    /// `coordinates`: most materials need neither, and a sphere's cost an atan2 and an acos
+    /// per hit.
     #[inline]
-    pub fn surface_with(
+    pub fn surface_at(
         &self,
         p: Vec3,
+        ng: Vec3,
         attrs: Option<&TriangleAttrs>,
         coordinates: bool,
     ) -> SurfacePoint {
-        let ng = self.normal(p);
         if !coordinates
             && !matches!(
                 attrs,

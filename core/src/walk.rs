@@ -320,15 +320,8 @@ pub fn walk_to_diffuse(
             if let Some((light_id, le)) = scene.escaped(seg.ray.dir)
                 && !(hidden && bounces == 0)
             {
-                let w = match glossy_from {
-                    None => 1.0,
-                    Some((pdf, p)) => {
-                        let light = &scene.lights[light_id as usize];
-                        let pdf_light = scene.light_pmf(light_id as usize)
-                            * light.pdf_li(p, p + seg.ray.dir, Vec3::ZERO);
-                        power_heuristic(pdf, pdf_light)
-                    }
-                };
+                let far = glossy_from.map(|(_, p)| p + seg.ray.dir);
+                let w = emission_weight(scene, glossy_from, light_id, far, Vec3::ZERO);
                 emitted += beta * le * w;
             }
             break;
@@ -343,14 +336,7 @@ pub fn walk_to_diffuse(
         if let Some((light_id, light)) = scene.area_light(&hit) {
             let le = light.emitted(hit.ng, wo);
             if le != Rgb::ZERO {
-                let w = match glossy_from {
-                    None => 1.0,
-                    Some((pdf, p)) => {
-                        let pdf_light =
-                            scene.light_pmf(light_id as usize) * light.pdf_li(p, hit.p, hit.ng);
-                        power_heuristic(pdf, pdf_light)
-                    }
-                };
+                let w = emission_weight(scene, glossy_from, light_id, Some(hit.p), hit.ng);
                 emitted += beta * le * w;
             }
         }
@@ -410,6 +396,25 @@ pub fn walk_to_diffuse(
         emitted,
         visible: None,
     }
+}
+
+/// The MIS weight of emission met by the camera walk at `point` (normal `n`) on light
+/// `light_id`: 1 after the camera or a delta bounce; after a glossy bounce `from` (its pdf and
+/// point), the power heuristic against the light sample next-event estimation took there.
+/// For a light at infinity `point` is any point along the direction (`n` unused).
+fn emission_weight(
+    scene: &Scene,
+    from: Option<(f32, Vec3)>,
+    light_id: u32,
+    point: Option<Vec3>,
+    n: Vec3,
+) -> f32 {
+    let (Some((pdf, x)), Some(point)) = (from, point) else {
+        return 1.0;
+    };
+    let light = &scene.lights[light_id as usize];
+    let pdf_light = scene.light_pmf(light_id as usize) * light.pdf_li(x, point, n);
+    power_heuristic(pdf, pdf_light)
 }
 
 /// [`walk_to_diffuse`] for integrators that do not render media (the media are still

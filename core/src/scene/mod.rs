@@ -182,12 +182,16 @@ impl Scene {
     /// The surface at a hit: shading normal, texture coordinates, tangent.
     #[inline]
     pub fn surface(&self, hit: &Hit) -> SurfacePoint {
+        self.surface_point(hit, true)
+    }
+
+    /// [`Scene::surface`], the coordinates only if asked for (see [`crate::geometry::Shape::surface_at`]); the
+    /// geometric normal is the hit's, the one every other query used.
+    #[inline]
+    fn surface_point(&self, hit: &Hit, coordinates: bool) -> SurfacePoint {
         let prim = self.primitive(hit);
         let attrs = self.triangle_attrs.get(prim.attrs as usize);
-        let mut sp = prim.shape.surface(hit.p, attrs);
-        // The hit's normal is the one every other query used: keep it exact.
-        sp.ng = hit.ng;
-        sp
+        prim.shape.surface_at(hit.p, hit.ng, attrs, coordinates)
     }
 
     /// The BSDF at a hit (None on a null boundary, which does not scatter).
@@ -197,13 +201,7 @@ impl Scene {
         if material.is_null() {
             return None;
         }
-        let prim = self.primitive(hit);
-        let attrs = self.triangle_attrs.get(prim.attrs as usize);
-        let mut sp = prim
-            .shape
-            .surface_with(hit.p, attrs, material.needs_coordinates());
-        sp.ng = hit.ng;
-        material.bsdf(&sp)
+        material.bsdf(&self.surface_point(hit, material.needs_coordinates()))
     }
 
     /// The area light a hit lies on, if its object emits.
