@@ -351,6 +351,12 @@ pub fn format_of(path: &Path) -> Result<ImageFormat> {
 /// Checks before rendering that an output can be written: known extension, existing and
 /// writable folder. Finding out after a long render would lose it.
 pub fn check_output(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::io(
+            path,
+            "is a directory, not a file: name the image in it (e.g. render.exr or render.png)",
+        ));
+    }
     format_of(path)?;
     if path.exists() && !path.is_file() {
         return Err(Error::io(

@@ -3,13 +3,33 @@
 //! `Properties`, pbrt-v4's `ParameterDictionary`). It remembers which keys were read, so that
 //! unknown (misspelt) parameters can be reported afterwards.
 
-use crate::error::{Error, Location, Result};
+use crate::error::{Error, Location, Result, did_you_mean};
 use crate::kernel::{BUILTIN_KERNELS, NormalizedKernel};
 use crate::plugin::Registry;
 use crate::value::{Node, Table, Value};
 use glam::Vec3;
 use std::cell::RefCell;
 use std::path::Path;
+
+/// A key written in a table that nothing read.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Unused {
+    /// Its TOML key path (`integrators.path.rr_dept`).
+    pub key: String,
+    pub location: Location,
+    /// The key path it most likely meant (`integrators.path.rr_depth`), if one is close.
+    pub suggestion: Option<String>,
+}
+
+impl Unused {
+    /// "unknown field" and what it may have meant, for messages.
+    pub fn message(&self) -> String {
+        match &self.suggestion {
+            Some(s) => format!("unknown field (did you mean `{s}`?)"),
+            None => "unknown field".into(),
+        }
+    }
+}
 
 pub struct Properties<'a> {
     file: &'a Path,
@@ -18,6 +38,8 @@ pub struct Properties<'a> {
     line: u32,
     column: u32,
     used: RefCell<Vec<String>>,
+    /// Every name asked for, present or not: what an unknown key may have meant.
+    asked: RefCell<Vec<String>>,
     /// Kernel plugins that `kernel()` may return (handed over by the host).
     plugins: Option<&'a Registry>,
 }
@@ -35,6 +57,7 @@ impl<'a> Properties<'a> {
                 line: node.line,
                 column: node.column,
                 used: RefCell::new(Vec::new()),
+                asked: RefCell::new(Vec::new()),
                 plugins: None,
             }),
             other => Err(Error::Scene {
@@ -58,6 +81,7 @@ impl<'a> Properties<'a> {
             line: 0,
             column: 0,
             used: RefCell::new(Vec::new()),
+            asked: RefCell::new(Vec::new()),
             plugins: None,
         }
     }
@@ -71,6 +95,7 @@ impl<'a> Properties<'a> {
             line: 0,
             column: 0,
             used: RefCell::new(Vec::new()),
+            asked: RefCell::new(Vec::new()),
             plugins: None,
         }
     }
@@ -152,7 +177,15 @@ impl<'a> Properties<'a> {
     }
 
     pub fn has(&self, name: &str) -> bool {
+        self.ask(name);
         self.table.get(name).is_some()
+    }
+
+    fn ask(&self, name: &str) {
+        let mut asked = self.asked.borrow_mut();
+        if !asked.iter().any(|k| k == name) {
+            asked.push(name.to_string());
+        }
     }
 
     pub fn keys(&self) -> impl Iterator<Item = &'a str> {
@@ -161,6 +194,7 @@ impl<'a> Properties<'a> {
 
     /// The raw node, marked as used.
     pub fn node(&self, name: &str) -> Option<&'a Node> {
+        self.ask(name);
         let node = self.table.get(name)?;
         let mut used = self.used.borrow_mut();
         if !used.iter().any(|k| k == name) {
@@ -372,13 +406,20 @@ impl<'a> Properties<'a> {
         }
     }
 
-    /// Keys present in the table but never read: misspelt or unsupported parameters.
-    pub fn unused(&self) -> Vec<(String, Location)> {
+    /// Keys present in the table but never read: misspelt or unsupported parameters, each
+    /// with the name it most likely meant among those that were asked for.
+    pub fn unused(&self) -> Vec<Unused> {
         let used = self.used.borrow();
+        let asked = self.asked.borrow();
         self.table
             .keys()
             .filter(|k| !used.iter().any(|u| u == k))
-            .map(|k| (self.key_path(k), self.location(k)))
+            .map(|k| Unused {
+                key: self.key_path(k),
+                location: self.location(k),
+                suggestion: did_you_mean(k, asked.iter().map(String::as_str))
+                    .map(|s| self.key_path(s)),
+            })
             .collect()
     }
 }

@@ -417,9 +417,9 @@ fn read_to_uv(t: &Properties<'_>) -> Result<Affine2> {
             .map_or(Vec2::ZERO, |v| Vec2::from_slice(&v));
         Affine2::from_scale_angle_translation(scale, 0.0, offset)
     };
-    if let Some((key, _)) = m.unused().first() {
+    if let Some(u) = m.unused().first() {
         return Err(m.error(
-            key.rsplit('.').next().unwrap_or(key),
+            u.key.rsplit('.').next().unwrap_or(&u.key),
             "unknown parameter of to_uv; expected matrix, or scale and offset",
         ));
     }

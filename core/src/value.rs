@@ -273,16 +273,52 @@ fn find_renamed(
     None
 }
 
+/// `path` relative to the folder `base` (both absolute): `../meshes/a.obj`. Lexical: `..`
+/// in `path` is resolved against the components before it, which is right for the canonical
+/// folders `foton convert` passes.
+pub fn relative_path(path: &Path, base: &Path) -> PathBuf {
+    use std::path::Component;
+    let normal = |p: &Path| {
+        let mut out: Vec<Component<'_>> = Vec::new();
+        for c in p.components() {
+            match c {
+                Component::CurDir => {}
+                Component::ParentDir if matches!(out.last(), Some(Component::Normal(_))) => {
+                    out.pop();
+                }
+                c => out.push(c),
+            }
+        }
+        out.into_iter()
+            .map(|c| c.as_os_str().to_owned())
+            .collect::<Vec<_>>()
+    };
+    let (p, b) = (normal(path), normal(base));
+    let common = p.iter().zip(&b).take_while(|(x, y)| x == y).count();
+    let mut out = PathBuf::new();
+    for _ in common..b.len() {
+        out.push("..");
+    }
+    for c in &p[common..] {
+        out.push(c);
+    }
+    out
+}
+
 impl Document {
-    /// Makes the relative `file` of every shape, the `filename` of every light (an envmap's
-    /// image) and of every material's texture, and the film's `output` absolute against `base`
-    /// (for a document written into another folder than the one it was read from).
-    pub fn absolutize_files(&mut self, base: &Path) {
+    /// Rewrites the relative `file` of every shape and the `filename` of every light (an
+    /// envmap's image) and of every material's texture, written relative to the folder `from`,
+    /// relative to the folder `to` (both absolute): for a document written into another folder
+    /// than the one it was read from, whose inputs must still be found. The film's `output`
+    /// is left as it is, so the image is written beside the new file.
+    pub fn rebase_files(&mut self, from: &Path, to: &Path) {
         let fix = |node: &mut Node| {
             if let Value::Str(s) = &mut node.value
                 && Path::new(s.as_str()).is_relative()
             {
-                *s = base.join(&*s).to_string_lossy().into_owned();
+                *s = relative_path(&from.join(&*s), to)
+                    .to_string_lossy()
+                    .into_owned();
             }
         };
         for (array, key) in [("shapes", "file"), ("lights", "filename")] {
@@ -317,14 +353,6 @@ impl Document {
                     }
                 }
             }
-        }
-        if let Some(Node {
-            value: Value::Table(film),
-            ..
-        }) = self.root.get_mut("film")
-            && let Some(output) = film.get_mut("output")
-        {
-            fix(output);
         }
     }
 

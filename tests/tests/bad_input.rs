@@ -766,13 +766,94 @@ fn samples_per_pixel_zero() {
         "render.spp",
         &["must be at least 1"],
     );
-    // From the command line: no line to show, but still the file and the key.
+    // From the command line: one message about the option, whatever the bad value (clap
+    // would otherwise take `-4` for an unknown flag and advise `-- -4`).
     let scene = SceneFile::new("spp-zero-flag", BASE);
-    let run = scene.render(&["--spp", "0"]);
-    assert_error(
-        &run,
-        &[scene.path_str(), "`render.spp`", "must be at least 1"],
-    );
+    for (value, words) in [
+        ("0", "at least 1, not 0"),
+        ("-4", "at least 1, not -4"),
+        ("four", "expected a whole number"),
+    ] {
+        let run = scene.render(&["--spp", value]);
+        assert_ne!(run.code, 0, "--spp {value} rendered:\n{}", show(&run));
+        let errors: Vec<&str> = run
+            .stderr
+            .lines()
+            .filter(|l| l.starts_with("error"))
+            .collect();
+        assert_eq!(
+            errors.len(),
+            1,
+            "--spp {value}: one message:\n{}",
+            show(&run)
+        );
+        assert!(
+            errors[0].contains("--spp") && errors[0].contains(words),
+            "--spp {value}:\n{}",
+            show(&run)
+        );
+        assert!(!run.stderr.contains("tip:"), "{}", show(&run));
+    }
+}
+
+/// A value set on the command line that nothing reads is an error (the user asked for it),
+/// naming what it probably meant; the same key written in the file stays a warning (the test
+/// above). In the table of another integrator than the one rendering, it is an error too.
+#[test]
+fn set_keys_that_nothing_reads_are_errors() {
+    let scene = SceneFile::new("set-typo", BASE);
+    for (set, words) in [
+        (
+            "integrators.path.rr_dept=3",
+            &[
+                "--set integrators.path.rr_dept",
+                "did you mean `integrators.path.rr_depth`",
+            ][..],
+        ),
+        (
+            "render.sppp=2",
+            &["--set render.sppp", "did you mean `render.spp`"][..],
+        ),
+        (
+            "film.colour=1",
+            &[
+                "--set film.colour",
+                "neither the scene nor the integrator `path`",
+            ][..],
+        ),
+        (
+            "integrators.photon.k=10",
+            &[
+                "--set integrators.photon.k",
+                "renders with `path`",
+                "[integrators.photon]",
+            ][..],
+        ),
+    ] {
+        let run = scene.render(&["--set", set]);
+        assert_error(&run, words);
+        assert!(!run.stderr.contains("did you mean") || words[1].contains("did you mean"));
+    }
+    // Keys that are read are fine, and a suggestion never names an unrelated key.
+    let run = scene.render(&[
+        "--set",
+        "integrators.path.rr_depth=3",
+        "--set",
+        "render.spp=1",
+    ]);
+    assert_eq!(run.code, 0, "{}", show(&run));
+    // A sweep over a misspelt key renders nothing (it used to render identical cells).
+    let out = scene.dir.join("sweep.png");
+    let run = foton(&[
+        "sweep",
+        scene.path_str(),
+        "--set",
+        "integrators.path.rr_dept=3,4",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_error(&run, &["integrators.path.rr_dept", "did you mean"]);
+    assert!(!out.exists());
 }
 
 #[test]

@@ -277,9 +277,19 @@ fn xml_renders_as_its_toml_meaning_and_convert_round_trips() {
     ok(&render(&xml, &c1, &["-D", "res=20"]));
     ok(&render(&converted, &c2, &[]));
     assert!(std::fs::read(&c1).unwrap() == std::fs::read(&c2).unwrap());
-    // Into another folder: the meshes are found by their full paths.
+    // Into another folder: the meshes are named relative to the new file (a folder of
+    // scenes moves as a whole), and the image is written beside it.
     let elsewhere = temp_dir("mitsuba-convert-elsewhere").join("scene.toml");
     ok(&foton(&["convert", s(&xml), "-o", s(&elsewhere)]));
+    let text = std::fs::read_to_string(&elsewhere).unwrap();
+    let full = std::fs::canonicalize(&dir).unwrap();
+    let files = text.lines().filter(|l| l.starts_with("file"));
+    assert!(files.clone().count() > 0, "{text}");
+    assert!(
+        files.clone().all(|l| !l.contains(full.to_str().unwrap())),
+        "{text}"
+    );
+    assert!(text.contains("file = \"../"), "{text}");
     let c3 = dir.join("c3.exr");
     ok(&render(&elsewhere, &c3, &["--set", "film.width=20"]));
     assert!(std::fs::read(&c1).unwrap() == std::fs::read(&c3).unwrap());

@@ -673,6 +673,86 @@ fn unknown_map_is_refused() {
     let _ = std::fs::remove_dir_all(dir);
 }
 
+/// Every file `compare` and `sweep` write goes beside -o: nothing is left in the scene's
+/// folder. A --set in the table of one of the compared integrators is for that one; in
+/// the table of an integrator not compared, it is an error.
+#[test]
+fn compare_and_sweep_write_only_beside_the_output() {
+    let (dir, scene) = setup("outputs");
+    let elsewhere = temp_dir("outputs-elsewhere");
+    let before: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    ok(&foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,photon",
+        "--spp",
+        "1",
+        "--set",
+        "integrators.photon.k=5",
+        "-o",
+        s(&elsewhere.join("c.png")),
+        "-q",
+    ]));
+    ok(&foton_with_plugins(&[
+        "sweep",
+        s(&scene),
+        "--set",
+        "render.seed=1,2",
+        "--spp",
+        "1",
+        "-o",
+        s(&elsewhere.join("s.png")),
+    ]));
+    let after: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    assert_eq!(before, after, "files were written beside the scene");
+    for f in ["c.png", "c.json", "c-path.exr", "c-photon.exr", "s.png"] {
+        assert!(elsewhere.join(f).is_file(), "{f} not beside -o");
+    }
+    let run = foton_with_plugins(&[
+        "compare",
+        s(&scene),
+        "--integrators",
+        "path,photon",
+        "--set",
+        "integrators.sppm.alpha=0.5",
+        "-o",
+        s(&elsewhere.join("d.png")),
+    ]);
+    fails_with(&run, &["integrators.sppm.alpha", "[integrators.sppm]"]);
+    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(elsewhere);
+}
+
+/// A folder given as the output is named as such, not as an image of unknown format.
+#[test]
+fn a_folder_as_output_is_refused_as_a_folder() {
+    let (dir, scene) = setup("folder-output");
+    for args in [
+        &["render", s(&scene), "-o", s(&dir)][..],
+        &["compare", s(&scene), "--integrators", "path", "-o", s(&dir)],
+        &[
+            "sweep",
+            s(&scene),
+            "--set",
+            "render.seed=1,2",
+            "-o",
+            s(&dir),
+        ],
+    ] {
+        let run = foton_with_plugins(args);
+        fails_with(&run, &["is a directory, not a file"]);
+        assert!(!run.stderr.contains("format"), "{}", run.stderr);
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 #[test]
 fn missing_output_folder_is_found_before_rendering() {
     let (dir, scene) = setup("bad-output");

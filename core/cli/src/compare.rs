@@ -38,7 +38,7 @@ pub(super) struct CompareArgs {
     )]
     integrators: Vec<String>,
     /// Samples per pixel for every integrator (overrides render.spp).
-    #[arg(long, conflicts_with = "time")]
+    #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = crate::parse_spp)]
     spp: Option<u32>,
     /// About S seconds of rendering per integrator: samples per pixel (a progressive
     /// integrator's iterations; a photon mapper's photon budgets and spp, half the time each)
@@ -527,8 +527,20 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     };
 
     // The scene as the command line sets it for integrator `name`, plus `extra` overrides.
+    // A --set in the table of another compared integrator is for that one alone.
     let overrides = |name: &str, extra: &[String]| {
-        let mut overrides = a.sets.clone();
+        let mut overrides: Vec<String> = a
+            .sets
+            .iter()
+            .filter(|set| {
+                let mut keys = set.split('=').next().unwrap_or_default().trim().split('.');
+                let target = (keys.next() == Some("integrators"))
+                    .then(|| keys.next())
+                    .flatten();
+                target.is_none_or(|t| t == name || !names.iter().any(|n| n == t))
+            })
+            .cloned()
+            .collect();
         overrides.push(format!("render.integrator={name:?}"));
         if let Some(spp) = a.spp {
             overrides.push(format!("render.spp={spp}"));

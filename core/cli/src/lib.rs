@@ -21,6 +21,7 @@ use foton_core::film::{Film, ImageFormat, check_output, format_of};
 use foton_core::integrator::{Integrator, Part, RenderContext};
 use foton_core::plugin::{IntegratorPlugin, Registry, search_path};
 use foton_core::scene::Scene;
+use foton_core::value::{Document, Value};
 pub use progress::TermProgress;
 use std::ffi::OsString;
 use std::io::Write;
@@ -45,8 +46,9 @@ pub fn install_interrupt_handler() {
     name = "foton",
     version,
     about = "foton: a physically based renderer whose integrators are plugins",
-    long_about = "foton renders a scene described in one TOML file (see docs/scene-format.md) with \
-                  the integrator plugin the file, or --integrator, names."
+    long_about = "foton renders a scene described in one TOML file or Mitsuba XML file (0.5, 0.6 or \
+                  3; see docs/scene-format.md) with the integrator plugin the file, or \
+                  --integrator, names."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -141,7 +143,7 @@ pub(crate) struct SceneArgs {
     #[arg(long)]
     integrator: Option<String>,
     /// Samples per pixel (overrides render.spp).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_spp)]
     spp: Option<u32>,
     /// Random seed (overrides render.seed).
     #[arg(long)]
@@ -205,12 +207,12 @@ struct CheckArgs {
 
 #[derive(Args)]
 struct BenchArgs {
-    /// The scene to render (default: scenes/cornell-box.toml).
-    #[arg(default_value = "scenes/cornell-box.toml")]
-    scene: PathBuf,
+    /// The scene to render (default: the Cornell box of scenes/cornell-box.toml, built into
+    /// the program so that the benchmark runs from any folder).
+    scene: Option<PathBuf>,
     #[arg(long)]
     integrator: Option<String>,
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_spp)]
     spp: Option<u32>,
     #[arg(long)]
     threads: Option<usize>,
@@ -254,6 +256,20 @@ pub fn run(args: Vec<OsString>, out: &mut dyn Write, err: &mut dyn Write) -> u8 
             let _ = writeln!(err, "error: {e}");
             1
         }
+    }
+}
+
+/// `--spp N`: one message for every value that is not a number of samples (`0`, `-4`, `x`),
+/// rather than clap's advice to pass `-4` after `--`.
+pub(crate) fn parse_spp(text: &str) -> std::result::Result<u32, String> {
+    match text.trim().parse::<i64>() {
+        Ok(n) if n >= 1 => {
+            u32::try_from(n).map_err(|_| format!("at most {} samples per pixel", u32::MAX))
+        }
+        Ok(n) => Err(format!("samples per pixel must be at least 1, not {n}")),
+        Err(_) => Err(format!(
+            "expected a whole number of samples per pixel (at least 1), not `{text}`"
+        )),
     }
 }
 
@@ -324,6 +340,9 @@ pub fn prepare_xml(
     strict: bool,
 ) -> Result<Prepared> {
     let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
+    // One command renders with one integrator: a --set for another one is not read. (The
+    // Python package keeps a scene's settings for every integrator, as a file does.)
+    refuse_sets_for_another_integrator(&scene)?;
     prepare_scene(scene, &search_path(plugin_dirs), strict)
 }
 
@@ -356,18 +375,34 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     let mut unused = scene.unused.clone();
     unused.extend(props.unused());
     drop(props);
-    if strict && let Some((key, loc)) = unused.first() {
+    // A value the command line set (--set, --spp, Python's overrides: no line in the file)
+    // that nothing reads was asked for explicitly: rendering without it would answer another
+    // question than the one asked, so it is an error even without --strict.
+    if let Some(u) = unused.iter().find(|u| u.location.line == 0) {
+        let hint = u
+            .suggestion
+            .as_ref()
+            .map_or(String::new(), |s| format!(" (did you mean `{s}`?)"));
+        return Err(Error::Usage(format!(
+            "--set {}: neither the scene nor the integrator `{}` reads it{hint}",
+            u.key, scene.render.integrator
+        )));
+    }
+    if strict && let Some(u) = unused.first() {
         return Err(Error::Scene {
-            location: loc.clone(),
-            key: key.clone(),
-            message: "unknown field (not used by the scene loader or the integrator)".into(),
+            location: u.location.clone(),
+            key: u.key.clone(),
+            message: format!(
+                "{} (not used by the scene loader or the integrator)",
+                u.message()
+            ),
         });
     }
     let mut warnings = scene.warnings.clone();
     warnings.extend(
         unused
             .iter()
-            .map(|(key, loc)| format!("{loc}: `{key}`: unknown field, ignored")),
+            .map(|u| format!("{}: `{}`: {}, ignored", u.location, u.key, u.message())),
     );
     Ok(Prepared {
         scene,
@@ -375,6 +410,42 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         plugin,
         warnings,
     })
+}
+
+/// An error for a value the command line set in the table of an integrator other than the
+/// one that renders (`integrators.photon.k` for `path`), which nothing reads.
+fn refuse_sets_for_another_integrator(scene: &Scene) -> Result<()> {
+    match set_for_another_integrator(scene) {
+        Some(other) => Err(Error::Usage(format!(
+            "--set {other}: the scene renders with `{}`, which does not read [integrators.{}]",
+            scene.render.integrator,
+            other.split('.').nth(1).unwrap_or_default()
+        ))),
+        None => Ok(()),
+    }
+}
+
+fn set_for_another_integrator(scene: &Scene) -> Option<String> {
+    fn first_set(table: &foton_core::value::Table, path: &str) -> Option<String> {
+        table.0.iter().find_map(|(k, node)| match &node.value {
+            Value::Table(t) => first_set(t, &format!("{path}.{k}")),
+            _ if node.line == 0 => Some(format!("{path}.{k}")),
+            _ => None,
+        })
+    }
+    let Some(Value::Table(integrators)) = scene.document.root.get("integrators").map(|n| &n.value)
+    else {
+        return None;
+    };
+    integrators
+        .0
+        .iter()
+        .find_map(|(name, node)| match &node.value {
+            Value::Table(t) if *name != scene.render.integrator => {
+                first_set(t, &format!("integrators.{name}"))
+            }
+            _ => None,
+        })
 }
 
 /// `<scene stem>-<suffix>` in the scene's folder: the default output of the tools.
@@ -592,17 +663,25 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
         )));
     }
     let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
-    // Files are named relative to the scene; from another folder, by their full path.
+    // Files are named relative to the scene; written into another folder, relative to it.
     let folder = |p: &Path| match p.parent() {
         Some(d) if !d.as_os_str().is_empty() => std::fs::canonicalize(d).ok(),
         _ => std::fs::canonicalize(".").ok(),
     };
     let base = folder(&a.scene).ok_or_else(|| Error::io(&a.scene, "cannot resolve its folder"))?;
-    if folder(&output).as_ref() != Some(&base) {
-        doc.absolutize_files(&base);
+    let target = folder(&output).ok_or_else(|| {
+        Error::io(
+            &output,
+            "the folder to write the TOML scene into does not exist",
+        )
+    })?;
+    if target != base {
+        doc.rebase_files(&base, &target);
     }
-    // The TOML must load: check it before writing.
-    Scene::from_document(doc.clone())?;
+    // The TOML must load from where it is written: check it before writing.
+    let mut written = doc.clone();
+    written.file = output.clone();
+    Scene::from_document(written)?;
     let header = format!(
         "# Converted by `foton convert` from {}\n",
         a.scene.display()
@@ -734,21 +813,32 @@ fn cmd_plugins(a: PluginArgs, out: &mut dyn Write) -> Result<u8> {
     Ok(0)
 }
 
+/// The scene `foton bench` renders when given none: the README's default scene.
+const DEFAULT_SCENE: &str = include_str!("../../../scenes/cornell-box.toml");
+const DEFAULT_SCENE_NAME: &str = "scenes/cornell-box.toml";
+
 fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let args = SceneArgs {
-        scene: a.scene.clone(),
+        scene: a.scene.clone().unwrap_or_default(),
         integrator: a.integrator.clone(),
         spp: a.spp,
         sets: a.sets.clone(),
         plugins: a.plugins.clone(),
         ..Default::default()
     };
-    let p = prepare(
-        &a.scene,
-        &scene_overrides(&args),
-        &a.plugins.plugin_dirs,
-        false,
-    )?;
+    let overrides = scene_overrides(&args);
+    let p = match &a.scene {
+        Some(path) => prepare(path, &overrides, &a.plugins.plugin_dirs, false)?,
+        None => {
+            let mut doc = Document::parse(DEFAULT_SCENE, Path::new(DEFAULT_SCENE_NAME))?;
+            for o in &overrides {
+                doc.set(o)?;
+            }
+            let scene = Scene::from_document(doc)?;
+            refuse_sets_for_another_integrator(&scene)?;
+            prepare_scene(scene, &search_path(&a.plugins.plugin_dirs), false)?
+        }
+    };
     for w in &p.warnings {
         let _ = writeln!(err, "warning: {w}");
     }
@@ -783,7 +873,7 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     let _ = writeln!(
         out,
         "{} with {}: {}x{} x {work}, {:.3} M rays/s",
-        a.scene.display(),
+        p.scene.file.display(),
         p.integrator.describe(),
         p.scene.film.width,
         p.scene.film.height,

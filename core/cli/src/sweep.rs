@@ -41,7 +41,7 @@ pub(super) struct SweepArgs {
     #[arg(long)]
     integrator: Option<String>,
     /// Samples per pixel (overrides render.spp).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_spp)]
     spp: Option<u32>,
     /// Random seed (overrides render.seed).
     #[arg(long)]

@@ -202,3 +202,84 @@ fn ctrl_c_writes_the_samples_done_so_far() {
     assert!(px.iter().all(|p| p.max_element() > 0.0));
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// Under a batch system or `nohup` stderr is a file or a pipe: the bar is replaced by a plain
+/// line every FOTON_PROGRESS_INTERVAL seconds (percentage, elapsed, time left), ending with
+/// the phase done; `-q` prints none.
+#[test]
+fn progress_without_a_terminal_is_a_plain_line_now_and_then() {
+    let (dir, exe) = install("progress", true);
+    let scene = scene(&dir, 64, 48);
+    let run = |quiet: bool| {
+        let mut cmd = Command::new(&exe);
+        cmd.args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(dir.join("out.png"))
+            .env_remove("FOTON_PLUGIN_PATH")
+            .env("FOTON_PROGRESS_INTERVAL", "0.001")
+            .stderr(Stdio::piped());
+        if quiet {
+            cmd.arg("-q");
+        }
+        let out = cmd.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let text = run(false);
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("pixels: ")).collect();
+    assert!(lines.len() >= 2, "no progress lines:\n{text}");
+    let percent = |l: &str| -> u32 {
+        l["pixels: ".len()..]
+            .split('%')
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
+    };
+    let all: Vec<u32> = lines.iter().map(|l| percent(l)).collect();
+    assert!(all.windows(2).all(|w| w[0] <= w[1]), "{text}");
+    assert!(lines.iter().all(|l| l.contains("elapsed")), "{text}");
+    let last = lines.last().unwrap();
+    assert!(percent(last) == 100 && last.ends_with("done"), "{text}");
+    assert!(
+        lines[..lines.len() - 1].iter().any(|l| l.contains("left")),
+        "{text}"
+    );
+    assert!(
+        !text.contains('\r'),
+        "no terminal escapes in a log: {text:?}"
+    );
+    assert!(!run(true).contains("pixels: "));
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// `foton bench` with no scene renders the default scene built into the program, from any
+/// folder.
+#[test]
+fn bench_without_a_scene_works_from_any_folder() {
+    let (dir, exe) = install("bench", true);
+    let out = Command::new(&exe)
+        .args([
+            "bench",
+            "--spp",
+            "1",
+            "--repeat",
+            "1",
+            "--set",
+            "film.width=16",
+        ])
+        .current_dir(&dir)
+        .env_remove("FOTON_PLUGIN_PATH")
+        .output()
+        .unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(
+        stdout.contains("cornell-box.toml with path") && stdout.contains("16x256"),
+        "{stdout}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}

@@ -9,7 +9,7 @@ use super::{BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene};
 use crate::Rgb;
 use crate::accel::Accel;
 use crate::camera::Camera;
-use crate::error::{Location, Result};
+use crate::error::Result;
 use crate::filter::{Filter, FilterSampler};
 use crate::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
 use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
@@ -17,7 +17,7 @@ use crate::light::{Light, area_light};
 use crate::material::Material;
 use crate::medium::{Homogeneous, Phase};
 use crate::microfacet::{Microfacet, MicrofacetKind};
-use crate::props::Properties;
+use crate::props::{Properties, Unused};
 use crate::sampling::Distribution1D;
 use crate::texture::Texture;
 use crate::value::{Document, Value};
@@ -56,7 +56,7 @@ const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 struct Loader {
     dir: PathBuf,
     sources: Vec<PathBuf>,
-    bags: Vec<Vec<(String, Location)>>,
+    bags: Vec<Vec<Unused>>,
     warnings: Vec<String>,
 }
 
@@ -241,8 +241,8 @@ impl Scene {
         }
 
         ld.done(&root);
-        let mut unused: Vec<(String, Location)> = ld.bags.into_iter().flatten().collect();
-        unused.sort_by(|a, b| (a.1.line, &a.0).cmp(&(b.1.line, &b.0)));
+        let mut unused: Vec<Unused> = ld.bags.into_iter().flatten().collect();
+        unused.sort_by(|a, b| (a.location.line, &a.key).cmp(&(b.location.line, &b.key)));
         let warnings = ld.warnings;
         let sources = ld.sources;
         Ok(Scene {

@@ -124,7 +124,7 @@ pub struct Scene {
     /// The files the scene read besides its own (meshes), in the order it read them.
     pub sources: Vec<PathBuf>,
     /// Keys that were present but never read by the loader (not counting `[integrators]`).
-    pub unused: Vec<(String, Location)>,
+    pub unused: Vec<crate::props::Unused>,
     /// Non-fatal problems (reflectance above one, no lights...).
     pub warnings: Vec<String>,
 }
