@@ -1088,7 +1088,7 @@ fn read_shapes(
             if !closed {
                 return Err(s.error(
                     "interior",
-                    format!("a {ty} that is not closed cannot hold a medium by itself: light would leak out of the medium through its edges (a mesh needs every edge shared by exactly two consistently oriented triangles); close it, or give `exterior` too (the medium on the side its normal points to) if other shapes close the medium"),
+                    format!("a {ty} that is not closed cannot hold an interior medium by itself: light would leak out of the medium through its edges (a mesh needs every edge shared by exactly two consistently oriented triangles); close it, or give `exterior` too (the medium on the side its normal points to) if other shapes close the medium"),
                 ));
             }
         }
