@@ -141,9 +141,9 @@ impl Scene {
 
         let render = read_render(&root, &mut ld)?;
         let film = read_film(&root, &mut ld)?;
-        let camera = read_camera(&root, &film, &mut ld)?;
         let (materials, material_index) = read_materials(&root, &mut ld)?;
         let (media, medium_index) = read_media(&root, &mut ld)?;
+        let (camera, camera_placed) = read_camera(&root, &film, &medium_index, &mut ld)?;
 
         let mut objects = Vec::new();
         let mut prims = Vec::new();
@@ -159,7 +159,19 @@ impl Scene {
             (&mut prims, &mut triangle_attrs),
             &mut lights,
         )?;
-        read_point_lights(&root, &mut ld, &mut lights)?;
+        // Per light: the medium the file puts it in (None: found from where it lies).
+        let mut light_media: Vec<Option<Option<u32>>> = lights
+            .iter()
+            .map(|l| match *l {
+                Light::Area { object, .. } => {
+                    let o: &Object = &objects[object as usize];
+                    // Mitsuba's area emitter emits into its shape's exterior.
+                    o.explicit_media.then_some(o.exterior)
+                }
+                _ => None,
+            })
+            .collect();
+        read_point_lights(&root, &mut ld, &medium_index, &mut lights, &mut light_media)?;
 
         let mut medium = None;
         if let Some(scene) = root.table("scene")? {
@@ -209,7 +221,12 @@ impl Scene {
         let light_distribution = Distribution1D::new(&powers);
 
         let accel = Accel::build(prims);
-        let uses_media = medium.is_some() || objects.iter().any(|o| o.interior.is_some());
+        let uses_media = medium.is_some()
+            || camera_placed.is_some_and(|m| m.is_some())
+            || light_media.iter().any(|m| m.is_some_and(|m| m.is_some()))
+            || objects
+                .iter()
+                .any(|o| o.interior.is_some() || o.exterior.is_some());
         let (interfaces, volumes, alone) = if uses_media {
             medium_interfaces(&objects, &materials, &accel, medium)
         } else {
@@ -219,8 +236,8 @@ impl Scene {
                 vec![false; objects.len()],
             )
         };
-        let mut camera_medium = None;
-        if uses_media {
+        let mut camera_medium = camera_placed.flatten();
+        if uses_media && camera_placed.is_none() {
             camera_medium = locate_medium(
                 &accel,
                 &objects,
@@ -262,6 +279,8 @@ impl Scene {
             interfaces,
             volumes,
             alone,
+            has_media: uses_media,
+            light_media,
             camera_medium,
             bounds: (lo, hi),
             document: doc,
@@ -493,7 +512,13 @@ fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
     })
 }
 
-fn read_camera(root: &Properties<'_>, film: &FilmSettings, ld: &mut Loader) -> Result<Camera> {
+/// The camera, and the medium the file puts it in (None: found from where it stands).
+fn read_camera(
+    root: &Properties<'_>,
+    film: &FilmSettings,
+    media: &Index,
+    ld: &mut Loader,
+) -> Result<(Camera, Option<Option<u32>>)> {
     let Some(t) = root.table("camera")? else {
         return Err(root.error(
             "camera",
@@ -533,16 +558,28 @@ fn read_camera(root: &Properties<'_>, film: &FilmSettings, ld: &mut Loader) -> R
     if forward.normalize().cross(up).length_squared() < 1e-12 {
         return Err(t.error("up", "is zero or parallel to the viewing direction"));
     }
+    let medium = medium_ref(&t, "medium", media)?;
     ld.done(&t);
-    Ok(Camera::new(
-        position,
-        look_at,
-        up,
-        fov,
-        film.width,
-        film.height,
-    ))
+    let camera = Camera::new(position, look_at, up, fov, film.width, film.height);
+    Ok((camera, medium))
 }
+
+/// A medium named at `key` (`interior`, `exterior`, a camera's or a light's `medium`):
+/// None if the key is absent, Some(None) for `"vacuum"`, which names no medium (Mitsuba's
+/// side without a medium).
+fn medium_ref(t: &Properties<'_>, key: &str, media: &Index) -> Result<Option<Option<u32>>> {
+    match t.string_opt(key)? {
+        None => Ok(None),
+        Some(VACUUM) => Ok(Some(None)),
+        Some(name) => match media.get(name) {
+            Some(&id) => Ok(Some(Some(id))),
+            None => Err(t.error(key, undefined("medium", name, media))),
+        },
+    }
+}
+
+/// The medium name that means no medium.
+const VACUUM: &str = "vacuum";
 
 type Index = HashMap<String, u32>;
 
@@ -780,6 +817,12 @@ fn read_media(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<Boxed
     let names: Vec<&str> = all.keys().collect();
     for name in names {
         let m = all.table(name)?.unwrap();
+        if name == VACUUM {
+            return Err(all.error(
+                name,
+                "`vacuum` is reserved: it names no medium (in `interior`, `exterior` and `medium`); call this medium something else",
+            ));
+        }
         let ty = m.string_opt("type")?.ok_or_else(|| {
             m.error(
                 "type",
@@ -1015,7 +1058,7 @@ fn read_shapes(
             }
         };
         if flip {
-            if ty == "sphere" && s.has("interior") {
+            if ty == "sphere" && s.has("interior") && !s.has("exterior") {
                 return Err(s.error(
                     "flip_normals",
                     "a sphere turned inside out cannot hold an interior medium (its inside would be all of space outside it)",
@@ -1030,21 +1073,27 @@ fn read_shapes(
         let material = *materials
             .get(material_name)
             .ok_or_else(|| s.error("material", undefined("material", material_name, materials)))?;
-        let interior = match s.string_opt("interior")? {
-            None => None,
-            Some(name) => {
-                let id = *media
-                    .get(name)
-                    .ok_or_else(|| s.error("interior", undefined("medium", name, media)))?;
-                if !closed {
-                    return Err(s.error(
-                        "interior",
-                        format!("a {ty} that is not closed cannot have an interior medium (a mesh needs every edge shared by exactly two consistently oriented triangles)"),
-                    ));
-                }
-                Some(id)
+        // With `exterior` the file names both sides (Mitsuba's media: interior behind the
+        // normal, exterior in front, whatever the shape); with `interior` alone the shape
+        // must close its medium in, and its outside is found from where it lies.
+        let exterior = medium_ref(&s, "exterior", media)?;
+        let interior = medium_ref(&s, "interior", media)?;
+        if let (Some(inside), None) = (interior, exterior) {
+            if inside.is_none() {
+                return Err(s.error(
+                    "interior",
+                    "`vacuum` as the only medium of a shape says nothing; give `exterior` too",
+                ));
             }
-        };
+            if !closed {
+                return Err(s.error(
+                    "interior",
+                    format!("a {ty} that is not closed cannot hold an interior medium by itself: light would leak out of the medium through its edges (a mesh needs every edge shared by exactly two consistently oriented triangles); close it, or give `exterior` too (the medium on the side its normal points to) if other shapes close the medium"),
+                ));
+            }
+        }
+        let explicit_media = exterior.is_some();
+        let (interior, exterior) = (interior.flatten(), exterior.flatten());
         let object = objects.len() as u32;
         let mut light = None;
         if let Some(emission) = s.rgb_opt("emission")?
@@ -1064,6 +1113,8 @@ fn read_shapes(
             material,
             light,
             interior,
+            exterior,
+            explicit_media,
             closed,
         });
         let first_attrs = triangle_attrs.len() as u32;
@@ -1083,10 +1134,14 @@ fn read_shapes(
     Ok(())
 }
 
+/// The lights of `[[lights]]`, each with the medium the file puts it in (`medium`, for point
+/// and spot lights; None: found from where it lies).
 fn read_point_lights(
     root: &Properties<'_>,
     ld: &mut Loader,
+    media: &Index,
     lights: &mut Vec<Light>,
+    light_media: &mut Vec<Option<Option<u32>>>,
 ) -> Result<()> {
     for l in array_of_tables(root, "lights")? {
         let ty = l.string_opt("type")?.ok_or_else(|| {
@@ -1121,15 +1176,18 @@ fn read_point_lights(
                 }
             };
             lights.push(light);
+            light_media.push(None);
             ld.done(&l);
             continue;
         }
         if ty == "directional" {
             lights.push(read_directional(&l)?);
+            light_media.push(None);
             ld.done(&l);
             continue;
         }
         let position = l.vec3_required("position")?;
+        light_media.push(medium_ref(&l, "medium", media)?);
         if ty == "spot" {
             lights.push(read_spot(&l, position)?);
             ld.done(&l);

@@ -49,12 +49,13 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         bsdfs: HashMap::new(),
         textures: HashMap::new(),
         media: HashMap::new(),
-        exteriors: Vec::new(),
+        sensor_medium: None,
+        shape_media: false,
         anonymous: 0,
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text, true)?;
-    r.check_exteriors()?;
+    r.place_sensor_medium();
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
         root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
@@ -250,9 +251,10 @@ struct Reader {
     lights: Vec<Node>,
     /// BSDF ids to their material names in `[materials]`.
     bsdfs: HashMap<String, String>,
-    /// The `exterior` media shapes declared (medium name, line): foton infers a shape's
-    /// outside from the volumes around it, so these are checked against that at the end.
-    exteriors: Vec<(String, u32)>,
+    /// The sensor's medium (its name in `[media]`, line).
+    sensor_medium: Option<(String, u32)>,
+    /// Whether any shape names an interior or exterior medium.
+    shape_media: bool,
     /// Top-level `<texture id="...">`s, as the inline tables a material field takes.
     textures: HashMap<String, Table>,
     /// Medium ids to their names in `[media]`.
@@ -617,53 +619,17 @@ impl Reader {
         Ok(m)
     }
 
-    /// A shape's `exterior` is what foton infers from where it lies: the medium filling free
-    /// space (`[scene] medium`, which the sensor's medium or the first exterior sets), or
-    /// the interior of another shape around it. An exterior that is neither cannot be
-    /// rendered as written.
-    fn check_exteriors(&mut self) -> Result<()> {
-        if self.exteriors.is_empty() {
-            return Ok(());
-        }
-        let interiors: Vec<String> = self
-            .shapes
-            .iter()
-            .filter_map(|s| match &s.value {
-                Value::Table(t) => match t.get("interior").map(|n| &n.value) {
-                    Some(Value::Str(m)) => Some(m.clone()),
-                    _ => None,
-                },
-                _ => None,
-            })
-            .collect();
-        let scene_medium = |root: &Table| match root.get("scene").map(|n| &n.value) {
-            Some(Value::Table(t)) => match t.get("medium").map(|n| &n.value) {
-                Some(Value::Str(m)) => Some(m.clone()),
-                _ => None,
-            },
-            _ => None,
+    /// The sensor's medium is the camera's. When no shape names a medium, Mitsuba's scene is
+    /// that medium everywhere (every ray stays in the camera's medium), which is foton's
+    /// scene medium; otherwise the shapes say where each medium is.
+    fn place_sensor_medium(&mut self) {
+        let Some((name, line)) = self.sensor_medium.take() else {
+            return;
         };
-        for (medium, line) in std::mem::take(&mut self.exteriors) {
-            match scene_medium(&self.root) {
-                Some(m) if m == medium => {}
-                None if !interiors.contains(&medium) => {
-                    table_mut(&mut self.root, "scene")
-                        .insert("medium", at(Value::Str(medium), line));
-                }
-                _ if interiors.contains(&medium) => {}
-                _ => {
-                    let message = format!(
-                        "{}:{line}: a shape's `exterior` medium that is neither the medium around the camera nor the interior of another shape is not supported (foton infers a shape's outside from the volumes around it)",
-                        self.file.display()
-                    );
-                    if !self.lenient {
-                        return Err(Error::Usage(message));
-                    }
-                    self.report.left_out.push(message);
-                }
-            }
+        table_mut(&mut self.root, "camera").insert("medium", at(Value::Str(name.clone()), line));
+        if !self.shape_media {
+            table_mut(&mut self.root, "scene").insert("medium", at(Value::Str(name), line));
         }
-        Ok(())
     }
 
     fn top_level(&mut self, obj: Obj) -> Result<()> {
@@ -840,7 +806,7 @@ impl Reader {
             let name = self.media.get(&id).cloned().ok_or_else(|| {
                 o.error(format!("medium `{id}` is not defined (before line {l})"))
             })?;
-            table_mut(&mut self.root, "scene").insert("medium", at(Value::Str(name), l));
+            self.sensor_medium = Some((name, l));
         }
         let nested: Vec<Obj> = o
             .props
@@ -858,7 +824,7 @@ impl Reader {
                 "medium" => {
                     let l = child.line;
                     let name = self.medium(child)?;
-                    table_mut(&mut self.root, "scene").insert("medium", at(Value::Str(name), l));
+                    self.sensor_medium = Some((name, l));
                 }
                 _ => {
                     let mut c = child;
@@ -1257,7 +1223,9 @@ impl Reader {
         // The material: a nested BSDF, a reference, or Mitsuba's default (diffuse 0.5).
         let mut material = None;
         let mut emission = None;
+        // Mitsuba's interior (behind the normal) and exterior (in front of it).
         let mut interior = None;
+        let mut exterior = None;
         let props = std::mem::take(&mut o.props);
         for (name, p, l) in props {
             match p {
@@ -1285,14 +1253,12 @@ impl Reader {
                     })?)
                 }
                 Prop::Object(med) if med.tag == "medium" && name == "exterior" => {
-                    let m = self.medium(med)?;
-                    self.exteriors.push((m, l));
+                    exterior = Some(self.medium(med)?)
                 }
                 Prop::Ref(id) if name == "exterior" => {
-                    let m = self.media.get(&id).cloned().ok_or_else(|| {
+                    exterior = Some(self.media.get(&id).cloned().ok_or_else(|| {
                         o.error(format!("line {l}: no medium with id `{id}` before it"))
-                    })?;
-                    self.exteriors.push((m, l));
+                    })?)
                 }
                 other => o.props.push((name, other, l)),
             }
@@ -1400,13 +1366,6 @@ impl Reader {
                 DVec3::new(0.0, 2.0, 0.0),
             )),
             "cube" => {
-                if interior.is_some() {
-                    self.unsupported(
-                        &o,
-                        "a cube bounding a medium is not supported yet (use an obj or ply)",
-                    )?;
-                    return Ok(());
-                }
                 // Six outward-facing faces of [-1, 1]^3.
                 for axis in 0..3 {
                     for side in [-1.0, 1.0] {
@@ -1429,8 +1388,13 @@ impl Reader {
             if let Some(e) = emission {
                 t.insert("emission", vec3(e, line));
             }
-            if let Some(i) = &interior {
-                t.insert("interior", at(Value::Str(i.clone()), line));
+            // Both sides, as Mitsuba crosses them: a side without a medium is vacuum.
+            if interior.is_some() || exterior.is_some() {
+                self.shape_media = true;
+                for (key, side) in [("interior", &interior), ("exterior", &exterior)] {
+                    let name = side.clone().unwrap_or_else(|| "vacuum".into());
+                    t.insert(key, at(Value::Str(name), line));
+                }
             }
             self.shapes.push(at(Value::Table(t), line));
         }
@@ -1442,6 +1406,22 @@ impl Reader {
         let mut t = Table::default();
         t.insert("type", at(Value::Str(o.ty.clone()), line));
         let m = o.transform("to_world")?;
+        // The medium a point or spot light sits in (Mitsuba's emitter `medium`).
+        if let Some((p, l)) = o.take("medium") {
+            let name = match p {
+                Prop::Ref(id) => self.media.get(&id).cloned().ok_or_else(|| {
+                    o.error(format!("line {l}: no medium with id `{id}` before it"))
+                })?,
+                Prop::Object(med) if med.tag == "medium" => self.medium(med)?,
+                other => {
+                    return Err(o.error(format!("`medium`: expected a medium, found {other:?}")));
+                }
+            };
+            if !matches!(o.ty.as_str(), "point" | "spot") {
+                return Err(o.error("only point and spot emitters sit in a medium"));
+            }
+            t.insert("medium", at(Value::Str(name), l));
+        }
         match o.ty.as_str() {
             "point" => {
                 let p = o.point("position")?.unwrap_or(DVec3::ZERO);

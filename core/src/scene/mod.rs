@@ -72,8 +72,14 @@ pub struct Object {
     pub material: u32,
     /// The area light this object is, if it emits.
     pub light: Option<u32>,
-    /// Medium inside the (closed) shape.
+    /// Medium inside the shape (behind its normal).
     pub interior: Option<u32>,
+    /// Medium outside the shape (on its normal's side), when the file names it.
+    pub exterior: Option<u32>,
+    /// Whether the file names both sides (`exterior` given: Mitsuba's interior and exterior,
+    /// None being vacuum): the shape is a medium interface as written, open or closed, and
+    /// nothing about it is inferred.
+    pub explicit_media: bool,
     /// Whether the shape is closed (a sphere, a watertight consistently oriented mesh).
     pub closed: bool,
 }
@@ -110,8 +116,14 @@ pub struct Scene {
     /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
     /// None in a scene without media.
     pub interfaces: Vec<Option<MediumInterface>>,
-    /// The medium around the camera (None: vacuum).
+    /// The medium around the camera (None: vacuum): the camera's `medium`, or the one found
+    /// where it stands.
     pub camera_medium: Option<u32>,
+    /// Whether any medium is used (see [`Scene::has_media`]).
+    has_media: bool,
+    /// Per light: the medium the file puts it in (a point or spot light's `medium`, an area
+    /// light whose shape names its exterior); None: found from where it lies.
+    light_media: Vec<Option<Option<u32>>>,
     /// The objects that bound volumes, for [`Scene::medium_at`].
     volumes: Vec<Volume>,
     /// Per object: a volume whose bounding box meets no other volume's, so that no other
@@ -245,10 +257,10 @@ impl Scene {
         self.media[id as usize].value.as_ref()
     }
 
-    /// Whether any participating medium is used. Cheap (every shadow ray asks): a shape with
-    /// an `interior` is closed, so it is among the volumes, which exist only when media do.
+    /// Whether any participating medium is used (by the scene, a shape, the camera or a
+    /// light). Cheap: every shadow ray asks.
     #[inline]
     pub fn has_media(&self) -> bool {
-        self.medium.is_some() || !self.volumes.is_empty()
+        self.has_media
     }
 }

@@ -1,26 +1,28 @@
-//! Where media are: which closed shapes bound volumes and how they nest (their medium
-//! interfaces), the medium at a point, and the medium a ray enters or leaves into at a
-//! boundary.
+//! Where media are: the medium interfaces of shapes, written in the file (Mitsuba's interior
+//! and exterior) or found from how closed shapes nest; the medium at a point, and the medium a
+//! ray enters or leaves into at a boundary.
 
 use super::{Named, Object, Scene};
 use crate::accel::Accel;
 use crate::geometry::{Hit, Ray, Shape};
 use crate::material::Material;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
-/// The media on the two sides of a closed shape that bounds a volume: pbrt's MediumInterface,
-/// except that the outside is not written in the scene but found from how the shapes nest.
-/// A ray crossing the shape against its outward normal enters `inside`, along it leaves to
+/// The media on the two sides of a shape: pbrt's MediumInterface, Mitsuba's interior and
+/// exterior. A ray crossing the shape against its normal enters `inside`, along it leaves to
 /// `outside`, so that every boundary crossing sets the medium afresh and an error made
-/// between two crossings does not propagate along the path.
+/// between two crossings does not propagate along the path. Either both sides are written in
+/// the file (`exterior` given: any shape, open or closed), or the shape is closed and bounds
+/// a volume whose outside is found from how the volumes nest.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct MediumInterface {
     /// The `interior` medium; None: vacuum (clear glass, a bubble).
     pub inside: Option<u32>,
-    /// The inside of the innermost boundary enclosing this one, or the scene medium.
+    /// The `exterior` medium, or the inside of the innermost volume enclosing this one, or
+    /// the scene medium.
     pub outside: Option<u32>,
-    /// Number of boundaries enclosing this one (0: outermost). Decides between coincident
-    /// boundaries.
+    /// Number of volumes enclosing this one (0: outermost, or an open shape). Decides between
+    /// coincident boundaries.
     pub depth: u32,
 }
 
@@ -40,14 +42,33 @@ impl Scene {
         )
     }
 
+    /// The medium light `i` emits into (None: vacuum): the one the file puts it in (a point or
+    /// spot light's `medium`, an area light's exterior when its shape names it), or the one
+    /// found just off its emitting side (an area light is taken to lie in one medium). An
+    /// error (saying why) where [`Scene::medium_at`] gives one.
+    pub fn light_medium(&self, i: usize) -> std::result::Result<Option<u32>, String> {
+        if !self.has_media() {
+            return Ok(None);
+        }
+        if let Some(given) = self.light_media[i] {
+            return Ok(given);
+        }
+        let scale = 1.0 + (self.bounds.1 - self.bounds.0).length();
+        let e = self.lights[i].sample_emission(Vec2::splat(0.5), Vec2::splat(0.5), 0.5);
+        self.medium_at(e.origin + e.n * (1e-3 * scale))
+    }
+
     /// The medium on the side of the surface at `hit` that `dir` points into: the medium a
     /// ray crossing the surface along `dir` enters, or the one a ray leaving the surface
     /// along `dir` (reflected, or a shadow ray) travels in. `current` is the medium the path
-    /// was in; it is kept unless the surface bounds a volume.
+    /// was in; it is kept unless the surface is a medium interface (Mitsuba's medium
+    /// transition).
     ///
-    /// Coincident boundaries (two volumes touching, a volume sharing a face with its
-    /// container) are crossed together: every boundary through the point is found, and the
-    /// innermost one entered wins, or if none is entered, the outermost one left.
+    /// A shape whose file names both its media is taken as written (Mitsuba's
+    /// `target_medium`). Coincident boundaries of volumes found from their nesting (two
+    /// volumes touching, a volume sharing a face with its container) are crossed together:
+    /// every such boundary through the point is found, and the innermost one entered wins, or
+    /// if none is entered, the outermost one left.
     pub fn medium_after(&self, hit: &Hit, dir: Vec3, current: Option<u32>) -> Option<u32> {
         let object = self.primitive(hit).object as usize;
         let Some(own) = self.interfaces[object] else {
@@ -77,6 +98,9 @@ impl Scene {
         let prims = self.accel.primitives();
         self.accel.for_each_hit(&probe, 2.0 * eps, |i, t| {
             let prim = &prims[i as usize];
+            if self.objects[prim.object as usize].explicit_media {
+                return;
+            }
             if let Some(iface) = self.interfaces[prim.object as usize] {
                 consider(iface, prim.shape.normal(probe.at(t)));
             }
@@ -214,10 +238,14 @@ fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
     }
 }
 
-/// Which objects bound volumes, and their medium interfaces. A closed shape bounds a volume
-/// if it has an `interior` medium, or if light can enter it (a null or dielectric material):
-/// then its inside is vacuum (clear glass in fog). Opaque shapes without an interior leave
-/// the medium as it is (light reflected there stays on its side).
+/// Which objects bound volumes, and the medium interfaces of all objects. A shape whose file
+/// names its `exterior` has the interface written there; it bounds a volume if it is closed
+/// (and not a sphere turned inside out). Another closed shape bounds a volume if it has an
+/// `interior` medium, or if light can enter it (a null or dielectric material): then its
+/// inside is vacuum (clear glass in fog), and its outside is the inside of the innermost
+/// volume around it. Other shapes leave the medium as it is (light reflected there stays on
+/// its side). Also returns, per object, whether it is an interface crossed without a search
+/// for coincident boundaries (written in the file, or a volume no other one comes near).
 pub(super) fn medium_interfaces(
     objects: &[Object],
     materials: &[Named<Material>],
@@ -226,16 +254,26 @@ pub(super) fn medium_interfaces(
 ) -> (Vec<Option<MediumInterface>>, Vec<Volume>, Vec<bool>) {
     let mut index = vec![None; objects.len()];
     let mut volumes: Vec<Volume> = Vec::new();
+    // A sphere turned inside out has its interior outside it: no volume to locate points in.
+    let mut inside_out = vec![false; objects.len()];
+    for p in accel.primitives() {
+        if matches!(p.shape, Shape::Sphere { inward: true, .. }) {
+            inside_out[p.object as usize] = true;
+        }
+    }
     for (i, o) in objects.iter().enumerate() {
         let m = &materials[o.material as usize].value;
-        if o.closed
-            && (o.interior.is_some()
+        let bounds = if o.explicit_media {
+            !inside_out[i]
+        } else {
+            o.interior.is_some()
                 || m.is_null()
                 || matches!(
                     m,
                     Material::Dielectric { .. } | Material::RoughDielectric { .. }
-                ))
-        {
+                )
+        };
+        if o.closed && bounds {
             index[i] = Some(volumes.len());
             volumes.push(Volume {
                 object: i as u32,
@@ -266,24 +304,35 @@ pub(super) fn medium_interfaces(
         })
         .collect();
     let depth: Vec<u32> = containers.iter().map(|c| c.len() as u32).collect();
-    let mut out = vec![None; objects.len()];
+    let mut out: Vec<Option<MediumInterface>> = objects
+        .iter()
+        .map(|o| {
+            o.explicit_media.then_some(MediumInterface {
+                inside: o.interior,
+                outside: o.exterior,
+                depth: 0,
+            })
+        })
+        .collect();
+    let mut alone: Vec<bool> = objects.iter().map(|o| o.explicit_media).collect();
     for (k, volume) in volumes.iter().enumerate() {
         let parent = containers[k].iter().copied().max_by_key(|&c| depth[c]);
         let i = volume.object as usize;
-        out[i] = Some(MediumInterface {
+        let iface = out[i].get_or_insert(MediumInterface {
             inside: objects[i].interior,
             outside: parent.map_or(scene_medium, |c| {
                 objects[volumes[c].object as usize].interior
             }),
-            depth: depth[k],
+            depth: 0,
         });
+        iface.depth = depth[k];
     }
-    let mut alone = vec![false; objects.len()];
     let pad = |v: &Volume| 1e-3 * (1.0 + v.lo.abs().max(v.hi.abs()).max_element());
-    for (k, v) in volumes.iter().enumerate() {
+    let inferred = |v: &Volume| !objects[v.object as usize].explicit_media;
+    for (k, v) in volumes.iter().enumerate().filter(|(_, v)| inferred(v)) {
         alone[v.object as usize] = volumes.iter().enumerate().all(|(c, w)| {
             let e = pad(v).max(pad(w));
-            c == k || (v.lo - e).cmpgt(w.hi).any() || (w.lo - e).cmpgt(v.hi).any()
+            c == k || !inferred(w) || (v.lo - e).cmpgt(w.hi).any() || (w.lo - e).cmpgt(v.hi).any()
         });
     }
     (out, volumes, alone)

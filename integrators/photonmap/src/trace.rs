@@ -19,7 +19,6 @@ use foton_core::render::with_pool;
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
 use foton_core::walk::{RayWalk, Reached};
-use glam::Vec2;
 use rayon::prelude::*;
 
 /// The path a photon took to reach a diffuse surface.
@@ -63,21 +62,12 @@ pub enum Site {
     Volume,
 }
 
-/// The medium each light sits in (None: vacuum), for photons to start in. An area light is
-/// taken to lie in one medium, the one just off its emitting side.
+/// The medium each light sits in (None: vacuum), for photons to start in
+/// ([`Scene::light_medium`]).
 pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
-    if !scene.has_media() {
-        return Ok(vec![None; scene.lights.len()]);
-    }
-    let scale = 1.0 + (scene.bounds.1 - scene.bounds.0).length();
-    scene
-        .lights
-        .iter()
-        .enumerate()
-        .map(|(i, light)| {
-            let e = light.sample_emission(Vec2::splat(0.5), Vec2::splat(0.5), 0.5);
-            let p = e.origin + e.n * (1e-3 * scale);
-            scene.medium_at(p).map_err(|why| {
+    (0..scene.lights.len())
+        .map(|i| {
+            scene.light_medium(i).map_err(|why| {
                 Error::Render(format!(
                     "{}: cannot tell which medium light {i} is in: {why}",
                     scene.file.display()
