@@ -6,10 +6,12 @@
  * folder of the foton executable). It exports one symbol, `foton_kernel_plugin`, a
  * FotonKernelPlugin with the API version, the kernel's name and its radial profile w(t).
  *
- * foton checks the version, evaluates w on [0, 1] and refuses a kernel that is negative or
- * not finite anywhere there, and normalises w numerically so that it integrates to one over
- * the disc (surface estimates) and over the ball (volume estimates). The profile therefore
- * need not be normalised, and no plugin can break energy conservation.
+ * foton checks the version, evaluates w on [0, 1] (at t = i / 4096) and refuses a kernel
+ * that is negative or not finite anywhere there, and normalises w numerically so that it
+ * integrates to one over the disc (surface estimates) and over the ball (volume estimates).
+ * The profile therefore need not be normalised, and no plugin can break energy conservation.
+ * Every weight w returns during a render is checked too: a NaN, infinite or negative one
+ * makes the render fail with an error that names it.
  *
  * w must be a pure function: it is called from many threads at once.
  */

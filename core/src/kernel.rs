@@ -5,9 +5,17 @@
 //! r (surface estimates) and over the ball of radius r (volume estimates). Normalising here,
 //! not in each kernel, is what keeps any kernel (a plugin's included) from breaking energy
 //! conservation.
+//!
+//! A kernel whose code foton does not own (a plugin's, [`Kernel::untrusted`]) is checked on
+//! every use as well: a weight that is not finite and non-negative counts as zero, and the
+//! first one is kept for [`NormalizedKernel::check_weights`], which the integrators call after
+//! a render to fail with an error that names it (a check at 4097 points cannot see what the
+//! code returns between them).
 
 use crate::error::{Error, Result};
 use std::f64::consts::PI;
+use std::sync::Mutex;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A radial kernel profile.
 pub trait Kernel: Send + Sync {
@@ -18,6 +26,11 @@ pub trait Kernel: Send + Sync {
     /// `Integrator::parameters`.
     fn parameters(&self) -> Vec<(&'static str, f64)> {
         Vec::new()
+    }
+    /// True for a profile from code foton does not own (a kernel plugin): each weight it
+    /// gives is checked (module comment).
+    fn untrusted(&self) -> bool {
+        false
     }
 }
 
@@ -69,6 +82,11 @@ pub struct NormalizedKernel {
     norm2: f64,
     /// 1 / integral over the unit ball of w(|x|).
     norm3: f64,
+    /// Whether each weight is checked (an untrusted profile).
+    checked: bool,
+    /// Set once a checked weight was bad; `first_bad` then holds its (t, w).
+    bad: AtomicBool,
+    first_bad: Mutex<Option<(f64, f64)>>,
 }
 
 /// Composite Simpson's rule of f on [0, 1].
@@ -105,9 +123,12 @@ impl NormalizedKernel {
             )));
         }
         Ok(NormalizedKernel {
+            checked: kernel.untrusted(),
             kernel,
             norm2: 1.0 / disc,
             norm3: 1.0 / ball,
+            bad: AtomicBool::new(false),
+            first_bad: Mutex::new(None),
         })
     }
 
@@ -126,6 +147,45 @@ impl NormalizedKernel {
         p
     }
 
+    /// The profile at t, checked if untrusted: a bad weight is zero and is remembered.
+    #[inline]
+    fn profile(&self, t: f64) -> f64 {
+        let w = self.kernel.profile(t);
+        if self.checked && !(w >= 0.0 && w.is_finite()) {
+            self.note_bad(t, w);
+            return 0.0;
+        }
+        w
+    }
+
+    #[cold]
+    fn note_bad(&self, t: f64, w: f64) {
+        if !self.bad.swap(true, Ordering::Relaxed)
+            && let Ok(mut first) = self.first_bad.lock()
+        {
+            *first = Some((t, w));
+        }
+    }
+
+    /// An error naming the first bad weight an untrusted kernel gave since it was made (such
+    /// weights were used as zero): a render that met one is wrong, and says so.
+    pub fn check_weights(&self) -> Result<()> {
+        if !self.bad.load(Ordering::Relaxed) {
+            return Ok(());
+        }
+        let (t, w) = self
+            .first_bad
+            .lock()
+            .ok()
+            .and_then(|f| *f)
+            .unwrap_or((f64::NAN, f64::NAN));
+        Err(Error::Render(format!(
+            "kernel `{}` returned w({t}) = {w} during the render (weights must be finite and >= 0 \
+             on [0, 1]; the kernel was checked at 4097 points only, and passed there)",
+            self.name()
+        )))
+    }
+
     /// Weight of a photon at distance d in a surface estimate of radius r (per unit area).
     #[inline]
     pub fn weight_2d(&self, d: f32, r: f32) -> f32 {
@@ -133,7 +193,7 @@ impl NormalizedKernel {
         if t > 1.0 {
             return 0.0;
         }
-        (self.norm2 * self.kernel.profile(t) / (r as f64 * r as f64)) as f32
+        (self.norm2 * self.profile(t) / (r as f64 * r as f64)) as f32
     }
 
     /// Weight of a photon at distance d in a volume estimate of radius r (per unit volume).
@@ -143,7 +203,7 @@ impl NormalizedKernel {
         if t > 1.0 {
             return 0.0;
         }
-        (self.norm3 * self.kernel.profile(t) / (r as f64).powi(3)) as f32
+        (self.norm3 * self.profile(t) / (r as f64).powi(3)) as f32
     }
 }
 

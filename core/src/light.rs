@@ -96,10 +96,59 @@ pub struct EmittedRay {
     pub flux: Rgb,
 }
 
-fn sphere_cone(center: Vec3, radius: f32, x: Vec3) -> Option<f32> {
-    let d2 = (center - x).length_squared();
-    let r2 = radius * radius;
-    (d2 > r2 * 1.0001).then(|| (1.0 - r2 / d2).max(0.0).sqrt())
+/// The cone of directions a sphere subtends from a point outside it: sin^2 and 1 - cos of its
+/// half-angle theta_max. 1 - cos is taken as sin^2 / (1 + cos), which has no cancellation:
+/// sqrt(1 - r^2/d^2) rounds to 1 in 32-bit floats once r/d falls below about 2e-4 (the pdf
+/// 1 / (2 pi (1 - cos)) is then infinite), and is visibly off well before. pbrt-v4 switches
+/// to a Taylor series below 1.5 degrees for the same reason; the identity is exact at every
+/// angle.
+#[derive(Clone, Copy, Debug)]
+struct SphereCone {
+    sin2_max: f32,
+    one_minus_cos_max: f32,
+}
+
+impl SphereCone {
+    /// None at points inside the sphere or on it (those sample its area instead).
+    fn from(center: Vec3, radius: f32, x: Vec3) -> Option<SphereCone> {
+        let d2 = (center - x).length_squared();
+        let r2 = radius * radius;
+        // Written so that a NaN distance gives None too.
+        if d2.partial_cmp(&(r2 * 1.0001)) != Some(std::cmp::Ordering::Greater) {
+            return None;
+        }
+        let sin2_max = r2 / d2;
+        let cos_max = (1.0 - sin2_max).sqrt();
+        Some(SphereCone {
+            sin2_max,
+            one_minus_cos_max: sin2_max / (1.0 + cos_max),
+        })
+    }
+
+    /// Solid-angle pdf of a direction sampled uniformly in the cone.
+    fn pdf(&self) -> f32 {
+        1.0 / (2.0 * PI * self.one_minus_cos_max)
+    }
+
+    /// A direction uniform in the cone (in the frame whose z axis points at the centre) and
+    /// the unit normal of the sphere where it first meets it, from the angle alpha at the
+    /// centre between the receiver and that point (pbrt-v4's Sphere::Sample): no ray is
+    /// intersected, so no sample misses the sphere however small it looks.
+    fn sample(&self, u: Vec2) -> (Vec3, Vec3) {
+        // 1 - cos theta uniform on [0, 1 - cos theta_max], sin^2 from it without cancellation.
+        let one_minus_cos = u.x * self.one_minus_cos_max;
+        let sin2 = (one_minus_cos * (2.0 - one_minus_cos)).min(self.sin2_max);
+        let cos = 1.0 - one_minus_cos;
+        let sin = sin2.sqrt();
+        let ratio = sin2 / self.sin2_max;
+        let cos_alpha = sin2 / self.sin2_max.sqrt() + cos * (1.0 - ratio).max(0.0).sqrt();
+        let sin_alpha = (1.0 - cos_alpha * cos_alpha).max(0.0).sqrt();
+        let (sin_phi, cos_phi) = (2.0 * PI * u.y).sin_cos();
+        let wi = Vec3::new(sin * cos_phi, sin * sin_phi, cos);
+        // The point lies on the side of the centre the direction leans to, facing back.
+        let n = Vec3::new(sin_alpha * cos_phi, sin_alpha * sin_phi, -cos_alpha);
+        (wi, n)
+    }
 }
 
 /// The spot light's falloff at angle theta from its axis (Mitsuba's `falloff_curve`): 1 within
@@ -299,28 +348,21 @@ impl Light {
                     inward,
                 } = *shape
                     && shapes.len() == 1
-                    && let Some(cos_max) = sphere_cone(center, radius, x)
+                    && let Some(cone) = SphereCone::from(center, radius, x)
                 {
-                    // Sample the cone of directions the sphere subtends (pbrt's
-                    // Sphere::Sample(ctx)): every sample sees the emitting side.
+                    // Sample the cone of directions the sphere subtends (pbrt-v4's
+                    // Sphere::Sample(ctx)): every sample sees the near side.
                     let axis = (center - x).normalize();
-                    let wi = to_world(uniform_cone(u, cos_max), axis);
-                    let t = shape
-                        .intersect(&crate::geometry::Ray::new(x, wi), f32::INFINITY)
-                        .unwrap_or_else(|| (center - x).dot(wi));
-                    let p = x + wi * t;
-                    let outward = (p - center).normalize();
+                    let (wi, outward) = cone.sample(u);
+                    let (wi, outward) = (to_world(wi, axis), to_world(outward, axis));
+                    let p = center + outward * radius;
                     // A sphere turned inside out is dark from outside.
                     let n = if inward { -outward } else { outward };
                     return Some(LightSample {
                         wi,
-                        dist: t,
-                        li: if n.dot(-wi) > 0.0 {
-                            *radiance
-                        } else {
-                            Rgb::ZERO
-                        },
-                        pdf: 1.0 / (2.0 * PI * (1.0 - cos_max)),
+                        dist: x.distance(p),
+                        li: if inward { Rgb::ZERO } else { *radiance },
+                        pdf: cone.pdf(),
                         delta: false,
                         p,
                         n,
@@ -362,9 +404,9 @@ impl Light {
             Light::Area { shapes, area, .. } => {
                 if let Shape::Sphere { center, radius, .. } = shapes[0]
                     && shapes.len() == 1
-                    && let Some(cos_max) = sphere_cone(center, radius, x)
+                    && let Some(cone) = SphereCone::from(center, radius, x)
                 {
-                    return 1.0 / (2.0 * PI * (1.0 - cos_max));
+                    return cone.pdf();
                 }
                 let d = p - x;
                 let cos_l = n.dot(-d.normalize()).abs();

@@ -87,7 +87,7 @@ where
                                 let at = scene.film.filter.film_position(x, y, sampler.next_2d());
                                 let ray = scene.camera.generate_ray(at);
                                 let mut l = radiance(&ray, &mut sampler, &mut tile_rays);
-                                if !l.is_finite() || l.min_element() < 0.0 {
+                                if !usable(l) {
                                     bad_samples.fetch_add(1, Ordering::Relaxed);
                                     l = Rgb::ZERO;
                                 }
@@ -110,11 +110,30 @@ where
     }
     ctx.progress.finish();
     film.rays = rays.load(Ordering::Relaxed);
-    let bad = bad_samples.load(Ordering::Relaxed);
+    warn_unusable(
+        ctx,
+        bad_samples.load(Ordering::Relaxed),
+        "sample(s)",
+        "replaced by zero",
+    );
+    Ok(film)
+}
+
+/// Whether radiance (or flux) can be added to a pixel's sums: finite and non-negative. One
+/// value that is not (a NaN from 0 x inf in a corner case of some BSDF) would stay in the
+/// pixel for the rest of the render, so integrators replace such values by zero (the
+/// guard of [`render_pixels`], which `sppm` applies to its camera samples and photons).
+#[inline]
+pub fn usable(l: Rgb) -> bool {
+    l.is_finite() && l.min_element() >= 0.0
+}
+
+/// The warning after a render that met `bad` values that were not [`usable`]: `what` they
+/// were, `done` what was done with them.
+pub fn warn_unusable(ctx: &RenderContext<'_>, bad: u64, what: &str, done: &str) {
     if bad > 0 {
         ctx.progress.warn(&format!(
-            "{bad} sample(s) were NaN, infinite or negative and were replaced by zero"
+            "{bad} {what} were NaN, infinite or negative and were {done}"
         ));
     }
-    Ok(film)
 }

@@ -219,3 +219,61 @@ fn unknown_kernel_lists_the_kernels_found() {
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// A kernel plugin checked at 4097 points could return anything between them. These two give
+/// Epanechnikov's 1 - t^2 at the checked points t = i / 4096 and a NaN or a negative weight
+/// everywhere else: every integrator that reads kernels fails with an error that names the
+/// kernel and the bad weight, instead of rendering with it (or, for `sppm`, keeping a NaN in
+/// its pixel statistics).
+#[test]
+fn a_kernel_plugin_bad_between_the_checked_points_is_an_error() {
+    let dir = temp_dir("kernel-between");
+    for (name, elsewhere) in [("nan_between", "0.0 / 0.0"), ("negative_between", "-5.0")] {
+        let weight =
+            format!("(t * 4096.0 == (double)(long)(t * 4096.0)) ? 1.0 - t * t : {elsewhere}");
+        broken_kernel(&dir, name, 1, &weight);
+    }
+    let scene = repo_root().join("scenes/caustics.toml");
+    let out = dir.join("out.exr");
+    for integrator in ["photon", "sppm"] {
+        for (name, shown) in [("nan_between", "NaN"), ("negative_between", "-5")] {
+            let set = format!("integrators.{integrator}.kernel={name}");
+            let run = foton(&[
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--integrator",
+                integrator,
+                "--set",
+                "film.width=8",
+                "--set",
+                "film.height=8",
+                "--set",
+                "render.spp=1",
+                "--set",
+                "integrators.photon.global_photons=5000",
+                "--set",
+                "integrators.photon.caustic_photons=5000",
+                "--set",
+                "integrators.sppm.iterations=2",
+                "--set",
+                "integrators.sppm.photons_per_iteration=5000",
+                "--set",
+                &set,
+                "--plugin-dir",
+                dir.to_str().unwrap(),
+                "--plugin-dir",
+                plugin_dir().to_str().unwrap(),
+            ]);
+            assert_eq!(run.code, 1, "{integrator}, {name}: {}", run.stderr);
+            let expect = format!("kernel `{name}` returned w(");
+            assert!(
+                run.stderr.contains(&expect) && run.stderr.contains(&format!(") = {shown}")),
+                "{integrator}, {name}: {}",
+                run.stderr
+            );
+        }
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}

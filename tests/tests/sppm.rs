@@ -290,3 +290,72 @@ fn time_budget_ends_the_render() {
     let m = film.mean();
     assert!(m.min_element() > 0.0 && m.is_finite(), "{m}");
 }
+
+/// A kernel that is 1 on [0, 1] except in a narrow band off the points where kernels are
+/// checked (t = i / 4096), where it gives `band`: a Rust kernel, trusted, so that its NaN
+/// reaches the gather as a NaN photon contribution would from a corner case of some BSDF.
+struct Banded {
+    band: f64,
+}
+
+impl foton_core::kernel::Kernel for Banded {
+    fn name(&self) -> &str {
+        "banded"
+    }
+    fn profile(&self, t: f64) -> f64 {
+        let on_grid = (t * 4096.0).fract() == 0.0;
+        if (0.40..0.43).contains(&t) && !on_grid {
+            self.band
+        } else {
+            1.0
+        }
+    }
+}
+
+/// `sppm` keeps the NaN guard of the render loop: a photon whose contribution is NaN is left
+/// out of the pixel's statistics (without the guard it stayed in them for the rest of the
+/// render, and the pixel was NaN). The render with NaN contributions is exactly the render
+/// whose kernel gives those photons weight zero instead, for both radius schedules.
+#[test]
+fn a_nan_photon_does_not_poison_a_pixel() {
+    use foton_core::integrator::{Integrator, NoProgress, RenderContext};
+    use foton_core::kernel::NormalizedKernel;
+    use foton_sppm::{RadiusSchedule, Sppm};
+    let overrides: Vec<String> = ["film.width=12", "film.height=12"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let scene =
+        foton_core::scene::Scene::load(&repo_root().join("scenes/cornell-box.toml"), &overrides)
+            .unwrap();
+    let cancel = Default::default();
+    let ctx = RenderContext::new(2, &cancel, &NoProgress);
+    for schedule in [RadiusSchedule::Pixel, RadiusSchedule::Global] {
+        let render = |band: f64| {
+            let sppm = Sppm {
+                iterations: Some(4),
+                time: None,
+                photons_per_iteration: 20_000,
+                initial_radius: None,
+                alpha: 0.7,
+                kernel: NormalizedKernel::new(Box::new(Banded { band })).unwrap(),
+                direct: foton_core::direct::Direct::ShadowRays,
+                max_depth: 8,
+                camera: foton_core::walk::CameraWalk {
+                    max_depth: 8,
+                    glossy_roughness: foton_core::walk::GLOSSY_ROUGHNESS,
+                },
+                schedule,
+            };
+            sppm.render(&scene, &ctx).unwrap().pixels()
+        };
+        let (nan, zero) = (render(f64::NAN), render(0.0));
+        let poisoned = nan.iter().filter(|p| !p.is_finite()).count();
+        assert_eq!(
+            poisoned, 0,
+            "{schedule:?}: {poisoned} pixels are not finite"
+        );
+        assert!(zero.iter().any(|p| p.max_element() > 0.0));
+        assert_eq!(nan, zero, "{schedule:?}");
+    }
+}

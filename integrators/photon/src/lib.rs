@@ -249,9 +249,11 @@ impl Integrator for PhotonMapper {
         if ctx.cancelled() {
             return Ok(Film::new(scene.film.width, scene.film.height));
         }
-        render_pixels(scene, ctx, |ray, sampler, rays| {
+        let film = render_pixels(scene, ctx, |ray, sampler, rays| {
             self.li(scene, &maps, *ray, sampler, rays)
-        })
+        })?;
+        self.kernel.check_weights()?;
+        Ok(film)
     }
 
     fn name(&self) -> &str {

@@ -87,7 +87,7 @@ use foton_core::integrator::{
 };
 use foton_core::kernel::NormalizedKernel;
 use foton_core::props::Properties;
-use foton_core::render::with_pool;
+use foton_core::render::{usable, warn_unusable, with_pool};
 use foton_core::sampling::{Rng, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
@@ -97,6 +97,7 @@ use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photo
 use glam::{DVec3, Vec2};
 use rayon::prelude::*;
 use std::f64::consts::PI;
+use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
 pub struct Sppm {
@@ -352,6 +353,9 @@ impl Integrator for Sppm {
         let mut photons_total = 0u64;
         let mut rays = 0u64;
         let mut seconds_reported = 0u64;
+        // Camera samples and photon contributions that were not finite and non-negative,
+        // replaced by zero: one would stay in a pixel's statistics for the rest of the render.
+        let (bad_samples, bad_photons) = (AtomicU64::new(0), AtomicU64::new(0));
         if global && first > 0 {
             // r_1 comes from the first iteration's camera sample: a part that starts later
             // traces that camera pass for its radii alone.
@@ -384,6 +388,12 @@ impl Integrator for Sppm {
                     .par_iter_mut()
                     .zip(camera.par_iter())
                     .for_each(|(st, cs)| {
+                        let ld = if usable(cs.ld) {
+                            cs.ld
+                        } else {
+                            bad_samples.fetch_add(1, Ordering::Relaxed);
+                            Rgb::ZERO
+                        };
                         if global && done == 0 {
                             // r_1 from the first iteration's camera sample alone (a pixel
                             // without a visible point there gets the largest automatic one),
@@ -392,8 +402,8 @@ impl Integrator for Sppm {
                         }
                         let Some(vp) = &cs.visible else {
                             match self.schedule {
-                                RadiusSchedule::Pixel => st.ld += cs.ld.as_dvec3(),
-                                RadiusSchedule::Global => st.sum.add(cs.ld),
+                                RadiusSchedule::Pixel => st.ld += ld.as_dvec3(),
+                                RadiusSchedule::Global => st.sum.add(ld),
                             }
                             return;
                         };
@@ -420,20 +430,25 @@ impl Integrator for Sppm {
                             }
                             let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;
                             let f = vp.bsdf.eval_density(vp.wo, photon.wi());
+                            let flux = f * photon.power() * w;
+                            if !(usable(flux) && w.is_finite() && w >= 0.0) {
+                                bad_photons.fetch_add(1, Ordering::Relaxed);
+                                return;
+                            }
                             m += w as f64;
-                            phi += (f * photon.power() * w).as_dvec3();
+                            phi += flux.as_dvec3();
                         });
                         let phi = phi * vp.beta.as_dvec3();
                         match self.schedule {
                             RadiusSchedule::Pixel => {
-                                st.ld += cs.ld.as_dvec3();
+                                st.ld += ld.as_dvec3();
                                 st.update(alpha, m, phi);
                             }
                             RadiusSchedule::Global => {
                                 // This iteration's estimate: its direct light and reflected
                                 // radiance tau / (pi r^2) with its own radius; iterations
                                 // are averaged.
-                                let l = cs.ld.as_dvec3() + phi / disc as f64;
+                                let l = ld.as_dvec3() + phi / disc as f64;
                                 st.sum.add_f64(l.to_array());
                             }
                         }
@@ -467,6 +482,11 @@ impl Integrator for Sppm {
             });
         }
         ctx.progress.finish();
+        self.kernel.check_weights()?;
+        let bad = bad_samples.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "camera sample(s)", "replaced by zero");
+        let bad = bad_photons.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "photon contribution(s)", "left out");
         let mut film = film_of(&stats, self.schedule, width, height, done - first);
         film.part = ctx.part;
         film.rays = rays;

@@ -405,9 +405,11 @@ impl Integrator for Vpm {
         if ctx.cancelled() {
             return Ok(Film::new(scene.film.width, scene.film.height));
         }
-        render_pixels(scene, ctx, |ray, sampler, rays| {
+        let film = render_pixels(scene, ctx, |ray, sampler, rays| {
             self.li(scene, &maps, *ray, sampler, rays)
-        })
+        })?;
+        self.kernel.check_weights()?;
+        Ok(film)
     }
 
     fn name(&self) -> &str {
