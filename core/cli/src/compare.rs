@@ -527,20 +527,8 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     };
 
     // The scene as the command line sets it for integrator `name`, plus `extra` overrides.
-    // A --set in the table of another compared integrator is for that one alone.
     let overrides = |name: &str, extra: &[String]| {
-        let mut overrides: Vec<String> = a
-            .sets
-            .iter()
-            .filter(|set| {
-                let mut keys = set.split('=').next().unwrap_or_default().trim().split('.');
-                let target = (keys.next() == Some("integrators"))
-                    .then(|| keys.next())
-                    .flatten();
-                target.is_none_or(|t| t == name || !names.iter().any(|n| n == t))
-            })
-            .cloned()
-            .collect();
+        let mut overrides = a.sets.clone();
         overrides.push(format!("render.integrator={name:?}"));
         if let Some(spp) = a.spp {
             overrides.push(format!("render.spp={spp}"));

@@ -20,6 +20,7 @@ use foton_core::error::{Error, Result};
 use foton_core::film::{Film, ImageFormat, check_output, format_of};
 use foton_core::integrator::{Integrator, Part, RenderContext};
 use foton_core::plugin::{IntegratorPlugin, Registry, search_path};
+use foton_core::props::Unused;
 use foton_core::scene::Scene;
 use foton_core::value::{Document, Value};
 pub use progress::TermProgress;
@@ -340,9 +341,6 @@ pub fn prepare_xml(
     strict: bool,
 ) -> Result<Prepared> {
     let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
-    // One command renders with one integrator: a --set for another one is not read. (The
-    // Python package keeps a scene's settings for every integrator, as a file does.)
-    refuse_sets_for_another_integrator(&scene)?;
     prepare_scene(scene, &search_path(plugin_dirs), strict)
 }
 
@@ -378,15 +376,18 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     // A value the command line set (--set, --spp, Python's overrides: no line in the file)
     // that nothing reads was asked for explicitly: rendering without it would answer another
     // question than the one asked, so it is an error even without --strict.
-    if let Some(u) = unused.iter().find(|u| u.location.line == 0) {
-        let hint = u
-            .suggestion
-            .as_ref()
-            .map_or(String::new(), |s| format!(" (did you mean `{s}`?)"));
-        return Err(Error::Usage(format!(
-            "--set {}: neither the scene nor the integrator `{}` reads it{hint}",
-            u.key, scene.render.integrator
-        )));
+    unread_set(&unused, &scene.render.integrator)?;
+    // Values set for other integrators (settings for several, as a file holds, switched with
+    // --integrator) are checked by those integrators' plugins, so that a typo there is caught
+    // too. One that cannot be created for this scene (`photon` refuses media) is not checked.
+    for (name, key) in other_integrators_set(&scene) {
+        let other = registry
+            .integrator(&name)
+            .map_err(|e| Error::Usage(format!("--set {key}: {e}")))?;
+        let props = scene.integrator_properties(&name)?.with_plugins(&registry);
+        if other.create(&props, &scene).is_ok() {
+            unread_set(&props.unused(), &name)?;
+        }
     }
     if strict && let Some(u) = unused.first() {
         return Err(Error::Scene {
@@ -412,20 +413,9 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     })
 }
 
-/// An error for a value the command line set in the table of an integrator other than the
-/// one that renders (`integrators.photon.k` for `path`), which nothing reads.
-fn refuse_sets_for_another_integrator(scene: &Scene) -> Result<()> {
-    match set_for_another_integrator(scene) {
-        Some(other) => Err(Error::Usage(format!(
-            "--set {other}: the scene renders with `{}`, which does not read [integrators.{}]",
-            scene.render.integrator,
-            other.split('.').nth(1).unwrap_or_default()
-        ))),
-        None => Ok(()),
-    }
-}
-
-fn set_for_another_integrator(scene: &Scene) -> Option<String> {
+/// The integrators other than `scene`'s whose tables hold a value the command line set (no
+/// line in the file), with the key path of the first such value.
+fn other_integrators_set(scene: &Scene) -> Vec<(String, String)> {
     fn first_set(table: &foton_core::value::Table, path: &str) -> Option<String> {
         table.0.iter().find_map(|(k, node)| match &node.value {
             Value::Table(t) => first_set(t, &format!("{path}.{k}")),
@@ -435,17 +425,35 @@ fn set_for_another_integrator(scene: &Scene) -> Option<String> {
     }
     let Some(Value::Table(integrators)) = scene.document.root.get("integrators").map(|n| &n.value)
     else {
-        return None;
+        return Vec::new();
     };
     integrators
         .0
         .iter()
-        .find_map(|(name, node)| match &node.value {
+        .filter_map(|(name, node)| match &node.value {
             Value::Table(t) if *name != scene.render.integrator => {
-                first_set(t, &format!("integrators.{name}"))
+                first_set(t, &format!("integrators.{name}")).map(|key| (name.clone(), key))
             }
             _ => None,
         })
+        .collect()
+}
+
+/// The error for a value set from the command line that `integrator` does not read.
+fn unread_set(unused: &[Unused], integrator: &str) -> Result<()> {
+    match unused.iter().find(|u| u.location.line == 0) {
+        Some(u) => {
+            let hint = u
+                .suggestion
+                .as_ref()
+                .map_or(String::new(), |s| format!(" (did you mean `{s}`?)"));
+            Err(Error::Usage(format!(
+                "--set {}: neither the scene nor the integrator `{integrator}` reads it{hint}",
+                u.key
+            )))
+        }
+        None => Ok(()),
+    }
 }
 
 /// `<scene stem>-<suffix>` in the scene's folder: the default output of the tools.
@@ -835,7 +843,6 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
                 doc.set(o)?;
             }
             let scene = Scene::from_document(doc)?;
-            refuse_sets_for_another_integrator(&scene)?;
             prepare_scene(scene, &search_path(&a.plugins.plugin_dirs), false)?
         }
     };
