@@ -135,8 +135,9 @@ impl PhotonMapper {
         SurfaceMaps::build(lists, need_direct, self.k, "integrators.photon.k")
     }
 
-    /// Indirect light at a diffuse point by final gathering: cosine-distributed rays, followed
-    /// through mirrors and glass to a diffuse point whose reflected radiance the maps give.
+    /// Indirect light at a diffuse point by final gathering: rays by the BSDF's non-delta part,
+    /// followed through mirrors and glass to a diffuse point whose reflected radiance the maps
+    /// give.
     /// Emission found along them is not counted: it is direct light (L D) or a caustic
     /// (L S+ D), both counted elsewhere.
     fn final_gather(
@@ -162,6 +163,14 @@ impl PhotonMapper {
             let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
                 continue;
             };
+            // The camera walk followed the delta part (a smooth plastic's coat) with its
+            // probability and estimates the rest here, so a gather ray that picks the delta
+            // part would count its reflection twice: it gathers nothing. The other rays'
+            // weight f cos / pdf, with the pdf of the whole BSDF, already holds one over
+            // the rest's probability, so the gather's mean is the non-delta part's integral.
+            if bs.delta {
+                continue;
+            }
             let mut beta = bs.weight;
             let mut ray = Ray::new(offset_origin(hit.p, hit.ng, bs.wi), bs.wi);
             for b in 0..MAX_SPECULAR.min(budget) {

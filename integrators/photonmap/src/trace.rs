@@ -41,7 +41,9 @@ pub struct TraceOptions {
     pub seed: u64,
     /// Separates the random streams of different photon passes (global, caustic, ...).
     pub stream: u64,
-    /// End each photon at its first diffuse hit (a caustic pass has nothing to store after).
+    /// End each photon at its first non-delta bounce (a caustic pass has nothing to store
+    /// after): at a diffuse surface after storing it, at a smooth plastic when it takes the
+    /// base rather than the delta coat.
     pub stop_at_diffuse: bool,
 }
 
@@ -181,10 +183,9 @@ pub fn trace_one(
                 Site::Surface,
                 class_of(hits, specular_only),
             );
-            if opts.stop_at_diffuse {
+            if opts.stop_at_diffuse && bsdf.delta_probability(wi) == 0.0 {
                 return;
             }
-            specular_only = false;
         }
         if hits >= opts.max_depth {
             return;
@@ -193,6 +194,17 @@ pub fn trace_one(
         let Some(bs) = bsdf.sample(wi, u, uc, TransportMode::Importance) else {
             return;
         };
+        // A bounce is specular by the lobe it took, not by the surface: a photon reflected by
+        // a smooth plastic's delta coat is still on an L S+ path, as the camera walk and the
+        // gather rays, which follow that coat by sampling, count it (the coat's light reaches
+        // a diffuse point through the caustic map). Only a non-delta bounce makes the path
+        // indirect, and ends a caustic pass's photon.
+        if !bs.delta {
+            if opts.stop_at_diffuse {
+                return;
+            }
+            specular_only = false;
+        }
         // Russian roulette on the scattering weight (the reflectance for a Lambertian
         // surface): a survivor's flux is divided by its survival probability, so the flux is
         // kept in expectation and a grey surface keeps every photon's power unchanged.
