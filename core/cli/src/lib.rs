@@ -170,6 +170,9 @@ struct ConvertArgs {
     /// Leave out what foton cannot render yet (listed) instead of refusing the scene.
     #[arg(long)]
     lenient: bool,
+    /// A parameter foton understands but ignores is an error, not a warning.
+    #[arg(long)]
+    strict: bool,
 }
 
 #[derive(Args)]
@@ -284,7 +287,9 @@ pub(crate) fn scene_overrides(a: &SceneArgs) -> Vec<String> {
 /// scene errors (they name the scene file, key and line).
 pub(crate) fn blame_plugin(plugin: &IntegratorPlugin, e: Error) -> Error {
     match e {
-        Error::Scene { .. } | Error::Syntax { .. } | Error::Io { .. } => e,
+        Error::Scene { .. } | Error::Syntax { .. } | Error::XmlSyntax { .. } | Error::Io { .. } => {
+            e
+        }
         other => Error::Plugin {
             file: plugin.file.clone(),
             message: format!("integrator `{}`: {other}", plugin.name),
@@ -356,6 +361,11 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     let mut unused = scene.unused.clone();
     unused.extend(props.unused());
     drop(props);
+    if strict && let Some(w) = scene.ignored.first() {
+        return Err(Error::Usage(format!(
+            "{w} (--strict: a parameter foton ignores is an error)"
+        )));
+    }
     if strict && let Some((key, loc)) = unused.first() {
         return Err(Error::Scene {
             location: loc.clone(),
@@ -364,6 +374,7 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         });
     }
     let mut warnings = scene.warnings.clone();
+    warnings.extend(scene.ignored.iter().cloned());
     warnings.extend(
         unused
             .iter()
@@ -592,6 +603,13 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
         )));
     }
     let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    if a.strict
+        && let Some(w) = report.warnings.first()
+    {
+        return Err(Error::Usage(format!(
+            "{w} (--strict: a parameter foton ignores is an error)"
+        )));
+    }
     // Files are named relative to the scene; from another folder, by their full path.
     let folder = |p: &Path| match p.parent() {
         Some(d) if !d.as_os_str().is_empty() => std::fs::canonicalize(d).ok(),
@@ -602,7 +620,11 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
         doc.absolutize_files(&base);
     }
     // The TOML must load: check it before writing.
-    Scene::from_document(doc.clone())?;
+    let mut scene = Scene::from_document(doc.clone())?;
+    if let Some((integrator, factor, line)) = &report.relative_radius {
+        foton_core::scene::set_relative_radius(&mut scene, integrator, *factor, *line);
+        doc = scene.document;
+    }
     let header = format!(
         "# Converted by `foton convert` from {}\n",
         a.scene.display()
@@ -610,6 +632,9 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
     write_atomic(&output, (header + &doc.to_toml()).as_bytes())?;
     for l in &report.left_out {
         let _ = writeln!(err, "left out: {l}");
+    }
+    for w in &report.warnings {
+        let _ = writeln!(err, "warning: {w}");
     }
     for n in &report.notes {
         let _ = writeln!(err, "note: {n}");
