@@ -591,3 +591,43 @@ fn bitterli_veach_bidir_renders_with_path() {
         run.stderr
     );
 }
+
+/// scenes/bitterli is the published files unchanged: the same bytes as in
+/// `../shared/scenes/bitterli` (beside the repository in CI, which sets FOTON_REQUIRE_SHARED
+/// so that its absence fails there; a clone elsewhere says that it skips).
+#[test]
+fn bitterli_scenes_are_the_published_files() {
+    let shared = repo_root().join("../shared/scenes/bitterli");
+    if !shared.join("veach-bidir").exists() {
+        assert!(
+            std::env::var_os("FOTON_REQUIRE_SHARED").is_none(),
+            "{} is missing",
+            shared.display()
+        );
+        eprintln!("skipped: {} is not beside this clone", shared.display());
+        return;
+    }
+    let mut compared = 0;
+    let mut folders = vec![
+        PathBuf::from("veach-bidir"),
+        PathBuf::from("volumetric-caustic"),
+    ];
+    while let Some(folder) = folders.pop() {
+        for entry in std::fs::read_dir(shared.join(&folder)).unwrap() {
+            let rel = folder.join(entry.unwrap().file_name());
+            if shared.join(&rel).is_dir() {
+                folders.push(rel);
+                continue;
+            }
+            let ours = std::fs::read(bitterli(s(&rel)))
+                .unwrap_or_else(|e| panic!("{}: {e}", rel.display()));
+            assert!(
+                ours == std::fs::read(shared.join(&rel)).unwrap(),
+                "{} differs",
+                rel.display()
+            );
+            compared += 1;
+        }
+    }
+    assert!(compared >= 16, "{compared}");
+}

@@ -127,7 +127,7 @@ pub(crate) struct PluginArgs {
 
 #[derive(Args, Clone, Default)]
 pub(crate) struct SceneArgs {
-    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
+    /// The scene file (TOML, or a Mitsuba scene: .xml, version 3 or 0.4 to 0.6).
     scene: PathBuf,
     /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (Mitsuba's -D;
     /// repeatable).
@@ -150,7 +150,8 @@ pub(crate) struct SceneArgs {
     /// --set integrators.photon.k=100 (repeatable).
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     sets: Vec<String>,
-    /// Treat unknown (unused) scene fields and integrator parameters as errors.
+    /// Treat unknown (unused) scene fields and integrator parameters, and Mitsuba parameters
+    /// foton understands but ignores (warnings otherwise), as errors.
     #[arg(long)]
     strict: bool,
     #[command(flatten)]
@@ -159,7 +160,7 @@ pub(crate) struct SceneArgs {
 
 #[derive(Args)]
 struct ConvertArgs {
-    /// The Mitsuba 3 scene (.xml).
+    /// The Mitsuba scene (.xml, version 3 or 0.4 to 0.6).
     scene: PathBuf,
     /// The TOML scene to write; default: <scene stem>.toml beside the scene.
     #[arg(short, long)]

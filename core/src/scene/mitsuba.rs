@@ -1305,7 +1305,7 @@ impl Reader {
                 Prop::Float(-1.0) => {}
                 Prop::Float(g) if (g - 2.2).abs() < 1e-6 => self.note(
                     o,
-                    "gamma 2.2 is written with the sRGB curve (within 1% of it above 0.04)",
+                    "gamma 2.2 is written with the sRGB curve, which differs from it by at most 3.4% of white (in the darkest tones)",
                 ),
                 other => self.warn(
                     o,
