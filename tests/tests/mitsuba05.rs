@@ -631,3 +631,32 @@ fn bitterli_scenes_are_the_published_files() {
     }
     assert!(compared >= 16, "{compared}");
 }
+
+/// A plugin type Mitsuba has and foton does not read is "not supported"; one Mitsuba does not
+/// have either is "unknown", with the close name.
+#[test]
+fn unknown_plugin_types_suggest_the_close_one() {
+    let dir = temp_dir("plugin-types");
+    for (element, says) in [
+        (
+            r#"<shape type="sphere"><bsdf type="difuse"/></shape>"#,
+            "unknown bsdf type `difuse` (did you mean `diffuse`?)",
+        ),
+        (
+            r#"<shape type="sphere"><bsdf type="ward"/></shape>"#,
+            "this BSDF is not supported yet",
+        ),
+        (
+            r#"<shape type="spheer"/>"#,
+            "unknown shape type `spheer` (did you mean `sphere`?)",
+        ),
+        (
+            r#"<emitter type="sunsky"/>"#,
+            "this emitter is not supported yet",
+        ),
+    ] {
+        let xml = write(&dir, "types.xml", &scene_with("", "", FILM, element));
+        let run = foton(&["convert", s(&xml)]);
+        assert!(failed(&run).contains(says), "{}", run.stderr);
+    }
+}

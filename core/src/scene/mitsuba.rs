@@ -1078,7 +1078,8 @@ impl Reader {
     fn sensor(&mut self, mut o: Obj) -> Result<()> {
         if o.ty != "perspective" {
             o.props.clear();
-            return self.unsupported(&o, "only the perspective sensor is supported");
+            let m = not_read("sensor", &o.ty, "only the perspective sensor is supported");
+            return self.unsupported(&o, &m);
         }
         let line = o.line;
         let m = o.transform("to_world")?;
@@ -1173,7 +1174,11 @@ impl Reader {
                 o.props.clear();
                 return self.unsupported(
                     &o,
-                    "this film is not supported; foton reads hdrfilm and ldrfilm",
+                    &not_read(
+                        "film",
+                        &o.ty,
+                        "this film is not supported; foton reads hdrfilm and ldrfilm",
+                    ),
                 );
             }
         };
@@ -1226,7 +1231,12 @@ impl Reader {
                     }
                     _ => {
                         rf.props.clear();
-                        self.unsupported(&rf, "foton's filters are box, tent and gaussian")?;
+                        let m = not_read(
+                            "rfilter",
+                            &rf.ty,
+                            "foton's filters are box, tent and gaussian",
+                        );
+                        self.unsupported(&rf, &m)?;
                         filter = Table::default();
                     }
                 }
@@ -1473,7 +1483,8 @@ impl Reader {
             "null" => put("type", Value::Str("null".into())),
             _ => {
                 o.props.clear();
-                self.unsupported(&o, "this BSDF is not supported yet")?;
+                let m = not_read("bsdf", &o.ty, "this BSDF is not supported yet");
+                self.unsupported(&o, &m)?;
                 return Ok(None);
             }
         }
@@ -1552,7 +1563,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                self.unsupported(&o, "this texture is not supported yet")?;
+                let m = not_read("texture", &o.ty, "this texture is not supported yet");
+                self.unsupported(&o, &m)?;
                 return Ok(None);
             }
         }
@@ -1615,7 +1627,11 @@ impl Reader {
     /// A medium into `[media]`; returns its name there.
     fn medium(&mut self, mut o: Obj) -> Result<String> {
         if o.ty != "homogeneous" {
-            return Err(o.error("only homogeneous media are supported"));
+            return Err(o.error(not_read(
+                "medium",
+                &o.ty,
+                "only homogeneous media are supported",
+            )));
         }
         let line = o.line;
         let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
@@ -1657,7 +1673,14 @@ impl Reader {
                     p.insert("g", at(Value::Float(g), l));
                     t.insert("phase", at(Value::Table(p), l));
                 }
-                _ => return Err(phase.error("foton's phase functions are isotropic and hg")),
+                _ => {
+                    let m = not_read(
+                        "phase",
+                        &phase.ty,
+                        "foton's phase functions are isotropic and hg",
+                    );
+                    return Err(phase.error(m));
+                }
             }
             self.leftovers(&phase)?;
         }
@@ -1839,7 +1862,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                return self.unsupported(&o, "this shape is not supported yet");
+                let m = not_read("shape", &o.ty, "this shape is not supported yet");
+                return self.unsupported(&o, &m);
             }
         }
         self.leftovers(&o)?;
@@ -1906,7 +1930,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                return self.unsupported(&o, "this emitter is not supported yet");
+                let m = not_read("emitter", &o.ty, "this emitter is not supported yet");
+                return self.unsupported(&o, &m);
             }
         }
         self.leftovers(&o)?;
@@ -2084,6 +2109,164 @@ fn show(p: &Prop) -> String {
         Prop::Ref(id) => format!("<ref id={id:?}>"),
         Prop::Object(o) => o.what(),
         Prop::Transform(_) => "a transform".into(),
+    }
+}
+
+/// The plugins of each kind in Mitsuba 3 and 0.6 (for "not supported" against "unknown").
+const MITSUBA_PLUGINS: &[(&str, &[&str])] = &[
+    (
+        "bsdf",
+        &[
+            "diffuse",
+            "dielectric",
+            "thindielectric",
+            "roughdielectric",
+            "conductor",
+            "roughconductor",
+            "plastic",
+            "roughplastic",
+            "twosided",
+            "null",
+            "principled",
+            "principledthin",
+            "bumpmap",
+            "normalmap",
+            "blendbsdf",
+            "mask",
+            "hair",
+            "measured",
+            "pplastic",
+            "polarizer",
+            "retarder",
+            "circular",
+            "coating",
+            "roughcoating",
+            "phong",
+            "ward",
+            "mixturebsdf",
+            "difftrans",
+            "hk",
+            "irawan",
+            "roughdiffuse",
+            "bump",
+        ],
+    ),
+    (
+        "shape",
+        &[
+            "obj",
+            "ply",
+            "serialized",
+            "sphere",
+            "rectangle",
+            "cube",
+            "disk",
+            "cylinder",
+            "bsplinecurve",
+            "linearcurve",
+            "sdfgrid",
+            "shapegroup",
+            "instance",
+            "ellipsoids",
+            "ellipsoidsmesh",
+            "merge",
+            "hair",
+            "heightfield",
+        ],
+    ),
+    (
+        "emitter",
+        &[
+            "area",
+            "point",
+            "spot",
+            "directional",
+            "constant",
+            "envmap",
+            "projector",
+            "directionalarea",
+            "sunsky",
+            "sky",
+            "sun",
+            "collimated",
+        ],
+    ),
+    (
+        "texture",
+        &[
+            "bitmap",
+            "checkerboard",
+            "mesh_attribute",
+            "volume",
+            "gridtexture",
+            "scale",
+            "vertexcolors",
+            "wireframe",
+            "curvature",
+        ],
+    ),
+    (
+        "sensor",
+        &[
+            "perspective",
+            "thinlens",
+            "orthographic",
+            "radiancemeter",
+            "irradiancemeter",
+            "distant",
+            "batch",
+            "telecentric",
+            "spherical",
+            "fluencemeter",
+            "perspective_rdist",
+        ],
+    ),
+    ("medium", &["homogeneous", "heterogeneous"]),
+    (
+        "phase",
+        &[
+            "isotropic",
+            "hg",
+            "rayleigh",
+            "sggx",
+            "tabphase",
+            "blendphase",
+            "kkay",
+            "microflake",
+            "mixturephase",
+        ],
+    ),
+    (
+        "film",
+        &["hdrfilm", "ldrfilm", "specfilm", "tiledhdrfilm", "mfilm"],
+    ),
+    (
+        "rfilter",
+        &[
+            "box",
+            "tent",
+            "gaussian",
+            "mitchell",
+            "catmullrom",
+            "lanczos",
+        ],
+    ),
+];
+
+/// The message for a plugin type foton does not read: `supported` (with `not supported`
+/// wording) when Mitsuba has it, "unknown" with the close name otherwise.
+fn not_read(kind: &str, ty: &str, supported: &str) -> String {
+    let known = MITSUBA_PLUGINS
+        .iter()
+        .find(|(k, _)| *k == kind)
+        .map_or(&[][..], |(_, names)| names);
+    if known.contains(&ty) {
+        supported.to_string()
+    } else {
+        format!(
+            "unknown {kind} type `{ty}`{}",
+            crate::error::suggestion(ty, known.iter().copied())
+        )
     }
 }
 
