@@ -660,3 +660,74 @@ fn unknown_plugin_types_suggest_the_close_one() {
         assert!(failed(&run).contains(says), "{}", run.stderr);
     }
 }
+
+/// The 0.6 forms of a medium, colours and parameters, each as Mitsuba 0.6 means it: a
+/// medium as sigmaT and albedo with densityMultiplier, Henyey-Greenstein's default g (0 in
+/// 0.6), `<srgb>` colours (sRGB-decoded), a conductor's extEta, a texture's uscale and
+/// uoffset (a to_uv transform), hdrfilm's componentFormat float16 (a warning: foton writes
+/// 32-bit floats), and a medium given both ways (an error).
+#[test]
+fn old_media_colours_and_parameters() {
+    let dir = temp_dir("old-params");
+    let extra = r##"<medium type="homogeneous" id="fog">
+        <rgb name="sigmaT" value="2"/><rgb name="albedo" value="0.5"/>
+        <float name="densityMultiplier" value="0.5"/><phase type="hg"/>
+    </medium>
+    <medium type="homogeneous" id="haze">
+        <rgb name="sigmaS" value="1"/><rgb name="sigmaA" value="0"/><phase type="isotropic"/>
+    </medium>
+    <shape type="sphere"><bsdf type="null"/><ref name="interior" id="fog"/></shape>
+    <shape type="sphere"><point name="center" x="3" y="0" z="0"/><bsdf type="null"/><ref name="interior" id="haze"/></shape>
+    <shape type="sphere"><point name="center" x="0" y="3" z="0"/>
+        <bsdf type="diffuse"><srgb name="reflectance" value="#ff8000"/></bsdf></shape>
+    <shape type="sphere"><point name="center" x="0" y="-3" z="0"/>
+        <bsdf type="conductor"><rgb name="eta" value="2, 3, 4"/><rgb name="k" value="4"/><float name="extEta" value="2"/></bsdf></shape>
+    <shape type="sphere"><point name="center" x="3" y="3" z="0"/>
+        <bsdf type="diffuse"><texture type="checkerboard" name="reflectance">
+            <float name="uscale" value="4"/><float name="voffset" value="0.5"/>
+        </texture></bsdf></shape>"##;
+    let film = r#"<film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/><string name="componentFormat" value="float16"/></film>"#;
+    let (toml, run) = convert(&dir, "old.xml", &scene_with("", "", film, extra), &[]);
+    assert!(
+        run.stderr.contains("old.xml:6:")
+            && run.stderr.contains("`component_format` = \"float16\""),
+        "{}",
+        run.stderr
+    );
+    let table = |name: &str| {
+        let start = toml.find(&format!("[media.{name}]")).unwrap();
+        toml[start..]
+            .split("\n\n")
+            .take(2)
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let fog = table("fog");
+    assert_eq!(vector(&fog, "sigma_s"), [0.5, 0.5, 0.5], "{fog}");
+    assert_eq!(vector(&fog, "sigma_a"), [0.5, 0.5, 0.5], "{fog}");
+    assert_eq!(number(&fog, "g"), 0.0, "{fog}");
+    assert!(table("haze").contains("phase = \"isotropic\""), "{toml}");
+    let orange = vector(&toml, "reflectance");
+    assert_eq!(orange[0], 1.0);
+    assert!(
+        (orange[1] - 0.2158605).abs() < 1e-6 && orange[2] == 0.0,
+        "{orange:?}"
+    );
+    assert_eq!(vector(&toml, "eta"), [1.0, 1.5, 2.0]);
+    assert_eq!(vector(&toml, "k"), [2.0, 2.0, 2.0]);
+    // to_uv = scale(4, 1) translate(0, 0.5): row-major [4, 0, 0, 0, 0, 1, 0, 0.5, ...].
+    let to_uv = &toml[toml.find("to_uv]").unwrap()..];
+    let to_uv = to_uv.lines().find(|l| l.starts_with("matrix")).unwrap();
+    assert!(
+        to_uv.contains("matrix = [4.0, 0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.5,"),
+        "{to_uv}"
+    );
+
+    let both = extra.replace(
+        r#"<rgb name="albedo" value="0.5"/>"#,
+        r#"<rgb name="sigmaS" value="0.5"/>"#,
+    );
+    let xml = write(&dir, "both.xml", &scene_with("", "", FILM, &both));
+    let run = foton(&["convert", s(&xml)]);
+    assert!(failed(&run).contains("not both"), "{}", run.stderr);
+}
