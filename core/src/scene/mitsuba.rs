@@ -1,7 +1,9 @@
-//! Mitsuba XML scenes (Mitsuba 3, and 0.4 to 0.6 upgraded as Mitsuba 3 upgrades them), read into the document a TOML scene makes: `foton render scene.xml`
-//! renders what the same scene written in TOML would (`foton convert` writes that TOML), and
-//! every value keeps the XML line it came from, so the loader's errors name the XML file and
-//! line.
+//! Mitsuba XML scenes (Mitsuba 3, and 0.4 to 0.6 upgraded as Mitsuba 3 upgrades them), read
+//! into the document a TOML scene makes: `foton render scene.xml` renders what the same scene
+//! written in TOML would (`foton convert` writes that TOML), and every value keeps the XML
+//! line it came from, so the loader's errors name the XML file and line. Parameters foton
+//! understands but ignores are warnings with their file:line (`XmlReport::warnings`), errors
+//! with `--strict`.
 //!
 //! Mitsuba's conventions, as its documentation states them: `<default>` and `$name`
 //! substitution (`-D name=value` overrides a default), `ref`/`id`, `include`; transforms
@@ -35,7 +37,7 @@ pub struct XmlReport {
     pub relative_radius: Option<(String, f64, u32)>,
 }
 
-/// Reads a Mitsuba 3 XML scene. `defines` are `NAME=VALUE` overrides of its `<default>`s.
+/// Reads a Mitsuba XML scene (3.x, 2.x, or 0.x and 1.x upgraded). `defines` are `NAME=VALUE` overrides of its `<default>`s.
 pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Document, XmlReport)> {
     let mut defaults = HashMap::new();
     for d in defines {
@@ -65,7 +67,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         integrator: None,
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    r.read_file(path, &text, true)?;
+    r.read_file(path, &text)?;
     r.check_defines(path)?;
     if let Some(o) = r.integrator.take() {
         r.integrator(o)?;
@@ -397,7 +399,7 @@ impl Reader {
             .push(format!("{}: {}: {what}", obj.place(), obj.what()));
     }
 
-    fn read_file(&mut self, path: &Path, text: &str, top: bool) -> Result<()> {
+    fn read_file(&mut self, path: &Path, text: &str) -> Result<()> {
         let doc = roxmltree::Document::parse(text).map_err(|e| {
             let pos = e.pos();
             Error::XmlSyntax {
@@ -426,7 +428,6 @@ impl Reader {
                 "the root element must be <scene>",
             ));
         }
-        let _ = top;
         // Each file is upgraded by its own version, as Mitsuba 3 does with included files.
         let version = scene.attribute("version").ok_or_else(|| {
             syntax(
@@ -477,7 +478,7 @@ impl Reader {
                     let inc = path.parent().unwrap_or(Path::new("")).join(file);
                     let text = std::fs::read_to_string(&inc).map_err(|e| Error::io(&inc, e))?;
                     self.report.included.push(inc.clone());
-                    self.read_file(&inc, &text, false)?;
+                    self.read_file(&inc, &text)?;
                 }
                 "alias" => {
                     let id = self.subst(&attr(child, "id", path, line)?, path, line)?;
@@ -990,7 +991,10 @@ impl Reader {
                 params.push(("k", Value::Int(k)));
                 let kc = o.int("caustic_lookup_size", lookup)?;
                 if kc != k {
-                    self.warn(&o, line, &format!("`caustic_lookup_size` = {kc}: foton's photon maps share one k ({k}, the global lookup size)"));
+                    let why = format!(
+                        "`caustic_lookup_size` = {kc}: foton's photon maps share one k ({k}, the global lookup size)"
+                    );
+                    self.warn(&o, line, &why);
                 }
                 let kv = o.int("volume_lookup_size", lookup)?;
                 if name == "vpm" {
@@ -1001,7 +1005,11 @@ impl Reader {
                 let rg = o.float("global_lookup_radius", 0.05)?;
                 self.report.relative_radius = Some((name.to_string(), rg, line));
                 if let Some((p, l)) = o.take("caustic_lookup_radius") {
-                    self.warn(&o, l, &format!("`caustic_lookup_radius` = {}: foton's photon maps share one largest radius (the global lookup radius)", show(&p)));
+                    let why = format!(
+                        "`caustic_lookup_radius` = {}: foton's photon maps share one largest radius (the global lookup radius)",
+                        show(&p)
+                    );
+                    self.warn(&o, l, &why);
                 }
                 for k in ["direct_samples", "glossy_samples"] {
                     self.ignored(&mut o, k, &same, noise);
@@ -1045,7 +1053,12 @@ impl Reader {
                 };
                 match passes {
                     Some((n, _)) if n >= 1 => params.push(("iterations", Value::Int(n))),
-                    Some((n, l)) => self.warn(&o, l, &format!("passes = {n} (until stopped): foton runs its default number of iterations; give integrators.sppm.iterations or time")),
+                    Some((n, l)) => {
+                        let why = format!(
+                            "passes = {n} (until stopped): foton runs its default number of iterations; give integrators.sppm.iterations or time"
+                        );
+                        self.warn(&o, l, &why);
+                    }
                     None => {}
                 }
                 for k in ["granularity", "auto_cancel_gathering", "samples_per_pass"] {
