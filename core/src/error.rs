@@ -35,6 +35,9 @@ pub enum Error {
     /// TOML that does not parse.
     #[error("{location}: TOML syntax error: {message}")]
     Syntax { location: Location, message: String },
+    /// XML that does not parse or breaks Mitsuba's scene structure (a Mitsuba scene file).
+    #[error("{location}: XML error: {message}")]
+    XmlSyntax { location: Location, message: String },
     #[error("{path}: {message}")]
     Io { path: PathBuf, message: String },
     #[error("plugin {file}: {message}")]
@@ -59,40 +62,52 @@ impl Error {
     }
 }
 
-/// The candidate closest to `word` (Levenshtein distance), if it is close enough to be what
-/// was meant: at most one edit per three characters, and never the whole word.
-pub fn did_you_mean<'c>(
-    word: &str,
-    candidates: impl IntoIterator<Item = &'c str>,
-) -> Option<&'c str> {
-    let limit = (word.chars().count() / 3).max(1);
+/// The candidate closest to `name` when it is close enough to be a typo (Levenshtein distance
+/// at most a third of the name's length, and at least 1 allowed): the "did you mean" of
+/// unknown names, shared by the TOML and the XML readers.
+pub fn did_you_mean<'a>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
+    let limit = (name.chars().count() / 3).max(1);
     candidates
         .into_iter()
-        .filter(|c| *c != word)
-        .map(|c| (edit_distance(word, c), c))
-        .filter(|&(d, c)| d <= limit && d < c.chars().count().max(word.chars().count()))
-        .min_by_key(|&(d, _)| d)
+        .filter(|c| *c != name)
+        .map(|c| (edit_distance(&name.to_lowercase(), &c.to_lowercase()), c))
+        .filter(|(d, _)| *d <= limit)
+        .min_by_key(|(d, _)| *d)
         .map(|(_, c)| c)
 }
 
-/// Levenshtein distance, with a transposition of neighbours counted as one edit (`rr_dpeth`).
-fn edit_distance(a: &str, b: &str) -> usize {
+/// " (did you mean `x`?)" or nothing: the suffix an "unknown ..." message takes.
+pub fn suggestion<'a>(name: &str, candidates: impl IntoIterator<Item = &'a str>) -> String {
+    did_you_mean(name, candidates).map_or_else(String::new, |c| format!(" (did you mean `{c}`?)"))
+}
+
+/// The edit distance with adjacent transpositions (optimal string alignment): insertions,
+/// deletions, substitutions and swaps of neighbouring characters each count one, so that
+/// `flaot` is one edit from `float`.
+pub fn edit_distance(a: &str, b: &str) -> usize {
     let (a, b): (Vec<char>, Vec<char>) = (a.chars().collect(), b.chars().collect());
-    // d[i][j]: distance between a[..i] and b[..j], three rows kept.
-    let mut prev2 = vec![0usize; b.len() + 1];
-    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    let mut d = vec![vec![0usize; b.len() + 1]; a.len() + 1];
+    for (i, row) in d.iter_mut().enumerate() {
+        row[0] = i;
+    }
+    for (j, cell) in d[0].iter_mut().enumerate() {
+        *cell = j;
+    }
     for i in 1..=a.len() {
-        let mut row = vec![i; b.len() + 1];
         for j in 1..=b.len() {
             let cost = usize::from(a[i - 1] != b[j - 1]);
-            row[j] = (prev[j] + 1).min(row[j - 1] + 1).min(prev[j - 1] + cost);
+            d[i][j] = (d[i - 1][j] + 1)
+                .min(d[i][j - 1] + 1)
+                .min(d[i - 1][j - 1] + cost);
             if i > 1 && j > 1 && a[i - 1] == b[j - 2] && a[i - 2] == b[j - 1] {
-                row[j] = row[j].min(prev2[j - 2] + 1);
+                d[i][j] = d[i][j].min(d[i - 2][j - 2] + 1);
             }
         }
-        prev2 = std::mem::replace(&mut prev, row);
     }
-    prev[b.len()]
+    d[a.len()][b.len()]
 }
 
 #[cfg(test)]
@@ -100,7 +115,16 @@ mod tests {
     use super::*;
 
     #[test]
-    fn close_names_are_suggested_and_far_ones_not() {
+    fn edit_distance_counts_single_character_edits() {
+        assert_eq!(edit_distance("kitten", "sitting"), 3);
+        assert_eq!(edit_distance("", "abc"), 3);
+        assert_eq!(edit_distance("path", "path"), 0);
+        assert_eq!(edit_distance("flaot", "float"), 1);
+        assert_eq!(
+            did_you_mean("phtonmapper", ["path", "photonmapper", "sppm"]),
+            Some("photonmapper")
+        );
+        assert_eq!(did_you_mean("xyz", ["path", "sppm"]), None);
         let keys = ["rr_depth", "max_depth", "spp", "seed"];
         assert_eq!(did_you_mean("rr_dept", keys), Some("rr_depth"));
         assert_eq!(did_you_mean("rr_dpeth", keys), Some("rr_depth"));
@@ -111,7 +135,5 @@ mod tests {
             None,
             "an exact name is not a typo"
         );
-        assert_eq!(edit_distance("kitten", "sitting"), 3);
-        assert_eq!(edit_distance("", "abc"), 3);
     }
 }

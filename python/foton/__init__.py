@@ -171,7 +171,7 @@ def load(
 
     ``plugin_dirs`` are searched for plugins first (``--plugin-dir``), then
     ``FOTON_PLUGIN_PATH``, the running executable's folder and its ``plugins/``, then the
-    package's own plugins (:data:`PLUGIN_DIR`). ``strict``: unknown fields are errors.
+    package's own plugins (:data:`PLUGIN_DIR`). ``strict``: unknown fields, and Mitsuba XML parameters foton ignores, are errors.
 
     Raises :class:`SceneError` (file, line, key), :class:`PluginError`, :class:`FileError`,
     :class:`UsageError`. Unknown fields are :class:`FotonWarning` warnings.

@@ -59,7 +59,7 @@ fn py_error(py: Python<'_>, e: Error) -> PyErr {
                 kwargs.set_item("reason", message)?;
                 "SceneError"
             }
-            Error::Syntax { location, message } => {
+            Error::Syntax { location, message } | Error::XmlSyntax { location, message } => {
                 kwargs.set_item("file", path(&location.file))?;
                 kwargs.set_item("line", (location.line > 0).then_some(location.line))?;
                 kwargs.set_item("column", (location.line > 0).then_some(location.column))?;

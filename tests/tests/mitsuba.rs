@@ -361,8 +361,8 @@ fn unsupported_and_bad_xml_is_a_clear_error() {
             vec!["$nothing", "-D nothing"],
         ),
         (
-            XML.replace("version=\"3.0.0\"", "version=\"0.6.0\""),
-            vec!["version 3.x"],
+            XML.replace("version=\"3.0.0\"", "version=\"4.0.0\""),
+            vec!["scene.xml:1:", "XML error", "expected a Mitsuba version"],
         ),
         (
             XML.replace("</sensor>", "</sensr>"),

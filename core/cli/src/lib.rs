@@ -130,7 +130,7 @@ pub(crate) struct PluginArgs {
 
 #[derive(Args, Clone, Default)]
 pub(crate) struct SceneArgs {
-    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
+    /// The scene file (TOML, or a Mitsuba scene: .xml, version 3 or 0.4 to 0.6).
     scene: PathBuf,
     /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (Mitsuba's -D;
     /// repeatable).
@@ -153,7 +153,8 @@ pub(crate) struct SceneArgs {
     /// --set integrators.photon.k=100 (repeatable).
     #[arg(long = "set", value_name = "KEY.PATH=VALUE")]
     sets: Vec<String>,
-    /// Treat unknown (unused) scene fields and integrator parameters as errors.
+    /// Treat unknown (unused) scene fields and integrator parameters, and Mitsuba parameters
+    /// foton understands but ignores (warnings otherwise), as errors.
     #[arg(long)]
     strict: bool,
     #[command(flatten)]
@@ -162,7 +163,7 @@ pub(crate) struct SceneArgs {
 
 #[derive(Args)]
 struct ConvertArgs {
-    /// The Mitsuba 3 scene (.xml).
+    /// The Mitsuba scene (.xml, version 3 or 0.4 to 0.6).
     scene: PathBuf,
     /// The TOML scene to write; default: <scene stem>.toml beside the scene.
     #[arg(short, long)]
@@ -173,6 +174,9 @@ struct ConvertArgs {
     /// Leave out what foton cannot render yet (listed) instead of refusing the scene.
     #[arg(long)]
     lenient: bool,
+    /// A parameter foton understands but ignores is an error, not a warning.
+    #[arg(long)]
+    strict: bool,
 }
 
 #[derive(Args)]
@@ -301,7 +305,9 @@ pub(crate) fn scene_overrides(a: &SceneArgs) -> Vec<String> {
 /// scene errors (they name the scene file, key and line).
 pub(crate) fn blame_plugin(plugin: &IntegratorPlugin, e: Error) -> Error {
     match e {
-        Error::Scene { .. } | Error::Syntax { .. } | Error::Io { .. } => e,
+        Error::Scene { .. } | Error::Syntax { .. } | Error::XmlSyntax { .. } | Error::Io { .. } => {
+            e
+        }
         other => Error::Plugin {
             file: plugin.file.clone(),
             message: format!("integrator `{}`: {other}", plugin.name),
@@ -389,6 +395,11 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
             unread_set(&props.unused(), &name)?;
         }
     }
+    if strict && let Some(w) = scene.ignored.first() {
+        return Err(Error::Usage(format!(
+            "{w} (--strict: a parameter foton ignores is an error)"
+        )));
+    }
     if strict && let Some(u) = unused.first() {
         return Err(Error::Scene {
             location: u.location.clone(),
@@ -400,6 +411,7 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         });
     }
     let mut warnings = scene.warnings.clone();
+    warnings.extend(scene.ignored.iter().cloned());
     warnings.extend(
         unused
             .iter()
@@ -671,6 +683,13 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
         )));
     }
     let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    if a.strict
+        && let Some(w) = report.warnings.first()
+    {
+        return Err(Error::Usage(format!(
+            "{w} (--strict: a parameter foton ignores is an error)"
+        )));
+    }
     // Files are named relative to the scene; written into another folder, relative to it.
     let folder = |p: &Path| match p.parent() {
         Some(d) if !d.as_os_str().is_empty() => std::fs::canonicalize(d).ok(),
@@ -689,7 +708,11 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
     // The TOML must load from where it is written: check it before writing.
     let mut written = doc.clone();
     written.file = output.clone();
-    Scene::from_document(written)?;
+    let mut scene = Scene::from_document(written)?;
+    if let Some((integrator, factor, line)) = &report.relative_radius {
+        foton_core::scene::set_relative_radius(&mut scene, integrator, *factor, *line);
+        doc.root = scene.document.root;
+    }
     let header = format!(
         "# Converted by `foton convert` from {}\n",
         a.scene.display()
@@ -697,6 +720,9 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
     write_atomic(&output, (header + &doc.to_toml()).as_bytes())?;
     for l in &report.left_out {
         let _ = writeln!(err, "left out: {l}");
+    }
+    for w in &report.warnings {
+        let _ = writeln!(err, "warning: {w}");
     }
     for n in &report.notes {
         let _ = writeln!(err, "note: {n}");

@@ -112,6 +112,10 @@ impl Scene {
         }
         let mut scene = Scene::from_document(doc)?;
         if let Some(report) = report {
+            if let Some((integrator, factor, line)) = &report.relative_radius {
+                set_relative_radius(&mut scene, integrator, *factor, *line);
+            }
+            scene.ignored.extend(report.warnings);
             scene.sources.extend(report.included);
             let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
             scene.warnings.extend(left_out.chain(report.notes));
@@ -287,7 +291,40 @@ impl Scene {
             sources,
             unused,
             warnings,
+            ignored: Vec::new(),
         })
+    }
+}
+
+/// A Mitsuba photon mapper's lookup radius, a fraction of the radius of the scene's bounding
+/// sphere (Mitsuba's `getBSphere`: around the bounding box, half its diagonal), as the
+/// plugin's `max_radius` in world units, unless the document already gives one (`--set`).
+pub fn set_relative_radius(scene: &mut Scene, integrator: &str, factor: f64, line: u32) {
+    use crate::value::{Node, Value};
+    let (lo, hi) = scene.bounds;
+    let radius = 0.5 * f64::from((hi - lo).length());
+    if !radius.is_finite() || radius <= 0.0 {
+        return;
+    }
+    let node = |value| Node {
+        value,
+        line,
+        column: u32::from(line > 0),
+    };
+    let root = &mut scene.document.root;
+    if root.get("integrators").is_none() {
+        root.insert("integrators", node(Value::Table(Default::default())));
+    }
+    let Some(Value::Table(integrators)) = root.get_mut("integrators").map(|n| &mut n.value) else {
+        return;
+    };
+    if integrators.get(integrator).is_none() {
+        integrators.insert(integrator, node(Value::Table(Default::default())));
+    }
+    if let Some(Value::Table(t)) = integrators.get_mut(integrator).map(|n| &mut n.value)
+        && t.get("max_radius").is_none()
+    {
+        t.insert("max_radius", node(Value::Float(factor * radius)));
     }
 }
 

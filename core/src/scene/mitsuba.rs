@@ -1,7 +1,9 @@
-//! Mitsuba 3 XML scenes, read into the document a TOML scene makes: `foton render scene.xml`
-//! renders what the same scene written in TOML would (`foton convert` writes that TOML), and
-//! every value keeps the XML line it came from, so the loader's errors name the XML file and
-//! line.
+//! Mitsuba XML scenes (Mitsuba 3, and 0.4 to 0.6 upgraded as Mitsuba 3 upgrades them), read
+//! into the document a TOML scene makes: `foton render scene.xml` renders what the same scene
+//! written in TOML would (`foton convert` writes that TOML), and every value keeps the XML
+//! line it came from, so the loader's errors name the XML file and line. Parameters foton
+//! understands but ignores are warnings with their file:line (`XmlReport::warnings`), errors
+//! with `--strict`.
 //!
 //! Mitsuba's conventions, as its documentation states them: `<default>` and `$name`
 //! substitution (`-D name=value` overrides a default), `ref`/`id`, `include`; transforms
@@ -13,7 +15,8 @@
 use crate::error::{Error, Location, Result};
 use crate::value::{Document, Node, Table, Value};
 use glam::{DMat4, DVec3};
-use std::collections::HashMap;
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// What reading an XML scene produced besides the document.
@@ -25,9 +28,16 @@ pub struct XmlReport {
     pub notes: Vec<String>,
     /// The files it included (`<include>`), which make the scene as much as its own file.
     pub included: Vec<PathBuf>,
+    /// Parameters foton understands but ignores (or renders otherwise), each with its
+    /// file:line: warnings, errors with `--strict`.
+    pub warnings: Vec<String>,
+    /// A photon lookup radius Mitsuba gives relative to the scene's bounding sphere: the
+    /// integrator, the factor and its line; the loader sets `max_radius` once it knows the
+    /// scene's bounds.
+    pub relative_radius: Option<(String, f64, u32)>,
 }
 
-/// Reads a Mitsuba 3 XML scene. `defines` are `NAME=VALUE` overrides of its `<default>`s.
+/// Reads a Mitsuba XML scene (3.x, 2.x, or 0.x and 1.x upgraded). `defines` are `NAME=VALUE` overrides of its `<default>`s.
 pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Document, XmlReport)> {
     let mut defaults = HashMap::new();
     for d in defines {
@@ -52,10 +62,18 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         sensor_medium: None,
         shape_media: false,
         anonymous: 0,
+        v1: false,
+        used: RefCell::default(),
+        declared: HashSet::new(),
+        integrator: None,
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
-    r.read_file(path, &text, true)?;
+    r.read_file(path, &text)?;
+    r.check_defines(path)?;
     r.place_sensor_medium();
+    if let Some(o) = r.integrator.take() {
+        r.integrator(o)?;
+    }
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
         root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
@@ -260,6 +278,16 @@ struct Reader {
     /// Medium ids to their names in `[media]`.
     media: HashMap<String, String>,
     anonymous: usize,
+    /// The file being read is Mitsuba 0.x or 1.x: its properties are upgraded as Mitsuba 3
+    /// upgrades them (camelCase to snake_case...).
+    v1: bool,
+    /// The `$name`s substituted so far (a `-D` nobody uses is a typo).
+    used: RefCell<HashSet<String>>,
+    /// The `<default>`s declared.
+    declared: HashSet<String>,
+    /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
+    /// the scene has media.
+    integrator: Option<Obj>,
 }
 
 /// Mitsuba's named indices of refraction (its documentation's table).
@@ -314,22 +342,75 @@ impl Reader {
         Ok(())
     }
 
+    /// A parameter foton understands but ignores or renders otherwise (at `line`).
+    fn warn(&mut self, obj: &Obj, line: u32, what: &str) {
+        self.report.warnings.push(format!(
+            "{}:{line}: {}: {what}",
+            obj.file.display(),
+            obj.what()
+        ));
+    }
+
+    /// Takes a parameter foton does not honour: a warning unless `same` says its value asks
+    /// for what foton does anyway (`why` empty: it changes nothing foton renders).
+    fn ignored(&mut self, o: &mut Obj, name: &str, same: &dyn Fn(&Prop) -> bool, why: &str) {
+        if let Some((p, line)) = o.take(name)
+            && !same(&p)
+        {
+            let why = if why.is_empty() {
+                "ignored (it changes how Mitsuba runs, not the image)"
+            } else {
+                why
+            };
+            self.warn(o, line, &format!("`{name}` = {}: {why}", show(&p)));
+        }
+    }
+
+    /// A `-D NAME=...` that no `<default>` declares and no `$NAME` uses is a typo.
+    fn check_defines(&self, path: &Path) -> Result<()> {
+        let used = self.used.borrow();
+        for name in &self.defined {
+            if !self.declared.contains(name) && !used.contains(name) {
+                let known: Vec<&str> = self
+                    .declared
+                    .iter()
+                    .chain(used.iter())
+                    .map(String::as_str)
+                    .collect();
+                let mut sorted = known.clone();
+                sorted.sort_unstable();
+                sorted.dedup();
+                return Err(Error::Usage(format!(
+                    "-D {name}: {} never uses `${name}`{}; its parameters: {}",
+                    path.display(),
+                    crate::error::suggestion(name, known),
+                    if sorted.is_empty() {
+                        "none".to_string()
+                    } else {
+                        sorted.join(", ")
+                    }
+                )));
+            }
+        }
+        Ok(())
+    }
+
     fn note(&mut self, obj: &Obj, what: &str) {
         self.report
             .notes
             .push(format!("{}: {}: {what}", obj.place(), obj.what()));
     }
 
-    fn read_file(&mut self, path: &Path, text: &str, top: bool) -> Result<()> {
+    fn read_file(&mut self, path: &Path, text: &str) -> Result<()> {
         let doc = roxmltree::Document::parse(text).map_err(|e| {
             let pos = e.pos();
-            Error::Syntax {
+            Error::XmlSyntax {
                 location: Location {
                     file: path.to_path_buf(),
                     line: pos.row,
                     column: pos.col,
                 },
-                message: format!("XML: {e}"),
+                message: e.to_string(),
             }
         })?;
         let scene = doc.root_element();
@@ -349,24 +430,47 @@ impl Reader {
                 "the root element must be <scene>",
             ));
         }
-        if top {
-            let version = scene.attribute("version").unwrap_or("");
-            if !version.starts_with("3.") && !version.starts_with("2.") {
-                return Err(syntax(
+        // Each file is upgraded by its own version, as Mitsuba 3 does with included files.
+        let version = scene.attribute("version").ok_or_else(|| {
+            syntax(
+                path,
+                line_of(scene),
+                "<scene> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")",
+            )
+        })?;
+        let major = version
+            .split('.')
+            .next()
+            .and_then(|m| m.trim().parse::<u32>().ok())
+            .filter(|m| *m <= 3)
+            .ok_or_else(|| {
+                syntax(
                     path,
                     line_of(scene),
                     &format!(
-                        "<scene version=\"{version}\">: foton reads Mitsuba 3 scenes (version 3.x)"
+                        "<scene version=\"{version}\">: expected a Mitsuba version, 0.4.0 to 3.x"
                     ),
-                ));
-            }
-        }
+                )
+            })?;
+        let outer_v1 = std::mem::replace(&mut self.v1, major < 2);
+        self.read_scene_children(path, scene, &line_of)?;
+        self.v1 = outer_v1;
+        Ok(())
+    }
+
+    fn read_scene_children(
+        &mut self,
+        path: &Path,
+        scene: roxmltree::Node<'_, '_>,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+    ) -> Result<()> {
         for child in scene.children().filter(|n| n.is_element()) {
             let line = line_of(child);
             match child.tag_name().name() {
                 "default" => {
                     let name = attr(child, "name", path, line)?;
                     let value = attr(child, "value", path, line)?;
+                    self.declared.insert(name.clone());
                     if !self.defined.contains(&name) {
                         self.defaults.entry(name).or_insert(value);
                     }
@@ -376,10 +480,41 @@ impl Reader {
                     let inc = path.parent().unwrap_or(Path::new("")).join(file);
                     let text = std::fs::read_to_string(&inc).map_err(|e| Error::io(&inc, e))?;
                     self.report.included.push(inc.clone());
-                    self.read_file(&inc, &text, false)?;
+                    self.read_file(&inc, &text)?;
+                }
+                "alias" => {
+                    let id = self.subst(&attr(child, "id", path, line)?, path, line)?;
+                    let alias = self.subst(&attr(child, "as", path, line)?, path, line)?;
+                    let mut found = false;
+                    for map in [&mut self.bsdfs, &mut self.media] {
+                        if let Some(name) = map.get(&id).cloned() {
+                            map.insert(alias.clone(), name);
+                            found = true;
+                        }
+                    }
+                    if let Some(t) = self.textures.get(&id).cloned() {
+                        self.textures.insert(alias.clone(), t);
+                        found = true;
+                    }
+                    if !found {
+                        return Err(syntax(
+                            path,
+                            line,
+                            &format!(
+                                "<alias id=\"{id}\">: no BSDF, medium or texture with that id before it"
+                            ),
+                        ));
+                    }
+                }
+                "path" => {
+                    return Err(syntax(
+                        path,
+                        line,
+                        "<path> (a folder searched for files) is not supported: give file names relative to the scene",
+                    ));
                 }
                 _ => {
-                    let obj = self.object(child, path, &line_of)?;
+                    let obj = self.object(child, path, line_of)?;
                     self.top_level(obj)?;
                 }
             }
@@ -398,6 +533,7 @@ impl Reader {
                 .find(|c: char| !(c.is_alphanumeric() || c == '_'))
                 .unwrap_or(after.len());
             let name = &after[..end];
+            self.used.borrow_mut().insert(name.to_string());
             let value = self.defaults.get(name).ok_or_else(|| {
                 syntax(
                     file,
@@ -501,19 +637,54 @@ impl Reader {
                     let id = cget("id")?.ok_or_else(|| syntax(file, cl, "<ref> without id"))?;
                     Prop::Ref(id)
                 }
+                // Mitsuba 0.6's sRGB colour: "#rrggbb" or numbers, both sRGB-encoded.
+                "srgb" => {
+                    let v = value()?;
+                    let xs = match v.trim().strip_prefix('#') {
+                        Some(hex) if hex.len() == 6 => (0..3)
+                            .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok())
+                            .map(|x| x.map(|x| f64::from(x) / 255.0))
+                            .collect::<Option<Vec<f64>>>(),
+                        Some(_) => None,
+                        None => numbers(&v),
+                    }
+                    .filter(|xs| xs.len() == 1 || xs.len() == 3)
+                    .ok_or_else(|| bad("expected #rrggbb or one or three numbers", &v))?;
+                    let c = if xs.len() == 1 {
+                        DVec3::splat(xs[0])
+                    } else {
+                        DVec3::new(xs[0], xs[1], xs[2])
+                    };
+                    Prop::Color(DVec3::from_array(c.to_array().map(srgb_to_linear)))
+                }
                 "bsdf" | "emitter" | "medium" | "phase" | "texture" | "rfilter" | "sampler"
                 | "film" | "shape" | "sensor" | "integrator" => {
                     Prop::Object(self.object(c, file, line_of)?)
                 }
-                other => {
+                other if KNOWN_UNREAD.contains(&other) => {
                     return Err(syntax(
                         file,
                         cl,
-                        &format!("unknown element <{other}> in <{}>", obj.tag),
+                        &format!("<{other}> in <{}> is not supported", obj.tag),
+                    ));
+                }
+                other => {
+                    let known = PROPERTY_TAGS.iter().chain(OBJECT_TAGS).copied();
+                    return Err(syntax(
+                        file,
+                        cl,
+                        &format!(
+                            "unknown element <{other}> in <{}>{}",
+                            obj.tag,
+                            crate::error::suggestion(other, known)
+                        ),
                     ));
                 }
             };
             obj.props.push((name, prop, cl));
+        }
+        if self.v1 {
+            upgrade_v1(&mut obj);
         }
         Ok(obj)
     }
@@ -588,8 +759,19 @@ impl Reader {
                     }
                 }
                 "lookat" => {
-                    let (origin, target, up) = (vec("origin")?, vec("target")?, vec("up")?);
+                    let (origin, target) = (vec("origin")?, vec("target")?);
                     let dir = (target - origin).normalize();
+                    // Without `up` (or with a zero one), Mitsuba completes the direction to
+                    // an orthonormal basis (its coordinate_system) and takes the first vector.
+                    let up = match get("up")? {
+                        Some(_) => vec("up")?,
+                        None => DVec3::ZERO,
+                    };
+                    let up = if up == DVec3::ZERO && dir.is_finite() {
+                        coordinate_system(dir).0
+                    } else {
+                        up
+                    };
                     let left = up.cross(dir).normalize();
                     if !dir.is_finite() || !left.is_finite() {
                         return Err(syntax(
@@ -607,10 +789,14 @@ impl Reader {
                     )
                 }
                 other => {
+                    let ops = ["translate", "scale", "rotate", "matrix", "lookat"];
                     return Err(syntax(
                         file,
                         l,
-                        &format!("unknown transform operation <{other}>"),
+                        &format!(
+                            "unknown transform operation <{other}>{}",
+                            crate::error::suggestion(other, ops)
+                        ),
                     ));
                 }
             };
@@ -634,7 +820,13 @@ impl Reader {
 
     fn top_level(&mut self, obj: Obj) -> Result<()> {
         match obj.tag.as_str() {
-            "integrator" => self.integrator(obj),
+            "integrator" => {
+                if self.integrator.is_some() {
+                    return Err(obj.error("a second <integrator>: a scene has one"));
+                }
+                self.integrator = Some(obj);
+                Ok(())
+            }
             "sensor" => self.sensor(obj),
             "bsdf" => self.bsdf(obj).map(|_| ()),
             "medium" => self.medium(obj).map(|_| ()),
@@ -654,32 +846,47 @@ impl Reader {
         }
     }
 
+    /// Mitsuba's integrator: the foton plugin that renders it, its parameters translated
+    /// (each one foton has no equivalent for is a warning). Read after the rest of the scene.
     fn integrator(&mut self, mut o: Obj) -> Result<()> {
-        let render = table_mut(&mut self.root, "render");
-        let (name, depth_default) = match o.ty.as_str() {
-            "path" | "volpath" | "volpathmis" => ("path", -1),
-            "direct" => ("path", 2),
-            "sppm" => ("sppm", -1),
-            "photonmapper" => ("photon", -1),
-            _ => {
-                o.props.clear();
-                return self.unsupported(
-                    &o,
-                    "unknown integrator; foton reads path, volpath, volpathmis, direct, sppm and photonmapper",
-                );
-            }
+        // Mitsuba 3 reads integrators' names as written; 0.6 files are upgraded. Accept the
+        // 0.6 spelling in either (older exporters mix them).
+        for (name, _, _) in &mut o.props {
+            *name = camel_to_snake(name);
+        }
+        let has_media = !self.media.is_empty();
+        let Some(name) = foton_integrator(&o.ty, has_media) else {
+            o.props.clear();
+            let message = if MITSUBA_INTEGRATORS.contains(&o.ty.as_str()) {
+                format!(
+                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm and bdpt",
+                    o.ty
+                )
+            } else {
+                format!(
+                    "unknown integrator `{}`{}",
+                    o.ty,
+                    crate::error::suggestion(&o.ty, MITSUBA_INTEGRATORS.iter().copied())
+                )
+            };
+            return self.unsupported(&o, &message);
         };
-        render.insert("integrator", at(Value::Str(name.into()), o.line));
         let line = o.line;
+        table_mut(&mut self.root, "render").insert("integrator", at(Value::Str(name.into()), line));
+        if o.ty == "ppm" {
+            self.note(
+                &o,
+                "rendered by sppm (the stochastic variant of progressive photon mapping converges to the same image)",
+            );
+        }
+        // Mitsuba's max_depth counts path segments (1: emitters seen directly, 2: direct
+        // light); foton's counts scattering events, one less. -1 is unbounded in both
+        // Mitsubas: a cap no path reaches (Russian roulette ends them long before).
         let max_depth = if o.ty == "direct" {
             2
         } else {
-            let md = o.float("max_depth", depth_default as f64)?;
-            let md = o.float("maxDepth", md)?;
-            md as i64
+            o.int("max_depth", -1)?
         };
-        // Mitsuba counts path segments (the camera ray is one); foton counts scattering
-        // events. Unbounded: a cap no path reaches (Russian roulette ends them long before).
         let bounces = match max_depth {
             -1 => 65_536,
             d if d >= 1 => d - 1,
@@ -689,60 +896,160 @@ impl Reader {
                 )));
             }
         };
-        let render = table_mut(&mut self.root, "render");
-        render.insert("max_depth", at(Value::Int(bounces), line));
-        let params = table_mut(table_mut(&mut self.root, "integrators"), name);
-        let mut set = |key: &str, v: Value| params.insert(key, at(v, line));
-        match o.ty.as_str() {
-            "path" | "volpath" | "volpathmis" => {
-                let rr = o.int("rr_depth", 5)?;
-                set("rr_depth", Value::Int(rr.max(1) - 1));
-            }
-            "sppm" => {
-                for (mitsuba, foton) in [
-                    ("photon_count", "photons_per_iteration"),
-                    ("photonCount", "photons_per_iteration"),
-                    ("passes", "iterations"),
-                    ("maxPasses", "iterations"),
-                ] {
-                    if let Some((Prop::Int(v), _)) = o.take(mitsuba) {
-                        set(foton, Value::Int(v));
-                    }
-                }
-                for (mitsuba, foton) in [
-                    ("initial_radius", "initial_radius"),
-                    ("initialRadius", "initial_radius"),
-                    ("alpha", "alpha"),
-                ] {
-                    if let Some((Prop::Float(v), _)) = o.take(mitsuba) {
-                        set(foton, Value::Float(v));
-                    }
-                }
-            }
-            "photonmapper" => {
-                for (mitsuba, foton) in [
-                    ("globalPhotons", "global_photons"),
-                    ("causticPhotons", "caustic_photons"),
-                    ("globalLookupSize", "k"),
-                ] {
-                    if let Some((Prop::Int(v), _)) = o.take(mitsuba) {
-                        set(foton, Value::Int(v));
-                    }
-                }
-            }
-            _ => {}
-        }
-        for ignored in [
-            "rrDepth",
-            "samples_per_pass",
-            "emitter_samples",
-            "bsdf_samples",
-        ] {
-            o.take(ignored);
-        }
+        table_mut(&mut self.root, "render").insert("max_depth", at(Value::Int(bounces), line));
         if o.boolean("hide_emitters", false)? {
             table_mut(&mut self.root, "render")
                 .insert("hide_emitters", at(Value::Bool(true), line));
+        }
+        let mut params: Vec<(&str, Value)> = Vec::new();
+        let rr = o.take("rr_depth");
+        match name {
+            "path" | "bdpt" => {
+                // Mitsuba starts Russian roulette at path depth rr_depth (segments): foton
+                // counts scattering events.
+                if let Some((p, l)) = rr {
+                    o.props.push(("rr_depth".into(), p, l));
+                    let rr = o.int("rr_depth", 5)?;
+                    params.push(("rr_depth", Value::Int(rr.max(1) - 1)));
+                }
+            }
+            _ => {
+                if let Some((p, l)) = rr {
+                    self.warn(
+                        &o,
+                        l,
+                        &format!(
+                            "`rr_depth` = {}: ignored ({name} traces photons with its own Russian roulette)",
+                            show(&p)
+                        ),
+                    );
+                }
+            }
+        }
+        let same = |_: &Prop| false;
+        self.ignored(
+            &mut o,
+            "strict_normals",
+            &|p| matches!(p, Prop::Bool(false)),
+            "ignored (foton does not end paths whose shading and geometric normals disagree)",
+        );
+        let noise = "ignored (it changes the noise, not the image: foton takes one sample per camera sample; raise spp)";
+        match o.ty.as_str() {
+            "direct" => {
+                for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
+                    self.ignored(&mut o, k, &same, noise);
+                }
+            }
+            "photonmapper" => {
+                // Mitsuba 0.6's defaults, written out: the budgets and k are its meaning.
+                let photons = |o: &mut Obj, k: &str| o.int(k, 250_000);
+                params.push((
+                    "global_photons",
+                    Value::Int(photons(&mut o, "global_photons")?),
+                ));
+                params.push((
+                    "caustic_photons",
+                    Value::Int(photons(&mut o, "caustic_photons")?),
+                ));
+                let volume = photons(&mut o, "volume_photons")?;
+                let lookup = o.int("lookup_size", 120)?;
+                let k = o.int("global_lookup_size", lookup)?;
+                params.push(("k", Value::Int(k)));
+                let kc = o.int("caustic_lookup_size", lookup)?;
+                if kc != k {
+                    let why = format!(
+                        "`caustic_lookup_size` = {kc}: foton's photon maps share one k ({k}, the global lookup size)"
+                    );
+                    self.warn(&o, line, &why);
+                }
+                let kv = o.int("volume_lookup_size", lookup)?;
+                if name == "vpm" {
+                    params.push(("volume_photons", Value::Int(volume)));
+                    params.push(("k_volume", Value::Int(kv)));
+                }
+                // Mitsuba's lookup radii are fractions of the bounding sphere's radius.
+                let rg = o.float("global_lookup_radius", 0.05)?;
+                self.report.relative_radius = Some((name.to_string(), rg, line));
+                if let Some((p, l)) = o.take("caustic_lookup_radius") {
+                    let why = format!(
+                        "`caustic_lookup_radius` = {}: foton's photon maps share one largest radius (the global lookup radius)",
+                        show(&p)
+                    );
+                    self.warn(&o, l, &why);
+                }
+                for k in ["direct_samples", "glossy_samples"] {
+                    self.ignored(&mut o, k, &same, noise);
+                }
+                self.ignored(
+                    &mut o,
+                    "max_specular_depth",
+                    &same,
+                    "ignored (foton follows specular bounces up to max_depth)",
+                );
+                for k in ["granularity", "gather_locally", "auto_cancel_gathering"] {
+                    self.ignored(&mut o, k, &|_| true, "");
+                }
+            }
+            "sppm" | "ppm" => {
+                if let Some(n) = o
+                    .take("photon_count")
+                    .or_else(|| o.take("photons_per_iteration"))
+                {
+                    o.props.push(("photon_count".into(), n.0, n.1));
+                    params.push((
+                        "photons_per_iteration",
+                        Value::Int(o.int("photon_count", 250_000)?),
+                    ));
+                }
+                // 0 (Mitsuba's default): a radius guessed from the scene, as foton's is.
+                let r = o.float("initial_radius", 0.0)?;
+                if r > 0.0 {
+                    params.push(("initial_radius", Value::Float(r)));
+                }
+                if let Some((p, l)) = o.take("alpha") {
+                    o.props.push(("alpha".into(), p, l));
+                    params.push(("alpha", Value::Float(o.float("alpha", 0.7)?)));
+                }
+                let passes = match o.take("passes").or_else(|| o.take("max_passes")) {
+                    Some((p, l)) => {
+                        o.props.push(("passes".into(), p, l));
+                        Some((o.int("passes", -1)?, l))
+                    }
+                    None => None,
+                };
+                match passes {
+                    Some((n, _)) if n >= 1 => params.push(("iterations", Value::Int(n))),
+                    Some((n, l)) => {
+                        let why = format!(
+                            "passes = {n} (until stopped): foton runs its default number of iterations; give integrators.sppm.iterations or time"
+                        );
+                        self.warn(&o, l, &why);
+                    }
+                    None => {}
+                }
+                for k in ["granularity", "auto_cancel_gathering", "samples_per_pass"] {
+                    self.ignored(&mut o, k, &|_| true, "");
+                }
+            }
+            "bdpt" => {
+                self.ignored(
+                    &mut o,
+                    "light_image",
+                    &|p| matches!(p, Prop::Bool(false)),
+                    "ignored (no light image: foton's bdpt adds no light-tracing image)",
+                );
+                self.ignored(
+                    &mut o,
+                    "sample_direct",
+                    &|p| matches!(p, Prop::Bool(true)),
+                    "ignored",
+                );
+            }
+            _ => {}
+        }
+        let t = table_mut(table_mut(&mut self.root, "integrators"), name);
+        for (k, v) in params {
+            t.insert(k, at(v, line));
         }
         self.leftovers(&o)
     }
@@ -750,7 +1057,8 @@ impl Reader {
     fn sensor(&mut self, mut o: Obj) -> Result<()> {
         if o.ty != "perspective" {
             o.props.clear();
-            return self.unsupported(&o, "only the perspective sensor is supported");
+            let m = not_read("sensor", &o.ty, "only the perspective sensor is supported");
+            return self.unsupported(&o, &m);
         }
         let line = o.line;
         let m = o.transform("to_world")?;
@@ -837,20 +1145,49 @@ impl Reader {
     }
 
     fn film(&mut self, mut o: Obj) -> Result<()> {
-        if o.ty != "hdrfilm" {
-            self.note(&o, "read as hdrfilm");
-        }
         let line = o.line;
+        let ldr = match o.ty.as_str() {
+            "hdrfilm" | "tiledhdrfilm" => false,
+            "ldrfilm" => true,
+            _ => {
+                o.props.clear();
+                return self.unsupported(
+                    &o,
+                    &not_read(
+                        "film",
+                        &o.ty,
+                        "this film is not supported; foton reads hdrfilm and ldrfilm",
+                    ),
+                );
+            }
+        };
         let width = o.int("width", 768)?;
         let height = o.int("height", 576)?;
-        for ignored in [
-            "pixel_format",
-            "component_format",
-            "file_format",
-            "sample_border",
-        ] {
-            o.take(ignored);
+        if ldr {
+            self.ldr_film(&mut o)?;
+        } else {
+            let exr = |p: &Prop| matches!(p, Prop::Str(s) if s == "openexr" || s == "exr");
+            self.ignored(&mut o, "file_format", &exr, "foton writes OpenEXR");
+            let f32 = |p: &Prop| matches!(p, Prop::Str(s) if s == "float32");
+            self.ignored(
+                &mut o,
+                "component_format",
+                &f32,
+                "foton writes 32-bit floats",
+            );
         }
+        let rgb = |p: &Prop| matches!(p, Prop::Str(s) if s == "rgb");
+        self.ignored(&mut o, "pixel_format", &rgb, "foton writes RGB");
+        let no = |p: &Prop| matches!(p, Prop::Bool(false));
+        self.ignored(&mut o, "banner", &no, "foton draws no banner");
+        self.ignored(
+            &mut o,
+            "high_quality_edges",
+            &no,
+            "ignored (pixels at the border are filtered as inside)",
+        );
+        self.ignored(&mut o, "attach_log", &|_| true, "");
+        o.take("sample_border");
         let film = table_mut(&mut self.root, "film");
         film.insert("width", at(Value::Int(width), line));
         film.insert("height", at(Value::Int(height), line));
@@ -873,7 +1210,12 @@ impl Reader {
                     }
                     _ => {
                         rf.props.clear();
-                        self.unsupported(&rf, "foton's filters are box, tent and gaussian")?;
+                        let m = not_read(
+                            "rfilter",
+                            &rf.ty,
+                            "foton's filters are box, tent and gaussian",
+                        );
+                        self.unsupported(&rf, &m)?;
                         filter = Table::default();
                     }
                 }
@@ -895,16 +1237,97 @@ impl Reader {
 
     fn sampler(&mut self, mut o: Obj) -> Result<()> {
         let line = o.line;
+        let Some((_sampler, exact)) = foton_sampler(&o.ty) else {
+            let known = [
+                "independent",
+                "stratified",
+                "multijitter",
+                "orthogonal",
+                "ldsampler",
+                "sobol",
+                "halton",
+                "hammersley",
+            ];
+            return Err(o.error(format!(
+                "unknown sampler `{}`{}",
+                o.ty,
+                crate::error::suggestion(&o.ty, known)
+            )));
+        };
+        if !exact {
+            self.warn(
+                &o,
+                line,
+                &format!("foton samples with `independent` (the same image, other noise) instead of `{}`", o.ty),
+            );
+        }
         let spp = o.int("sample_count", 4)?;
         let render = table_mut(&mut self.root, "render");
         render.insert("spp", at(Value::Int(spp), line));
         let seed = o.int("seed", 0)?;
         table_mut(&mut self.root, "render").insert("seed", at(Value::Int(seed), line));
-        // The sample pattern (stratified, multijitter...) changes noise, not the image.
-        for ignored in ["jitter", "scramble"] {
+        // The pattern's options go with the pattern (warned about above).
+        for ignored in ["jitter", "scramble", "dimension", "resolution"] {
             o.take(ignored);
         }
         self.leftovers(&o)
+    }
+
+    /// Mitsuba 0.6's `ldrfilm`: a PNG through foton's exposure and tone curve (the sRGB
+    /// curve; `gamma` = 2.2 is close to it, a note; another gamma a warning).
+    fn ldr_film(&mut self, o: &mut Obj) -> Result<()> {
+        let line = o.line;
+        let png = |p: &Prop| matches!(p, Prop::Str(s) if s == "png");
+        self.ignored(o, "file_format", &png, "foton writes a PNG");
+        let stem = self
+            .file
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+        let film = table_mut(&mut self.root, "film");
+        film.insert("output", at(Value::Str(format!("{stem}.png")), line));
+        let exposure = o.float("exposure", 0.0)?;
+        if exposure != 0.0 {
+            table_mut(&mut self.root, "film").insert("exposure", at(Value::Float(exposure), line));
+        }
+        if let Some((p, l)) = o.take("gamma") {
+            match p {
+                Prop::Float(-1.0) => {}
+                Prop::Float(g) if (g - 2.2).abs() < 1e-6 => self.note(
+                    o,
+                    "gamma 2.2 is written with the sRGB curve, which differs from it by at most 3.4% of white (in the darkest tones)",
+                ),
+                other => self.warn(
+                    o,
+                    l,
+                    &format!("`gamma` = {}: foton writes the sRGB curve", show(&other)),
+                ),
+            }
+        }
+        let method = o
+            .string("tonemap_method")?
+            .unwrap_or_else(|| "gamma".into());
+        match method.as_str() {
+            "gamma" => {}
+            "reinhard" => self.warn(
+                o,
+                line,
+                "`tonemap_method` = \"reinhard\": foton's tone curves are clamp (used) and filmic",
+            ),
+            other => {
+                return Err(o.error(format!(
+                    "`tonemap_method` = {other:?}: expected gamma or reinhard"
+                )));
+            }
+        }
+        for k in ["key", "burn"] {
+            self.ignored(
+                o,
+                k,
+                &|_| false,
+                "ignored (a parameter of Reinhard's tone mapping)",
+            );
+        }
+        Ok(())
     }
 
     fn new_name(&mut self, prefix: &str, id: &Option<String>) -> String {
@@ -989,8 +1412,10 @@ impl Reader {
                         o.props.push(("eta".into(), eta, l1));
                         o.props.push(("k".into(), k, l2));
                         let (eta, k) = (o.color("eta", DVec3::ONE)?, o.color("k", DVec3::ZERO)?);
-                        t.insert("eta", vec3(eta, line));
-                        t.insert("k", vec3(k, line));
+                        // Mitsuba 0.6's index of the outside: the Fresnel terms take eta / ext.
+                        let ext = self.ior(&mut o, "ext_eta", 1.0)?;
+                        t.insert("eta", vec3(eta / ext, line));
+                        t.insert("k", vec3(k / ext, line));
                     }
                     _ => {
                         return Err(
@@ -1037,7 +1462,8 @@ impl Reader {
             "null" => put("type", Value::Str("null".into())),
             _ => {
                 o.props.clear();
-                self.unsupported(&o, "this BSDF is not supported yet")?;
+                let m = not_read("bsdf", &o.ty, "this BSDF is not supported yet");
+                self.unsupported(&o, &m)?;
                 return Ok(None);
             }
         }
@@ -1116,7 +1542,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                self.unsupported(&o, "this texture is not supported yet")?;
+                let m = not_read("texture", &o.ty, "this texture is not supported yet");
+                self.unsupported(&o, &m)?;
                 return Ok(None);
             }
         }
@@ -1179,32 +1606,60 @@ impl Reader {
     /// A medium into `[media]`; returns its name there.
     fn medium(&mut self, mut o: Obj) -> Result<String> {
         if o.ty != "homogeneous" {
-            return Err(o.error("only homogeneous media are supported"));
+            return Err(o.error(not_read(
+                "medium",
+                &o.ty,
+                "only homogeneous media are supported",
+            )));
         }
         let line = o.line;
-        let sigma_t = o.color("sigma_t", DVec3::ONE)?;
-        let albedo = o.color("albedo", DVec3::splat(0.75))?;
-        let scale = o.float("scale", 1.0)?;
+        let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
+        if has(&o, "material") {
+            return Err(o.error("`material` (Mitsuba 0.6's measured media) is not supported: give sigma_s and sigma_a"));
+        }
+        // Mitsuba 0.6 writes a medium as sigma_s and sigma_a or as sigma_t and albedo (Mitsuba
+        // 3 only the latter, and its upgrade drops the former: foton keeps them).
+        let (sigma_s, sigma_a) = if has(&o, "sigma_s") || has(&o, "sigma_a") {
+            if has(&o, "sigma_t") || has(&o, "albedo") {
+                return Err(o.error("give sigma_s and sigma_a, or sigma_t and albedo, not both"));
+            }
+            (
+                o.color("sigma_s", DVec3::ONE)?,
+                o.color("sigma_a", DVec3::ONE)?,
+            )
+        } else {
+            let sigma_t = o.color("sigma_t", DVec3::ONE)?;
+            let albedo = o.color("albedo", DVec3::splat(0.75))?;
+            (sigma_t * albedo, sigma_t * (DVec3::ONE - albedo))
+        };
+        // Mitsuba 0.6 calls the scale density_multiplier.
+        let scale = o.float("density_multiplier", 1.0)?;
+        let scale = o.float("scale", scale)?;
         // Whether a medium samples emitters changes noise, not the image.
         o.take("sample_emitters");
         let mut t = Table::default();
         t.insert("type", at(Value::Str("homogeneous".into()), line));
-        t.insert("sigma_s", vec3(sigma_t * albedo * scale, line));
-        t.insert(
-            "sigma_a",
-            vec3(sigma_t * (DVec3::ONE - albedo) * scale, line),
-        );
+        t.insert("sigma_s", vec3(sigma_s * scale, line));
+        t.insert("sigma_a", vec3(sigma_a * scale, line));
         if let Some((Prop::Object(mut phase), l)) = o.take("") {
             match phase.ty.as_str() {
                 "isotropic" => t.insert("phase", at(Value::Str("isotropic".into()), l)),
                 "hg" => {
-                    let g = phase.float("g", 0.8)?;
+                    // Mitsuba 0.6's default g is 0, Mitsuba 3's 0.8.
+                    let g = phase.float("g", if self.v1 { 0.0 } else { 0.8 })?;
                     let mut p = Table::default();
                     p.insert("type", at(Value::Str("hg".into()), l));
                     p.insert("g", at(Value::Float(g), l));
                     t.insert("phase", at(Value::Table(p), l));
                 }
-                _ => return Err(phase.error("foton's phase functions are isotropic and hg")),
+                _ => {
+                    let m = not_read(
+                        "phase",
+                        &phase.ty,
+                        "foton's phase functions are isotropic and hg",
+                    );
+                    return Err(phase.error(m));
+                }
             }
             self.leftovers(&phase)?;
         }
@@ -1266,11 +1721,25 @@ impl Reader {
         let material = match material {
             Some(Some(name)) => name,
             Some(None) => return Ok(()), // left out with its BSDF (lenient)
+            // Mitsuba 0.x gives a medium transition without a BSDF the null BSDF (its
+            // Shape::configure): an index-matched boundary of the fog (Bitterli's
+            // volumetric caustic); Mitsuba 3 gives every shape its diffuse default.
+            None if self.v1 && emission.is_none() && (interior.is_some() || exterior.is_some()) => {
+                let name = "null_boundary".to_string();
+                let mut t = Table::default();
+                t.insert("type", at(Value::Str("null".into()), line));
+                table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
+                name
+            }
             None => {
                 let name = format!("default_diffuse_{line}");
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("diffuse".into()), line));
                 t.insert("twosided", at(Value::Bool(false), line));
+                // ... and an emitter without one an all-absorbing diffuse BSDF.
+                if self.v1 && emission.is_some() {
+                    t.insert("reflectance", vec3(DVec3::ZERO, line));
+                }
                 table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
                 name
             }
@@ -1379,7 +1848,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                return self.unsupported(&o, "this shape is not supported yet");
+                let m = not_read("shape", &o.ty, "this shape is not supported yet");
+                return self.unsupported(&o, &m);
             }
         }
         self.leftovers(&o)?;
@@ -1467,7 +1937,8 @@ impl Reader {
             }
             _ => {
                 o.props.clear();
-                return self.unsupported(&o, "this emitter is not supported yet");
+                let m = not_read("emitter", &o.ty, "this emitter is not supported yet");
+                return self.unsupported(&o, &m);
             }
         }
         self.leftovers(&o)?;
@@ -1477,7 +1948,7 @@ impl Reader {
 }
 
 fn syntax(file: &Path, line: u32, message: &str) -> Error {
-    Error::Syntax {
+    Error::XmlSyntax {
         location: Location {
             file: file.to_path_buf(),
             line,
@@ -1503,4 +1974,398 @@ fn numbers(s: &str) -> Option<Vec<f64>> {
         .filter(|x| !x.is_empty())
         .map(|x| x.parse().ok())
         .collect()
+}
+
+/// The property elements of Mitsuba 3's parser (and 0.6's `srgb`) that foton reads.
+const PROPERTY_TAGS: &[&str] = &[
+    "float",
+    "integer",
+    "boolean",
+    "string",
+    "rgb",
+    "srgb",
+    "spectrum",
+    "point",
+    "vector",
+    "transform",
+    "ref",
+];
+
+/// The object elements of Mitsuba's parser.
+const OBJECT_TAGS: &[&str] = &[
+    "bsdf",
+    "emitter",
+    "medium",
+    "phase",
+    "texture",
+    "rfilter",
+    "sampler",
+    "film",
+    "shape",
+    "sensor",
+    "integrator",
+];
+
+/// Elements Mitsuba (3 or 0.6) reads that foton does not: "not supported", not "unknown".
+const KNOWN_UNREAD: &[&str] = &[
+    "volume",
+    "blackbody",
+    "animation",
+    "alias",
+    "path",
+    "include",
+    "default",
+    "subsurface",
+    "luminaire",
+    "null",
+];
+
+/// Mitsuba 3's upgrade of a property list from a file older than 2.0 (its `upgrade_from_v1`):
+/// camelCase names to snake_case, a diffuse BSDF's `diffuse_reflectance` to `reflectance`,
+/// and `uoffset`, `voffset`, `uscale`, `vscale` to a `to_uv` transform. Unlike Mitsuba 3,
+/// nothing is dropped: a medium's `sigma_s` and `sigma_a` stay (Mitsuba 0.6 honours them).
+fn upgrade_v1(o: &mut Obj) {
+    for (name, _, _) in &mut o.props {
+        *name = camel_to_snake(name);
+    }
+    if o.ty == "diffuse" {
+        for (name, _, _) in &mut o.props {
+            if name == "diffuse_reflectance" {
+                *name = "reflectance".into();
+            }
+        }
+    }
+    let mut offset = DVec3::ZERO;
+    let mut scale = DVec3::ONE;
+    let mut any = None;
+    o.props.retain(|(name, p, line)| {
+        let x = match p {
+            Prop::Float(x) => *x,
+            Prop::Int(i) => *i as f64,
+            _ => return true,
+        };
+        match name.as_str() {
+            "uoffset" => offset.x = x,
+            "voffset" => offset.y = x,
+            "uscale" => scale.x = x,
+            "vscale" => scale.y = x,
+            _ => return true,
+        }
+        any = Some(*line);
+        false
+    });
+    if let Some(line) = any {
+        let m = DMat4::from_scale(scale) * DMat4::from_translation(offset);
+        o.props.push(("to_uv".into(), Prop::Transform(m), line));
+    }
+}
+
+/// Mitsuba 3's `camel_to_underscore_case`: an upper-case letter after a lower-case one starts
+/// a new word (`toWorld` to `to_world`), and the upper-case letters right after it stay in
+/// that word (`intIOR` to `int_ior`).
+fn camel_to_snake(name: &str) -> String {
+    let c: Vec<char> = name.chars().collect();
+    let mut out = String::with_capacity(name.len() + 4);
+    let mut i = 0;
+    while i < c.len() {
+        if i > 0 && c[i - 1].is_ascii_lowercase() && c[i].is_ascii_uppercase() {
+            out.push('_');
+            out.push(c[i].to_ascii_lowercase());
+            while i + 1 < c.len() && c[i + 1].is_ascii_uppercase() {
+                i += 1;
+                out.push(c[i].to_ascii_lowercase());
+            }
+        } else {
+            out.push(c[i]);
+        }
+        i += 1;
+    }
+    out
+}
+
+/// Completes the unit vector `n` to an orthonormal basis (Duff et al. 2017, "Building an
+/// orthonormal basis, revisited"), as Mitsuba 3's `coordinate_system` does: `<lookat>`
+/// without `up` takes the first vector, so foton's camera is Mitsuba's.
+fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(n.x * n.x * a * sign + 1.0, b * sign, -n.x * sign),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// The sRGB transfer curve inverted (IEC 61966-2-1): Mitsuba 0.6's `<srgb>` colours.
+fn srgb_to_linear(v: f64) -> f64 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+/// A property's value as the file wrote it, for messages.
+fn show(p: &Prop) -> String {
+    match p {
+        Prop::Float(x) => x.to_string(),
+        Prop::Int(i) => i.to_string(),
+        Prop::Bool(b) => b.to_string(),
+        Prop::Str(s) => format!("{s:?}"),
+        Prop::Color(c) | Prop::Point(c) => format!("[{}, {}, {}]", c.x, c.y, c.z),
+        Prop::Ref(id) => format!("<ref id={id:?}>"),
+        Prop::Object(o) => o.what(),
+        Prop::Transform(_) => "a transform".into(),
+    }
+}
+
+/// The plugins of each kind in Mitsuba 3 and 0.6 (for "not supported" against "unknown").
+const MITSUBA_PLUGINS: &[(&str, &[&str])] = &[
+    (
+        "bsdf",
+        &[
+            "diffuse",
+            "dielectric",
+            "thindielectric",
+            "roughdielectric",
+            "conductor",
+            "roughconductor",
+            "plastic",
+            "roughplastic",
+            "twosided",
+            "null",
+            "principled",
+            "principledthin",
+            "bumpmap",
+            "normalmap",
+            "blendbsdf",
+            "mask",
+            "hair",
+            "measured",
+            "pplastic",
+            "polarizer",
+            "retarder",
+            "circular",
+            "coating",
+            "roughcoating",
+            "phong",
+            "ward",
+            "mixturebsdf",
+            "difftrans",
+            "hk",
+            "irawan",
+            "roughdiffuse",
+            "bump",
+        ],
+    ),
+    (
+        "shape",
+        &[
+            "obj",
+            "ply",
+            "serialized",
+            "sphere",
+            "rectangle",
+            "cube",
+            "disk",
+            "cylinder",
+            "bsplinecurve",
+            "linearcurve",
+            "sdfgrid",
+            "shapegroup",
+            "instance",
+            "ellipsoids",
+            "ellipsoidsmesh",
+            "merge",
+            "hair",
+            "heightfield",
+        ],
+    ),
+    (
+        "emitter",
+        &[
+            "area",
+            "point",
+            "spot",
+            "directional",
+            "constant",
+            "envmap",
+            "projector",
+            "directionalarea",
+            "sunsky",
+            "sky",
+            "sun",
+            "collimated",
+        ],
+    ),
+    (
+        "texture",
+        &[
+            "bitmap",
+            "checkerboard",
+            "mesh_attribute",
+            "volume",
+            "gridtexture",
+            "scale",
+            "vertexcolors",
+            "wireframe",
+            "curvature",
+        ],
+    ),
+    (
+        "sensor",
+        &[
+            "perspective",
+            "thinlens",
+            "orthographic",
+            "radiancemeter",
+            "irradiancemeter",
+            "distant",
+            "batch",
+            "telecentric",
+            "spherical",
+            "fluencemeter",
+            "perspective_rdist",
+        ],
+    ),
+    ("medium", &["homogeneous", "heterogeneous"]),
+    (
+        "phase",
+        &[
+            "isotropic",
+            "hg",
+            "rayleigh",
+            "sggx",
+            "tabphase",
+            "blendphase",
+            "kkay",
+            "microflake",
+            "mixturephase",
+        ],
+    ),
+    (
+        "film",
+        &["hdrfilm", "ldrfilm", "specfilm", "tiledhdrfilm", "mfilm"],
+    ),
+    (
+        "rfilter",
+        &[
+            "box",
+            "tent",
+            "gaussian",
+            "mitchell",
+            "catmullrom",
+            "lanczos",
+        ],
+    ),
+];
+
+/// The message for a plugin type foton does not read: `supported` (with `not supported`
+/// wording) when Mitsuba has it, "unknown" with the close name otherwise.
+fn not_read(kind: &str, ty: &str, supported: &str) -> String {
+    let known = MITSUBA_PLUGINS
+        .iter()
+        .find(|(k, _)| *k == kind)
+        .map_or(&[][..], |(_, names)| names);
+    if known.contains(&ty) {
+        supported.to_string()
+    } else {
+        format!(
+            "unknown {kind} type `{ty}`{}",
+            crate::error::suggestion(ty, known.iter().copied())
+        )
+    }
+}
+
+/// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
+const MITSUBA_INTEGRATORS: &[&str] = &[
+    "path",
+    "volpath",
+    "volpath_simple",
+    "volpathmis",
+    "direct",
+    "photonmapper",
+    "sppm",
+    "ppm",
+    "bdpt",
+    "ao",
+    "aov",
+    "depth",
+    "moment",
+    "stokes",
+    "prb",
+    "prbvolpath",
+    "direct_projective",
+    "prb_projective",
+    "ptracer",
+    "vpl",
+    "irrcache",
+    "adaptive",
+    "field",
+    "multichannel",
+    "mlt",
+    "pssmlt",
+    "erpt",
+];
+
+/// The foton plugin that renders a Mitsuba integrator, or None (not supported). A photon
+/// mapper in a scene with media is foton's volumetric one.
+fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
+    Some(match mitsuba {
+        "path" | "volpath" | "volpath_simple" | "volpathmis" | "direct" => "path",
+        "photonmapper" if has_media => "vpm",
+        "photonmapper" => "photon",
+        "sppm" | "ppm" => "sppm",
+        "bdpt" => "bdpt",
+        _ => return None,
+    })
+}
+
+/// Mitsuba's samplers and what foton samples with: the one place that decides it. Every
+/// sampler gives the same image in expectation; those foton lacks are rendered by its
+/// independent sampler (other noise), with a warning. None: not a Mitsuba sampler.
+// When foton gains `[render] sampler`, map the ones it has here.
+fn foton_sampler(mitsuba: &str) -> Option<(&'static str, bool)> {
+    Some(match mitsuba {
+        "independent" => ("independent", true),
+        "stratified" | "multijitter" | "orthogonal" | "ldsampler" | "sobol" | "halton"
+        | "hammersley" => ("independent", false),
+        _ => return None,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn camel_case_becomes_snake_case_as_in_mitsuba_3() {
+        for (old, new) in [
+            ("toWorld", "to_world"),
+            ("intIOR", "int_ior"),
+            ("sampleCount", "sample_count"),
+            ("sigmaS", "sigma_s"),
+            ("specularReflectance", "specular_reflectance"),
+            ("globalLookupRadius", "global_lookup_radius"),
+            ("max_depth", "max_depth"),
+            ("fov", "fov"),
+        ] {
+            assert_eq!(camel_to_snake(old), new);
+        }
+    }
+
+    #[test]
+    fn coordinate_system_is_orthonormal() {
+        for n in [
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::new(0.3, -0.5, 0.2).normalize(),
+            DVec3::X,
+        ] {
+            let (s, t) = coordinate_system(n);
+            assert!((s.length() - 1.0).abs() < 1e-12 && (t.length() - 1.0).abs() < 1e-12);
+            assert!(s.dot(n).abs() < 1e-12 && t.dot(n).abs() < 1e-12 && s.dot(t).abs() < 1e-12);
+            assert!((s.cross(t) - n).length() < 1e-12, "right-handed for {n}");
+        }
+    }
 }

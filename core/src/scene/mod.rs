@@ -4,6 +4,7 @@
 //! closed shapes nest) and [`visibility`] (shadow rays, through null boundaries and media).
 
 mod load;
+pub use load::set_relative_radius;
 pub mod mesh;
 pub mod mitsuba;
 pub mod ply;
@@ -139,6 +140,9 @@ pub struct Scene {
     pub unused: Vec<crate::props::Unused>,
     /// Non-fatal problems (reflectance above one, no lights...).
     pub warnings: Vec<String>,
+    /// Parameters of a Mitsuba file foton understands but ignores, each with its file:line:
+    /// warnings, or errors with `--strict`.
+    pub ignored: Vec<String>,
 }
 
 impl Scene {
