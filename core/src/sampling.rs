@@ -142,7 +142,12 @@ impl Sampler {
         Sampler {
             kind,
             rng: Rng::new(keys),
-            pixel_key: splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel),
+            // Not needed by the independent stream, whose samples should cost what they did.
+            pixel_key: if kind == SamplerKind::Independent {
+                0
+            } else {
+                splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
+            },
             index,
             spp: spp.max(1),
             dimension: 0,
@@ -229,11 +234,13 @@ impl Sampler {
                 // Padding (Burley 2020, section 4): every pair takes Sobol dimensions 0 and 1,
                 // a (0, 2)-sequence, with its own shuffle of the sample index, so pairs are
                 // independent of one another and each is as well stratified as the first.
+                // One 64-bit hash gives the three 32-bit seeds (the third by an odd multiplier:
+                // the scramble's hash needs distinct seeds, not independent bits).
                 let i = shuffled_index(self.index, key as u32);
-                let seed = splitmix64(key);
+                let (sx, sy) = ((key >> 32) as u32, (key >> 16) as u32 ^ 0x9E37_79B9);
                 Vec2::new(
-                    unit_f32(owen_scramble(sobol_dimension(i, 0), seed as u32)),
-                    unit_f32(owen_scramble(sobol_dimension(i, 1), (seed >> 32) as u32)),
+                    unit_f32(owen_scramble(sobol_dimension(i, 0), sx)),
+                    unit_f32(owen_scramble(sobol_dimension(i, 1), sy)),
                 )
             }
         }
@@ -297,7 +304,7 @@ pub fn permutation_element(mut i: u32, n: u32, seed: u32) -> u32 {
 /// numbers (new-joe-kuo-6.21201: (s, a, m) = (1, 0, [1]), (2, 1, [1, 3]), (3, 1, [1, 3, 1]),
 /// (3, 2, [1, 1, 1]), (4, 1, [1, 1, 3, 3])).
 pub const SOBOL_DIMENSIONS: usize = 6;
-const SOBOL_MATRICES: [[u32; 32]; SOBOL_DIMENSIONS] = {
+static SOBOL_MATRICES: [[u32; 32]; SOBOL_DIMENSIONS] = {
     let params: [(u32, u32, [u32; 4]); SOBOL_DIMENSIONS - 1] = [
         (1, 0, [1, 0, 0, 0]),
         (2, 1, [1, 3, 0, 0]),
@@ -345,13 +352,9 @@ pub fn sobol_dimension(mut index: u32, dimension: usize) -> u32 {
     }
     let matrix = &SOBOL_MATRICES[dimension];
     let mut x = 0;
-    let mut k = 0;
     while index != 0 {
-        if index & 1 == 1 {
-            x ^= matrix[k];
-        }
-        index >>= 1;
-        k += 1;
+        x ^= matrix[index.trailing_zeros() as usize];
+        index &= index - 1;
     }
     x
 }
@@ -376,10 +379,12 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 }
 
 /// The sample index shuffled by a nested uniform permutation (Burley 2020): the first 2^k
-/// indices go to one aligned block of 2^k, so a power-of-two count of samples is still a net.
+/// indices are a permutation of themselves for every k, so a power-of-two count of samples is
+/// still a net. (The scramble alone sends them to another aligned block; the xor with the
+/// image of 0 brings them back, which keeps the index, and so the Sobol loop, short.)
 #[inline]
 pub fn shuffled_index(index: u32, seed: u32) -> u32 {
-    owen_scramble(index, splitmix64(seed as u64) as u32)
+    owen_scramble(index, seed) ^ owen_scramble(0, seed)
 }
 
 /// A 32-bit fraction as a float in [0, 1).

@@ -7,8 +7,8 @@
 //! has clearly less error at 16 spp on an area-lit scene.
 
 use foton_core::sampling::{
-    Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, owen_scramble, sobol_dimension,
-    strata_2d,
+    Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, owen_scramble, shuffled_index,
+    sobol_dimension, strata_2d,
 };
 use foton_tests::render_toml;
 use foton_tests::stats::rel_rmse;
@@ -250,6 +250,16 @@ fn sobol_matrices_are_those_of_the_sobol_sequence() {
         seen[(owen_scramble(i << 24, 0xDEAD_BEEF) >> 24) as usize] = true;
     }
     assert!(seen.iter().all(|&s| s));
+    // The index shuffle permutes the first 2^k indices among themselves for every k.
+    for seed in [1u32, 0xFFFF_FFFF, 12345] {
+        for k in 0..12 {
+            let mut seen = vec![false; 1 << k];
+            for i in 0..1u32 << k {
+                seen[shuffled_index(i, seed) as usize] = true;
+            }
+            assert!(seen.iter().all(|&s| s), "seed {seed}, 2^{k}");
+        }
+    }
 }
 
 /// A small diffuse box lit by an area light on its ceiling, direct light only: soft shadows of
@@ -394,11 +404,21 @@ fn unknown_samplers_are_refused_with_a_suggestion() {
     ] {
         assert!(e.contains(want), "{want:?} not in {e}");
     }
-    let e = error(&["render.sampler=\"sobol\"".into(), "render.jitter=false".into()]);
-    assert!(e.contains("render.jitter") && e.contains("\"stratified\" only"), "{e}");
+    let e = error(&[
+        "render.sampler=\"sobol\"".into(),
+        "render.jitter=false".into(),
+    ]);
+    assert!(
+        e.contains("render.jitter") && e.contains("\"stratified\" only"),
+        "{e}"
+    );
     let scene = path.to_str().unwrap();
     let run = foton_tests::foton_with_plugins(&["compare", scene, "--integrators", "path:sobl"]);
     assert_ne!(run.code, 0);
-    assert!(run.stderr.contains("did you mean \"sobol\""), "{}", run.stderr);
+    assert!(
+        run.stderr.contains("did you mean \"sobol\""),
+        "{}",
+        run.stderr
+    );
     let _ = std::fs::remove_dir_all(&dir);
 }
