@@ -71,7 +71,8 @@ pub enum SamplerKind {
     /// (pbrt's `StratifiedSampler`); `jitter = false` takes each stratum's centre.
     Stratified { jitter: bool },
     /// Owen-scrambled Sobol points (Burley 2020), padded: every 1-D or 2-D request takes the
-    /// first two Sobol dimensions with its own index shuffle and scramble.
+    /// first two Sobol dimensions with its own index shuffle and scramble. The least error at
+    /// equal time on every scene measured, but not yet the default (docs/PERFORMANCE.md).
     Sobol,
 }
 
