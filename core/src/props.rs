@@ -324,13 +324,7 @@ impl<'a> Properties<'a> {
         if options.contains(&s) {
             Ok(s)
         } else {
-            Err(self.error(
-                name,
-                format!(
-                    "unknown value {s:?}; expected one of: {}",
-                    options.join(", ")
-                ),
-            ))
+            Err(self.error(name, unknown_value(s, options)))
         }
     }
 
@@ -422,4 +416,39 @@ impl<'a> Properties<'a> {
             })
             .collect()
     }
+}
+
+/// "unknown value "sobl" (did you mean "sobol"?); expected one of: ...": the suggestion is
+/// the option nearest in edit distance, when it is near enough to be a typing slip.
+pub fn unknown_value(value: &str, options: &[&str]) -> String {
+    let nearest = options
+        .iter()
+        .map(|o| (edit_distance(&value.to_lowercase(), o), *o))
+        .min();
+    let hint = match nearest {
+        Some((d, o)) if d <= (o.len() / 3).max(1) => format!(" (did you mean {o:?}?)"),
+        _ => String::new(),
+    };
+    format!(
+        "unknown value {value:?}{hint}; expected one of: {}",
+        options.join(", ")
+    )
+}
+
+/// Levenshtein distance between two strings (by characters).
+fn edit_distance(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut row: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut diagonal = row[0];
+        row[0] = i + 1;
+        for (j, &cb) in b.iter().enumerate() {
+            let above = row[j + 1];
+            row[j + 1] = (above + 1)
+                .min(row[j] + 1)
+                .min(diagonal + usize::from(ca != cb));
+            diagonal = above;
+        }
+    }
+    row[b.len()]
 }

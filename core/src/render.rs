@@ -14,7 +14,7 @@ use crate::film::{Film, RadianceSum};
 use crate::geometry::Ray;
 use crate::integrator::RenderContext;
 use crate::sampling::Sampler;
-use crate::scene::Scene;
+use crate::scene::{RenderSettings, Scene};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -30,10 +30,18 @@ pub fn with_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> Resul
     Ok(pool.install(f))
 }
 
-/// The sampler of camera sample `sample` of pixel (x, y).
+/// The sampler of camera sample `sample` of pixel (x, y): the scene's kind, with the strata
+/// of all `[render] spp` samples (not of a part's share, so that parts sum to the whole).
 #[inline]
-pub fn pixel_sampler(seed: u64, width: u32, x: u32, y: u32, sample: u32) -> Sampler {
-    Sampler::new(&[seed, (y as u64) * width as u64 + x as u64, sample as u64])
+pub fn pixel_sampler(
+    settings: &RenderSettings,
+    width: u32,
+    x: u32,
+    y: u32,
+    sample: u32,
+) -> Sampler {
+    let pixel = (y as u64) * width as u64 + x as u64;
+    Sampler::new(settings.sampler, settings.seed, pixel, sample, settings.spp)
 }
 
 /// Renders `scene.render.spp` samples per pixel, or the share of them `ctx.part` names;
@@ -47,7 +55,6 @@ where
     let (width, height) = (scene.film.width, scene.film.height);
     let share = ctx.part.share(scene.render.spp as u64);
     let (first, spp) = (share.start as u32, share.end as u32);
-    let seed = scene.render.seed;
     let mut film = Film::new(width, height);
     film.part = ctx.part;
     let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
@@ -83,7 +90,7 @@ where
                         for x in x0..(x0 + TILE).min(width) {
                             let mut sum = RadianceSum::ZERO;
                             for s in s0..s1 {
-                                let mut sampler = pixel_sampler(seed, width, x, y, s);
+                                let mut sampler = pixel_sampler(&scene.render, width, x, y, s);
                                 let at = scene.film.filter.film_position(x, y, sampler.next_2d());
                                 let ray = scene.camera.generate_ray(at);
                                 let mut l = radiance(&ray, &mut sampler, &mut tile_rays);

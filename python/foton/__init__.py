@@ -230,6 +230,7 @@ class Scene:
     height = property(lambda self: self._native.height, doc="Image height in pixels.")
     spp = property(lambda self: self._native.spp, doc="render.spp")
     seed = property(lambda self: self._native.seed, doc="render.seed")
+    sampler = property(lambda self: self._native.sampler, doc="render.sampler")
     max_depth = property(lambda self: self._native.max_depth, doc="render.max_depth")
     integrator = property(lambda self: self._native.integrator, doc="render.integrator")
     description = property(
@@ -261,6 +262,7 @@ class Scene:
         seed: int | None = None,
         threads: int | None = None,
         params: Mapping[str, Any] | None = None,
+        sampler: str | None = None,
         *,
         progress: bool | ProgressCallback | None = True,
     ) -> np.ndarray:
@@ -269,7 +271,8 @@ class Scene:
         ``integrator``, ``spp`` and ``seed`` override the scene's as the program's
         ``--integrator``, ``--spp`` and ``--seed`` do; ``params`` sets the integrator's
         parameters (``{"k": 50}`` is ``--set integrators.NAME.k=50``). ``threads``: worker
-        threads (default: all cores; the image does not depend on it).
+        threads (default: all cores; the image does not depend on it). ``sampler``:
+        ``"independent"``, ``"stratified"`` or ``"sobol"`` (``render.sampler``).
 
         ``progress``: ``True`` shows a tqdm bar per phase if tqdm is installed; a callable is
         called as ``progress(phase, done, total)`` from the calling thread while the render
@@ -294,6 +297,8 @@ class Scene:
             sets["render.spp"] = spp
         if seed is not None:
             sets["render.seed"] = seed
+        if sampler is not None:
+            sets["render.sampler"] = sampler
         if threads is not None and (isinstance(threads, bool) or int(threads) < 1):
             raise ValueError(f"threads must be at least 1, not {threads!r}")
         bars = None

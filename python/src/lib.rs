@@ -299,6 +299,10 @@ impl NativeScene {
         self.base.scene.render.seed
     }
     #[getter]
+    fn sampler(&self) -> &'static str {
+        self.base.scene.render.sampler.name()
+    }
+    #[getter]
     fn max_depth(&self) -> u32 {
         self.base.scene.render.max_depth
     }
@@ -426,6 +430,7 @@ impl NativeScene {
         info.set_item("integrator", p.integrator.describe())?;
         info.set_item("seconds", elapsed.as_secs_f64())?;
         info.set_item("spp", p.scene.render.spp)?;
+        info.set_item("sampler", p.scene.render.sampler.name())?;
         info.set_item("samples", film.total_samples())?;
         info.set_item("iterations", film.iterations)?;
         info.set_item("iterations_planned", film.iterations_planned)?;

@@ -77,6 +77,20 @@ def test_seed_and_spp_change_the_image_and_repeat_it():
     assert scene.spp == 64 and scene.seed == 0
 
 
+def test_sampler_is_the_programs_and_a_misspelt_one_is_refused(program, tmp_path):
+    scene = foton.load(SCENES / "cornell-box.toml", **TINY)
+    sobol = scene.render(spp=4, sampler="sobol", progress=False)
+    assert scene.last_render["sampler"] == "sobol"
+    out = tmp_path / "program.exr"
+    sets = as_sets({k: v for k, v in TINY.items() if k.startswith("film.")})
+    run_program(program, "render", SCENES / "cornell-box.toml", "--spp", 4, "--set", 'render.sampler="sobol"', *sets, "-q", "-o", out)
+    assert np.array_equal(sobol, foton.read(out))
+    assert not np.array_equal(sobol, scene.render(spp=4, progress=False))
+    assert scene.sampler == "independent"
+    with pytest.raises(foton.SceneError, match='did you mean "sobol"'):
+        scene.render(spp=4, sampler="sobl", progress=False)
+
+
 def test_the_array_is_a_writable_view_of_one_buffer():
     image = foton.load(SCENES / "cornell-box.toml", **TINY).render(spp=1, progress=False)
     assert image.flags.c_contiguous and image.flags.writeable

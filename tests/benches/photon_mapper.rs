@@ -25,6 +25,7 @@ fn main() {
         seed: 0,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: false,
+        sobol_emission: false,
     };
     let t = Instant::now();
     let photons = trace_photons(&scene, &opts, &ctx, 1, |_, c| {

@@ -12,7 +12,7 @@
 //!   cargo bench -p foton-tests --bench sppm_gather
 
 use foton_core::integrator::{NoProgress, RenderContext};
-use foton_core::sampling::Rng;
+use foton_core::sampling::{Sampler, SamplerKind};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, GLOSSY_ROUGHNESS, trace_to_diffuse};
 use foton_photonmap::map::PhotonMap;
@@ -47,7 +47,8 @@ fn main() {
     let mut rays = 0;
     let vps: Vec<Vp> = (0..w * h)
         .filter_map(|i| {
-            let mut s = Rng::new(&[1, i as u64]);
+            let mut s =
+                Sampler::with_keys(SamplerKind::Independent, &[1, i as u64], 1, i as u64, 0, 1);
             let film = Vec2::new((i % w) as f32, (i / w) as f32) + s.next_2d();
             let path = trace_to_diffuse(
                 &scene,
@@ -72,6 +73,7 @@ fn main() {
         seed: 3,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: false,
+        sobol_emission: false,
     };
     let t = Instant::now();
     let photons = trace_photons(&scene, &opts, &ctx, 1, |_, c| {

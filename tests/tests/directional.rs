@@ -97,6 +97,7 @@ fn photons_deliver_irradiance_times_area() {
         seed: 4,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
+        sobol_emission: false,
     };
     let media = light_media(&scene).unwrap();
     let mut total = DVec3::ZERO;

@@ -148,6 +148,7 @@ fn environment_photons(light: &str) {
         seed: 8,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
+        sobol_emission: false,
     };
     let media = light_media(&scene).unwrap();
     let mut total = DVec3::ZERO;

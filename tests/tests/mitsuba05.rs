@@ -272,21 +272,23 @@ fn film_line(path: &Path, what: &str) -> usize {
         + 1
 }
 
-/// Every sampler Mitsuba has is read: its sample count is the spp; those foton does not have
-/// are rendered by the independent sampler with a warning naming the sampler and its line,
-/// an error with --strict. An unknown sampler is an error that suggests the close name.
+/// Every sampler Mitsuba has is read: its sample count is the spp; foton's own samplers
+/// (independent, stratified, sobol) are taken as they are, the others rendered by the nearest
+/// foton has (multijitter by stratified, the low-discrepancy ones by sobol) with a warning
+/// naming the sampler and its line, an error with --strict. An unknown sampler is an error
+/// that suggests the close name.
 #[test]
-fn old_samplers_are_independent_with_a_warning() {
+fn samplers_map_to_the_nearest_foton_sampler() {
     let dir = temp_dir("samplers");
-    for sampler in [
-        "independent",
-        "stratified",
-        "multijitter",
-        "orthogonal",
-        "ldsampler",
-        "sobol",
-        "halton",
-        "hammersley",
+    for (sampler, foton_sampler) in [
+        ("independent", "independent"),
+        ("stratified", "stratified"),
+        ("sobol", "sobol"),
+        ("multijitter", "stratified"),
+        ("orthogonal", "sobol"),
+        ("ldsampler", "sobol"),
+        ("halton", "sobol"),
+        ("hammersley", "sobol"),
     ] {
         let s_ = format!(
             r#"<sampler type="{sampler}"><integer name="sampleCount" value="7"/><integer name="scramble" value="2"/></sampler>"#
@@ -294,23 +296,22 @@ fn old_samplers_are_independent_with_a_warning() {
         let text = scene_with("", &s_, FILM, "");
         let (toml, run) = convert(&dir, &format!("{sampler}.xml"), &text, &[]);
         assert_eq!(number(&toml, "spp"), 7.0);
+        assert!(
+            toml.contains(&format!("sampler = \"{foton_sampler}\"")),
+            "{sampler}: {toml}"
+        );
+        let exact = sampler == foton_sampler;
         let warned = run.stderr.contains(&format!("{sampler}.xml:5:"))
             && run.stderr.contains(&format!("`{sampler}`"));
-        assert_eq!(
-            warned,
-            sampler != "independent",
-            "{sampler}: {}",
-            run.stderr
-        );
+        assert_eq!(warned, !exact, "{sampler}: {}", run.stderr);
         let xml = dir.join(format!("{sampler}.xml"));
         let strict = foton(&["convert", s(&xml), "-o", s(&dir.join("x.toml")), "--strict"]);
-        assert_eq!(
-            strict.code == 0,
-            sampler == "independent",
-            "{}",
-            strict.stderr
-        );
+        assert_eq!(strict.code == 0, exact, "{}", strict.stderr);
     }
+    // A stratified sampler's jitter is foton's.
+    let s_ = r#"<sampler type="stratified"><integer name="sampleCount" value="4"/><boolean name="jitter" value="false"/></sampler>"#;
+    let (toml, _) = convert(&dir, "centred.xml", &scene_with("", s_, FILM, ""), &[]);
+    assert!(toml.contains("jitter = false"), "{toml}");
     let text = scene_with("", r#"<sampler type="sobel"/>"#, FILM, "");
     let xml = write(&dir, "typo.xml", &text);
     let err = foton(&["convert", s(&xml)]);

@@ -104,6 +104,41 @@ fn path_parts_merge_to_the_whole_render() {
     );
 }
 
+/// The structured samplers too: strata and Sobol points are of the whole render's spp and
+/// depend on (seed, pixel, sample) alone, so parts and thread counts change nothing; `photon`
+/// with `sobol` also emits its photons from Sobol points.
+#[test]
+fn stratified_and_sobol_parts_merge_to_the_whole_render() {
+    for sampler in ["stratified", "sobol"] {
+        let set = format!("render.sampler={sampler:?}");
+        assert_merge_is_exact(
+            &format!("parts-path-{sampler}"),
+            &Case::new(
+                "cornell-box.toml",
+                &["--integrator", "path", "--spp", "6", "--set", &set],
+            ),
+        );
+    }
+    assert_merge_is_exact(
+        "parts-photon-sobol",
+        &Case::new(
+            "caustics.toml",
+            &[
+                "--integrator",
+                "photon",
+                "--spp",
+                "4",
+                "--set",
+                "render.sampler=\"sobol\"",
+                "--set",
+                "integrators.photon.global_photons=20000",
+                "--set",
+                "integrators.photon.caustic_photons=20000",
+            ],
+        ),
+    );
+}
+
 #[test]
 fn photon_parts_merge_to_the_whole_render() {
     assert_merge_is_exact(

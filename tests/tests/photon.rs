@@ -74,6 +74,7 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
         seed: 3,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
+        sobol_emission: false,
     };
     let media = light_media(&scene).unwrap();
     let mut sum = DVec3::ZERO;
@@ -98,6 +99,7 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
     let all = TraceOptions {
         max_depth: 1000,
         stop_at_diffuse: false,
+        sobol_emission: false,
         ..opts
     };
     let lists = trace_photons(&scene, &all, &ctx, 2, |_, c| match c {
@@ -151,6 +153,7 @@ intensity = [1.0, 1.0, 1.0]
         seed: 5,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: true,
+        sobol_emission: false,
     };
     let photons = trace_photons(&scene, &opts, &ctx, 1, |_, _| Some(0))
         .unwrap()

@@ -55,6 +55,7 @@ fn balance(scene: &Scene, albedo: f64, photons: u64) -> (f64, f64, u64) {
         seed: 11,
         stream: STREAM_GLOBAL,
         stop_at_diffuse: false,
+        sobol_emission: false,
     };
     let media = light_media(scene).unwrap();
     assert_eq!(media, vec![Some(0)], "the light is in the fog");

@@ -10,6 +10,8 @@ use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::{DisplayTransform, Film, check_output, read_image};
 use foton_core::integrator::{Budget, Work};
+use foton_core::props::unknown_value;
+use foton_core::sampling::SamplerKind;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
@@ -29,7 +31,8 @@ pub(super) struct CompareArgs {
     /// Mitsuba XML scenes: leave out what foton cannot render yet (listed) instead of refusing.
     #[arg(long)]
     lenient: bool,
-    /// The integrator plugins to compare, comma-separated (e.g. path,photon), left to right.
+    /// The integrator plugins to compare, comma-separated (e.g. path,photon), left to right;
+    /// NAME:SAMPLER renders with that sampler (path:sobol,path:independent).
     #[arg(
         long,
         value_delimiter = ',',
@@ -471,6 +474,14 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
                 a.integrators.join(",")
             )));
         }
+        if let Some((_, sampler)) = name.split_once(':')
+            && !SamplerKind::NAMES.contains(&sampler)
+        {
+            return Err(Error::Usage(format!(
+                "--integrators {name}: sampler {}",
+                unknown_value(sampler, &SamplerKind::NAMES)
+            )));
+        }
         if names.iter().any(|n| n == name) {
             return Err(Error::Usage(format!(
                 "--integrators: `{name}` is listed twice"
@@ -506,7 +517,8 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let stem = output
         .file_stem()
         .map_or_else(|| "compare".into(), |s| s.to_string_lossy().into_owned());
-    let exr_of = |name: &str| output.with_file_name(format!("{stem}-{name}.exr"));
+    let exr_of =
+        |name: &str| output.with_file_name(format!("{stem}-{}.exr", name.replace(':', "-")));
     let json_path = output.with_file_name(format!("{stem}.json"));
     let curve_path = output.with_file_name(format!("{stem}-curve.png"));
     for name in &names {
@@ -529,7 +541,13 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     // The scene as the command line sets it for integrator `name`, plus `extra` overrides.
     let overrides = |name: &str, extra: &[String]| {
         let mut overrides = a.sets.clone();
-        overrides.push(format!("render.integrator={name:?}"));
+        let (integrator, sampler) = name
+            .split_once(':')
+            .map_or((name, None), |(i, s)| (i, Some(s)));
+        overrides.push(format!("render.integrator={integrator:?}"));
+        if let Some(sampler) = sampler {
+            overrides.push(format!("render.sampler={sampler:?}"));
+        }
         if let Some(spp) = a.spp {
             overrides.push(format!("render.spp={spp}"));
         }

@@ -18,7 +18,7 @@ use crate::material::Material;
 use crate::medium::{Homogeneous, Phase};
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::{Properties, Unused};
-use crate::sampling::Distribution1D;
+use crate::sampling::{Distribution1D, SamplerKind};
 use crate::texture::Texture;
 use crate::value::{Document, Value};
 use glam::{Mat4, Vec3};
@@ -363,9 +363,27 @@ fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings>
         seed: t.u64("seed", 0)?,
         max_depth: t.u32("max_depth", 16)?,
         hide_emitters: t.bool("hide_emitters", false)?,
+        sampler: read_sampler(&t)?,
     };
     ld.done(&t);
     Ok(settings)
+}
+
+/// `[render] sampler` and, for `stratified`, `jitter`.
+fn read_sampler(t: &Properties<'_>) -> Result<SamplerKind> {
+    let name = t.choice("sampler", &SamplerKind::NAMES, "independent")?;
+    let jitter = t.bool("jitter", true)?;
+    let kind = SamplerKind::from_name(name, jitter).expect("a name of SamplerKind::NAMES");
+    if t.has("jitter") && !matches!(kind, SamplerKind::Stratified { .. }) {
+        return Err(t.error(
+            "jitter",
+            format!(
+                "applies to sampler = \"stratified\" only, not {:?}",
+                kind.name()
+            ),
+        ));
+    }
+    Ok(kind)
 }
 
 fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {

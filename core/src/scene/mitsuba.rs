@@ -1237,7 +1237,7 @@ impl Reader {
 
     fn sampler(&mut self, mut o: Obj) -> Result<()> {
         let line = o.line;
-        let Some((_sampler, exact)) = foton_sampler(&o.ty) else {
+        let Some((sampler, exact)) = foton_sampler(&o.ty) else {
             let known = [
                 "independent",
                 "stratified",
@@ -1258,15 +1258,24 @@ impl Reader {
             self.warn(
                 &o,
                 line,
-                &format!("foton samples with `independent` (the same image, other noise) instead of `{}`", o.ty),
+                &format!(
+                    "foton samples with `{sampler}` (the same image, other noise) instead of `{}`",
+                    o.ty
+                ),
             );
         }
         let spp = o.int("sample_count", 4)?;
         let render = table_mut(&mut self.root, "render");
         render.insert("spp", at(Value::Int(spp), line));
+        render.insert("sampler", at(Value::Str(sampler.into()), line));
         let seed = o.int("seed", 0)?;
         table_mut(&mut self.root, "render").insert("seed", at(Value::Int(seed), line));
-        // The pattern's options go with the pattern (warned about above).
+        if sampler == "stratified" {
+            let jitter = o.boolean("jitter", true)?;
+            table_mut(&mut self.root, "render").insert("jitter", at(Value::Bool(jitter), line));
+        }
+        // The other patterns' options go with the pattern (warned about above); Sobol's
+        // scrambling is always Owen's.
         for ignored in ["jitter", "scramble", "dimension", "resolution"] {
             o.take(ignored);
         }
@@ -2322,14 +2331,17 @@ fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
 }
 
 /// Mitsuba's samplers and what foton samples with: the one place that decides it. Every
-/// sampler gives the same image in expectation; those foton lacks are rendered by its
-/// independent sampler (other noise), with a warning. None: not a Mitsuba sampler.
-// When foton gains `[render] sampler`, map the ones it has here.
+/// sampler gives the same image in expectation; one foton lacks is rendered by the nearest
+/// foton has (`multijitter` is jittered strata, the low-discrepancy ones Owen-scrambled
+/// Sobol points: other noise), with a warning. None: not a Mitsuba sampler. The flag says
+/// whether foton's sampler is Mitsuba's.
 fn foton_sampler(mitsuba: &str) -> Option<(&'static str, bool)> {
     Some(match mitsuba {
         "independent" => ("independent", true),
-        "stratified" | "multijitter" | "orthogonal" | "ldsampler" | "sobol" | "halton"
-        | "hammersley" => ("independent", false),
+        "stratified" => ("stratified", true),
+        "sobol" => ("sobol", true),
+        "multijitter" => ("stratified", false),
+        "orthogonal" | "ldsampler" | "halton" | "hammersley" => ("sobol", false),
         _ => return None,
     })
 }

@@ -42,6 +42,8 @@ pub struct RenderSettings {
     /// Emitters (area lights, the environment) are not seen directly by the camera: camera
     /// rays pass through them until they first scatter (Mitsuba's `hide_emitters`).
     pub hide_emitters: bool,
+    /// The points camera samples draw (`[render] sampler`, and `jitter` for `stratified`).
+    pub sampler: crate::sampling::SamplerKind,
 }
 
 #[derive(Clone, Debug)]

@@ -46,6 +46,7 @@ pub fn trace_surface_photons(
         seed: scene.render.seed,
         stream,
         stop_at_diffuse,
+        sobol_emission: TraceOptions::emission_for(scene.render.sampler),
     };
     let caustic_map = budgets.caustic > 0;
     let global = pass(budgets.global, STREAM_GLOBAL, false);

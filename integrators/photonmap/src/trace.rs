@@ -16,9 +16,10 @@ use foton_core::integrator::RenderContext;
 use foton_core::material::TransportMode;
 use foton_core::medium::HeroChannel;
 use foton_core::render::with_pool;
-use foton_core::sampling::Rng;
+use foton_core::sampling::{Rng, SOBOL_DIMENSIONS, SamplerKind, SobolPoint, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{RayWalk, Reached};
+use glam::Vec2;
 use rayon::prelude::*;
 
 /// The path a photon took to reach a diffuse surface.
@@ -45,6 +46,17 @@ pub struct TraceOptions {
     /// after): at a diffuse surface after storing it, at a smooth plastic when it takes the
     /// base rather than the delta coat.
     pub stop_at_diffuse: bool,
+    /// Emission (position, direction, light choice) from Owen-scrambled Sobol points indexed
+    /// by photon number, scrambled per (seed, stream) so that passes differ (quasi-Monte Carlo
+    /// photon mapping, Keller 1997); false: the photon's independent stream.
+    pub sobol_emission: bool,
+}
+
+impl TraceOptions {
+    /// Sobol emission when the scene's sampler is other than `independent`.
+    pub fn emission_for(kind: SamplerKind) -> bool {
+        kind != SamplerKind::Independent
+    }
 }
 
 /// Stream identifiers, so that passes draw independent random numbers.
@@ -96,11 +108,23 @@ pub fn trace_one(
     mut store: impl FnMut(Photon, Site, PathClass),
 ) {
     let mut rng = Rng::new(&[opts.seed, opts.stream, index]);
-    let Some((light_id, pmf)) = scene.sample_light(rng.next_f32()) else {
+    // In the independent stream's order: light choice, position, direction, component.
+    let mut u = [0.0f32; SOBOL_DIMENSIONS];
+    if opts.sobol_emission {
+        // Sobol's first dimensions are its best stratified together: position and direction
+        // there, the light choice and the emission component after.
+        let mut point = SobolPoint::new(index, splitmix64(opts.seed ^ opts.stream));
+        for k in [1, 2, 3, 4, 0, 5] {
+            u[k] = point.next_f32().expect("six Sobol dimensions");
+        }
+    } else {
+        u.iter_mut().for_each(|u| *u = rng.next_f32());
+    }
+    let Some((light_id, pmf)) = scene.sample_light(u[0]) else {
         return;
     };
     let light = &scene.lights[light_id];
-    let (u_pos, u_dir, uc) = (rng.next_2d(), rng.next_2d(), rng.next_f32());
+    let (u_pos, u_dir, uc) = (Vec2::new(u[1], u[2]), Vec2::new(u[3], u[4]), u[5]);
     let emitted = light.sample_emission(u_pos, u_dir, uc);
     let mut flux: Rgb = emitted.flux / (pmf * opts.photons as f32);
     let origin = if emitted.n == glam::Vec3::ZERO {

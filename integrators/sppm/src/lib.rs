@@ -88,7 +88,7 @@ use foton_core::integrator::{
 use foton_core::kernel::NormalizedKernel;
 use foton_core::props::Properties;
 use foton_core::render::{usable, warn_unusable, with_pool};
-use foton_core::sampling::{Rng, splitmix64};
+use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
@@ -209,7 +209,14 @@ impl Sppm {
                 let row = (0..width)
                     .map(|x| {
                         let pixel = y as u64 * width as u64 + x as u64;
-                        let mut sampler = Rng::new(&[seed, STREAM_CAMERA, pixel, iteration]);
+                        let mut sampler = Sampler::with_keys(
+                            scene.render.sampler,
+                            &[seed, STREAM_CAMERA, pixel, iteration],
+                            seed,
+                            pixel,
+                            iteration as u32,
+                            self.iterations.unwrap_or(1) as u32,
+                        );
                         let film = scene.film.filter.film_position(x, y, sampler.next_2d());
                         let ray = scene.camera.generate_ray(film);
                         let path =
@@ -262,6 +269,7 @@ impl Sppm {
             seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
             stream: STREAM_GLOBAL,
             stop_at_diffuse: false,
+            sobol_emission: TraceOptions::emission_for(scene.render.sampler),
         };
         let keep_direct = self.direct == Direct::Photons;
         Ok(trace_photons(scene, &options, ctx, 1, |_, class| {

@@ -167,6 +167,7 @@ impl Vpm {
                 seed: scene.render.seed,
                 stream: STREAM_VOLUME,
                 stop_at_diffuse: false,
+                sobol_emission: TraceOptions::emission_for(scene.render.sampler),
             };
             trace_photons(scene, &opts, ctx, 1, |site, class| {
                 (site == Site::Volume && (class != PathClass::Direct || photons_direct))
