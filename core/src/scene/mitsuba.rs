@@ -905,13 +905,13 @@ impl Reader {
         let rr = o.take("rr_depth");
         match name {
             "path" | "bdpt" => {
-                // Mitsuba starts Russian roulette at path depth rr_depth (segments): foton
-                // counts scattering events.
+                // Mitsuba starts Russian roulette at path depth rr_depth (segments, 5 unless
+                // the file says): foton counts scattering events.
                 if let Some((p, l)) = rr {
                     o.props.push(("rr_depth".into(), p, l));
-                    let rr = o.int("rr_depth", 5)?;
-                    params.push(("rr_depth", Value::Int(rr.max(1) - 1)));
                 }
+                let rr = o.int("rr_depth", 5)?;
+                params.push(("rr_depth", Value::Int(rr.max(1) - 1)));
             }
             _ => {
                 if let Some((p, l)) = rr {

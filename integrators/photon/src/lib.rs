@@ -132,7 +132,7 @@ impl PhotonMapper {
             ctx.progress
                 .warn("no photon reached a second diffuse surface: the indirect map is empty");
         }
-        SurfaceMaps::build(lists, need_direct, self.k, "integrators.photon.k")
+        Ok(SurfaceMaps::build(lists, need_direct))
     }
 
     /// Indirect light at a diffuse point by final gathering: rays by the BSDF's non-delta part,

@@ -13,7 +13,7 @@ use crate::map::{Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
 use foton_core::bsdf::Bsdf;
 use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
-use foton_core::error::{Error, Result};
+use foton_core::error::Result;
 use foton_core::geometry::Hit;
 use foton_core::integrator::RenderContext;
 use foton_core::sampling::Sampler;
@@ -75,17 +75,6 @@ pub fn trace_surface_photons(
     Ok([direct, caustic, indirect])
 }
 
-/// An error if a map holds photons but fewer than an estimate's k: `key` is the parameter
-/// that sets k (`integrators.photon.k`), `name` the map's.
-pub fn check_k(key: &str, k: usize, name: &str, stored: usize) -> Result<()> {
-    if stored > 0 && stored < k {
-        return Err(Error::Usage(format!(
-            "{key} = {k} is larger than the {stored} photons stored in the {name} map; lower it or emit more photons"
-        )));
-    }
-    Ok(())
-}
-
 /// The surface maps. `direct` exists when something reads it.
 pub struct SurfaceMaps {
     pub direct: Option<PhotonMap>,
@@ -94,26 +83,16 @@ pub struct SurfaceMaps {
 }
 
 impl SurfaceMaps {
-    /// Builds the maps from the passes' lists (see [`trace_surface_photons`]); `k_key` names
-    /// the parameter that sets `k`, for the error when a map is smaller than k.
-    pub fn build(
-        [direct, caustic, indirect]: [Vec<Photon>; 3],
-        keep_direct: bool,
-        k: usize,
-        k_key: &str,
-    ) -> Result<SurfaceMaps> {
-        for (name, list) in [
-            ("direct", &direct),
-            ("caustic", &caustic),
-            ("indirect", &indirect),
-        ] {
-            check_k(k_key, k, name, list.len())?;
-        }
-        Ok(SurfaceMaps {
+    /// Builds the maps from the passes' lists (see [`trace_surface_photons`]). A map may hold
+    /// fewer photons than an estimate's k (a scene with a few caustic paths, off a plastic's
+    /// coat): every query then finds fewer than k and takes `max_radius`, as in any sparse
+    /// region, so that is no error.
+    pub fn build([direct, caustic, indirect]: [Vec<Photon>; 3], keep_direct: bool) -> SurfaceMaps {
+        SurfaceMaps {
             direct: keep_direct.then(|| PhotonMap::build(direct)),
             caustic: PhotonMap::build(caustic),
             indirect: PhotonMap::build(indirect),
-        })
+        }
     }
 
     /// Radiance reflected towards the camera at a visible point by light of at most `depth`

@@ -90,7 +90,7 @@ use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
-use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
+use foton_photonmap::surface::{Budgets, SurfaceMaps, trace_surface_photons};
 use foton_photonmap::trace::{PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons};
 use rayon::prelude::*;
 
@@ -184,13 +184,7 @@ impl Vpm {
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
         let photons_direct = self.direct == Direct::Photons;
         let (surface, volume) = self.trace_lists(scene, ctx, photons_direct)?;
-        let surface = SurfaceMaps::build(surface, photons_direct, self.k, "integrators.vpm.k")?;
-        check_k(
-            "integrators.vpm.k_volume",
-            self.k_volume,
-            "volume",
-            volume.len(),
-        )?;
+        let surface = SurfaceMaps::build(surface, photons_direct);
         let volume = PhotonMap::build(volume);
         let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
             with_pool(ctx.threads, || {
