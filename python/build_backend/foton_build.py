@@ -13,8 +13,8 @@ with them.
 
 The cargo profile is ``release`` unless chosen by the config setting ``profile``
 (``pip install ./python --config-settings=profile=dev``) or the environment variable
-``FOTON_PYTHON_PROFILE``. CI uses ``dev``, whose artifacts ``cargo test --workspace`` has
-already built (this workspace's dev profile is optimised). The libraries in the wheel are
+``FOTON_PYTHON_PROFILE``. CI uses ``release``, whose artifacts ``cargo build --release`` and
+``cargo test --release --workspace`` have already built. The libraries in the wheel are
 stripped of their debug info (maturin's --strip for the extension, unless the build args say
 otherwise; `strip --strip-debug` for the plugins).
 
