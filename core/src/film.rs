@@ -10,7 +10,7 @@
 
 use crate::Rgb;
 use crate::error::{Error, Result};
-use crate::integrator::Part;
+use crate::part::Part;
 use std::path::Path;
 
 /// Fractional bits of the film's fixed-point sums.

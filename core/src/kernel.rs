@@ -138,8 +138,8 @@ impl NormalizedKernel {
 
     /// `kernel = NAME` and the kernel's own parameters, as `Integrator::parameters` lists
     /// them.
-    pub fn parameters(&self) -> Vec<crate::integrator::Parameter> {
-        use crate::integrator::Parameter;
+    pub fn parameters(&self) -> Vec<crate::param::Parameter> {
+        use crate::param::Parameter;
         let mut p = vec![Parameter::str("kernel", self.name())];
         for (key, value) in self.kernel.parameters() {
             p.push(Parameter::float(key, value as f32));

@@ -26,6 +26,8 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod microfacet;
+pub mod param;
+pub mod part;
 pub mod plugin;
 pub mod props;
 pub mod render;
