@@ -219,6 +219,41 @@ pub fn builtin(name: &str, cone_c: f64) -> Option<Box<dyn Kernel>> {
 
 pub const BUILTIN_KERNELS: &[&str] = &["box", "cone", "gaussian"];
 
+/// A loaded kernel plugin (C ABI, found by [`crate::plugin`]): here, below `props`, which
+/// hands a plugin the host's kernel plugins, so that `props` need not import `plugin`.
+#[derive(Clone, Debug)]
+pub struct KernelPlugin {
+    pub name: String,
+    pub file: std::path::PathBuf,
+    weight: unsafe extern "C" fn(f64) -> f64,
+}
+
+impl KernelPlugin {
+    /// `weight` must come from a kernel declaration whose version was checked
+    /// ([`crate::plugin`] loads them).
+    pub(crate) fn new(
+        name: String,
+        file: std::path::PathBuf,
+        weight: unsafe extern "C" fn(f64) -> f64,
+    ) -> KernelPlugin {
+        KernelPlugin { name, file, weight }
+    }
+}
+
+impl Kernel for KernelPlugin {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn profile(&self, t: f64) -> f64 {
+        // SAFETY: the function comes from a declaration whose version was checked.
+        unsafe { (self.weight)(t) }
+    }
+    /// C code: called only while it is checked, then read from its table.
+    fn untrusted(&self) -> bool {
+        true
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

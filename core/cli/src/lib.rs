@@ -373,7 +373,7 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     };
     let props = scene
         .integrator_properties(&scene.render.integrator)?
-        .with_plugins(&registry);
+        .with_kernels(&registry.kernels);
     let integrator = plugin
         .create(&props, &scene)
         .map_err(|e| blame_plugin(&plugin, e))?;
@@ -391,7 +391,9 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         let other = registry
             .integrator(&name)
             .map_err(|e| Error::Usage(format!("--set {key}: {e}")))?;
-        let props = scene.integrator_properties(&name)?.with_plugins(&registry);
+        let props = scene
+            .integrator_properties(&name)?
+            .with_kernels(&registry.kernels);
         if other.create(&props, &scene).is_ok() {
             unread_set(&props.unused(), &name)?;
         }

@@ -58,7 +58,7 @@ pub const LAYOUT_FINGERPRINT: u64 = {
         size_of::<Film>(),
         size_of::<Properties<'static>>(),
         size_of::<RenderContext<'static>>(),
-        size_of::<super::Registry>(),
+        size_of::<crate::kernel::KernelPlugin>(),
         size_of::<Error>(),
         size_of::<crate::value::Document>(),
     ];
