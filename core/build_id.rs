@@ -6,8 +6,9 @@
 //! sources (every type that crosses the boundary, and the code both sides run over them), the
 //! same versions of core's dependencies (glam, obvhs... whose types are inside core's), the
 //! same rustc, target and code-generation settings that can change layouts. Nothing else: the
-//! `foton` program's sources and the dependencies only it links (clap, indicatif...) are not
-//! inputs, so a plugin built before a change to the tools still loads after it.
+//! `foton` program's sources (cli/), the scene loader's (loader/: the TOML, XML, mesh and image
+//! readers) and the dependencies only they link (clap, indicatif, roxmltree, image...) are not
+//! inputs, so a plugin built before a change to the tools or a reader still loads after it.
 
 use std::collections::hash_map::DefaultHasher;
 use std::collections::{BTreeSet, HashMap};

@@ -16,8 +16,10 @@
 
 use crate::Rgb;
 use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
-use crate::material::{TransportMode, fresnel_conductor, fresnel_dielectric};
+use crate::scattering::{TransportMode, fresnel_conductor, fresnel_dielectric};
+
 use crate::sampling::{basis, cosine_hemisphere};
+pub use crate::scattering::LocalSample;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -76,15 +78,6 @@ pub struct BsdfSample {
     /// path throughput is multiplied by.
     pub weight: Rgb,
     /// Solid-angle pdf; for a delta lobe the probability of having chosen it.
-    pub pdf: f32,
-    pub delta: bool,
-}
-
-/// A sampled direction in the local frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct LocalSample {
-    pub wi: Vec3,
-    pub weight: Rgb,
     pub pdf: f32,
     pub delta: bool,
 }
@@ -232,7 +225,7 @@ impl Lobe {
                     return delta(reflect_local(wo), Rgb::ONE, f);
                 }
                 let n = if cos_o > 0.0 { Vec3::Z } else { Vec3::NEG_Z };
-                let wi = crate::material::refract(wo, n, eta)?;
+                let wi = crate::scattering::refract(wo, n, eta)?;
                 let scale = match mode {
                     TransportMode::Radiance => 1.0 / (eta * eta),
                     TransportMode::Importance => 1.0,

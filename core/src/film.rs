@@ -1,15 +1,16 @@
 //! The film: per-pixel sums of radiance samples (exact, in fixed point: [`RadianceSum`]) and
 //! their counts (a sample lands in its own pixel: the reconstruction filter is importance
-//! sampled), and writing it out atomically as linear EXR or sRGB PNG.
+//! sampled), and what an image file of it holds: linear EXR or sRGB PNG (the files themselves
+//! are written and read by foton-loader's `image`, so that core links no image codec).
 //!
 //! An EXR holds the radiance as it is. A PNG holds display values: each linear value is
 //! scaled by the exposure and tone mapped into [0, 1] ([`DisplayTransform`]), then encoded with
-//! the sRGB curve. Every PNG foton writes goes through [`write_image`] so that the tools show
+//! the sRGB curve. Every PNG foton writes goes through foton-loader's `write_image` so that the tools show
 //! a scene the same way.
 
 use crate::Rgb;
 use crate::error::{Error, Result};
-use crate::integrator::Part;
+use crate::part::Part;
 use std::path::Path;
 
 /// Fractional bits of the film's fixed-point sums.
@@ -201,11 +202,6 @@ impl Film {
         let sum: glam::DVec3 = px.iter().map(|p| p.as_dvec3()).sum();
         (sum / px.len().max(1) as f64).as_vec3()
     }
-
-    /// Writes the image atomically: an EXR as linear radiance, a PNG through `display`.
-    pub fn write(&self, path: &Path, display: &DisplayTransform) -> Result<()> {
-        write_image(path, self.width, self.height, &self.pixels(), display)
-    }
 }
 
 /// How exposed radiance is squeezed into the [0, 1] an 8-bit image can hold.
@@ -391,81 +387,6 @@ pub fn check_output(path: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Writes linear RGB pixels (row-major, top-left first): EXR as linear float32, unchanged
-/// (`display` is not applied: an EXR keeps the radiance); PNG as 8-bit sRGB of the pixels
-/// through `display`. Atomic: written to a temporary file in the same folder, then renamed
-/// over `path`.
-pub fn write_image(
-    path: &Path,
-    width: u32,
-    height: u32,
-    pixels: &[Rgb],
-    display: &DisplayTransform,
-) -> Result<()> {
-    let format = format_of(path)?;
-    let file_name = path
-        .file_name()
-        .ok_or_else(|| Error::io(path, "not a file name"))?
-        .to_string_lossy();
-    let tmp = path.with_file_name(format!(".{file_name}.tmp-{}", std::process::id()));
-    let result = match format {
-        ImageFormat::Exr => {
-            if pixels.len() != width as usize * height as usize {
-                return Err(Error::io(path, "pixel buffer has the wrong size"));
-            }
-            // exr directly rather than through `image`, whose encoder writes compressed
-            // blocks in the order threads finish them: the same pixels must make the same
-            // bytes (a merged render is compared with the one-process render by its bytes).
-            use exr::prelude::{
-                Encoding, Image, Layer, LayerAttributes, SpecificChannels, Vec2, WritableImage,
-            };
-            let w = width as usize;
-            let channels = SpecificChannels::rgb(|Vec2(x, y): Vec2<usize>| {
-                let p = pixels[y * w + x];
-                (p.x, p.y, p.z)
-            });
-            let layer = Layer::new(
-                (w, height as usize),
-                LayerAttributes::default(),
-                Encoding::SMALL_LOSSLESS,
-                channels,
-            );
-            Image::from_layer(layer)
-                .write()
-                .to_file(&tmp)
-                .map_err(|e| image::ImageError::IoError(std::io::Error::other(e.to_string())))
-        }
-        ImageFormat::Png => {
-            let data: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
-            let img = image::RgbImage::from_raw(width, height, data)
-                .ok_or_else(|| Error::io(path, "pixel buffer has the wrong size"))?;
-            img.save_with_format(&tmp, image::ImageFormat::Png)
-        }
-    };
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(Error::io(path, e));
-    }
-    std::fs::rename(&tmp, path).map_err(|e| {
-        let _ = std::fs::remove_file(&tmp);
-        Error::io(path, e)
-    })
-}
-
-/// Reads an image as linear RGB (EXR as stored; PNG decoded from sRGB).
-pub fn read_image(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
-    let img = image::open(path).map_err(|e| Error::io(path, e))?;
-    let is_png = format_of(path).ok() == Some(ImageFormat::Png);
-    let rgb = img.to_rgb32f();
-    let (w, h) = rgb.dimensions();
-    let decode = |c: f32| if is_png { srgb_decode(c) } else { c };
-    let px = rgb
-        .pixels()
-        .map(|p| Rgb::new(decode(p.0[0]), decode(p.0[1]), decode(p.0[2])))
-        .collect();
-    Ok((w, h, px))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -527,49 +448,6 @@ mod tests {
             assert_eq!(ToneMap::from_name(name).unwrap().name(), name);
         }
         assert_eq!(ToneMap::from_name("aces"), None);
-    }
-
-    #[test]
-    fn png_goes_through_the_display_transform_and_exr_does_not() {
-        let dir = std::env::temp_dir().join(format!("foton-film-test-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let pixels = [Rgb::new(0.2, 1.0, 3.0), Rgb::new(0.02, 0.5, 100.0)];
-        let display = DisplayTransform::new(-1.5, ToneMap::Filmic);
-        let png = dir.join("a.png");
-        write_image(&png, 2, 1, &pixels, &display).unwrap();
-        let bytes = image::open(&png).unwrap().to_rgb8().into_raw();
-        let expected: Vec<u8> = pixels.iter().flat_map(|p| display.encode(*p)).collect();
-        assert_eq!(bytes, expected);
-        // And that is not the plain clip: the transform was applied.
-        assert_ne!(bytes[..3], DisplayTransform::default().encode(pixels[0]));
-        let exr = dir.join("a.exr");
-        write_image(&exr, 2, 1, &pixels, &display).unwrap();
-        assert_eq!(read_image(&exr).unwrap().2, pixels);
-        let _ = std::fs::remove_dir_all(&dir);
-    }
-
-    /// The same pixels make the same bytes: an EXR of many compressed blocks (compressed in
-    /// parallel) is written in a fixed block order.
-    #[test]
-    fn an_exr_is_the_same_bytes_every_time() {
-        let dir = std::env::temp_dir().join(format!("foton-film-exr-{}", std::process::id()));
-        std::fs::create_dir_all(&dir).unwrap();
-        let (w, h) = (320u32, 240u32);
-        let mut rng = crate::sampling::Rng::new(&[3]);
-        let pixels: Vec<Rgb> = (0..w * h)
-            .map(|_| Rgb::new(rng.next_f32(), rng.next_f32() * 10.0, rng.next_f32() * 0.1))
-            .collect();
-        let write = |name: &str| {
-            let path = dir.join(name);
-            write_image(&path, w, h, &pixels, &DisplayTransform::default()).unwrap();
-            std::fs::read(path).unwrap()
-        };
-        let first = write("a.exr");
-        for i in 0..4 {
-            assert!(first == write(&format!("b{i}.exr")), "write {i} differs");
-        }
-        assert_eq!(read_image(&dir.join("a.exr")).unwrap().2, pixels);
-        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

@@ -18,14 +18,14 @@
 //! default exterior is air, 1.000277, not 1.
 
 use crate::Rgb;
-use crate::material::{TransportMode, fresnel_conductor, fresnel_dielectric};
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::sampling::cosine_hemisphere;
+use crate::scattering::{TransportMode, fresnel_conductor, fresnel_dielectric};
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
 use std::sync::Mutex;
 
-pub use crate::bsdf::LocalSample;
+pub use crate::scattering::LocalSample;
 
 /// True for a finite positive number (false for NaN).
 #[inline]

@@ -14,6 +14,11 @@ use crate::scene::Scene;
 use glam::Vec3;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+// Parts of the interface in modules of their own, below it, so that `film` and `kernel`
+// need not import it; their paths here are kept.
+pub use crate::param::{ParamValue, Parameter};
+pub use crate::part::Part;
+
 /// Progress and messages from a render, implemented by the host (a terminal progress bar, or
 /// nothing). Shared with plugins by reference: a plugin has its own copy of every static, so
 /// anything that must be shared is handed over through this interface.
@@ -69,100 +74,6 @@ impl<'a> RenderContext<'a> {
 
     pub fn cancelled(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
-    }
-}
-
-/// One of `count` disjoint shares of a render's work, `index` counted from 0. The shares of
-/// the `count` parts cover the work exactly once, and a render of a part fills a film whose
-/// sums add up, over the parts, to the whole render's: the film records the part it holds
-/// ([`Film::part`]), so that a host can tell an integrator that ignored it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub struct Part {
-    pub index: u32,
-    pub count: u32,
-}
-
-impl Part {
-    pub const WHOLE: Part = Part { index: 0, count: 1 };
-
-    /// Part `index` of `count`; None unless index < count.
-    pub fn new(index: u32, count: u32) -> Option<Part> {
-        (index < count).then_some(Part { index, count })
-    }
-
-    pub fn is_whole(&self) -> bool {
-        self.count == 1
-    }
-
-    /// This part's share of `total` units of work (samples, iterations): the contiguous range
-    /// [total i / n, total (i + 1) / n), so that shares differ in size by one at most.
-    pub fn share(&self, total: u64) -> std::ops::Range<u64> {
-        let split = |i: u64| (total as u128 * i as u128 / self.count as u128) as u64;
-        split(self.index as u64)..split(self.index as u64 + 1)
-    }
-}
-
-impl std::fmt::Display for Part {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        write!(f, "{}/{}", self.index, self.count)
-    }
-}
-
-/// A parameter's value, as a scene file would write it.
-#[derive(Clone, Debug, PartialEq)]
-pub enum ParamValue {
-    Int(i64),
-    Float(f64),
-    Bool(bool),
-    Str(String),
-}
-
-impl std::fmt::Display for ParamValue {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            ParamValue::Int(n) => write!(f, "{n}"),
-            // A value that came from an f32 prints as that f32 (0.1, not 0.10000000149).
-            ParamValue::Float(x) if (*x as f32) as f64 == *x => write!(f, "{}", *x as f32),
-            ParamValue::Float(x) => write!(f, "{x}"),
-            ParamValue::Bool(b) => write!(f, "{b}"),
-            ParamValue::Str(s) => write!(f, "{s}"),
-        }
-    }
-}
-
-/// One configured parameter of an integrator: its key in `[integrators.NAME]` and the value
-/// in force (the default where the scene gives none).
-#[derive(Clone, Debug, PartialEq)]
-pub struct Parameter {
-    pub name: String,
-    pub value: ParamValue,
-}
-
-impl Parameter {
-    pub fn int(name: &str, value: impl TryInto<i64>) -> Parameter {
-        let value = value.try_into().unwrap_or(i64::MAX);
-        Parameter {
-            name: name.into(),
-            value: ParamValue::Int(value),
-        }
-    }
-    pub fn float(name: &str, value: impl Into<f64>) -> Parameter {
-        Parameter {
-            name: name.into(),
-            value: ParamValue::Float(value.into()),
-        }
-    }
-    pub fn bool(name: &str, value: bool) -> Parameter {
-        Parameter {
-            name: name.into(),
-            value: ParamValue::Bool(value),
-        }
-    }
-    pub fn str(name: &str, value: impl Into<String>) -> Parameter {
-        Parameter {
-            name: name.into(),
-            value: ParamValue::Str(value.into()),
-        }
     }
 }
 

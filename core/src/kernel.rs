@@ -138,8 +138,8 @@ impl NormalizedKernel {
 
     /// `kernel = NAME` and the kernel's own parameters, as `Integrator::parameters` lists
     /// them.
-    pub fn parameters(&self) -> Vec<crate::integrator::Parameter> {
-        use crate::integrator::Parameter;
+    pub fn parameters(&self) -> Vec<crate::param::Parameter> {
+        use crate::param::Parameter;
         let mut p = vec![Parameter::str("kernel", self.name())];
         for (key, value) in self.kernel.parameters() {
             p.push(Parameter::float(key, value as f32));
@@ -218,6 +218,41 @@ pub fn builtin(name: &str, cone_c: f64) -> Option<Box<dyn Kernel>> {
 }
 
 pub const BUILTIN_KERNELS: &[&str] = &["box", "cone", "gaussian"];
+
+/// A loaded kernel plugin (C ABI, found by [`crate::plugin`]): here, below `props`, which
+/// hands a plugin the host's kernel plugins, so that `props` need not import `plugin`.
+#[derive(Clone, Debug)]
+pub struct KernelPlugin {
+    pub name: String,
+    pub file: std::path::PathBuf,
+    weight: unsafe extern "C" fn(f64) -> f64,
+}
+
+impl KernelPlugin {
+    /// `weight` must come from a kernel declaration whose version was checked
+    /// ([`crate::plugin`] loads them).
+    pub(crate) fn new(
+        name: String,
+        file: std::path::PathBuf,
+        weight: unsafe extern "C" fn(f64) -> f64,
+    ) -> KernelPlugin {
+        KernelPlugin { name, file, weight }
+    }
+}
+
+impl Kernel for KernelPlugin {
+    fn name(&self) -> &str {
+        &self.name
+    }
+    fn profile(&self, t: f64) -> f64 {
+        // SAFETY: the function comes from a declaration whose version was checked.
+        unsafe { (self.weight)(t) }
+    }
+    /// C code: called only while it is checked, then read from its table.
+    fn untrusted(&self) -> bool {
+        true
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -1,12 +1,14 @@
 //! foton-core: what an integrator plugin links, and what the host hands it.
 //!
 //! One module per concept, named as in the literature: [`scene`] (the scene and its queries,
-//! loading, meshes, volumes, visibility), [`geometry`] and [`accel`] (the BVH), [`material`]
-//! and [`bsdf`], [`light`], [`camera`], [`film`], [`sampling`], [`medium`], [`kernel`]
-//! (density-estimation kernels), [`integrator`] (the plugin interface), [`render`] (the shared
-//! parallel image loop) and [`plugin`] (declaring and loading plugins). Nothing host-only lives
-//! here: the `foton` program and its tools are the crate in `cli/`, the photon machinery of
-//! the photon-mapping plugins is `integrators/photonmap`.
+//! volumes, visibility), [`geometry`] and [`accel`] (the BVH), [`material`] and [`bsdf`] (over
+//! [`scattering`], the Fresnel terms and transport mode they share), [`light`], [`camera`],
+//! [`film`], [`sampling`], [`medium`], [`kernel`] (density-estimation kernels), [`integrator`]
+//! (the plugin interface), [`render`] (the shared parallel image loop) and [`plugin`]
+//! (declaring and loading plugins). Nothing host-only lives here: the `foton` program and its
+//! tools are the crate in `cli/`, the scene files (TOML, Mitsuba XML, meshes, images) are read
+//! by the crate in `loader/`, the photon machinery of the photon-mapping plugins is
+//! `integrators/photonmap`.
 
 pub mod accel;
 pub mod bsdf;
@@ -24,10 +26,13 @@ pub mod light;
 pub mod material;
 pub mod medium;
 pub mod microfacet;
+pub mod param;
+pub mod part;
 pub mod plugin;
 pub mod props;
 pub mod render;
 pub mod sampling;
+pub mod scattering;
 pub mod scene;
 pub mod texture;
 pub mod value;

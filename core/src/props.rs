@@ -4,8 +4,7 @@
 //! unknown (misspelt) parameters can be reported afterwards.
 
 use crate::error::{Error, Location, Result, did_you_mean};
-use crate::kernel::{BUILTIN_KERNELS, NormalizedKernel};
-use crate::plugin::Registry;
+use crate::kernel::{BUILTIN_KERNELS, KernelPlugin, NormalizedKernel};
 use crate::value::{Node, Table, Value};
 use glam::Vec3;
 use std::cell::RefCell;
@@ -41,7 +40,7 @@ pub struct Properties<'a> {
     /// Every name asked for, present or not: what an unknown key may have meant.
     asked: RefCell<Vec<String>>,
     /// Kernel plugins that `kernel()` may return (handed over by the host).
-    plugins: Option<&'a Registry>,
+    plugins: &'a [KernelPlugin],
 }
 
 static EMPTY: Table = Table(Vec::new());
@@ -58,7 +57,7 @@ impl<'a> Properties<'a> {
                 column: node.column,
                 used: RefCell::new(Vec::new()),
                 asked: RefCell::new(Vec::new()),
-                plugins: None,
+                plugins: &[],
             }),
             other => Err(Error::Scene {
                 location: Location {
@@ -82,7 +81,7 @@ impl<'a> Properties<'a> {
             column: 0,
             used: RefCell::new(Vec::new()),
             asked: RefCell::new(Vec::new()),
-            plugins: None,
+            plugins: &[],
         }
     }
 
@@ -96,13 +95,14 @@ impl<'a> Properties<'a> {
             column: 0,
             used: RefCell::new(Vec::new()),
             asked: RefCell::new(Vec::new()),
-            plugins: None,
+            plugins: &[],
         }
     }
 
-    /// Makes the kernel plugins of `registry` available to [`Properties::kernel`].
-    pub fn with_plugins(mut self, registry: &'a Registry) -> Self {
-        self.plugins = Some(registry);
+    /// Makes the host's kernel plugins (its registry's `kernels`) available to
+    /// [`Properties::kernel`].
+    pub fn with_kernels(mut self, kernels: &'a [KernelPlugin]) -> Self {
+        self.plugins = kernels;
         self
     }
 
@@ -123,13 +123,11 @@ impl<'a> Properties<'a> {
             crate::kernel::builtin(kind, cone_c as f64)
         {
             k
-        } else if let Some(k) = self.plugins.and_then(|r| r.kernel(kind)) {
+        } else if let Some(k) = self.plugins.iter().find(|k| k.name == kind) {
             Box::new(k.clone())
         } else {
             let mut known: Vec<String> = BUILTIN_KERNELS.iter().map(|s| s.to_string()).collect();
-            if let Some(r) = self.plugins {
-                known.extend(r.kernels.iter().map(|k| format!("{} (plugin)", k.name)));
-            }
+            known.extend(self.plugins.iter().map(|k| format!("{} (plugin)", k.name)));
             return Err(self.error(
                 name,
                 format!("unknown kernel {kind:?}; available: {}", known.join(", ")),

@@ -2,7 +2,7 @@
 //!
 //! A thin layer over the program's own code paths, so that an image rendered from Python is
 //! the image `foton render` writes, bit for bit: scenes are loaded by foton-core
-//! (`Scene::load_with`, TOML or Mitsuba XML; `Document::parse` for TOML text) with `--set`
+//! (`foton_loader::load_with`, TOML or Mitsuba XML; `Document::parse` for TOML text) with `--set`
 //! style overrides, their
 //! integrator is created by `foton_cli::prepare_scene` from the plugins on the search path,
 //! and rendered by `foton_cli::render_with`; images are written and read by foton-core's film
@@ -18,11 +18,13 @@
 use foton_cli::{Prepared, prepare_scene, render_with};
 use foton_core::Rgb;
 use foton_core::error::Error;
-use foton_core::film::{DisplayTransform, Film, ToneMap, read_image, write_image};
+use foton_core::film::{DisplayTransform, Film, ToneMap};
 use foton_core::integrator::{ParamValue, Progress, RenderContext};
 use foton_core::plugin::{Registry, search_path};
 use foton_core::scene::Scene;
 use foton_core::value::Document;
+use foton_loader::TomlDocument;
+use foton_loader::image::{read_image, write_image};
 use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict, PyList};
@@ -111,20 +113,20 @@ enum Source {
 }
 
 impl Source {
-    /// As `foton render` loads a scene file (`Scene::load_with`), or the same from text.
+    /// As `foton render` loads a scene file (`foton_loader::load_with`), or the same from text.
     fn load(&self, overrides: &[String]) -> foton_core::Result<Scene> {
         match self {
             Source::File {
                 path,
                 defines,
                 lenient,
-            } => Scene::load_with(path, overrides, defines, *lenient),
+            } => foton_loader::load_with(path, overrides, defines, *lenient),
             Source::Text { text, file } => {
                 let mut doc = Document::parse(text, file)?;
                 for o in overrides {
                     doc.set(o)?;
                 }
-                Scene::from_document(doc)
+                foton_loader::from_document(doc)
             }
         }
     }

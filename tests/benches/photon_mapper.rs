@@ -6,7 +6,6 @@
 use foton_cli::{TermProgress, prepare, render_prepared};
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
-use foton_core::scene::Scene;
 use foton_photonmap::map::{Estimate, PhotonMap};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::{plugin_dir, repo_root};
@@ -17,7 +16,7 @@ fn main() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let cancel = AtomicBool::new(false);
     let ctx = RenderContext::new(threads, &cancel, &NoProgress);
-    let scene = Scene::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
+    let scene = foton_loader::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
     let n = 1_000_000;
     let opts = TraceOptions {
         photons: n,

@@ -1,7 +1,7 @@
 //! Loading a large binary PLY mesh (a benchmark, not a test): a 708x708 grid bent into a
 //! sphere, 1,002,528 triangles, written as binary little-endian with normals and uv (as
 //! scanners and exporters write them). Prints the seconds of the parse alone (bytes to
-//! positions, triangles, normals and uv), of `Scene::load` (read, parse, transform,
+//! positions, triangles, normals and uv), of `foton_loader::load` (read, parse, transform,
 //! closedness, BVH) and of its largest parts; then loads the same mesh written without normals
 //! and uv, with and without `face_normals`, which shows what computing vertex normals costs.
 //!
@@ -13,8 +13,8 @@
 use foton_core::accel::Accel;
 use foton_core::geometry::Primitive;
 use foton_core::scene::Scene;
-use foton_core::scene::mesh::is_closed;
-use foton_core::scene::ply;
+use foton_loader::mesh::is_closed;
+use foton_loader::ply;
 use foton_tests::{temp_dir, write};
 use glam::Vec3;
 use std::f32::consts::PI;
@@ -99,10 +99,10 @@ intensity = [1, 1, 1]
     )
 }
 
-/// `Scene::load` of `scene`, and its seconds.
+/// `foton_loader::load` of `scene`, and its seconds.
 fn load(scene: &Path) -> (Scene, f64) {
     let start = Instant::now();
-    let loaded = Scene::load(scene, &[]).unwrap();
+    let loaded = foton_loader::load(scene, &[]).unwrap();
     let seconds = start.elapsed().as_secs_f64();
     assert_eq!(loaded.accel.primitives().len(), 2 * (N - 1) * (N - 1));
     (loaded, seconds)
@@ -128,7 +128,7 @@ fn main() {
     println!("parse:              {parse:.3} s");
 
     let (loaded, total) = load(&write(&dir, "scene.toml", &scene_toml("sphere.ply", false)));
-    println!("Scene::load + BVH:  {total:.3} s");
+    println!("loader::load + BVH:{total:.3} s");
 
     // Where the load's time goes: the two largest parts, timed alone.
     let corners: Vec<[Vec3; 3]> = raw
@@ -166,7 +166,7 @@ fn main() {
         &scene_toml("sphere-plain.ply", true),
     ));
     println!(
-        "without normals and uv ({:.1} MB): Scene::load {computed:.3} s, with face_normals {faceted:.3} s",
+        "without normals and uv ({:.1} MB): load {computed:.3} s, with face_normals {faceted:.3} s",
         plain.len() as f64 / 1e6
     );
 

@@ -13,7 +13,6 @@
 
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::sampling::{Sampler, SamplerKind};
-use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, GLOSSY_ROUGHNESS, trace_to_diffuse};
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
@@ -42,7 +41,7 @@ fn atomic_add(a: &AtomicU32, v: f32) {
 
 fn main() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
-    let scene = Scene::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
+    let scene = foton_loader::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
     let (w, h) = (scene.film.width, scene.film.height);
     let mut rays = 0;
     let vps: Vec<Vp> = (0..w * h)

@@ -1,6 +1,7 @@
 //! The build identifier covers exactly what defines the plugin ABI (core/build_id.rs): a
-//! change to the `foton` program or to a dependency only it links leaves it as it is (plugins
-//! built before still load), a change to core or to one of its dependencies changes it (such
+//! change to the `foton` program, to the scene loader (core/loader: the TOML, XML, PLY, OBJ
+//! and image readers) or to a dependency only they link leaves it as it is (plugins built
+//! before still load), a change to core or to one of its dependencies changes it (such
 //! plugins are refused, with both identifiers named: bad_input.rs). The function tested here
 //! is the one build.rs runs: it reproduces this build's identifier.
 
@@ -83,6 +84,29 @@ fn tools_do_not_change_the_identifier_and_core_does() {
         );
     }
 
+    // Every reader (core/loader) and the file formats only the loader links: a fix to the XML
+    // reader must not refuse the plugins built before it.
+    for reader in [
+        "mitsuba.rs",
+        "load.rs",
+        "ply.rs",
+        "mesh.rs",
+        "texture.rs",
+        "image.rs",
+    ] {
+        let path = core.join("loader/src").join(reader);
+        let text = std::fs::read_to_string(&path).unwrap();
+        std::fs::write(&path, text + "\n// a fix to a reader\n").unwrap();
+        assert_eq!(id(&core, &lock), before, "an edit to {reader} changed it");
+    }
+    for loader_only in ["roxmltree", "tobj", "toml", "image", "exr"] {
+        assert_eq!(
+            id(&core, &bump(&lock, loader_only)),
+            before,
+            "{loader_only} changed it"
+        );
+    }
+
     // A type that crosses the boundary, and a dependency of core (glam, whose vectors are in
     // every core type).
     assert_ne!(
@@ -109,24 +133,29 @@ fn tools_do_not_change_the_identifier_and_core_does() {
 }
 
 #[test]
-fn core_dependency_closure_holds_its_dependencies_and_not_the_tools() {
+fn core_dependency_closure_holds_its_dependencies_and_not_the_tools_or_readers() {
     let lock = std::fs::read_to_string(repo_root().join("Cargo.lock")).unwrap();
     let closure = dependency_closure(&lock, "foton-core");
     let has = |name: &str| closure.iter().any(|p| p.starts_with(&format!("{name} ")));
-    for name in [
-        "foton-core",
-        "glam",
-        "obvhs",
-        "rayon",
-        "rayon-core",
-        "toml",
-        "image",
-    ] {
+    for name in ["foton-core", "glam", "obvhs", "rayon", "rayon-core"] {
         assert!(has(name), "{name} missing from {closure:?}");
     }
     // (clap may be in it: the lock file's closure holds the optional dependencies of core's
     // dependencies, obvhs's rdst has criterion, which has clap: more than needed, never less.)
-    for name in ["indicatif", "ctrlc", "font8x8", "foton", "foton-photonmap"] {
+    for name in [
+        "indicatif",
+        "ctrlc",
+        "font8x8",
+        "foton",
+        "foton-photonmap",
+        "foton-loader",
+        // The readers' formats, linked by the loader only.
+        "roxmltree",
+        "tobj",
+        "toml",
+        "image",
+        "exr",
+    ] {
         assert!(!has(name), "{name} is in core's closure");
     }
 }

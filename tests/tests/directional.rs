@@ -55,7 +55,7 @@ irradiance = [2.0, 1.0, 0.5]
 fn load(text: &str) -> Scene {
     let dir = temp_dir("directional");
     let path = write(&dir, "scene.toml", text);
-    let scene = Scene::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let scene = foton_loader::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
     let _ = std::fs::remove_dir_all(dir);
     scene
 }
@@ -156,14 +156,14 @@ fn a_directional_light_without_a_direction_is_an_error() {
     let text = scene("path", 1, "[0.0, 0.0, 0.0]");
     let dir = temp_dir("directional-bad");
     let path = write(&dir, "scene.toml", &text);
-    let err = Scene::load(&path, &[]).err().unwrap().to_string();
+    let err = foton_loader::load(&path, &[]).err().unwrap().to_string();
     assert!(
         err.contains("lights[0].direction") && err.contains("zero length"),
         "{err}"
     );
     let text = text.replace("direction = [0.0, 0.0, 0.0]\n", "");
     let path = write(&dir, "scene.toml", &text);
-    let err = Scene::load(&path, &[]).err().unwrap().to_string();
+    let err = foton_loader::load(&path, &[]).err().unwrap().to_string();
     assert!(
         err.contains("lights[0].direction") && err.contains("missing"),
         "{err}"

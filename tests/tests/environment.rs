@@ -4,7 +4,6 @@
 //! point of the sphere. An envmap of a constant image L is the same environment, sampled and
 //! emitted through its image's distribution.
 
-use foton_core::scene::Scene;
 use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, light_media, trace_one};
 use foton_tests::{header, region_mean, render_toml, temp_dir, write};
 use glam::{DVec3, Vec3};
@@ -139,7 +138,7 @@ fn envmap_photons_deliver_pi_l_everywhere() {
 fn environment_photons(light: &str) {
     let dir = temp_dir("environment-photons");
     let path = write(&dir, "scene.toml", &scene("photon", 1, light));
-    let scene = Scene::load(&path, &[]).unwrap();
+    let scene = foton_loader::load(&path, &[]).unwrap();
     let _ = std::fs::remove_dir_all(dir);
     let power = scene.lights[0].power().as_dvec3();
     let opts = TraceOptions {
@@ -174,7 +173,10 @@ fn envmap_errors_name_the_key_and_the_file() {
     let load = |text: &str| {
         let d = temp_dir("envmap-errors-scene");
         let path = write(&d, "scene.toml", text);
-        let e = Scene::load(&path, &[]).map(|_| ()).unwrap_err().to_string();
+        let e = foton_loader::load(&path, &[])
+            .map(|_| ())
+            .unwrap_err()
+            .to_string();
         let _ = std::fs::remove_dir_all(d);
         e
     };
@@ -240,8 +242,8 @@ scale = 2.0
 to_world = { rotate = { axis = [0, 1, 0], degrees = 90 } }
 "#,
     );
-    let from_xml = Scene::load(&xml, &[]).unwrap();
-    let from_toml = Scene::load(&toml, &[]).unwrap();
+    let from_xml = foton_loader::load(&xml, &[]).unwrap();
+    let from_toml = foton_loader::load(&toml, &[]).unwrap();
     let (a, b) = (&from_xml.lights[0], &from_toml.lights[0]);
     for d in [
         Vec3::X,

@@ -5,7 +5,6 @@
 
 use foton_core::filter::{Filter, FilterSampler};
 use foton_core::sampling::Rng;
-use foton_core::scene::Scene;
 use foton_tests::stats::assert_gof;
 use foton_tests::{header, render_toml, temp_dir, write};
 use glam::Vec2;
@@ -90,7 +89,7 @@ emission = [1.0, 1.0, 1.0]
 "#;
         let dir = temp_dir("filter-edge");
         let path = write(&dir, "scene.toml", &s);
-        let scene = Scene::load(&path, &[]).unwrap();
+        let scene = foton_loader::load(&path, &[]).unwrap();
         let e = scene
             .camera
             .project(glam::Vec3::new(0.0123, 0.0, 0.0))
@@ -145,7 +144,7 @@ fn the_field_of_view_spans_the_axis_asked_for() {
         );
         let dir = temp_dir("fov-axis");
         let path = write(&dir, "scene.toml", &s);
-        let scene = Scene::load(&path, &[]).unwrap();
+        let scene = foton_loader::load(&path, &[]).unwrap();
         let _ = std::fs::remove_dir_all(dir);
         let (a, b) = ends(axis);
         let (ra, rb) = (scene.camera.generate_ray(a), scene.camera.generate_ray(b));

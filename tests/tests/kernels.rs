@@ -106,7 +106,7 @@ fn render_with_the_kernel_plugin_from_the_search_path() {
             "{}",
             run.stdout
         );
-        let (w, h, px) = foton_core::film::read_image(&out).unwrap();
+        let (w, h, px) = foton_loader::image::read_image(&out).unwrap();
         images.push(film_of(w, h, &px));
     }
     // Both kernels are normalised: the image means agree (the kernels only differ in blur).

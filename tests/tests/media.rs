@@ -58,7 +58,7 @@ fn scene_dir(name: &str, toml: &str, boxes: &[(&str, Vec3, Vec3)]) -> (PathBuf, 
 }
 
 fn load(path: &Path) -> Scene {
-    Scene::load(path, &[]).unwrap_or_else(|e| panic!("{e}"))
+    foton_loader::load(path, &[]).unwrap_or_else(|e| panic!("{e}"))
 }
 
 fn medium_index(scene: &Scene, name: &str) -> Option<u32> {
@@ -247,9 +247,9 @@ fn medium_at_finds_the_innermost_volume_and_the_interfaces_their_outsides() {
 #[test]
 fn camera_inside_a_nested_medium_starts_there() {
     let (dir, path) = scene_dir("media-camera", &nested_scene(""), &nested_boxes());
-    let scene = Scene::load(&path, &["camera.position=[0.2, 0.1, 1.0]".into()]).unwrap();
+    let scene = foton_loader::load(&path, &["camera.position=[0.2, 0.1, 1.0]".into()]).unwrap();
     assert_eq!(scene.camera_medium, medium_index(&scene, "B"));
-    let scene = Scene::load(&path, &["camera.position=[4.0, 0.1, 0.0]".into()]).unwrap();
+    let scene = foton_loader::load(&path, &["camera.position=[4.0, 0.1, 0.0]".into()]).unwrap();
     assert_eq!(scene.camera_medium, None, "inside the clear glass");
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -69,7 +69,7 @@ interior = "vacuum"
 fn load_toml(name: &str, toml: &str) -> Scene {
     let dir = temp_dir(name);
     let path = write(&dir, "scene.toml", toml);
-    let scene = Scene::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let scene = foton_loader::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
     let _ = std::fs::remove_dir_all(dir);
     scene
 }
@@ -267,7 +267,7 @@ fn a_medium_whose_boundary_leaks_is_an_error_naming_the_shape() {
     let text = slab_scene(1).replace("exterior = \"vacuum\"\n", "");
     let dir = temp_dir("sides-leak");
     let path = write(&dir, "scene.toml", &text);
-    let err = Scene::load(&path, &[])
+    let err = foton_loader::load(&path, &[])
         .err()
         .expect("an open quad holding fog alone")
         .to_string();
@@ -284,7 +284,7 @@ fn a_medium_whose_boundary_leaks_is_an_error_naming_the_shape() {
     let text = slab_scene(1).replace("fov = 0.5\n", "fov = 0.5\nmedium = \"smoke\"\n");
     let dir = temp_dir("sides-undefined");
     let path = write(&dir, "scene.toml", &text);
-    let err = Scene::load(&path, &[])
+    let err = foton_loader::load(&path, &[])
         .err()
         .expect("an undefined medium")
         .to_string();
@@ -301,7 +301,7 @@ fn a_medium_whose_boundary_leaks_is_an_error_naming_the_shape() {
 #[test]
 fn bitterli_volumetric_caustic_v3_renders_its_caustic_with_vpm() {
     let file = repo_root().join("scenes/bitterli/volumetric-caustic/scene_v3.xml");
-    let scene = Scene::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let scene = foton_loader::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
         scene.camera_medium, None,
         "the camera stands outside the fog"

@@ -3,7 +3,7 @@
 //! scenes of Mitsuba's tutorials from `../shared/scenes/mitsuba` rendered by every integrator
 //! that can.
 
-use foton_core::film::read_image;
+use foton_loader::image::read_image;
 use foton_tests::{Run, foton, foton_with_plugins, repo_root, temp_dir, write};
 use std::path::{Path, PathBuf};
 
@@ -628,7 +628,7 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
 </scene>
 "#;
     let xml = write(&dir, "glossy.xml", text);
-    let scene = foton_core::scene::Scene::load_with(&xml, &[], &[], false).unwrap();
+    let scene = foton_loader::load_with(&xml, &[], &[], false).unwrap();
     assert!(scene.render.hide_emitters);
     // 50 mm on 35 mm film: a diagonal field of view of 2 atan(43.27 / 100) = 46.8 degrees.
     let toml = dir.join("glossy.toml");
@@ -793,7 +793,7 @@ fn a_shapes_exterior_medium_is_the_medium_in_front_of_it() {
     };
     let load = |text: &str| {
         let xml = write(&dir, "scene.xml", text);
-        foton_core::scene::Scene::load_with(&xml, &[], &[], false)
+        foton_loader::load_with(&xml, &[], &[], false)
     };
     let name =
         |s: &foton_core::scene::Scene, m: Option<u32>| m.map(|m| s.media[m as usize].name.clone());

@@ -5,7 +5,7 @@
 //! including file, -D typos, unknown against unsupported elements). The Bitterli scenes in
 //! scenes/bitterli are read as published.
 
-use foton_core::film::read_image;
+use foton_loader::image::read_image;
 use foton_tests::{Run, foton, foton_with_plugins, repo_root, temp_dir, write};
 use std::path::{Path, PathBuf};
 

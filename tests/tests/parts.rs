@@ -3,9 +3,10 @@
 //! split its work, and parts that do not belong together are refused with nothing written.
 
 use foton_core::Rgb;
-use foton_core::film::{RadianceSum, read_image};
+use foton_core::film::RadianceSum;
 use foton_core::integrator::Part;
 use foton_core::sampling::Rng;
+use foton_loader::image::read_image;
 use foton_tests::{Run, foton, foton_with_plugins, repo_root, temp_dir};
 use std::path::{Path, PathBuf};
 

@@ -19,7 +19,7 @@ use std::sync::atomic::AtomicBool;
 fn scene_from(name: &str, toml: &str) -> Scene {
     let dir = temp_dir(name);
     let path = write(&dir, "scene.toml", toml);
-    let scene = Scene::load(&path, &[]).unwrap();
+    let scene = foton_loader::load(&path, &[]).unwrap();
     let _ = std::fs::remove_dir_all(dir);
     scene
 }
@@ -637,7 +637,7 @@ fn a_scene_without_lights_renders_black_with_a_warning() {
     ]);
     assert_eq!(run.code, 0, "{}", run.stderr);
     assert!(run.stderr.contains("no lights"), "{}", run.stderr);
-    let (_, _, px) = foton_core::film::read_image(&out).unwrap();
+    let (_, _, px) = foton_loader::image::read_image(&out).unwrap();
     assert!(px.iter().all(|p| *p == Vec3::ZERO));
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -4,6 +4,7 @@
 
 use foton_core::geometry::Ray;
 use foton_core::scene::Scene;
+use foton_loader::FilmFile;
 use foton_tests::{header, region_mean, render_file, render_toml, temp_dir, write};
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -78,7 +79,7 @@ intensity = [{intensity}, {intensity}, {intensity}]
     );
     let dir = temp_dir("point-plane");
     let path = write(&dir, "scene.toml", &toml);
-    let scene = Scene::load(&path, &[]).unwrap();
+    let scene = foton_loader::load(&path, &[]).unwrap();
     let film = render_file(&path, &[], 2);
     let expected = analytic_image(&scene, |p| {
         let d = light - p;
@@ -247,7 +248,7 @@ material = "floor"
     );
     let dir = temp_dir("far-field");
     let path = write(&dir, "scene.toml", &toml);
-    let scene = Scene::load(&path, &[]).unwrap();
+    let scene = foton_loader::load(&path, &[]).unwrap();
     let film = render_file(&path, &[], 2);
     let light_pos = Vec3::new(0.0, height, 0.0);
     let expected = analytic_image(&scene, |p| {
@@ -326,12 +327,12 @@ fn exr_reads_back_identically_and_png_is_srgb() {
     let dir = temp_dir("exr");
     let exr = dir.join("out.exr");
     film.write(&exr, &Default::default()).unwrap();
-    let (w, h, px) = foton_core::film::read_image(&exr).unwrap();
+    let (w, h, px) = foton_loader::image::read_image(&exr).unwrap();
     assert_eq!((w, h), (16, 12));
     assert_eq!(px, film.pixels());
     let png = dir.join("out.png");
     film.write(&png, &Default::default()).unwrap();
-    let (_, _, back) = foton_core::film::read_image(&png).unwrap();
+    let (_, _, back) = foton_loader::image::read_image(&png).unwrap();
     for (a, b) in back.iter().zip(film.pixels()) {
         let b = b.clamp(Vec3::ZERO, Vec3::ONE);
         // 8-bit sRGB quantisation: at most half a step in encoded space.

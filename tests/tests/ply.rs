@@ -302,7 +302,7 @@ intensity = [5, 5, 5]
 
 fn load(dir: &Path, file: &Path, extra: &str) -> Scene {
     let scene = write(dir, "scene.toml", &scene_text(file, extra));
-    Scene::load(&scene, &[]).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
+    foton_loader::load(&scene, &[]).unwrap_or_else(|e| panic!("{}: {e}", file.display()))
 }
 
 /// The mesh's triangles, as bits, in BVH order (the same for the same input).
@@ -383,7 +383,7 @@ fn polygons_are_fan_triangulated() {
         let ply = dir.join(format!("pentagon-{}.ply", enc.name()));
         std::fs::write(&ply, ply_bytes(enc, &elements)).unwrap();
         let scene = write(&dir, "scene.toml", &scene_text(&ply, ""));
-        let scene = Scene::load(&scene, &[]).unwrap();
+        let scene = foton_loader::load(&scene, &[]).unwrap();
         let mut corners: Vec<[[f32; 3]; 3]> = Vec::new();
         for p in scene.accel.primitives().iter().filter(|p| p.object == 1) {
             let Shape::Triangle { p0, e1, e2 } = p.shape else {

@@ -391,7 +391,7 @@ fn unknown_samplers_are_refused_with_a_suggestion() {
         "scene.toml",
         &(area_lit(4).replace("seed = 3", "seed = 3\nsampler = \"sobl\"")),
     );
-    let error = |overrides: &[String]| match foton_core::scene::Scene::load(&path, overrides) {
+    let error = |overrides: &[String]| match foton_loader::load(&path, overrides) {
         Ok(_) => panic!("loaded with {overrides:?}"),
         Err(e) => e.to_string(),
     };

@@ -1,7 +1,6 @@
 //! The example scenes and the scenes written by other tooling (copied unchanged from
 //! shared/scenes into scenes/) load without unknown fields and render.
 
-use foton_core::scene::Scene;
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
 use foton_tests::{render_file, repo_root};
 
@@ -20,7 +19,7 @@ fn every_scene_loads_with_no_unknown_field() {
     let files = scene_files();
     assert!(files.len() >= 3, "{files:?}");
     for file in files {
-        let scene = Scene::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
+        let scene = foton_loader::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
         assert!(
             scene.unused.is_empty(),
             "{}: unused {:?}",
@@ -63,7 +62,7 @@ fn cornell_point_from_other_tooling_matches_our_cornell_box() {
 
 #[test]
 fn fog_box_from_other_tooling_parses_its_media() {
-    let scene = Scene::load(&repo_root().join("scenes/fog_box.toml"), &[]).unwrap();
+    let scene = foton_loader::load(&repo_root().join("scenes/fog_box.toml"), &[]).unwrap();
     assert!(scene.has_media());
     let fog = scene.media.iter().find(|m| m.name == "fog").unwrap();
     assert_eq!(fog.value.sigma_t(glam::Vec3::ZERO), glam::Vec3::splat(1.05));

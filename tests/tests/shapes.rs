@@ -3,7 +3,6 @@
 //! when a file has none, or read from the file) and texture coordinates from files.
 
 use foton_core::Rgb;
-use foton_core::scene::Scene;
 use foton_tests::{foton_with_plugins, header, region_mean, render_toml, temp_dir, write};
 
 /// A camera for the scenes that are only loaded, not rendered.
@@ -111,7 +110,7 @@ fn flip_normals_turns_meshes_quads_and_spheres_over() {
                 "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[[shapes]]\n{shape}\nmaterial = \"m\"\nflip_normals = {flip}\n"
             );
             let path = write(&dir, "s.toml", &text);
-            let scene = Scene::load(&path, &[]).unwrap();
+            let scene = foton_loader::load(&path, &[]).unwrap();
             let hit = scene
                 .intersect(
                     &foton_core::geometry::Ray::new(
@@ -137,7 +136,7 @@ fn flip_normals_turns_meshes_quads_and_spheres_over() {
             "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[media.fog]\ntype = \"homogeneous\"\nsigma_a = [0.1, 0.1, 0.1]\nsigma_s = [0.1, 0.1, 0.1]\n\n[[shapes]]\ntype = \"sphere\"\ncenter = [0, 0, 0]\nradius = 1\nmaterial = \"m\"\nflip_normals = true\n{extra}"
         )
     };
-    let scene = Scene::load(&write(&dir, "sphere.toml", &sphere("")), &[]).unwrap();
+    let scene = foton_loader::load(&write(&dir, "sphere.toml", &sphere("")), &[]).unwrap();
     let ray = foton_core::geometry::Ray::new(glam::Vec3::new(0.0, 0.0, 3.0), glam::Vec3::NEG_Z);
     let hit = scene.intersect(&ray, f32::INFINITY).unwrap();
     assert!((hit.ng - glam::Vec3::NEG_Z).length() < 1e-6, "{}", hit.ng);
@@ -338,7 +337,7 @@ fn meshes_without_normals_are_shaded_smooth() {
             "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[[shapes]]\ntype = \"mesh\"\nfile = \"{}\"\nmaterial = \"m\"\n{extra}\n",
             obj.display()
         );
-        Scene::load(&write(&dir, "s.toml", &text), &[]).unwrap()
+        foton_loader::load(&write(&dir, "s.toml", &text), &[]).unwrap()
     };
     let (smooth, faceted) = (load(""), load("face_normals = true"));
     let mut rng = foton_core::sampling::Rng::new(&[5]);
@@ -400,7 +399,7 @@ fn normals_and_texture_coordinates_come_from_the_file() {
             "{CAMERA}[materials.m]\ntype = \"diffuse\"\n\n[[shapes]]\ntype = \"mesh\"\nfile = \"{}\"\nmaterial = \"m\"\n",
             file.display()
         );
-        let scene = Scene::load(&write(&dir, "s.toml", &text), &[]).unwrap();
+        let scene = foton_loader::load(&write(&dir, "s.toml", &text), &[]).unwrap();
         // Near the corner (1, 0, -1): u = 1 and v = 1 as written (0 once flipped).
         let ray =
             foton_core::geometry::Ray::new(glam::Vec3::new(0.98, 1.0, -0.98), glam::Vec3::NEG_Y);

@@ -8,7 +8,6 @@ use foton_core::Rgb;
 use foton_core::geometry::Shape;
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::light::area_light;
-use foton_core::scene::Scene;
 use foton_photonmap::surface::{Budgets, trace_surface_photons};
 use foton_tests::stats::rel_err;
 use foton_tests::{header, render_toml, temp_dir, write};
@@ -188,7 +187,7 @@ fn a_tiny_sphere_light_emits_photons_as_a_point_light_does() {
             &format!("{name}.toml"),
             &plane_scene("photon", &light),
         );
-        let scene = Scene::load(&path, &[]).unwrap();
+        let scene = foton_loader::load(&path, &[]).unwrap();
         let cancel = Default::default();
         let ctx = RenderContext::new(2, &cancel, &NoProgress);
         let budgets = Budgets {

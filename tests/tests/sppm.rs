@@ -326,8 +326,7 @@ fn a_nan_photon_does_not_poison_a_pixel() {
         .map(|s| s.to_string())
         .collect();
     let scene =
-        foton_core::scene::Scene::load(&repo_root().join("scenes/cornell-box.toml"), &overrides)
-            .unwrap();
+        foton_loader::load(&repo_root().join("scenes/cornell-box.toml"), &overrides).unwrap();
     let cancel = Default::default();
     let ctx = RenderContext::new(2, &cancel, &NoProgress);
     for schedule in [RadiusSchedule::Pixel, RadiusSchedule::Global] {

@@ -3,7 +3,7 @@
 //! process-wide interrupt flag that every in-process render watches.
 
 use foton_cli::{INTERRUPTED, TermProgress, prepare, render_prepared};
-use foton_core::film::read_image;
+use foton_loader::image::read_image;
 use foton_tests::{foton_with_plugins, plugin_dir, repo_root, temp_dir};
 use std::sync::atomic::Ordering;
 use std::time::Duration;

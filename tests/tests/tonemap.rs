@@ -11,8 +11,9 @@
 use foton_cli::TermProgress;
 use foton_cli::montage::BORDER;
 use foton_core::Rgb;
-use foton_core::film::{DisplayTransform, Film, ToneMap, read_image};
+use foton_core::film::{DisplayTransform, Film, ToneMap};
 use foton_core::integrator::Progress;
+use foton_loader::image::read_image;
 use foton_tests::{Run, foton_with_plugins, header, repo_root, temp_dir, with_area_light, write};
 use std::path::{Path, PathBuf};
 

@@ -5,7 +5,7 @@
 
 use foton_cli::montage::BORDER;
 use foton_cli::sweep::{SweepSet, parse_set};
-use foton_core::film::read_image;
+use foton_loader::image::read_image;
 use foton_tests::{Run, foton_with_plugins, header, temp_dir, write};
 use std::path::{Path, PathBuf};
 

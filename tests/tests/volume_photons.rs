@@ -40,7 +40,7 @@ intensity = [1.0, 1.0, 1.0]
 "#
     );
     let dir = temp_dir("volume-photons");
-    let scene = Scene::load(&write(&dir, "scene.toml", &toml), &[]).unwrap();
+    let scene = foton_loader::load(&write(&dir, "scene.toml", &toml), &[]).unwrap();
     let _ = std::fs::remove_dir_all(dir);
     scene
 }

@@ -176,7 +176,7 @@ fn volume_map_counts(scene: &str) -> (u64, u64) {
         out.to_str().unwrap(),
     ]);
     assert_eq!(run.code, 0, "{}", run.stderr);
-    let (w, h, _) = foton_core::film::read_image(&out).unwrap();
+    let (w, h, _) = foton_loader::image::read_image(&out).unwrap();
     assert_eq!((w, h), (32, 32));
     let _ = std::fs::remove_dir_all(dir);
     let number_before = |word: &str| -> u64 {

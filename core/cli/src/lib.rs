@@ -23,6 +23,7 @@ use foton_core::plugin::{IntegratorPlugin, Registry, search_path};
 use foton_core::props::Unused;
 use foton_core::scene::Scene;
 use foton_core::value::{Document, Value};
+use foton_loader::{FilmFile, TomlDocument};
 pub use progress::TermProgress;
 use std::ffi::OsString;
 use std::io::Write;
@@ -346,7 +347,7 @@ pub fn prepare_xml(
     plugin_dirs: &[PathBuf],
     strict: bool,
 ) -> Result<Prepared> {
-    let scene = Scene::load_with(scene_path, overrides, defines, lenient)?;
+    let scene = foton_loader::load_with(scene_path, overrides, defines, lenient)?;
     prepare_scene(scene, &search_path(plugin_dirs), strict)
 }
 
@@ -372,7 +373,7 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
     };
     let props = scene
         .integrator_properties(&scene.render.integrator)?
-        .with_plugins(&registry);
+        .with_kernels(&registry.kernels);
     let integrator = plugin
         .create(&props, &scene)
         .map_err(|e| blame_plugin(&plugin, e))?;
@@ -390,7 +391,9 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         let other = registry
             .integrator(&name)
             .map_err(|e| Error::Usage(format!("--set {key}: {e}")))?;
-        let props = scene.integrator_properties(&name)?.with_plugins(&registry);
+        let props = scene
+            .integrator_properties(&name)?
+            .with_kernels(&registry.kernels);
         if other.create(&props, &scene).is_ok() {
             unread_set(&props.unused(), &name)?;
         }
@@ -682,7 +685,7 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
             output.display()
         )));
     }
-    let (mut doc, report) = foton_core::scene::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    let (mut doc, report) = foton_loader::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
     if a.strict
         && let Some(w) = report.warnings.first()
     {
@@ -708,9 +711,9 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
     // The TOML must load from where it is written: check it before writing.
     let mut written = doc.clone();
     written.file = output.clone();
-    let mut scene = Scene::from_document(written)?;
+    let mut scene = foton_loader::from_document(written)?;
     if let Some((integrator, factor, line)) = &report.relative_radius {
-        foton_core::scene::set_relative_radius(&mut scene, integrator, *factor, *line);
+        foton_loader::set_relative_radius(&mut scene, integrator, *factor, *line);
         doc.root = scene.document.root;
     }
     let header = format!(
@@ -868,7 +871,7 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
             for o in &overrides {
                 doc.set(o)?;
             }
-            let scene = Scene::from_document(doc)?;
+            let scene = foton_loader::from_document(doc)?;
             prepare_scene(scene, &search_path(&a.plugins.plugin_dirs), false)?
         }
     };

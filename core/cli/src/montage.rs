@@ -6,14 +6,15 @@
 //! through [`render_image`], which applies the scene's exposure and tone map when the montage
 //! is a PNG, so that a render looks in a montage as `foton render` writes it; colours chosen
 //! for display (text, the false-colour map) are stored sRGB-decoded. The montage is written
-//! with `film::write_image` and the plain clamp, which leaves such values as they are.
+//! with `foton_loader::image::write_image` and the plain clamp, which leaves such values as they are.
 //!
 //! Layout: cells as large as the largest tile, `BORDER` pixels around and between them; the
 //! label bands of a row have the height of the row's longest label, so the images line up.
 
 use foton_core::Rgb;
 use foton_core::error::Result;
-use foton_core::film::{DisplayTransform, Film, ImageFormat, format_of, srgb_decode, write_image};
+use foton_core::film::{DisplayTransform, Film, ImageFormat, format_of, srgb_decode};
+use foton_loader::image::write_image;
 use std::path::Path;
 
 /// Pixels around and between the cells of a grid.

@@ -22,6 +22,7 @@ use foton_core::film::{DisplayTransform, Film, ImageFormat, RadianceSum, ToneMap
 use foton_core::integrator::Part;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result as FotonResult};
+use foton_loader::FilmFile;
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

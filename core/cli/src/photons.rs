@@ -156,7 +156,7 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .zip(&count)
         .map(|(s, &n)| if n == 0 { Rgb::ZERO } else { *s / n as f32 })
         .collect();
-    foton_core::film::write_image(&output, width, height, &pixels, &scene.film.display())?;
+    foton_loader::image::write_image(&output, width, height, &pixels, &scene.film.display())?;
 
     let _ = writeln!(
         out,

@@ -5,6 +5,7 @@
 
 use foton_core::film::{DisplayTransform, Film};
 use foton_core::integrator::Progress;
+use foton_loader::FilmFile;
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::io::IsTerminal;
 use std::path::PathBuf;

@@ -196,7 +196,7 @@ fn ctrl_c_writes_the_samples_done_so_far() {
     assert_eq!(of, full, "{err}");
     let done: u64 = done.parse().unwrap();
     assert!(done > 0 && done < 32 * 32 * 100_000, "{err}");
-    let (w, h, px) = foton_core::film::read_image(&output).unwrap();
+    let (w, h, px) = foton_loader::image::read_image(&output).unwrap();
     assert_eq!((w, h), (32, 32));
     // Every pixel has samples from the passes completed: none is black in a lit box.
     assert!(px.iter().all(|p| p.max_element() > 0.0));

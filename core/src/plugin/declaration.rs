@@ -15,7 +15,7 @@ use std::ffi::{CStr, c_char};
 
 /// Version of the integrator plugin interface (bumped on any change of the declaration or of
 /// the traits that cross the boundary).
-pub const PLUGIN_API_VERSION: u32 = 3;
+pub const PLUGIN_API_VERSION: u32 = 4;
 /// Version of the C kernel interface.
 pub const KERNEL_API_VERSION: u32 = 1;
 
@@ -58,7 +58,7 @@ pub const LAYOUT_FINGERPRINT: u64 = {
         size_of::<Film>(),
         size_of::<Properties<'static>>(),
         size_of::<RenderContext<'static>>(),
-        size_of::<super::Registry>(),
+        size_of::<crate::kernel::KernelPlugin>(),
         size_of::<Error>(),
         size_of::<crate::value::Document>(),
     ];

@@ -18,7 +18,7 @@ pub use declaration::*;
 
 use crate::error::{Error, Result};
 use crate::integrator::{CreateIntegrator, Integrator};
-use crate::kernel::Kernel;
+pub use crate::kernel::KernelPlugin;
 use crate::props::Properties;
 use crate::scene::Scene;
 use std::ffi::{CStr, c_char};
@@ -38,28 +38,6 @@ impl IntegratorPlugin {
     /// to report (`props.unused()`).
     pub fn create(&self, props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
         (self.create)(props, scene)
-    }
-}
-
-/// A loaded kernel plugin.
-#[derive(Clone, Debug)]
-pub struct KernelPlugin {
-    pub name: String,
-    pub file: PathBuf,
-    weight: unsafe extern "C" fn(f64) -> f64,
-}
-
-impl Kernel for KernelPlugin {
-    fn name(&self) -> &str {
-        &self.name
-    }
-    fn profile(&self, t: f64) -> f64 {
-        // SAFETY: the function comes from a declaration whose version was checked.
-        unsafe { (self.weight)(t) }
-    }
-    /// C code: called only while it is checked, then read from its table.
-    fn untrusted(&self) -> bool {
-        true
     }
 }
 
@@ -189,13 +167,12 @@ fn load(file: &Path) -> Result<Loaded> {
         }
         // SAFETY: version checked.
         let decl = unsafe { &*decl };
-        return Ok(Loaded::Kernel(KernelPlugin {
-            name: read_c_str(decl.name, "name", file)?,
-            file: file.to_path_buf(),
-            weight: decl
-                .weight
+        return Ok(Loaded::Kernel(KernelPlugin::new(
+            read_c_str(decl.name, "name", file)?,
+            file.to_path_buf(),
+            decl.weight
                 .ok_or_else(|| err("its declaration has no weight function".into()))?,
-        }));
+        )));
     }
     Err(err(format!(
         "not a foton plugin: it exports neither `{}` nor `{}`",

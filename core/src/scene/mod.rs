@@ -1,13 +1,9 @@
 //! The scene: what a scene file describes, as the integrators use it, and the queries they
 //! make of it (closest hits, materials, lights). The rest of it, one concept per file:
-//! [`load`]ing a TOML file, [`mesh`]es (OBJ, [`ply`]), [`volumes`] (which medium is where, from how
-//! closed shapes nest) and [`visibility`] (shadow rays, through null boundaries and media).
+//! [`volumes`] (which medium is where, from how closed shapes nest) and [`visibility`]
+//! (shadow rays, through null boundaries and media). Reading scene files (TOML, Mitsuba XML,
+//! meshes, images) is not core's: foton-loader reads them and hands [`Scene::new`] the parts.
 
-mod load;
-pub use load::set_relative_radius;
-pub mod mesh;
-pub mod mitsuba;
-pub mod ply;
 mod visibility;
 mod volumes;
 
@@ -25,10 +21,12 @@ use crate::light::Light;
 use crate::material::Material;
 use crate::medium::Medium;
 use crate::props::Properties;
+use crate::props::Unused;
 use crate::sampling::Distribution1D;
 use crate::value::{Document, Value};
 use glam::Vec3;
 use std::path::PathBuf;
+use volumes::{locate_medium, medium_interfaces};
 
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
@@ -147,7 +145,143 @@ pub struct Scene {
     pub ignored: Vec<String>,
 }
 
+/// What a scene file describes, as the loader read it: the parts [`Scene::new`] builds a scene
+/// from (the BVH, the light distribution and the medium interfaces are core's work).
+pub struct SceneParts {
+    pub file: PathBuf,
+    pub render: RenderSettings,
+    pub film: FilmSettings,
+    pub camera: Camera,
+    /// The medium the file puts the camera in (`Some(None)`: vacuum); None: found from where
+    /// it stands.
+    pub camera_medium: Option<Option<u32>>,
+    pub materials: Vec<Named<Material>>,
+    pub media: Vec<Named<BoxedMedium>>,
+    pub objects: Vec<Object>,
+    pub primitives: Vec<Primitive>,
+    pub triangle_attrs: Vec<TriangleAttrs>,
+    pub lights: Vec<Light>,
+    /// Per light: the medium the file puts it in (None: found from where it lies).
+    pub light_media: Vec<Option<Option<u32>>>,
+    /// The medium filling free space, if any.
+    pub medium: Option<u32>,
+    pub document: Document,
+    pub sources: Vec<PathBuf>,
+    pub unused: Vec<Unused>,
+    pub warnings: Vec<String>,
+}
+
 impl Scene {
+    /// The scene of `parts`: its bounds, lights fitted to them and their distribution, the
+    /// BVH, the medium interfaces and the camera's medium. Err: why the medium around the
+    /// camera is undefined (the loader names the camera's line with it).
+    pub fn new(parts: SceneParts) -> std::result::Result<Scene, String> {
+        let SceneParts {
+            file,
+            render,
+            film,
+            camera,
+            camera_medium: camera_placed,
+            materials,
+            media,
+            objects,
+            primitives: prims,
+            triangle_attrs,
+            mut lights,
+            light_media,
+            medium,
+            document,
+            sources,
+            unused,
+            warnings,
+        } = parts;
+        let mut lo = Vec3::splat(f32::INFINITY);
+        let mut hi = Vec3::splat(f32::NEG_INFINITY);
+        for p in &prims {
+            let b = p.shape.aabb();
+            lo = lo.min(b.min.into());
+            hi = hi.max(b.max.into());
+        }
+        for position in lights.iter().filter_map(Light::position) {
+            lo = lo.min(position);
+            hi = hi.max(position);
+        }
+        if !lo.is_finite() {
+            lo = camera.position;
+            hi = camera.position;
+        }
+        // A light at infinity covers the scene's bounding sphere (the camera included), which
+        // its power and photons need.
+        let (centre, radius) = {
+            let (l, h) = (lo.min(camera.position), hi.max(camera.position));
+            (0.5 * (l + h), (0.5 * (h - l).length()).max(1e-3))
+        };
+        for light in &mut lights {
+            light.fit_to_scene(centre, radius);
+        }
+        let environment = lights
+            .iter()
+            .position(Light::is_environment)
+            .map(|i| i as u32);
+        let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
+        let light_distribution = Distribution1D::new(&powers);
+
+        let accel = Accel::build(prims);
+        let uses_media = medium.is_some()
+            || camera_placed.is_some_and(|m| m.is_some())
+            || light_media.iter().any(|m| m.is_some_and(|m| m.is_some()))
+            || objects
+                .iter()
+                .any(|o| o.interior.is_some() || o.exterior.is_some());
+        let (interfaces, volumes, alone) = if uses_media {
+            medium_interfaces(&objects, &materials, &accel, medium)
+        } else {
+            (
+                vec![None; objects.len()],
+                Vec::new(),
+                vec![false; objects.len()],
+            )
+        };
+        let mut camera_medium = camera_placed.flatten();
+        if uses_media && camera_placed.is_none() {
+            camera_medium = locate_medium(
+                &accel,
+                &objects,
+                &interfaces,
+                &volumes,
+                medium,
+                camera.position,
+            )?;
+        }
+        Ok(Scene {
+            file,
+            render,
+            film,
+            camera,
+            materials,
+            media,
+            objects,
+            lights,
+            light_distribution,
+            environment,
+            accel,
+            triangle_attrs,
+            medium,
+            interfaces,
+            volumes,
+            alone,
+            has_media: uses_media,
+            light_media,
+            camera_medium,
+            bounds: (lo, hi),
+            document,
+            sources,
+            unused,
+            warnings,
+            ignored: Vec::new(),
+        })
+    }
+
     /// Where a key path was written in the scene file (line 0: it came from `--set`).
     pub fn location_of(&self, path: &[&str]) -> Option<Location> {
         let mut node = self.document.root.get(path.first()?)?;

@@ -12,8 +12,8 @@
 //! sensor looks down its local +z with +y up. What foton cannot render yet is an error naming
 //! the element, its type and file:line, or with `lenient` is left out and listed.
 
-use crate::error::{Error, Location, Result};
-use crate::value::{Document, Node, Table, Value};
+use foton_core::error::{Error, Location, Result};
+use foton_core::value::{Document, Node, Table, Value};
 use glam::{DMat4, DVec3};
 use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
@@ -383,7 +383,7 @@ impl Reader {
                 return Err(Error::Usage(format!(
                     "-D {name}: {} never uses `${name}`{}; its parameters: {}",
                     path.display(),
-                    crate::error::suggestion(name, known),
+                    foton_core::error::suggestion(name, known),
                     if sorted.is_empty() {
                         "none".to_string()
                     } else {
@@ -676,7 +676,7 @@ impl Reader {
                         &format!(
                             "unknown element <{other}> in <{}>{}",
                             obj.tag,
-                            crate::error::suggestion(other, known)
+                            foton_core::error::suggestion(other, known)
                         ),
                     ));
                 }
@@ -795,7 +795,7 @@ impl Reader {
                         l,
                         &format!(
                             "unknown transform operation <{other}>{}",
-                            crate::error::suggestion(other, ops)
+                            foton_core::error::suggestion(other, ops)
                         ),
                     ));
                 }
@@ -866,7 +866,7 @@ impl Reader {
                 format!(
                     "unknown integrator `{}`{}",
                     o.ty,
-                    crate::error::suggestion(&o.ty, MITSUBA_INTEGRATORS.iter().copied())
+                    foton_core::error::suggestion(&o.ty, MITSUBA_INTEGRATORS.iter().copied())
                 )
             };
             return self.unsupported(&o, &message);
@@ -1251,7 +1251,7 @@ impl Reader {
             return Err(o.error(format!(
                 "unknown sampler `{}`{}",
                 o.ty,
-                crate::error::suggestion(&o.ty, known)
+                foton_core::error::suggestion(&o.ty, known)
             )));
         };
         if !exact {
@@ -1412,7 +1412,7 @@ impl Reader {
                 match (eta, k) {
                     (None, None) => {
                         let name = material.unwrap_or_else(|| "none".into());
-                        if name != "none" && crate::material::conductor(&name).is_none() {
+                        if name != "none" && foton_core::material::conductor(&name).is_none() {
                             return Err(o.error(format!("`material`: unknown conductor `{name}`")));
                         }
                         t.insert("material", at(Value::Str(name), line));
@@ -2281,7 +2281,7 @@ fn not_read(kind: &str, ty: &str, supported: &str) -> String {
     } else {
         format!(
             "unknown {kind} type `{ty}`{}",
-            crate::error::suggestion(ty, known.iter().copied())
+            foton_core::error::suggestion(ty, known.iter().copied())
         )
     }
 }

@@ -3,24 +3,26 @@
 //! Every table is read through a [`Properties`] bag, so every error names file, line, key path
 //! and what was expected, and every key that was never read is reported as unused.
 
-use super::mesh::{MeshOptions, load_mesh};
-use super::volumes::{locate_medium, medium_interfaces};
-use super::{BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene};
-use crate::Rgb;
-use crate::accel::Accel;
-use crate::camera::Camera;
-use crate::error::Result;
-use crate::filter::{Filter, FilterSampler};
-use crate::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
-use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
-use crate::light::{Light, area_light};
-use crate::material::Material;
-use crate::medium::{Homogeneous, Phase};
-use crate::microfacet::{Microfacet, MicrofacetKind};
-use crate::props::{Properties, Unused};
-use crate::sampling::{Distribution1D, SamplerKind};
-use crate::texture::Texture;
-use crate::value::{Document, Value};
+use crate::document::TomlDocument;
+use crate::mesh::{MeshOptions, load_mesh};
+use crate::texture::{load_bitmap, read_texture_param};
+use foton_core::Rgb;
+use foton_core::camera::Camera;
+use foton_core::error::{Error, Result};
+use foton_core::filter::{Filter, FilterSampler};
+use foton_core::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
+use foton_core::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
+use foton_core::light::{Light, area_light};
+use foton_core::material::Material;
+use foton_core::medium::{Homogeneous, Phase};
+use foton_core::microfacet::{Microfacet, MicrofacetKind};
+use foton_core::props::{Properties, Unused};
+use foton_core::sampling::SamplerKind;
+use foton_core::scene::{
+    BoxedMedium, FilmSettings, Named, Object, RenderSettings, Scene, SceneParts,
+};
+use foton_core::texture::Texture;
+use foton_core::value::{Document, Value};
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -74,233 +76,174 @@ impl Loader {
     }
 }
 
-impl Scene {
-    /// Loads a scene file, applying `--set` style overrides first.
-    pub fn load(path: &Path, overrides: &[String]) -> Result<Scene> {
-        Scene::load_with(path, overrides, &[], false)
-    }
+/// Loads a scene file, applying `--set` style overrides first.
+pub fn load(path: &Path, overrides: &[String]) -> Result<Scene> {
+    load_with(path, overrides, &[], false)
+}
 
-    /// Loads a scene file: TOML, or a Mitsuba 3 XML scene (`.xml`) whose `<default>`s
-    /// `defines` (`NAME=VALUE`, Mitsuba's `-D`) override and whose unsupported elements are
-    /// left out and listed among the warnings if `lenient`. `--set` style `overrides` apply
-    /// to the document in both cases (for XML: to the TOML it reads as).
-    pub fn load_with(
-        path: &Path,
-        overrides: &[String],
-        defines: &[String],
-        lenient: bool,
-    ) -> Result<Scene> {
-        let is_xml = path
-            .extension()
-            .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
-        let (mut doc, report) = if is_xml {
-            if path.is_dir() {
-                return Err(crate::Error::io(path, "is a directory, not a scene file"));
-            }
-            let (doc, report) = super::mitsuba::read_xml(path, defines, lenient)?;
-            (doc, Some(report))
-        } else {
-            if let Some(d) = defines.first() {
-                return Err(crate::Error::Usage(format!(
-                    "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
-                )));
-            }
-            (Document::load(path)?, None)
-        };
-        for o in overrides {
-            doc.set(o)?;
-        }
-        let mut scene = Scene::from_document(doc)?;
-        if let Some(report) = report {
-            if let Some((integrator, factor, line)) = &report.relative_radius {
-                set_relative_radius(&mut scene, integrator, *factor, *line);
-            }
-            scene.ignored.extend(report.warnings);
-            scene.sources.extend(report.included);
-            let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
-            scene.warnings.extend(left_out.chain(report.notes));
-        }
-        Ok(scene)
-    }
-
-    pub fn from_document(doc: Document) -> Result<Scene> {
-        let file = doc.file.clone();
-        let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
-        let mut ld = Loader {
-            dir,
-            sources: Vec::new(),
-            bags: Vec::new(),
-            warnings: Vec::new(),
-        };
-        let root = Properties::root(&file, &doc.root);
-        for key in root.keys() {
-            if !SECTIONS.contains(&key) {
-                return Err(root.error(
-                    key,
-                    format!("unknown section; expected one of: {}", SECTIONS.join(", ")),
-                ));
-            }
-        }
-        root.node("integrators");
-
-        let render = read_render(&root, &mut ld)?;
-        let film = read_film(&root, &mut ld)?;
-        let (materials, material_index) = read_materials(&root, &mut ld)?;
-        let (media, medium_index) = read_media(&root, &mut ld)?;
-        let (camera, camera_placed) = read_camera(&root, &film, &medium_index, &mut ld)?;
-
-        let mut objects = Vec::new();
-        let mut prims = Vec::new();
-        let mut triangle_attrs = Vec::new();
-        let mut lights = Vec::new();
-        read_shapes(
-            &root,
-            &mut ld,
-            &materials,
-            &material_index,
-            &medium_index,
-            &mut objects,
-            (&mut prims, &mut triangle_attrs),
-            &mut lights,
-        )?;
-        // Per light: the medium the file puts it in (None: found from where it lies).
-        let mut light_media: Vec<Option<Option<u32>>> = lights
-            .iter()
-            .map(|l| match *l {
-                Light::Area { object, .. } => {
-                    let o: &Object = &objects[object as usize];
-                    // Mitsuba's area emitter emits into its shape's exterior.
-                    o.explicit_media.then_some(o.exterior)
-                }
-                _ => None,
-            })
-            .collect();
-        read_point_lights(&root, &mut ld, &medium_index, &mut lights, &mut light_media)?;
-
-        let mut medium = None;
-        if let Some(scene) = root.table("scene")? {
-            if let Some(name) = scene.string_opt("medium")? {
-                medium = Some(*medium_index.get(name).ok_or_else(|| {
-                    scene.error("medium", undefined("medium", name, &medium_index))
-                })?);
-            }
-            ld.done(&scene);
-        }
-
-        if lights.is_empty() {
-            ld.warnings.push(format!(
-                "{}: the scene has no lights: the image will be black",
-                file.display()
+/// Loads a scene file: TOML, or a Mitsuba XML scene (`.xml`) whose `<default>`s `defines`
+/// (`NAME=VALUE`, Mitsuba's `-D`) override and whose unsupported elements are left out and
+/// listed among the warnings if `lenient`. `--set` style `overrides` apply to the document in
+/// both cases (for XML: to the TOML it reads as).
+pub fn load_with(
+    path: &Path,
+    overrides: &[String],
+    defines: &[String],
+    lenient: bool,
+) -> Result<Scene> {
+    let is_xml = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
+    let (mut doc, report) = if is_xml {
+        if path.is_dir() {
+            return Err(foton_core::Error::io(
+                path,
+                "is a directory, not a scene file",
             ));
         }
-        let mut lo = Vec3::splat(f32::INFINITY);
-        let mut hi = Vec3::splat(f32::NEG_INFINITY);
-        for p in &prims {
-            let b = p.shape.aabb();
-            lo = lo.min(b.min.into());
-            hi = hi.max(b.max.into());
+        let (doc, report) = crate::mitsuba::read_xml(path, defines, lenient)?;
+        (doc, Some(report))
+    } else {
+        if let Some(d) = defines.first() {
+            return Err(foton_core::Error::Usage(format!(
+                "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
+            )));
         }
-        for position in lights.iter().filter_map(Light::position) {
-            lo = lo.min(position);
-            hi = hi.max(position);
-        }
-        if !lo.is_finite() {
-            lo = camera.position;
-            hi = camera.position;
-        }
-        // A light at infinity covers the scene's bounding sphere (the camera included), which
-        // its power and photons need.
-        let (centre, radius) = {
-            let (l, h) = (lo.min(camera.position), hi.max(camera.position));
-            (0.5 * (l + h), (0.5 * (h - l).length()).max(1e-3))
-        };
-        for light in &mut lights {
-            light.fit_to_scene(centre, radius);
-        }
-        let environment = lights
-            .iter()
-            .position(Light::is_environment)
-            .map(|i| i as u32);
-        let powers: Vec<f32> = lights.iter().map(|l| crate::average(l.power())).collect();
-        let light_distribution = Distribution1D::new(&powers);
-
-        let accel = Accel::build(prims);
-        let uses_media = medium.is_some()
-            || camera_placed.is_some_and(|m| m.is_some())
-            || light_media.iter().any(|m| m.is_some_and(|m| m.is_some()))
-            || objects
-                .iter()
-                .any(|o| o.interior.is_some() || o.exterior.is_some());
-        let (interfaces, volumes, alone) = if uses_media {
-            medium_interfaces(&objects, &materials, &accel, medium)
-        } else {
-            (
-                vec![None; objects.len()],
-                Vec::new(),
-                vec![false; objects.len()],
-            )
-        };
-        let mut camera_medium = camera_placed.flatten();
-        if uses_media && camera_placed.is_none() {
-            camera_medium = locate_medium(
-                &accel,
-                &objects,
-                &interfaces,
-                &volumes,
-                medium,
-                camera.position,
-            )
-            .map_err(|why| {
-                let t = root.table("camera").ok().flatten();
-                let message =
-                    format!("the medium around the camera is undefined: {why}; move the camera");
-                match t {
-                    Some(t) => t.error("position", message),
-                    None => root.error("camera", message),
-                }
-            })?;
-        }
-
-        ld.done(&root);
-        let mut unused: Vec<Unused> = ld.bags.into_iter().flatten().collect();
-        unused.sort_by(|a, b| (a.location.line, &a.key).cmp(&(b.location.line, &b.key)));
-        let warnings = ld.warnings;
-        let sources = ld.sources;
-        Ok(Scene {
-            file,
-            render,
-            film,
-            camera,
-            materials,
-            media,
-            objects,
-            lights,
-            light_distribution,
-            environment,
-            accel,
-            triangle_attrs,
-            medium,
-            interfaces,
-            volumes,
-            alone,
-            has_media: uses_media,
-            light_media,
-            camera_medium,
-            bounds: (lo, hi),
-            document: doc,
-            sources,
-            unused,
-            warnings,
-            ignored: Vec::new(),
-        })
+        (Document::load(path)?, None)
+    };
+    for o in overrides {
+        doc.set(o)?;
     }
+    let mut scene = from_document(doc)?;
+    if let Some(report) = report {
+        if let Some((integrator, factor, line)) = &report.relative_radius {
+            set_relative_radius(&mut scene, integrator, *factor, *line);
+        }
+        scene.ignored.extend(report.warnings);
+        scene.sources.extend(report.included);
+        let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
+        scene.warnings.extend(left_out.chain(report.notes));
+    }
+    Ok(scene)
+}
+
+/// The scene a parsed document describes.
+pub fn from_document(doc: Document) -> Result<Scene> {
+    let file = doc.file.clone();
+    let dir = file.parent().map(Path::to_path_buf).unwrap_or_default();
+    let mut ld = Loader {
+        dir,
+        sources: Vec::new(),
+        bags: Vec::new(),
+        warnings: Vec::new(),
+    };
+    let root = Properties::root(&file, &doc.root);
+    for key in root.keys() {
+        if !SECTIONS.contains(&key) {
+            return Err(root.error(
+                key,
+                format!("unknown section; expected one of: {}", SECTIONS.join(", ")),
+            ));
+        }
+    }
+    root.node("integrators");
+
+    let render = read_render(&root, &mut ld)?;
+    let film = read_film(&root, &mut ld)?;
+    let (materials, material_index) = read_materials(&root, &mut ld)?;
+    let (media, medium_index) = read_media(&root, &mut ld)?;
+    let (camera, camera_placed) = read_camera(&root, &film, &medium_index, &mut ld)?;
+
+    let mut objects = Vec::new();
+    let mut prims = Vec::new();
+    let mut triangle_attrs = Vec::new();
+    let mut lights = Vec::new();
+    read_shapes(
+        &root,
+        &mut ld,
+        &materials,
+        &material_index,
+        &medium_index,
+        &mut objects,
+        (&mut prims, &mut triangle_attrs),
+        &mut lights,
+    )?;
+    // Per light: the medium the file puts it in (None: found from where it lies).
+    let mut light_media: Vec<Option<Option<u32>>> = lights
+        .iter()
+        .map(|l| match *l {
+            Light::Area { object, .. } => {
+                let o: &Object = &objects[object as usize];
+                // Mitsuba's area emitter emits into its shape's exterior.
+                o.explicit_media.then_some(o.exterior)
+            }
+            _ => None,
+        })
+        .collect();
+    read_point_lights(&root, &mut ld, &medium_index, &mut lights, &mut light_media)?;
+
+    let mut medium = None;
+    if let Some(scene) = root.table("scene")? {
+        if let Some(name) = scene.string_opt("medium")? {
+            medium =
+                Some(*medium_index.get(name).ok_or_else(|| {
+                    scene.error("medium", undefined("medium", name, &medium_index))
+                })?);
+        }
+        ld.done(&scene);
+    }
+
+    if lights.is_empty() {
+        ld.warnings.push(format!(
+            "{}: the scene has no lights: the image will be black",
+            file.display()
+        ));
+    }
+    ld.done(&root);
+    let mut unused: Vec<Unused> = ld.bags.into_iter().flatten().collect();
+    unused.sort_by(|a, b| (a.location.line, &a.key).cmp(&(b.location.line, &b.key)));
+    let warnings = ld.warnings;
+    let sources = ld.sources;
+    // Where the error is if the medium around the camera turns out undefined (the scene
+    // takes the document, which the bags borrow).
+    let camera_error = match root.table("camera").ok().flatten() {
+        Some(t) => t.error("position", ""),
+        None => root.error("camera", ""),
+    };
+    Scene::new(SceneParts {
+        file,
+        render,
+        film,
+        camera,
+        camera_medium: camera_placed,
+        materials,
+        media,
+        objects,
+        primitives: prims,
+        triangle_attrs,
+        lights,
+        light_media,
+        medium,
+        document: doc,
+        sources,
+        unused,
+        warnings,
+    })
+    .map_err(|why| match camera_error {
+        Error::Scene { location, key, .. } => Error::Scene {
+            location,
+            key,
+            message: format!("the medium around the camera is undefined: {why}; move the camera"),
+        },
+        other => other,
+    })
 }
 
 /// A Mitsuba photon mapper's lookup radius, a fraction of the radius of the scene's bounding
 /// sphere (Mitsuba's `getBSphere`: around the bounding box, half its diagonal), as the
 /// plugin's `max_radius` in world units, unless the document already gives one (`--set`).
 pub fn set_relative_radius(scene: &mut Scene, integrator: &str, factor: f64, line: u32) {
-    use crate::value::{Node, Value};
+    use foton_core::value::{Node, Value};
     let (lo, hi) = scene.bounds;
     let radius = 0.5 * f64::from((hi - lo).length());
     if !radius.is_finite() || radius <= 0.0 {
@@ -399,13 +342,13 @@ fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
     }
     let output = t.string("output", "out.exr")?;
     let out = PathBuf::from(output);
-    crate::film::format_of(&out).map_err(|_| {
+    foton_core::film::format_of(&out).map_err(|_| {
         t.error(
             "output",
             format!("{output:?}: unsupported format; expected a .exr or .png file name"),
         )
     })?;
-    use crate::film::ToneMap;
+    use foton_core::film::ToneMap;
     // 2^64 still fits a float with room to spare; beyond, an image is all black or all
     // white whatever the scene, which is surely a typo.
     const MAX_EXPOSURE: f32 = 64.0;
@@ -458,11 +401,11 @@ fn read_envmap(l: &Properties<'_>, ld: &mut Loader) -> Result<Light> {
     }
     let to_world = read_transform_at(l, "to_world", ld)?;
     let path = ld.dir.join(file);
-    let bitmap = crate::texture::Bitmap::load(&path, false)
-        .map_err(|e| l.error("filename", e.to_string()))?;
+    let bitmap = load_bitmap(&path, false).map_err(|e| l.error("filename", e.to_string()))?;
     ld.sources.push(path);
-    let map = crate::envmap::EnvironmentMap::new(&bitmap, scale, glam::Mat3::from_mat4(to_world))
-        .map_err(|e| l.error("to_world", e))?;
+    let map =
+        foton_core::envmap::EnvironmentMap::new(&bitmap, scale, glam::Mat3::from_mat4(to_world))
+            .map_err(|e| l.error("to_world", e))?;
     Ok(Light::Envmap {
         map: std::sync::Arc::new(map),
         centre: Vec3::ZERO,
@@ -655,7 +598,7 @@ fn read_materials(root: &Properties<'_>, ld: &mut Loader) -> Result<(Vec<Named<M
         })?;
         // A colour that may be a texture; a reflectance above 1 is warned about.
         let mut texture = |key: &str, default: Rgb, reflectance: bool| -> Result<Texture> {
-            let (t, bag) = Texture::read_param(&m, key, default, &ld.dir)?;
+            let (t, bag) = read_texture_param(&m, key, default, &ld.dir)?;
             if let Some(bag) = bag {
                 ld.done(&bag);
             }
@@ -794,8 +737,8 @@ fn read_conductor_ior(m: &Properties<'_>) -> Result<Option<(Rgb, Rgb)>> {
         }
         (None, None, None) | (Some("none"), None, None) => Ok(None),
         (Some(name), None, None) => {
-            let found = crate::material::conductor(name).ok_or_else(|| {
-                let names: Vec<&str> = crate::material::CONDUCTORS
+            let found = foton_core::material::conductor(name).ok_or_else(|| {
+                let names: Vec<&str> = foton_core::material::CONDUCTORS
                     .iter()
                     .map(|(n, _, _)| *n)
                     .collect();
@@ -1077,7 +1020,7 @@ fn read_shapes(
                     if normal.length_squared() == 0.0 {
                         return Err(s.error("normal", "must not be the zero vector"));
                     }
-                    let f = crate::bsdf::Frame::from_normal(normal.normalize());
+                    let f = foton_core::bsdf::Frame::from_normal(normal.normalize());
                     (f.s * radius, f.t * radius)
                 };
                 if u.cross(v).length_squared() == 0.0 {

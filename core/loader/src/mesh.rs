@@ -1,10 +1,10 @@
 //! Triangle meshes: OBJ and PLY files, and whether a triangle set is closed (needed for a
 //! medium inside it).
 
-use super::ply;
-use crate::error::Result;
-use crate::geometry::{Shape, TriangleAttrs};
-use crate::props::Properties;
+use crate::ply;
+use foton_core::error::Result;
+use foton_core::geometry::{Shape, TriangleAttrs};
+use foton_core::props::Properties;
 use glam::{Mat3, Mat4, Vec2, Vec3};
 use rayon::prelude::*;
 use std::io::Read;

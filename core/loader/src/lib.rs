@@ -1,0 +1,24 @@
+//! foton-loader: scene files into foton-core's [`Scene`](foton_core::scene::Scene), outside the
+//! plugin boundary.
+//!
+//! The readers are here rather than in core so that a fix to one of them leaves core, and so
+//! the build identifier plugins are checked against, as it is: a plugin built before the fix
+//! still loads. Core keeps the scene as plugins see it and builds it from the parts read here
+//! ([`foton_core::scene::Scene::new`]).
+//!
+//! [`load`] reads a TOML scene ([`document`]: TOML text into core's `Document`, `--set`) or a
+//! Mitsuba XML one ([`mitsuba`]: Mitsuba 3 and 0.4 to 0.6, read as the TOML document it
+//! stands for), with its meshes ([`mesh`]: OBJ and [`ply`]) and images ([`texture`]: texture
+//! tables and bitmaps; [`image`]: image files read and written).
+
+pub mod document;
+pub mod image;
+mod load;
+pub mod mesh;
+pub mod mitsuba;
+pub mod ply;
+pub mod texture;
+
+pub use document::TomlDocument;
+pub use image::FilmFile;
+pub use load::{from_document, load, load_with, set_relative_radius};

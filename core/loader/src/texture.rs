@@ -1,0 +1,409 @@
+//! Textures and images as a scene file names them: a texture table (Mitsuba 3's `bitmap` and
+//! `checkerboard`) into core's [`Texture`], and an image file decoded into core's [`Bitmap`] of
+//! linear RGB (the `image` crate is the loader's: core only sees decoded pixels). The
+//! conventions are core's ([`foton_core::texture`]).
+
+use foton_core::Rgb;
+use foton_core::error::{Error, Result};
+use foton_core::props::Properties;
+use foton_core::texture::{Bitmap, FilterType, Texture, WrapMode, srgb_to_linear};
+use foton_core::value::Value;
+use glam::{Affine2, Mat2, Vec2};
+use std::path::Path;
+use std::sync::Arc;
+
+pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard"];
+
+/// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR; the format is recognised by its
+/// content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
+/// images are taken as linear. The error names the file; a texel that is not finite is
+/// an error.
+pub fn load_bitmap(path: &Path, raw: bool) -> Result<Bitmap> {
+    let decoded = image::ImageReader::open(path)
+        .map_err(|e| Error::io(path, e))?
+        .with_guessed_format()
+        .map_err(|e| Error::io(path, e))?
+        .decode()
+        .map_err(|e| Error::io(path, format!("cannot decode the image: {e}")))?;
+    let linear = raw
+        || matches!(
+            decoded,
+            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+        );
+    let rgb = decoded.to_rgb32f();
+    let (width, height) = (rgb.width() as usize, rgb.height() as usize);
+    let mut texels = Vec::with_capacity(width * height);
+    for (i, p) in rgb.pixels().enumerate() {
+        let c = Rgb::from_array(p.0);
+        if !c.is_finite() {
+            return Err(Error::io(
+                path,
+                format!(
+                    "pixel ({}, {}) is not finite: {c}",
+                    i % width.max(1),
+                    i / width.max(1)
+                ),
+            ));
+        }
+        texels.push(if linear { c } else { c.map(srgb_to_linear) });
+    }
+    Bitmap::new(width, height, texels).ok_or_else(|| Error::io(path, "the image is empty"))
+}
+
+/// A texture table (`type = "bitmap"` or `"checkerboard"` and its parameters, see
+/// docs/scene-format.md); `filename` is relative to `base_dir`. Every error names the
+/// scene file, line and key; an image that cannot be read also names the image file.
+pub fn read_texture(t: &Properties<'_>, base_dir: &Path) -> Result<Texture> {
+    let ty = t.string_opt("type")?.ok_or_else(|| {
+        t.error(
+            "type",
+            format!("missing; expected one of: {}", TEXTURE_TYPES.join(", ")),
+        )
+    })?;
+    match ty {
+        "bitmap" => {
+            let filename = t.string_required("filename")?;
+            let raw = t.bool("raw", false)?;
+            let filter = match t.choice("filter_type", &["bilinear", "nearest"], "bilinear")? {
+                "nearest" => FilterType::Nearest,
+                _ => FilterType::Bilinear,
+            };
+            let wrap = match t.choice("wrap_mode", &["repeat", "mirror", "clamp"], "repeat")? {
+                "mirror" => WrapMode::Mirror,
+                "clamp" => WrapMode::Clamp,
+                _ => WrapMode::Repeat,
+            };
+            let to_uv = read_to_uv(t)?;
+            let bitmap = load_bitmap(&base_dir.join(filename), raw)
+                .map_err(|e| t.error("filename", e.to_string()))?;
+            Ok(Texture::Bitmap {
+                bitmap: Arc::new(bitmap),
+                filter,
+                wrap,
+                to_uv,
+            })
+        }
+        "checkerboard" => Ok(Texture::Checkerboard {
+            // Mitsuba's defaults.
+            color0: t.rgb("color0", Rgb::splat(0.4))?,
+            color1: t.rgb("color1", Rgb::splat(0.2))?,
+            to_uv: read_to_uv(t)?,
+        }),
+        other => Err(t.error(
+            "type",
+            format!(
+                "unknown texture type {other:?}; expected one of: {}",
+                TEXTURE_TYPES.join(", ")
+            ),
+        )),
+    }
+}
+
+/// Parameter `name` of `bag` as a colour that may vary: `[r, g, b]` (a constant) or a
+/// texture table, `default` when absent. Returns the texture table's bag too, so that the
+/// caller can report its unused keys.
+pub fn read_texture_param<'a>(
+    bag: &Properties<'a>,
+    name: &str,
+    default: Rgb,
+    base_dir: &Path,
+) -> Result<(Texture, Option<Properties<'a>>)> {
+    let is_table = bag
+        .node(name)
+        .is_some_and(|n| matches!(n.value, Value::Table(_)));
+    if is_table {
+        let t = bag.table(name)?.expect("present");
+        let texture = read_texture(&t, base_dir)?;
+        Ok((texture, Some(t)))
+    } else {
+        Ok((Texture::Constant(bag.rgb(name, default)?), None))
+    }
+}
+
+/// `to_uv`: a table with `matrix`, 9 numbers (3 x 3, row-major, last row [0, 0, 1]) or 16 (a
+/// 4 x 4 whose third row and column are dropped, as Mitsuba does), or with `scale` (a number
+/// or [su, sv]) and `offset` ([ou, ov]): uv' = scale uv + offset. Identity when absent.
+fn read_to_uv(t: &Properties<'_>) -> Result<Affine2> {
+    let Some(m) = t.table("to_uv")? else {
+        return Ok(Affine2::IDENTITY);
+    };
+    let affine = if m.has("matrix") {
+        if let Some(other) = ["scale", "offset"].iter().find(|k| m.has(k)) {
+            return Err(m.error(
+                other,
+                "to_uv is either `matrix` or scale and offset, not both",
+            ));
+        }
+        let n = match m.node("matrix").map(|n| &n.value) {
+            Some(Value::Array(items)) if items.len() == 16 => 16,
+            _ => 9,
+        };
+        let v = m.floats_opt("matrix", n)?.expect("present");
+        // Rows 0, 1 and the last; columns 0, 1 and the last.
+        let (r, c) = if n == 9 { (3, 2) } else { (4, 3) };
+        let last = [v[r * (r - 1)], v[r * (r - 1) + 1], v[r * r - 1]];
+        if last != [0.0, 0.0, 1.0] {
+            return Err(m.error(
+                "matrix",
+                format!("the last row must be [0, 0, 1] (an affine map of uv), found {last:?}"),
+            ));
+        }
+        Affine2::from_mat2_translation(
+            Mat2::from_cols(Vec2::new(v[0], v[r]), Vec2::new(v[1], v[r + 1])),
+            Vec2::new(v[c], v[r + c]),
+        )
+    } else {
+        let scale = match m.node("scale").map(|n| &n.value) {
+            None => Vec2::ONE,
+            Some(Value::Array(_)) => Vec2::from_slice(&m.floats_opt("scale", 2)?.expect("present")),
+            Some(_) => Vec2::splat(m.f32_required("scale")?),
+        };
+        let offset = m
+            .floats_opt("offset", 2)?
+            .map_or(Vec2::ZERO, |v| Vec2::from_slice(&v));
+        Affine2::from_scale_angle_translation(scale, 0.0, offset)
+    };
+    if let Some(u) = m.unused().first() {
+        return Err(m.error(
+            u.key.rsplit('.').next().unwrap_or(&u.key),
+            "unknown parameter of to_uv; expected matrix, or scale and offset",
+        ));
+    }
+    Ok(affine)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::document::TomlDocument;
+    use foton_core::value::Document;
+    use std::path::PathBuf;
+
+    fn temp_dir(name: &str) -> PathBuf {
+        let dir = std::env::temp_dir().join(format!("foton-texture-{name}-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        dir
+    }
+
+    /// Reads the texture written as the TOML table `text` (a `[t]` section).
+    fn read(dir: &Path, text: &str) -> Result<Texture> {
+        let file = dir.join("scene.toml");
+        let doc = Document::parse(text, &file)?;
+        let root = Properties::root(&file, &doc.root);
+        let t = root.table("t")?.unwrap();
+        read_texture(&t, dir)
+    }
+
+    fn close(a: Rgb, b: Rgb) -> bool {
+        (a - b).abs().max_element() <= 1e-6 * b.abs().max_element().max(1.0)
+    }
+
+    /// 3 x 2 sRGB bytes, row 0 first.
+    const PIXELS: [[u8; 3]; 6] = [
+        [0, 64, 128],
+        [255, 10, 200],
+        [30, 30, 30],
+        [90, 180, 5],
+        [128, 128, 128],
+        [250, 0, 60],
+    ];
+
+    fn write_png(dir: &Path) -> PathBuf {
+        let path = dir.join("t.png");
+        let img = image::RgbImage::from_raw(3, 2, PIXELS.concat()).unwrap();
+        img.save(&path).unwrap();
+        path
+    }
+
+    fn linear(i: usize) -> Rgb {
+        Rgb::from_array(PIXELS[i].map(|b| srgb_to_linear(b as f32 / 255.0)))
+    }
+
+    #[test]
+    fn bitmap_lookups_read_texel_centres_interpolate_between_them_and_repeat() {
+        let dir = temp_dir("png");
+        write_png(&dir);
+        let t = read(&dir, "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\n").unwrap();
+        let centre = |i: usize, j: usize| Vec2::new((i as f32 + 0.5) / 3.0, (j as f32 + 0.5) / 2.0);
+        for j in 0..2 {
+            for i in 0..3 {
+                let want = linear(j * 3 + i);
+                assert!(close(t.eval(centre(i, j)), want), "texel ({i}, {j})");
+                // Repeat: whole periods further, either way.
+                let far = centre(i, j) + Vec2::new(2.0, -3.0);
+                assert!(close(t.eval(far), want), "texel ({i}, {j}) + (2, -3)");
+            }
+        }
+        // Half-way between texel centres: the average of the two (four) texels.
+        let mid = t.eval(Vec2::new(1.0 / 3.0, 0.25));
+        assert!(close(mid, 0.5 * (linear(0) + linear(1))));
+        let mid4 = t.eval(Vec2::new(1.0 / 3.0, 0.5));
+        assert!(close(
+            mid4,
+            0.25 * (linear(0) + linear(1) + linear(3) + linear(4))
+        ));
+        // uv = (0, 0), the top-left corner, averages the four corner texels (repeat).
+        let corner = t.eval(Vec2::ZERO);
+        assert!(close(
+            corner,
+            0.25 * (linear(0) + linear(2) + linear(3) + linear(5))
+        ));
+        // Nearest: the texel containing the point.
+        let n = read(
+            &dir,
+            "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nfilter_type = \"nearest\"\n",
+        )
+        .unwrap();
+        assert_eq!(n.eval(Vec2::new(0.34, 0.49)), linear(1));
+        assert_eq!(n.eval(Vec2::new(0.99, 0.51)), linear(5));
+        // raw: the bytes over 255, not decoded.
+        let raw = read(
+            &dir,
+            "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nraw = true\n",
+        )
+        .unwrap();
+        let want = Rgb::from_array(PIXELS[4].map(|b| b as f32 / 255.0));
+        assert!(close(raw.eval(centre(1, 1)), want));
+        assert!(close(t.mean(), (0..6).map(linear).sum::<Rgb>() / 6.0));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn wrap_modes_and_to_uv() {
+        let dir = temp_dir("wrap");
+        write_png(&dir);
+        let with = |extra: &str| {
+            let head = "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nfilter_type = \"nearest\"";
+            read(&dir, &format!("{head}\n{extra}\n")).unwrap()
+        };
+        let clamp = with("wrap_mode = \"clamp\"");
+        assert_eq!(clamp.eval(Vec2::new(-5.0, 0.2)), linear(0));
+        assert_eq!(clamp.eval(Vec2::new(7.0, 9.0)), linear(5));
+        let mirror = with("wrap_mode = \"mirror\"");
+        // Just past the right edge: the last column again, then going back.
+        assert_eq!(mirror.eval(Vec2::new(1.1, 0.2)), linear(2));
+        assert_eq!(mirror.eval(Vec2::new(1.5, 0.2)), linear(1));
+        assert_eq!(mirror.eval(Vec2::new(-0.1, 0.2)), linear(0));
+        assert_eq!(mirror.eval(Vec2::new(0.2, -0.1)), linear(0));
+        assert_eq!(mirror.eval(Vec2::new(0.2, 1.2)), linear(3));
+        // to_uv scales then offsets: uv' = 2 uv + (0.5, 0).
+        let scaled = with("to_uv = { scale = 2.0, offset = [0.5, 0.0] }");
+        assert_eq!(scaled.eval(Vec2::new(0.1, 0.1)), linear(2));
+        let m9 = with("to_uv = { matrix = [2, 0, 0.5, 0, 2, 0, 0, 0, 1] }");
+        let m16 = with("to_uv = { matrix = [2, 0, 0, 0.5, 0, 2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] }");
+        for uv in [
+            Vec2::new(0.1, 0.1),
+            Vec2::new(0.3, 0.7),
+            Vec2::new(-0.4, 0.2),
+        ] {
+            assert_eq!(m9.eval(uv), scaled.eval(uv));
+            assert_eq!(m16.eval(uv), scaled.eval(uv));
+        }
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn float_images_are_linear_grey_is_copied_and_alpha_dropped() {
+        let dir = temp_dir("formats");
+        let values = [
+            0.25f32, 3.5, 0.0, 1e-3, 7.0, 0.5, 2.0, 1.0, 0.125, 0.75, 0.0, 12.0,
+        ];
+        image::Rgb32FImage::from_raw(2, 2, values.to_vec())
+            .unwrap()
+            .save(dir.join("t.exr"))
+            .unwrap();
+        let exr = load_bitmap(&dir.join("t.exr"), false).unwrap();
+        for i in 0..4 {
+            assert_eq!(exr.texels()[i], Rgb::from_slice(&values[3 * i..3 * i + 3]));
+        }
+        let hdr = dir.join("t.hdr");
+        image::Rgb32FImage::from_raw(2, 2, values.to_vec())
+            .unwrap()
+            .save(&hdr)
+            .unwrap();
+        let h = load_bitmap(&hdr, false).unwrap();
+        for i in 0..4 {
+            let want = Rgb::from_slice(&values[3 * i..3 * i + 3]);
+            // RGBE keeps 8 bits of mantissa for the largest channel.
+            assert!((h.texels()[i] - want).abs().max_element() <= want.max_element() / 100.0);
+        }
+        image::GrayImage::from_raw(2, 1, vec![100, 200])
+            .unwrap()
+            .save(dir.join("g.png"))
+            .unwrap();
+        let g = load_bitmap(&dir.join("g.png"), false).unwrap();
+        assert!(close(
+            g.texels()[1],
+            Rgb::splat(srgb_to_linear(200.0 / 255.0))
+        ));
+        image::RgbaImage::from_raw(1, 1, vec![200, 100, 50, 128])
+            .unwrap()
+            .save(dir.join("a.png"))
+            .unwrap();
+        let a = load_bitmap(&dir.join("a.png"), true).unwrap();
+        assert!(close(a.texels()[0], Rgb::new(200.0, 100.0, 50.0) / 255.0));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn checkerboard_quadrants_are_mitsubas() {
+        let dir = temp_dir("checker");
+        let t = read(
+            &dir,
+            "[t]\ntype = \"checkerboard\"\ncolor0 = [1, 0, 0]\ncolor1 = [0, 0, 1]\n",
+        )
+        .unwrap();
+        let (c0, c1) = (Rgb::X, Rgb::Z);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.25)), c0);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.75)), c0);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.25)), c1);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.75)), c1);
+        // 1/2 itself belongs to the low half; negative uv repeats.
+        assert_eq!(t.eval(Vec2::new(0.5, 0.5)), c0);
+        assert_eq!(t.eval(Vec2::new(-0.25, 0.25)), c1);
+        assert_eq!(t.mean(), Rgb::new(0.5, 0.0, 0.5));
+        let d = read(&dir, "[t]\ntype = \"checkerboard\"\n").unwrap();
+        assert_eq!(d.eval(Vec2::splat(0.1)), Rgb::splat(0.4));
+        assert_eq!(d.eval(Vec2::new(0.6, 0.1)), Rgb::splat(0.2));
+        let _ = std::fs::remove_dir_all(dir);
+    }
+
+    #[test]
+    fn bad_textures_are_errors_naming_the_file() {
+        let dir = temp_dir("errors");
+        std::fs::write(dir.join("junk.png"), "not an image").unwrap();
+        let cases = [
+            ("filename = \"missing.png\"", "missing.png"),
+            ("filename = \"junk.png\"", "junk.png: cannot decode"),
+            ("", "`t.filename`: missing"),
+            (
+                "filename = \"junk.png\"\nfilter_type = \"cubic\"",
+                "unknown value \"cubic\"",
+            ),
+            (
+                "filename = \"junk.png\"\nwrap_mode = \"wrap\"",
+                "expected one of: repeat, mirror, clamp",
+            ),
+            (
+                "filename = \"junk.png\"\nto_uv = { matrix = [1, 0, 0, 0, 1, 0, 1, 0, 1] }",
+                "last row",
+            ),
+            (
+                "filename = \"junk.png\"\nto_uv = { translate = [1, 0] }",
+                "`t.to_uv.translate`",
+            ),
+        ];
+        for (extra, want) in cases {
+            let e = read(&dir, &format!("[t]\ntype = \"bitmap\"\n{extra}\n"))
+                .unwrap_err()
+                .to_string();
+            assert!(e.contains(want), "{extra}: {e}");
+            assert!(e.contains("scene.toml:"), "{extra}: {e}");
+        }
+        let e = read(&dir, "[t]\ntype = \"marble\"\n")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("unknown texture type \"marble\""), "{e}");
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
