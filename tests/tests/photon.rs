@@ -602,6 +602,10 @@ fn bad_photon_parameters_are_clear_errors() {
     );
 }
 
+/// A k no estimate could find (more than the photons emitted for a map) is a parameter
+/// mistake, an error before any photon is traced. A map that stores fewer photons than k
+/// (the caustic map of a scene with almost no caustic path) is not: its estimates take
+/// `max_radius`, as in any sparse region.
 #[test]
 fn k_larger_than_a_map_is_an_error() {
     let run = render_caustics_with(&[
@@ -616,6 +620,14 @@ fn k_larger_than_a_map_is_an_error() {
         run.stderr
     );
     assert!(run.stderr.contains("map"), "{}", run.stderr);
+    // 1000 caustic photons emitted, 14 stored (the caustics scene's glass sphere is small):
+    // k = 50 renders.
+    let run = render_caustics_with(&[
+        "integrators.photon.global_photons=2000",
+        "integrators.photon.caustic_photons=1000",
+        "integrators.photon.k=50",
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
 }
 
 #[test]

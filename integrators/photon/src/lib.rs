@@ -19,8 +19,9 @@
 //! `[render] max_depth` bounds the scattering events of a whole light path, as in the path
 //! tracer: a photon's surface hits plus the camera path's delta bounces (each photon records
 //! its count, and an estimate takes only the photons that fit). `[render] spp` camera samples.
-//! A `k` larger than the photons stored in a non-empty map is an error; a scene with
-//! participating media is refused (`vpm` renders those).
+//! A `k` larger than a map's photon budget is an error (a map that stores fewer than k is not:
+//! its estimates take `max_radius`); a scene with participating media is refused (`vpm`
+//! renders those).
 //!
 //! Two passes. **Photons** leave the lights in proportion to power (the photon pass of
 //! foton-photonmap, `foton_photonmap::trace`), bounce by BSDF sampling with Russian roulette,
@@ -77,7 +78,7 @@ use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, first_surface, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
 use foton_photonmap::map::Estimate;
-use foton_photonmap::surface::{Budgets, SurfaceMaps, trace_surface_photons};
+use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
 
 pub struct PhotonMapper {
     pub global_photons: u64,
@@ -352,6 +353,15 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
             format!("must be at least 2, found {k} (the k-th nearest photon only sets the radius: the estimate sums the k - 1 inside it)"),
         ));
     }
+    check_k(
+        props,
+        "k",
+        k,
+        &[
+            ("global", "global_photons", global_photons),
+            ("caustic", "caustic_photons", caustic_photons),
+        ],
+    )?;
     let max_radius = props.f32("max_radius", default_max_radius(scene))?;
     if max_radius <= 0.0 {
         return Err(props.error(

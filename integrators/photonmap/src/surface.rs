@@ -16,6 +16,7 @@ use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
 use foton_core::error::Result;
 use foton_core::geometry::Hit;
 use foton_core::integrator::RenderContext;
+use foton_core::props::Properties;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::VisiblePoint;
@@ -73,6 +74,30 @@ pub fn trace_surface_photons(
         Vec::new()
     };
     Ok([direct, caustic, indirect])
+}
+
+/// An error if an estimate's `k` (parameter `key`) exceeds a photon budget it is drawn from:
+/// no estimate could ever find k photons, a mistake in the parameters. A map that merely
+/// stores fewer than k (a sparse caustic map) is no error: see [`SurfaceMaps::build`].
+/// `budgets`: each map's name, its budget's parameter and the photons emitted for it (0: no
+/// such map).
+pub fn check_k(
+    props: &Properties<'_>,
+    key: &str,
+    k: usize,
+    budgets: &[(&str, &str, u64)],
+) -> Result<()> {
+    for &(map, budget_key, emitted) in budgets {
+        if emitted > 0 && k as u64 > emitted {
+            return Err(props.error(
+                key,
+                format!(
+                    "k = {k} is larger than the {emitted} photons emitted for the {map} map ({budget_key}): no estimate could find k; lower it or emit more photons"
+                ),
+            ));
+        }
+    }
+    Ok(())
 }
 
 /// The surface maps. `direct` exists when something reads it.

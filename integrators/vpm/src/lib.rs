@@ -22,7 +22,8 @@
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
 //! medium scattering events alike), as in the path tracer. `[render] spp` camera samples. A
-//! `k` (or `k_volume`) larger than the photons stored in a non-empty map is an error.
+//! `k` (or `k_volume`) larger than a map's photon budget is an error (a map that stores
+//! fewer than k is not: its estimates take `max_radius`).
 //!
 //! **Photons** (foton-photonmap's photon pass through media, `foton_photonmap::trace`): three
 //! budgets, each with its own random stream. The global pass stores surface photons in the
@@ -90,7 +91,7 @@ use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
-use foton_photonmap::surface::{Budgets, SurfaceMaps, trace_surface_photons};
+use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
 use foton_photonmap::trace::{PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons};
 use rayon::prelude::*;
 
@@ -503,6 +504,21 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let volume_photons = count("volume_photons", 200_000, 0)?;
     let k = count("k", 50, 2)? as usize;
     let k_volume = count("k_volume", 50, 2)? as usize;
+    check_k(
+        props,
+        "k",
+        k,
+        &[
+            ("global", "global_photons", global_photons),
+            ("caustic", "caustic_photons", caustic_photons),
+        ],
+    )?;
+    check_k(
+        props,
+        "k_volume",
+        k_volume,
+        &[("volume", "volume_photons", volume_photons)],
+    )?;
     let max_radius = positive("max_radius", diagonal / 20.0)?;
     let max_radius_volume = positive("max_radius_volume", diagonal / 20.0)?;
     let step = positive("step", diagonal / 100.0)?;
