@@ -103,20 +103,20 @@ def test_defines_are_for_xml_scenes():
 
 
 def test_old_xml_warnings_and_strict(tmp_path):
-    """A Mitsuba 0.5 file loads (camelCase upgraded); a sampler foton lacks is a warning with
-    its file:line, an error with strict=True."""
+    """A Mitsuba 0.5 file loads (camelCase upgraded); a sampler foton lacks (halton, rendered
+    by sobol) is a warning with its file:line, an error with strict=True."""
     old = (
         XML.replace('version="3.0.0"', 'version="0.5.0"')
         .replace("to_world", "toWorld")
         .replace("max_depth", "maxDepth")
-        .replace('<sampler type="independent">', '<sampler type="sobol">')
+        .replace('<sampler type="independent">', '<sampler type="halton">')
         .replace("sample_count", "sampleCount")
         .replace("SPHERE_BSDF", DIFFUSE)
     )
     xml = tmp_path / "old.xml"
     xml.write_text(old)
-    line = next(i + 1 for i, l in enumerate(old.splitlines()) if "sobol" in l)
-    with pytest.warns(foton.FotonWarning, match=f"old.xml:{line}: .*`sobol`"):
+    line = next(i + 1 for i, l in enumerate(old.splitlines()) if "halton" in l)
+    with pytest.warns(foton.FotonWarning, match=f"old.xml:{line}: .*`halton`"):
         scene = foton.load(xml, defines={"spp": 1, "res": 8})
     assert (scene.spp, scene.width) == (1, 8)
     with pytest.raises(foton.UsageError, match=f"old.xml:{line}: .*--strict"):

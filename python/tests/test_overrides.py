@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import warnings
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -129,12 +130,19 @@ intensity = [1.0, 1.0, 1.0]
     assert str(ROOT / "docs" / "meshes") in e.value.reason
 
 
-def test_unknown_fields_warn_and_strict_refuses():
+def test_unknown_fields_warn_and_strict_refuses(tmp_path):
+    # In the file: a warning, an error with strict=True.
+    text = Path(BOX).read_text().replace("[render]\n", "[render]\nspp_typo = 3\n", 1)
+    typo = tmp_path / "typo.toml"
+    typo.write_text(text)
     with pytest.warns(foton.FotonWarning, match="unknown field"):
-        foton.load(BOX, **{"render.spp_typo": 3})
+        foton.load(typo)
     with pytest.raises(foton.SceneError) as e:
-        foton.load(BOX, strict=True, **{"render.spp_typo": 3})
+        foton.load(typo, strict=True)
     assert e.value.key == "render.spp_typo"
+    # Set from Python, as with --set: nothing reads it, so it is an error naming what it meant.
+    with pytest.raises(foton.UsageError, match="render.sppp.*did you mean `render.spp`"):
+        foton.load(BOX, **{"render.sppp": 3})
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         foton.load(BOX)  # no warning for a clean scene
