@@ -244,9 +244,10 @@ fn a_kernel_plugin_bad_between_the_checked_points_is_an_error() {
                     "integrators.sppm.iterations=2",
                     "integrators.sppm.photons_per_iteration=5000",
                 ],
+                // Enough caustic photons for the scene's k (200).
                 _ => [
                     "integrators.photon.global_photons=5000",
-                    "integrators.photon.caustic_photons=5000",
+                    "integrators.photon.caustic_photons=50000",
                 ],
             };
             let run = foton(&[

@@ -461,6 +461,9 @@ fn sphere_inside_glass_matches_the_path_tracer() {
             &[
                 "render.spp=16",
                 "integrators.photon.caustic_photons=1000000",
+                // The bounds below were measured with k = 50 (the scene's is larger, for the
+                // global map's look at 256x256).
+                "integrators.photon.k=50",
             ],
         ]
         .concat(),
