@@ -195,7 +195,7 @@ fn a_tiny_sphere_light_emits_photons_as_a_point_light_does() {
             caustic: 0,
             max_depth: 4,
         };
-        let [direct, _, _] = trace_surface_photons(&scene, &ctx, &budgets, true).unwrap();
+        let [direct, _, _] = trace_surface_photons(&scene, &ctx, &budgets, true, false).unwrap();
         let inside: Vec<f64> = direct
             .iter()
             .filter(|p| (p.position.x as f64).hypot(p.position.z as f64) < big_r)

@@ -48,7 +48,9 @@
 //! * `caustic_photons = 0` no longer drops the caustics: without a caustic map the global
 //!   pass keeps its L S+ D photons in the indirect map, so caustics come from the global
 //!   budget (fewer photons, more blur) instead of vanishing. With a caustic budget the global
-//!   pass drops them, as before (the caustic pass counts those paths).
+//!   pass drops them, as before (the caustic pass counts those paths). With `final_gather`,
+//!   which reads the caustic map at x but not the indirect one, they go to the caustic map
+//!   instead (before, final gathering without a caustic map lost every L S+ D path).
 //! * The BSDF is evaluated per photon with the photon's own incoming direction w_p (not a
 //!   reflectance times the density), so the estimate is right for any BSDF.
 //! * Photons are taken from a disc, not a ball: on the same side of a surface facing the same
@@ -128,7 +130,8 @@ impl PhotonMapper {
     /// maps; the direct map only when direct light or final gathering reads it).
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<SurfaceMaps> {
         let need_direct = self.direct == Direct::Photons || self.final_gather;
-        let lists = trace_surface_photons(scene, ctx, &self.budgets(), need_direct)?;
+        let lists =
+            trace_surface_photons(scene, ctx, &self.budgets(), need_direct, self.final_gather)?;
         if lists[2].is_empty() && !scene.lights.is_empty() {
             ctx.progress
                 .warn("no photon reached a second diffuse surface: the indirect map is empty");
@@ -308,7 +311,7 @@ impl Integrator for PhotonMapper {
     /// `caustic`: the L S+ D photons of the caustic budget.
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
         let [mut global, caustic, indirect] =
-            trace_surface_photons(scene, ctx, &self.budgets(), true)?;
+            trace_surface_photons(scene, ctx, &self.budgets(), true, false)?;
         global.extend(indirect);
         Ok(vec![
             foton_photonmap::view(

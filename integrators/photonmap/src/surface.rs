@@ -4,8 +4,10 @@
 //! Two budgets, each with its own random stream. The **global** pass stores every surface
 //! photon by its path: L D (first hit) in the direct map, kept only when something reads it
 //! (direct light from photons, a final gather), every path with a diffuse bounce before the
-//! last in the indirect map, and L S+ D in the indirect map too when there is no caustic
-//! budget (otherwise the caustic budget counts those paths and the global pass drops them).
+//! last in the indirect map, and L S+ D when there is no caustic budget (otherwise the caustic
+//! budget counts those paths and the global pass drops them) in the indirect map too, or,
+//! when a final gather replaces the indirect map's estimate at the visible point, in the
+//! caustic map, which is read there (`caustics_apart`).
 //! The **caustic** pass stores the L S+ D photons, traced to their first diffuse hit only.
 //! Each light path is thus counted once (docs/photon-mapping.md).
 
@@ -34,12 +36,16 @@ pub struct Budgets {
 }
 
 /// The stored photons of the two passes: [direct, caustic, indirect] (the direct list empty
-/// unless `keep_direct`).
+/// unless `keep_direct`). Without a caustic budget, the global pass's L S+ D photons go to
+/// the caustic list if `caustics_apart` (a final gather reads the caustic map at the visible
+/// point and not the indirect one), else to the indirect list (one denser map: its estimate
+/// has a smaller radius than a sparse caustic map's).
 pub fn trace_surface_photons(
     scene: &Scene,
     ctx: &RenderContext<'_>,
     budgets: &Budgets,
     keep_direct: bool,
+    caustics_apart: bool,
 ) -> Result<[Vec<Photon>; 3]> {
     let pass = |photons, stream, stop_at_diffuse| TraceOptions {
         photons,
@@ -51,17 +57,19 @@ pub fn trace_surface_photons(
     };
     let caustic_map = budgets.caustic > 0;
     let global = pass(budgets.global, STREAM_GLOBAL, false);
-    let mut lists = trace_photons(scene, &global, ctx, 2, |site, class| {
+    let mut lists = trace_photons(scene, &global, ctx, 3, |site, class| {
         if site != Site::Surface {
             return None;
         }
         match class {
             PathClass::Direct => keep_direct.then_some(0),
-            PathClass::Caustic => (!caustic_map).then_some(1),
-            PathClass::Indirect => Some(1),
+            PathClass::Caustic if caustic_map => None,
+            PathClass::Caustic if caustics_apart => Some(1),
+            PathClass::Caustic | PathClass::Indirect => Some(2),
         }
     })?;
     let indirect = lists.pop().unwrap();
+    let global_caustic = lists.pop().unwrap();
     let direct = lists.pop().unwrap();
     let caustic = if caustic_map {
         let opts = pass(budgets.caustic, STREAM_CAUSTIC, true);
@@ -71,7 +79,7 @@ pub fn trace_surface_photons(
         .pop()
         .unwrap()
     } else {
-        Vec::new()
+        global_caustic
     };
     Ok([direct, caustic, indirect])
 }

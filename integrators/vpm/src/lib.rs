@@ -159,7 +159,7 @@ impl Vpm {
             caustic: self.caustic_photons,
             max_depth: self.max_depth,
         };
-        let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct)?;
+        let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
         let photons_direct = self.direct == Direct::Photons;
         let volume = if self.volume_photons > 0 && scene.has_media() {
             let opts = TraceOptions {
