@@ -16,46 +16,61 @@ fn path_film(scene: &str) -> Film {
     )
 }
 
-/// vpm's image at a coarse setting (50k photons per map, volume radius 0.2) and a fine one
-/// (800k, radius 0.05).
-fn vpm_films(scene: &str, extra: &[&str]) -> [Film; 2] {
+/// vpm's image at a coarse setting (50k photons per map, volume radius 0.2, one seed, 16 spp)
+/// and a fine one (800k, radius 0.05), the fine one the sum of four renders of 16 spp with
+/// seeds 0 to 3 (four photon maps: see BOUND), with the standard error of its mean (relative
+/// to it) from the spread of the four renders' means (at 4 spp each the camera samples'
+/// noise alone spread them by 4 %).
+fn vpm_films(scene: &str, extra: &[&str]) -> ([Film; 2], f32) {
     let scene = repo_root().join(scene);
     let view = [&VIEW[..], extra].concat();
-    [("50000", "0.2"), ("800000", "0.05")].map(|(photons, radius)| {
+    let render = |photons: &str, radius: &str, spp: &str, seed: u32| {
         let set = [
             format!("integrators.vpm.global_photons={photons}"),
             format!("integrators.vpm.volume_photons={photons}"),
             format!("integrators.vpm.max_radius_volume={radius}"),
+            format!("render.spp={spp}"),
+            format!("render.seed={seed}"),
         ];
         let set: Vec<&str> = set.iter().map(|s| s.as_str()).collect();
         render_file(
             &scene,
-            &[
-                &view[..],
-                &["render.integrator=vpm", "render.spp=16"],
-                &set[..],
-            ]
-            .concat(),
+            &[&view[..], &["render.integrator=vpm"], &set[..]].concat(),
             2,
         )
-    })
+    };
+    let coarse = render("50000", "0.2", "16", 0);
+    let mut fine = render("800000", "0.05", "16", 0);
+    let mut means = vec![fine.mean().element_sum()];
+    for seed in 1..4 {
+        let other = render("800000", "0.05", "16", seed);
+        means.push(other.mean().element_sum());
+        for (i, (sum, &count)) in other.sums().iter().zip(other.counts()).enumerate() {
+            fine.add_pixel(i, sum, count);
+        }
+    }
+    let n = means.len() as f32;
+    let mean = means.iter().sum::<f32>() / n;
+    let variance = means.iter().map(|m| (m - mean).powi(2)).sum::<f32>() / (n - 1.0);
+    ([coarse, fine], (variance / n).sqrt() / mean)
 }
 
 /// vpm against the path tracer: the relative error of the image mean must be below BOUND at
-/// the fine setting and below the coarse setting's (it converges), and the fine setting's
-/// image must agree block by block.
+/// the fine setting and below the coarse setting's, or within two of the fine setting's
+/// standard errors of it (it converges; the murky glass's coarse setting is within 1 %); the
+/// fine setting's image must agree block by block.
 fn assert_agrees_and_converges(what: &str, scene: &str, path: &Film, extra: &[&str]) {
-    let [coarse, fine] = vpm_films(scene, extra);
+    let ([coarse, fine], se) = vpm_films(scene, extra);
     let p = path.mean();
     let errors = [rel_err(coarse.mean(), p), rel_err(fine.mean(), p)];
     eprintln!(
-        "{what}: path {p}, vpm (50k, r 0.2) {}, (800k, r 0.05) {}: {errors:?}",
+        "{what}: path {p}, vpm (50k, r 0.2) {}, (800k, r 0.05) {} (standard error {se}): {errors:?}",
         coarse.mean(),
         fine.mean()
     );
     assert!(
-        errors[1] < BOUND && errors[1] < errors[0],
-        "{what}: {} then {}",
+        errors[1] < BOUND && errors[1] < errors[0].max(2.0 * se),
+        "{what}: {} then {} (standard error {se})",
         errors[0],
         errors[1]
     );
@@ -70,7 +85,11 @@ fn assert_agrees_and_converges(what: &str, scene: &str, path: &Film, extra: &[&s
 // within a radius of surfaces (the ball reaches where no photon can be); measured 1.8 % and
 // 0.6 % (fog cube), 1.6 % and 0.5 % (thin fog) for the two settings. The path tracer's mean
 // at 2048 spp is good to about 0.3 %. The fine setting must be within 1.5 % and better than
-// the coarse one.
+// the coarse one. One render's photon maps and camera samples move the fine image's mean from
+// seed to seed by a standard deviation of 0.85 to 1.4 % (fog cube, seeds 0 to 9 with
+// `sampler = "sobol"`: seed 0 fell at -1.7 %; every scene here, seeds 0 to 3), so the fine
+// setting is the mean of four seeds (a standard error of 0.6 to 0.7 %, printed): 1.5 % is
+// the bias and two and a half of those.
 //
 // Block by block (4x4 blocks of 8x8 pixels, the fine setting): each within max(rel, 4 se) of
 // the path tracer's, se the standard error of the block mean of the pixel-wise difference
@@ -205,7 +224,8 @@ fn photons_command_shows_the_volume_map() {
 #[test]
 fn agrees_with_path_on_murky_glass_and_converges() {
     // A dielectric sphere holding a coloured, forward-scattering (HG g = 0.7) medium: photons
-    // and camera rays enter it by refraction. Image means: measured 0.86 % and 0.27 %. (Over
+    // and camera rays enter it by refraction. Image means: measured 0.86 % and 0.27 % (one
+    // seed), 0.36 % (the fine setting's four seeds). (Over
     // the sphere's pixels alone, one render's photon-map noise is +-4 to 12 % from seed to
     // seed, all pixels seeing the same few magnified blotches through the sphere; the mean of
     // four seeds agreed with the path tracer within 0.7 %.) Block by block, the sphere's
