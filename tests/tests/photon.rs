@@ -686,6 +686,7 @@ fn max_depth_bounds_whole_light_paths_as_in_the_path_tracer() {
                 "render.spp=16",
                 "integrators.photon.global_photons=400000",
                 "integrators.photon.caustic_photons=400000",
+                "integrators.photon.k=50",
             ],
         ]
         .concat(),
