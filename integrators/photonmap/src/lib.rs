@@ -20,6 +20,7 @@
 //! linking this crate. It is not part of the build identifier either: each plugin that links
 //! it carries its own copy (docs/crates.md).
 
+pub mod beams;
 pub mod map;
 pub mod surface;
 pub mod trace;
