@@ -22,6 +22,7 @@
 
 pub mod beams;
 pub mod map;
+pub mod progressive;
 pub mod surface;
 pub mod trace;
 
