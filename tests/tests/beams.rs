@@ -141,7 +141,7 @@ fn one_beam_against_its_analytic_in_scattered_radiance() {
                     kind,
                 };
                 let r = 0.04;
-                let map = BeamMap::build(vec![beam], r, 0.1);
+                let map = BeamMap::build(vec![beam], r);
                 // The ray direction (-s, 0, -c) meets the x axis at x = 0.3, t_c = 1 / c.
                 let theta = degrees.to_radians();
                 let (s, c) = (theta.cos(), theta.sin());

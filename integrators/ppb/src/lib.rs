@@ -160,10 +160,9 @@ impl Ppb {
         let (photons, beams) = self.trace(scene, iteration, ctx)?;
         let scale = global_radius2_scale(iteration + 1, self.alpha);
         let r = (self.initial_beam_radius as f64 * scale) as f32;
-        let diagonal = (scene.bounds.1 - scene.bounds.0).length();
         Ok(Pass {
             surface: PhotonMap::build(photons),
-            beams: BeamMap::build(beams, r, diagonal / 64.0),
+            beams: BeamMap::build(beams, r),
             surface_shrink: scale.sqrt(),
         })
     }

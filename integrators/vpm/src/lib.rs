@@ -235,10 +235,8 @@ impl Vpm {
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
         let photons_direct = self.direct == Direct::Photons;
         let (surface, volume, beams) = self.trace_lists(scene, ctx, photons_direct)?;
-        let beams = (self.estimate == VolumeEstimate::Beams).then(|| {
-            let diagonal = (scene.bounds.1 - scene.bounds.0).length();
-            BeamMap::build(beams, self.beam_radius, diagonal / 64.0)
-        });
+        let beams = (self.estimate == VolumeEstimate::Beams)
+            .then(|| BeamMap::build(beams, self.beam_radius));
         let surface = SurfaceMaps::build(surface, photons_direct);
         let volume = PhotonMap::build(volume);
         let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
