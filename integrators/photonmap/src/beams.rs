@@ -299,9 +299,10 @@ impl BeamMap {
         let Some(bvh) = &self.bvh else {
             return;
         };
-        // obvhs takes the ray's octant from the sign bits: a component -0.0 (the direction
-        // -z written as -Vec3::Z) would disagree with its inverse, and the traversal misses
-        // every box. Adding +0.0 turns -0.0 into +0.0.
+        // obvhs 0.4 takes the ray's octant from `d < 0.0` (false for -0.0) but the inverse
+        // direction from the sign (-1 / epsilon for -0.0): a component -0.0 (the direction -z
+        // written as -Vec3::Z) makes them disagree and the traversal misses every box.
+        // Adding +0.0 turns -0.0 into +0.0.
         let dir = ray.dir + Vec3::ZERO;
         let bray = BvhRay::new(ray.origin.into(), dir.into(), 0.0, t_end);
         let r = self.radius;
@@ -404,6 +405,35 @@ mod tests {
             "{c:?}"
         );
         assert!(closest_approach(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X).is_none());
+    }
+
+    #[test]
+    fn rays_with_negative_zero_components_find_beams() {
+        let beam = Beam {
+            origin: Vec3::new(-1.0, 0.0, 0.0),
+            dir: Vec3::X,
+            length: 2.0,
+            flux: Rgb::ONE,
+            hero_r: Rgb::ONE,
+            medium: 0,
+            depth: 1,
+            kind: BeamKind::Long,
+        };
+        let map = BeamMap::build(vec![beam], 0.1);
+        // -Vec3::Z is (-0.0, -0.0, -1.0).
+        for dir in [
+            -Vec3::Z,
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(-0.0, 0.0, -1.0),
+        ] {
+            let mut found = 0;
+            let ray = Ray::new(Vec3::new(0.2, 0.05, 1.0), dir);
+            map.along_ray(&ray, 3.0, 0, |_, c| {
+                found += 1;
+                assert!((c.t_c - 1.0).abs() < 1e-5 && (c.t_b - 1.2).abs() < 1e-5);
+            });
+            assert_eq!(found, 1, "{dir:?}");
+        }
     }
 
     #[test]
