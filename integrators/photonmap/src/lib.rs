@@ -1,5 +1,5 @@
 //! foton-photonmap: the photon machinery that the photon-mapping integrators (`photon`,
-//! `sppm`, `vpm`) share, linked into each of them. An ordinary library crate, not a plugin.
+//! `sppm`, `vpm`, `ppb`) share, linked into each of them. An ordinary library crate, not a plugin.
 //!
 //! - [`trace`]: the photon pass: photons leave the lights in proportion to power, walk the
 //!   scene (surfaces and media, through core's `walk::RayWalk`, the one null-boundary crossing
@@ -13,6 +13,10 @@
 //!   a hit), `irradiance` and `in_scattered` (the volume estimate). Surface estimates gather
 //!   from a disc, not a ball: photons farther from the tangent plane than
 //!   [`map::DISC_THICKNESS`] (1/4) of the radius are not counted.
+//! - [`beams`]: photon beams (each photon flight through a medium, short or long), their BVH
+//!   and the beam x beam estimate with a 1-D kernel (Jarosz et al. 2011), for `vpm` and `ppb`;
+//! - [`progressive`]: what `sppm` and `ppb` share: Knaus and Zwicker's radius schedule, the
+//!   automatic first radius, the disc gather at a visible point.
 //!
 //! Nothing here crosses the plugin boundary: the host never sees a `PhotonMap`. What the
 //! `foton photons` tool draws comes back through `Integrator::photon_maps` as core's plain
@@ -20,7 +24,9 @@
 //! linking this crate. It is not part of the build identifier either: each plugin that links
 //! it carries its own copy (docs/crates.md).
 
+pub mod beams;
 pub mod map;
+pub mod progressive;
 pub mod surface;
 pub mod trace;
 

@@ -8,6 +8,7 @@
 //! counting the photons that hit nothing. Photon i draws from its own random stream, so the
 //! maps are identical whatever the number of threads.
 
+use crate::beams::{Beam, BeamKind, exit_distance};
 use crate::map::Photon;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
@@ -105,7 +106,23 @@ pub fn trace_one(
     opts: &TraceOptions,
     light_media: &[Option<u32>],
     index: u64,
+    store: impl FnMut(Photon, Site, PathClass),
+) {
+    trace_one_with_beams(scene, opts, light_media, index, None, store, |_, _| {});
+}
+
+/// [`trace_one`], also calling `beam(beam, class)` for each flight through a medium that
+/// interacts, as a beam of kind `beams` (None: no beams), before the flight is sampled; the
+/// class is that of a light path scattering once on the beam. The photon walks exactly as in
+/// [`trace_one`] (the same random numbers): beams are a record of its flights.
+pub fn trace_one_with_beams(
+    scene: &Scene,
+    opts: &TraceOptions,
+    light_media: &[Option<u32>],
+    index: u64,
+    beams: Option<BeamKind>,
     mut store: impl FnMut(Photon, Site, PathClass),
+    mut beam: impl FnMut(Beam, PathClass),
 ) {
     let mut rng = Rng::new(&[opts.seed, opts.stream, index]);
     // In the independent stream's order: light choice, position, direction, component.
@@ -149,8 +166,36 @@ pub fn trace_one(
         let seg = walk.segment(scene, &mut 0);
         if let Some(m) = seg.interacting_medium(scene) {
             let hero = hero.get_or_insert_with(|| HeroChannel::new(rng.next_f32()));
-            let flight =
-                m.sample_free_flight(&seg.start(), seg.length(), hero.channel, rng.next_f32());
+            let start = seg.start();
+            let flight = m.sample_free_flight(&start, seg.length(), hero.channel, rng.next_f32());
+            if let Some(kind) = beams {
+                let end = match kind {
+                    BeamKind::Short => flight.t,
+                    BeamKind::Long => seg.length(),
+                };
+                // A photon leaving the scene inside a medium: its beam ends at the scene's box
+                // (no camera ray is marched beyond it either).
+                let length = if end.is_finite() {
+                    end
+                } else {
+                    exit_distance(&start, scene.bounds)
+                };
+                if length > 0.0 {
+                    beam(
+                        Beam {
+                            origin: start.origin,
+                            dir: start.dir,
+                            length,
+                            flux,
+                            hero_r: hero.r,
+                            medium: seg.medium.expect("an interacting medium"),
+                            depth: hits + 1,
+                            kind,
+                        },
+                        class_of(hits + 1, specular_only),
+                    );
+                }
+            }
             let weight = hero.update(&flight);
             if flight.scattered {
                 hits += 1;
@@ -251,36 +296,65 @@ pub fn trace_photons(
     lists: usize,
     sort: impl Fn(Site, PathClass) -> Option<usize> + Sync,
 ) -> Result<Vec<Vec<Photon>>> {
+    Ok(trace_photons_and_beams(scene, opts, ctx, lists, sort, None, |_| false)?.0)
+}
+
+/// [`trace_photons`], also recording the photons' flights through media as beams of kind
+/// `beams` (None: none), those whose class `keep_beam` accepts, in emission order.
+pub fn trace_photons_and_beams(
+    scene: &Scene,
+    opts: &TraceOptions,
+    ctx: &RenderContext<'_>,
+    lists: usize,
+    sort: impl Fn(Site, PathClass) -> Option<usize> + Sync,
+    beams: Option<BeamKind>,
+    keep_beam: impl Fn(PathClass) -> bool + Sync,
+) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
     let media = light_media(scene)?;
     ctx.progress.begin("photons", opts.photons);
     let chunks = opts.photons.div_ceil(CHUNK);
-    let parts: Vec<Vec<Vec<Photon>>> = with_pool(ctx.threads, || {
+    let parts: Vec<(Vec<Vec<Photon>>, Vec<Beam>)> = with_pool(ctx.threads, || {
         (0..chunks)
             .into_par_iter()
             .map(|c| {
                 let mut out = vec![Vec::new(); lists];
+                let mut out_beams = Vec::new();
                 if ctx.cancelled() {
-                    return out;
+                    return (out, out_beams);
                 }
                 let end = ((c + 1) * CHUNK).min(opts.photons);
                 for i in c * CHUNK..end {
-                    trace_one(scene, opts, &media, i, |p, site, class| {
-                        if let Some(list) = sort(site, class) {
-                            out[list].push(p);
-                        }
-                    });
+                    trace_one_with_beams(
+                        scene,
+                        opts,
+                        &media,
+                        i,
+                        beams,
+                        |p, site, class| {
+                            if let Some(list) = sort(site, class) {
+                                out[list].push(p);
+                            }
+                        },
+                        |b, class| {
+                            if keep_beam(class) {
+                                out_beams.push(b);
+                            }
+                        },
+                    );
                 }
                 ctx.progress.advance(end - c * CHUNK);
-                out
+                (out, out_beams)
             })
             .collect()
     })?;
     ctx.progress.finish();
     let mut result = vec![Vec::new(); lists];
-    for part in parts {
+    let mut all_beams = Vec::new();
+    for (part, part_beams) in parts {
         for (list, photons) in result.iter_mut().zip(part) {
             list.extend(photons);
         }
+        all_beams.extend(part_beams);
     }
-    Ok(result)
+    Ok((result, all_beams))
 }

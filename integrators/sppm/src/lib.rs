@@ -92,9 +92,10 @@ use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
-use foton_photonmap::map::{DISC_THICKNESS, PhotonMap};
+use foton_photonmap::map::PhotonMap;
+use foton_photonmap::progressive::{auto_radius, gather_disc, pixel_angle};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
-use glam::{DVec3, Vec2};
+use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -125,13 +126,8 @@ pub enum RadiusSchedule {
     Global,
 }
 
-/// Knaus and Zwicker's radius schedule: r_i^2 / r_1^2 for iteration i (1-based),
-/// prod_{j=1}^{i-1} (j + alpha) / (j + 1). It falls like i^(alpha - 1), so the radius shrinks
-/// to zero while the photons gathered per iteration, about r_i^2 times the photon count, fall
-/// slowly enough that the average over iterations converges: variance and bias both vanish.
-pub fn global_radius2_scale(iteration: u64, alpha: f64) -> f64 {
-    (1..iteration).fold(1.0, |s, j| s * (j as f64 + alpha) / (j as f64 + 1.0))
-}
+/// Knaus and Zwicker's radius schedule, shared with `ppb` (foton-photonmap's `progressive`).
+pub use foton_photonmap::progressive::global_radius2_scale;
 
 /// A pixel's progressive statistics.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -282,23 +278,11 @@ impl Sppm {
     /// The starting radius of a pixel whose first visible point lies `distance` along the
     /// camera path.
     fn first_radius(&self, scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
-        if let Some(r) = self.initial_radius {
-            return r as f64;
+        match self.initial_radius {
+            Some(r) => r as f64,
+            None => auto_radius(scene, pixel_angle, distance),
         }
-        let diagonal = (scene.bounds.1 - scene.bounds.0).length().max(1e-6) as f64;
-        (3.0 * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
     }
-}
-
-/// The angle one pixel subtends at the centre of the image.
-fn pixel_angle(scene: &Scene) -> f32 {
-    let (w, h) = (scene.film.width as f32, scene.film.height as f32);
-    let a = scene.camera.generate_ray(Vec2::new(w / 2.0, h / 2.0)).dir;
-    let b = scene
-        .camera
-        .generate_ray(Vec2::new(w / 2.0, h / 2.0 + 1.0))
-        .dir;
-    a.dot(b).clamp(-1.0, 1.0).acos()
 }
 
 /// The image after `iterations` iterations: under the global schedule each pixel's exact sum
@@ -424,29 +408,14 @@ impl Integrator for Sppm {
                             st.radius as f32
                         };
                         let disc = std::f32::consts::PI * r * r;
-                        let (mut m, mut phi) = (0.0f64, DVec3::ZERO);
-                        // No light path longer than max_depth, as in the path tracer.
+                        // No light path longer than max_depth, as in the path tracer; a
+                        // disc, as the k-nearest estimates gather from (foton-photonmap).
                         let depth = self.max_depth - vp.bounces;
-                        // A disc, as the k-nearest estimates gather from (foton-photonmap).
-                        let thickness = DISC_THICKNESS * r;
-                        map.within(vp.hit.p, r, |photon, d2| {
-                            if photon.depth() > depth
-                                || photon.normal().dot(vp.n) <= 0.9
-                                || (photon.position - vp.hit.p).dot(vp.n).abs() > thickness
-                            {
-                                return; // too long, another surface, or its other side
-                            }
-                            let w = self.kernel.weight_2d(d2.sqrt(), r) * disc;
-                            let f = vp.bsdf.eval_density(vp.wo, photon.wi());
-                            let flux = f * photon.power() * w;
-                            if !(usable(flux) && w.is_finite() && w >= 0.0) {
-                                bad_photons.fetch_add(1, Ordering::Relaxed);
-                                return;
-                            }
-                            m += w as f64;
-                            phi += flux.as_dvec3();
-                        });
-                        let phi = phi * vp.beta.as_dvec3();
+                        let g = gather_disc(&map, vp, r, depth, &self.kernel);
+                        if g.bad > 0 {
+                            bad_photons.fetch_add(g.bad, Ordering::Relaxed);
+                        }
+                        let (m, phi) = (g.m, g.phi * vp.beta.as_dvec3());
                         match self.schedule {
                             RadiusSchedule::Pixel => {
                                 st.ld += ld.as_dvec3();

@@ -17,7 +17,9 @@
 //! | `kernel`            | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces and for the beam estimate, in 3-D for the marched volume estimate) | `box` |
 //! | `cone_c`            | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1      |
 //! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
-//! | `estimate`          | string  | `march` (ray marching) or `beam` (beam radiance estimate)  | `march` |
+//! | `estimate`          | string  | `march` (ray marching), `beam` (beam radiance estimate: photon points, camera beams) or `beams` (photon beams, beam x beam estimate) | `march` |
+//! | `beam_type`         | string  | with `estimate = "beams"`: `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
+//! | `beam_radius`       | float   | with `estimate = "beams"`: the photon beams' width r (the 1-D kernel's radius), > 0 | 0.0287 x diagonal x volume_photons^(-1/5) (1/400 of the diagonal for 200000) |
 //! | `glossy_roughness`  | float   | glossy lobes smoother than this (microfacet alpha) are followed by the camera walk, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
@@ -60,6 +62,26 @@
 //! and K2 the kernel normalised over the disc. One tree walk per segment replaces the steps'
 //! queries; single scattering by shadow rays (`direct = "nee"`) is still marched.
 //!
+//! **Photon beams** (`estimate = "beams"`, Jarosz, Nowrouzezahrai, Sadeghi and Jensen 2011):
+//! the volume pass records each photon's flights through media as beams (foton-photonmap's
+//! `beams`: short or long, `beam_type`) instead of storing points, and each camera segment
+//! gathers every beam whose width it passes within, with the beam x beam estimate (a 1-D
+//! kernel across the two lines; `kernel` normalised in 1-D):
+//!
+//! ```text
+//! sum_b Phi_b W_b(t_b) sigma_s(x_c) p(w_b . -w) Tr(x, x_c) K1(u_b, r) / sin(theta_b)
+//! ```
+//!
+//! u_b the distance between the camera ray and the beam, theta_b their angle, t_b and x_c
+//! the closest points on the beam and on the camera ray, W_b = Tr_b(t_b) for long beams and
+//! Tr_b(t_b) / mean_c(r_c Tr_b,c(t_b)) for short ones (1 in a grey medium; r_c the photon
+//! path's spectral-MIS pdf ratios). The derivation is in foton-photonmap's `beams` module.
+//! With `direct = "nee"` the beams of first flights (L M) are not kept: single scattering is
+//! marched with shadow rays as for the other estimates. The default width follows the 1-D
+//! estimate's error: variance ~ 1 / (photons r), bias ~ r^2, least squared error at r ~
+//! photons^(-1/5). Beams are found through a BVH over their pieces: each camera segment is a
+//! BVH traversal, whose cost grows with photons x r.
+//!
 //! Each light path is counted once: through a march point x_t, L M (x_t) by shadow rays (or
 //! the volume map's first-event photons), everything else by the volume map; at surfaces as in
 //! `photon` (docs/photon-mapping.md).
@@ -90,9 +112,14 @@ use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
+use foton_photonmap::beams::{
+    Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
+};
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
 use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
-use foton_photonmap::trace::{PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons};
+use foton_photonmap::trace::{
+    PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons_and_beams,
+};
 use rayon::prelude::*;
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -101,6 +128,18 @@ pub enum VolumeEstimate {
     March,
     /// The beam radiance estimate along each camera segment.
     Beam,
+    /// Photon beams: the beam x beam estimate along each camera segment.
+    Beams,
+}
+
+impl VolumeEstimate {
+    pub fn name(self) -> &'static str {
+        match self {
+            VolumeEstimate::March => "march",
+            VolumeEstimate::Beam => "beam",
+            VolumeEstimate::Beams => "beams",
+        }
+    }
 }
 
 pub struct Vpm {
@@ -115,6 +154,11 @@ pub struct Vpm {
     pub kernel: NormalizedKernel,
     pub direct: Direct,
     pub estimate: VolumeEstimate,
+    /// With `estimate = "beams"`: short or long beams, their width.
+    pub beam_type: BeamKind,
+    pub beam_radius: f32,
+    /// The kernel's 1-D normalisation (`Kernel1d::norm`).
+    pub kernel_1d: f32,
     pub max_depth: u32,
     /// How camera paths treat glossy surfaces.
     pub camera: CameraWalk,
@@ -128,20 +172,16 @@ pub struct Maps {
     /// largest.
     pub volume_radius: Vec<f32>,
     pub volume_radius_max: f32,
+    /// With `estimate = "beams"`: the volume pass's photon beams.
+    pub beams: Option<BeamMap>,
     /// Where camera rays that leave the scene stop marching: the box around the geometry,
     /// the lights and the volume photons, grown by the volume radius.
     pub bounds: (Vec3, Vec3),
 }
 
-/// Distance along `ray` to where it leaves the box (0 if it misses it).
-fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
-    let inv = ray.dir.recip();
-    let t0 = (lo - ray.origin) * inv;
-    let t1 = (hi - ray.origin) * inv;
-    let far = t0.max(t1).min_element();
-    let near = t0.min(t1).max_element();
-    if far < near.max(0.0) { 0.0 } else { far }
-}
+/// What the photon passes store: the surface lists [direct, caustic, indirect], the volume
+/// photons and the photon beams.
+type PassLists = ([Vec<Photon>; 3], Vec<Photon>, Vec<Beam>);
 
 impl Vpm {
     /// The three photon passes: the surface maps' two (foton-photonmap's surface passes:
@@ -153,7 +193,7 @@ impl Vpm {
         scene: &Scene,
         ctx: &RenderContext<'_>,
         keep_direct: bool,
-    ) -> Result<([Vec<Photon>; 3], Vec<Photon>)> {
+    ) -> Result<PassLists> {
         let budgets = Budgets {
             global: self.global_photons,
             caustic: self.caustic_photons,
@@ -161,7 +201,7 @@ impl Vpm {
         };
         let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
         let photons_direct = self.direct == Direct::Photons;
-        let volume = if self.volume_photons > 0 && scene.has_media() {
+        let (volume, beams) = if self.volume_photons > 0 && scene.has_media() {
             let opts = TraceOptions {
                 photons: self.volume_photons,
                 max_depth: self.max_depth,
@@ -170,21 +210,33 @@ impl Vpm {
                 stop_at_diffuse: false,
                 sobol_emission: TraceOptions::emission_for(scene.render.sampler),
             };
-            trace_photons(scene, &opts, ctx, 1, |site, class| {
-                (site == Site::Volume && (class != PathClass::Direct || photons_direct))
-                    .then_some(0)
-            })?
-            .pop()
-            .unwrap()
+            // Each light path once: L M by shadow rays unless direct = "photons".
+            let keep = |class| class != PathClass::Direct || photons_direct;
+            let beams = (self.estimate == VolumeEstimate::Beams).then_some(self.beam_type);
+            let (mut lists, beams) = trace_photons_and_beams(
+                scene,
+                &opts,
+                ctx,
+                1,
+                |site, class| {
+                    let points = self.estimate != VolumeEstimate::Beams;
+                    (points && site == Site::Volume && keep(class)).then_some(0)
+                },
+                beams,
+                keep,
+            )?;
+            (lists.pop().unwrap(), beams)
         } else {
-            Vec::new()
+            (Vec::new(), Vec::new())
         };
-        Ok((surface, volume))
+        Ok((surface, volume, beams))
     }
 
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
         let photons_direct = self.direct == Direct::Photons;
-        let (surface, volume) = self.trace_lists(scene, ctx, photons_direct)?;
+        let (surface, volume, beams) = self.trace_lists(scene, ctx, photons_direct)?;
+        let beams = (self.estimate == VolumeEstimate::Beams)
+            .then(|| BeamMap::build(beams, self.beam_radius));
         let surface = SurfaceMaps::build(surface, photons_direct);
         let volume = PhotonMap::build(volume);
         let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
@@ -221,6 +273,7 @@ impl Vpm {
             volume,
             volume_radius,
             volume_radius_max,
+            beams,
             bounds: (lo - grow, hi + grow),
         })
     }
@@ -262,8 +315,16 @@ impl Vpm {
             return Rgb::ZERO;
         }
         let mut inscattered = Rgb::ZERO;
-        if self.estimate == VolumeEstimate::Beam {
-            inscattered += self.beam(maps, m, &start, t_end, bounces);
+        match (self.estimate, &maps.beams, seg.medium) {
+            (VolumeEstimate::Beam, _, _) => {
+                inscattered += self.beam(maps, m, &start, t_end, bounces);
+            }
+            (VolumeEstimate::Beams, Some(beams), Some(medium)) => {
+                let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
+                let depth = self.max_depth - bounces;
+                inscattered += beams.in_scattered(scene, &kernel, &start, t_end, medium, depth);
+            }
+            _ => {}
         }
         if self.estimate == VolumeEstimate::March || self.direct == Direct::ShadowRays {
             inscattered += self.march(
@@ -308,15 +369,15 @@ impl Vpm {
                 break;
             }
             let x = ray.at(t);
-            let mut inscattered = if maps.volume.is_empty() || self.estimate == VolumeEstimate::Beam
-            {
-                Rgb::ZERO
-            } else {
-                with_scratch(|s| {
-                    maps.volume
-                        .in_scattered(x, ray.dir, &phase, depth, &estimate, s)
-                })
-            };
+            let mut inscattered =
+                if maps.volume.is_empty() || self.estimate != VolumeEstimate::March {
+                    Rgb::ZERO
+                } else {
+                    with_scratch(|s| {
+                        maps.volume
+                            .in_scattered(x, ray.dir, &phase, depth, &estimate, s)
+                    })
+                };
             if self.direct == Direct::ShadowRays {
                 // Single scattering: sigma_s times the phase-weighted direct light.
                 let at = Scatter::Medium { p: x, phase };
@@ -426,15 +487,15 @@ impl Integrator for Vpm {
         p.extend(self.kernel.parameters());
         p.extend([
             Parameter::str("direct", self.direct.name()),
-            Parameter::str(
-                "estimate",
-                match self.estimate {
-                    VolumeEstimate::March => "march",
-                    VolumeEstimate::Beam => "beam",
-                },
-            ),
+            Parameter::str("estimate", self.estimate.name()),
             Parameter::float("glossy_roughness", self.camera.glossy_roughness),
         ]);
+        if self.estimate == VolumeEstimate::Beams {
+            p.extend([
+                Parameter::str("beam_type", self.beam_type.name()),
+                Parameter::float("beam_radius", self.beam_radius),
+            ]);
+        }
         p
     }
 
@@ -456,7 +517,12 @@ impl Integrator for Vpm {
     /// `global` (direct and indirect surface photons of the global budget), `caustic` (L S+ D
     /// surface photons of the caustic budget) and `volume` (the volume map as rendered).
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
-        let ([mut global, caustic, indirect], volume) = self.trace_lists(scene, ctx, true)?;
+        let ([mut global, caustic, indirect], mut volume, beams) =
+            self.trace_lists(scene, ctx, true)?;
+        if self.estimate == VolumeEstimate::Beams {
+            // A beam is drawn at its start.
+            volume = beams.iter().map(|b| b.as_photon()).collect();
+        }
         global.extend(indirect);
         Ok(vec![
             foton_photonmap::view(
@@ -524,10 +590,26 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let step = positive("step", diagonal / 100.0)?;
     let kernel = props.kernel("kernel", "box")?;
     let direct = Direct::read(props)?;
-    let estimate = match props.choice("estimate", &["march", "beam"], "march")? {
+    let estimate = match props.choice("estimate", &["march", "beam", "beams"], "march")? {
         "beam" => VolumeEstimate::Beam,
+        "beams" => VolumeEstimate::Beams,
         _ => VolumeEstimate::March,
     };
+    let beams = estimate == VolumeEstimate::Beams;
+    let beam_type = if beams {
+        read_beam_type(props)?
+    } else {
+        BeamKind::Short
+    };
+    let beam_radius = if beams {
+        positive(
+            "beam_radius",
+            default_beam_radius(diagonal, volume_photons.max(1)),
+        )?
+    } else {
+        0.0
+    };
+    let kernel_1d = Kernel1d::norm(&kernel);
     Ok(Box::new(Vpm {
         global_photons,
         caustic_photons,
@@ -540,6 +622,9 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         kernel,
         direct,
         estimate,
+        beam_type,
+        beam_radius,
+        kernel_1d,
         max_depth: scene.render.max_depth,
         camera: CameraWalk::read(props, scene)?,
     }))

@@ -1,0 +1,459 @@
+//! Photon beams and the beam x beam estimate (Jarosz, Nowrouzezahrai, Sadeghi and Jensen, "A
+//! comprehensive theory of volumetric radiance estimation using photon points and beams",
+//! TOG 2011, the "beam x beam 1D" estimate).
+//!
+//! **Beams.** A photon's flight through a medium is a beam: its start x_b, direction w_b,
+//! length, the flux Phi_b it carries at the start, its medium. *Long* beams run to the next
+//! surface (or out of the scene); the flux along them falls as the transmittance Tr_b(t). *Short*
+//! beams end at the photon's next scattering event (the free-flight sample), so they carry the
+//! flux unattenuated: the event "the flight passes t" has probability Tr_b(t) (with spectral MIS
+//! over the colour channels, the path's channel pdfs times Tr), which replaces the
+//! transmittance. Either way the photon walks on as before; only what is recorded differs.
+//!
+//! **The estimate.** A photon beam of flux Phi along a line is a fluence concentrated on the
+//! line: phi(x) = Phi Tr_b(t) delta_2(x_perp), delta_2 over the plane perpendicular to the
+//! beam. The radiance a camera ray (the *query beam*, direction w, medium with sigma_s and
+//! phase p) gathers is integral Tr_c(t_c) sigma_s p(w_b, -w) phi(x(t_c)) dt_c. Along the camera
+//! ray the perpendicular offset from the beam has one fixed coordinate, the distance u between
+//! the two lines (along their common perpendicular), and one that moves at speed sin(theta),
+//! theta the angle between the lines; so the integral of delta_2 along the ray is
+//! delta(u) / sin(theta). Blurring delta(u) by a 1-D kernel K1 of radius r gives the beam x
+//! beam estimate:
+//!
+//! ```text
+//! L_m(x, w) ~= sum_b Phi_b W_b(t_b) sigma_s(x_c) p(w_b . -w) Tr_c(t_c) K1(u_b, r) / sin(theta_b)
+//! ```
+//!
+//! with t_c, t_b the parameters of the closest approach on the camera ray and on the beam
+//! (both within their segments), W_b = Tr_b(t_b) (long beams) or Tr_b(t_b) / mean_c(r_c
+//! Tr_b,c(t_b)) (short beams; 1 in a grey medium), r_c the photon path's hero-channel pdf
+//! ratios. K1 is the kernel profile normalised in 1-D: integral_{-r}^{r} K1(u, r) du = 1 (box:
+//! 1 / (2 r)). Integrating the estimate over the camera rays of a pencil crossing the beam
+//! gives back Phi Tr_b per unit length of beam whatever the angle, which the tests check.
+//!
+//! **The map.** Beams are cut into pieces of 16 widths (a long diagonal beam's
+//! box would be mostly empty), and the pieces' boxes, grown by r, go into a BVH (obvhs'
+//! compressed wide BVH, as core's scene BVH). A camera segment traverses it like a ray and
+//! visits every piece whose box it crosses; a piece counts the crossing only if the closest
+//! point on the beam lies within the piece, so a beam is counted once.
+
+use crate::map::Photon;
+use foton_core::error::Result;
+use foton_core::geometry::Ray;
+use foton_core::kernel::NormalizedKernel;
+use foton_core::medium::Medium;
+use foton_core::props::Properties;
+use foton_core::scene::Scene;
+use foton_core::{Rgb, Vec3};
+use obvhs::BvhBuildParams;
+use obvhs::aabb::Aabb;
+use obvhs::cwbvh::CwBvh;
+use obvhs::cwbvh::builder::build_cwbvh;
+use obvhs::ray::Ray as BvhRay;
+
+/// Which flight segments a photon records (module comment).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BeamKind {
+    /// From the segment's start to the photon's next scattering event (or the surface).
+    Short,
+    /// From the segment's start to the next surface, with the transmittance along it.
+    Long,
+}
+
+impl BeamKind {
+    pub fn name(self) -> &'static str {
+        match self {
+            BeamKind::Short => "short",
+            BeamKind::Long => "long",
+        }
+    }
+}
+
+/// One photon's flight through a medium.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Beam {
+    pub origin: Vec3,
+    /// Unit direction the photon travels.
+    pub dir: Vec3,
+    pub length: f32,
+    /// Flux at the start (W).
+    pub flux: Rgb,
+    /// Short beams: the photon path's per-channel pdf ratios before this flight (spectral MIS;
+    /// [`foton_core::medium::HeroChannel::r`]).
+    pub hero_r: Rgb,
+    pub medium: u32,
+    /// Scattering events of a light path that scatters once on this beam (the photon's events
+    /// before it plus that one).
+    pub depth: u32,
+    pub kind: BeamKind,
+}
+
+impl Beam {
+    /// W_b(t): the fraction of the start flux the beam stands for at distance t (module
+    /// comment), in medium `m`.
+    #[inline]
+    pub fn weight(&self, m: &dyn Medium, t: f32) -> Rgb {
+        let tr = m.transmittance(&Ray::new(self.origin, self.dir), t);
+        match self.kind {
+            BeamKind::Long => tr,
+            BeamKind::Short => {
+                let p = foton_core::average(self.hero_r * tr);
+                if p > 0.0 { tr / p } else { Rgb::ZERO }
+            }
+        }
+    }
+
+    /// A volume photon at the beam's start, for the tools (`foton photons`).
+    pub fn as_photon(&self) -> Photon {
+        Photon::new(self.origin, self.flux, -self.dir, Vec3::ZERO).with_depth(self.depth)
+    }
+}
+
+/// Where two lines pass closest: the query ray o_c + t_c w_c and the beam o_b + t_b w_b.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Crossing {
+    pub t_c: f32,
+    pub t_b: f32,
+    /// Distance between the lines.
+    pub u: f32,
+    /// sin of the angle between them.
+    pub sin: f32,
+}
+
+/// Below this sine the lines are taken as parallel: the 1-D kernel across them is undefined
+/// (the estimate's 1 / sin(theta) is integrable over directions, but a parallel pair has no
+/// closest point).
+pub const MIN_SIN: f32 = 1e-4;
+
+/// The closest approach of two lines with unit directions (None if nearly parallel).
+#[inline]
+pub fn closest_approach(o_c: Vec3, w_c: Vec3, o_b: Vec3, w_b: Vec3) -> Option<Crossing> {
+    let n = w_c.cross(w_b);
+    let sin2 = n.length_squared();
+    if sin2 < MIN_SIN * MIN_SIN {
+        return None;
+    }
+    let d = o_b - o_c;
+    // Solve o_c + t_c w_c + s n = o_b + t_b w_b by Cramer's rule with n = w_c x w_b.
+    let t_c = d.cross(w_b).dot(n) / sin2;
+    let t_b = d.cross(w_c).dot(n) / sin2;
+    Some(Crossing {
+        t_c,
+        t_b,
+        u: d.dot(n).abs() / sin2.sqrt(),
+        sin: sin2.sqrt(),
+    })
+}
+
+/// A kernel normalised in one dimension, from a kernel normalised in two (core's
+/// [`NormalizedKernel`], so kernel plugins are checked as everywhere): K1(u, r) =
+/// w(|u| / r) / (r integral_{-1}^{1} w(|t|) dt).
+pub struct Kernel1d<'a> {
+    kernel: &'a NormalizedKernel,
+    /// 1 / integral_{-1}^{1} of the 2-D weight at radius 1.
+    inv_norm: f32,
+}
+
+impl<'a> Kernel1d<'a> {
+    /// The kernel with its 1-D normalisation ([`Kernel1d::norm`]: compute it once).
+    pub fn new(kernel: &'a NormalizedKernel) -> Self {
+        Kernel1d {
+            kernel,
+            inv_norm: Self::norm(kernel),
+        }
+    }
+
+    /// The kernel with a normalisation [`Kernel1d::norm`] computed before.
+    pub fn with_norm(kernel: &'a NormalizedKernel, inv_norm: f32) -> Self {
+        Kernel1d { kernel, inv_norm }
+    }
+
+    /// 1 / integral_{-1}^{1} of the kernel's 2-D weight at radius 1.
+    pub fn norm(kernel: &NormalizedKernel) -> f32 {
+        // Simpson's rule on [0, 1] (the profile is smooth or a step at 1).
+        const N: usize = 4096;
+        let h = 1.0 / N as f64;
+        let w = |i: usize| kernel.weight_2d((i as f64 * h) as f32, 1.0) as f64;
+        let mut s = w(0) + w(N);
+        for i in 1..N {
+            s += w(i) * if i % 2 == 1 { 4.0 } else { 2.0 };
+        }
+        let integral = 2.0 * s * h / 3.0;
+        if integral > 0.0 {
+            (1.0 / integral) as f32
+        } else {
+            0.0
+        }
+    }
+
+    /// K1(u, r): the weight of a beam at distance u across the query, per unit length.
+    #[inline]
+    pub fn weight(&self, u: f32, r: f32) -> f32 {
+        if u > r {
+            return 0.0;
+        }
+        self.kernel.weight_2d(u / r, 1.0) * self.inv_norm / r
+    }
+}
+
+/// Beams are cut into pieces this many widths long. Shorter pieces have tighter boxes (a
+/// camera ray visits fewer pieces it does not cross), longer ones make a smaller BVH with
+/// fewer nodes to visit; measured on the foggy Cornell box (ppb, 128 x 128, two passes):
+/// 1, 2, 4, 8, 16, 32 widths and unsplit beams took 18.8, 9.9, 9.0, 5.5, 3.3, 3.6 and 8.9 s.
+pub const PIECE_WIDTHS: f32 = 16.0;
+
+/// A piece of a beam, as the BVH holds it.
+#[derive(Clone, Copy, Debug)]
+struct Piece {
+    beam: u32,
+    t0: f32,
+    t1: f32,
+}
+
+/// The photon beams of one pass, with a common width r, in a BVH.
+pub struct BeamMap {
+    beams: Vec<Beam>,
+    /// In BVH leaf order, so a traversal's id indexes them.
+    pieces: Vec<Piece>,
+    bvh: Option<CwBvh>,
+    radius: f32,
+}
+
+impl BeamMap {
+    /// Builds the map of `beams` with width (kernel radius) `radius`, cutting beams into
+    /// pieces of at most [`PIECE_WIDTHS`] x `radius`.
+    pub fn build(beams: Vec<Beam>, radius: f32) -> BeamMap {
+        let piece = PIECE_WIDTHS * radius;
+        let mut pieces = Vec::with_capacity(beams.len());
+        let mut boxes = Vec::with_capacity(beams.len());
+        for (i, b) in beams.iter().enumerate() {
+            if !(b.length > 0.0 && b.length.is_finite()) {
+                continue;
+            }
+            let n = (b.length / piece).ceil().clamp(1.0, 1e6) as u32;
+            let step = b.length / n as f32;
+            for k in 0..n {
+                let t0 = k as f32 * step;
+                let t1 = if k + 1 == n { b.length } else { t0 + step };
+                let (p0, p1) = (b.origin + b.dir * t0, b.origin + b.dir * t1);
+                let grow = Vec3::splat(radius);
+                boxes.push(Aabb::new(
+                    (p0.min(p1) - grow).into(),
+                    (p0.max(p1) + grow).into(),
+                ));
+                pieces.push(Piece {
+                    beam: i as u32,
+                    t0,
+                    t1,
+                });
+            }
+        }
+        let bvh = (!boxes.is_empty()).then(|| {
+            build_cwbvh(
+                &boxes,
+                BvhBuildParams::fast_build(),
+                &mut std::time::Duration::default(),
+            )
+        });
+        if let Some(bvh) = &bvh {
+            pieces = bvh
+                .primitive_indices
+                .iter()
+                .map(|&i| pieces[i as usize])
+                .collect();
+        }
+        BeamMap {
+            beams,
+            pieces,
+            bvh,
+            radius,
+        }
+    }
+
+    pub fn len(&self) -> usize {
+        self.beams.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.beams.is_empty()
+    }
+
+    pub fn beams(&self) -> &[Beam] {
+        &self.beams
+    }
+
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// Calls `visit(beam, crossing)` for every beam of medium `medium` that passes within the
+    /// width of the query segment `ray` (unit direction) from 0 to `t_end`, its closest
+    /// point within the beam and the segment.
+    pub fn along_ray(
+        &self,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        mut visit: impl FnMut(&Beam, &Crossing),
+    ) {
+        let Some(bvh) = &self.bvh else {
+            return;
+        };
+        // obvhs 0.4 takes the ray's octant from `d < 0.0` (false for -0.0) but the inverse
+        // direction from the sign (-1 / epsilon for -0.0): a component -0.0 (the direction -z
+        // written as -Vec3::Z) makes them disagree and the traversal misses every box.
+        // Adding +0.0 turns -0.0 into +0.0.
+        let dir = ray.dir + Vec3::ZERO;
+        let bray = BvhRay::new(ray.origin.into(), dir.into(), 0.0, t_end);
+        let r = self.radius;
+        bvh.ray_traverse_anyhit(bray, |_, id| {
+            let piece = self.pieces[id];
+            let beam = &self.beams[piece.beam as usize];
+            if beam.medium != medium {
+                return;
+            }
+            let Some(c) = closest_approach(ray.origin, ray.dir, beam.origin, beam.dir) else {
+                return;
+            };
+            if c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end {
+                visit(beam, &c);
+            }
+        });
+    }
+
+    /// The beam x beam estimate of the in-scattering integral along `ray` from 0 to `t_end`
+    /// in medium `medium` (`m`), from beams of at most `depth` scattering events (module
+    /// comment). Not weighted by the throughput before `ray`.
+    pub fn in_scattered(
+        &self,
+        scene: &Scene,
+        kernel: &Kernel1d<'_>,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        depth: u32,
+    ) -> Rgb {
+        let m = scene.medium(medium);
+        let phase = m.phase();
+        let r = self.radius;
+        let mut sum = Rgb::ZERO;
+        self.along_ray(ray, t_end, medium, |beam, c| {
+            if beam.depth > depth {
+                return;
+            }
+            let x = ray.at(c.t_c);
+            let k = kernel.weight(c.u, r) / c.sin;
+            let f = phase.eval(beam.dir.dot(-ray.dir));
+            sum += beam.flux
+                * beam.weight(m, c.t_b)
+                * m.sigma_s(x)
+                * m.transmittance(ray, c.t_c)
+                * (f * k);
+        });
+        sum
+    }
+}
+
+/// The parameter `beam_type` (`short` or `long`, default short: see the integrators' docs).
+pub fn read_beam_type(props: &Properties<'_>) -> Result<BeamKind> {
+    Ok(
+        match props.choice("beam_type", &["short", "long"], "short")? {
+            "long" => BeamKind::Long,
+            _ => BeamKind::Short,
+        },
+    )
+}
+
+/// The default beam width for `photons` photons emitted in a scene of bounding-box diagonal
+/// `diagonal`. The 1-D estimate's variance falls as 1 / (photons r) and its bias grows as r^2,
+/// so the mean squared error is least for r proportional to photons^(-1/5); the constant puts
+/// r at 1/400 of the diagonal for 200000 photons (measured on the fog scenes: docs).
+pub fn default_beam_radius(diagonal: f32, photons: u64) -> f32 {
+    const C: f64 = 0.0025 * 11.486_983_549_970_35; // 200000^(1/5) = 11.487
+    (C * diagonal as f64 * (photons.max(1) as f64).powf(-0.2)) as f32
+}
+
+/// Distance along `ray` to where it leaves the box (0 if it misses it).
+pub fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
+    let inv = ray.dir.recip();
+    let t0 = (lo - ray.origin) * inv;
+    let t1 = (hi - ray.origin) * inv;
+    let far = t0.max(t1).min_element();
+    let near = t0.min(t1).max_element();
+    if far < near.max(0.0) { 0.0 } else { far }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use foton_core::kernel::{BoxKernel, ConeKernel};
+
+    #[test]
+    fn closest_approach_of_crossing_lines() {
+        // The x axis and a line along z through (2, 3, 0) at height... u = 3.
+        let c = closest_approach(
+            Vec3::new(2.0, 3.0, -5.0),
+            Vec3::Z,
+            Vec3::new(-1.0, 0.0, 0.0),
+            Vec3::X,
+        )
+        .unwrap();
+        assert!((c.t_c - 5.0).abs() < 1e-5, "{c:?}");
+        assert!((c.t_b - 3.0).abs() < 1e-5, "{c:?}");
+        assert!(
+            (c.u - 3.0).abs() < 1e-5 && (c.sin - 1.0).abs() < 1e-6,
+            "{c:?}"
+        );
+        assert!(closest_approach(Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::X).is_none());
+    }
+
+    #[test]
+    fn rays_with_negative_zero_components_find_beams() {
+        let beam = Beam {
+            origin: Vec3::new(-1.0, 0.0, 0.0),
+            dir: Vec3::X,
+            length: 2.0,
+            flux: Rgb::ONE,
+            hero_r: Rgb::ONE,
+            medium: 0,
+            depth: 1,
+            kind: BeamKind::Long,
+        };
+        let map = BeamMap::build(vec![beam], 0.1);
+        // -Vec3::Z is (-0.0, -0.0, -1.0).
+        for dir in [
+            -Vec3::Z,
+            Vec3::new(0.0, 0.0, -1.0),
+            Vec3::new(-0.0, 0.0, -1.0),
+        ] {
+            let mut found = 0;
+            let ray = Ray::new(Vec3::new(0.2, 0.05, 1.0), dir);
+            map.along_ray(&ray, 3.0, 0, |_, c| {
+                found += 1;
+                assert!((c.t_c - 1.0).abs() < 1e-5 && (c.t_b - 1.2).abs() < 1e-5);
+            });
+            assert_eq!(found, 1, "{dir:?}");
+        }
+    }
+
+    #[test]
+    fn kernel_1d_integrates_to_one() {
+        for k in [
+            NormalizedKernel::new(Box::new(BoxKernel)).unwrap(),
+            NormalizedKernel::new(Box::new(ConeKernel { c: 1.0 })).unwrap(),
+        ] {
+            let k1 = Kernel1d::new(&k);
+            let r = 0.3;
+            let n = 20000;
+            let sum: f64 = (0..n)
+                .map(|i| {
+                    let u = -r + 2.0 * r * (i as f32 + 0.5) / n as f32;
+                    k1.weight(u.abs(), r) as f64 * 2.0 * r as f64 / n as f64
+                })
+                .sum();
+            assert!((sum - 1.0).abs() < 1e-3, "{}: {sum}", k.name());
+        }
+        let b = NormalizedKernel::new(Box::new(BoxKernel)).unwrap();
+        assert!((Kernel1d::new(&b).weight(0.1, 0.5) - 1.0).abs() < 1e-4);
+    }
+}

@@ -1,0 +1,513 @@
+//! # `ppb`: progressive photon beams (Jarosz, Nowrouzezahrai, Thomas, Sloan and Zwicker 2011)
+//!
+//! This table is the one list of the parameters (`[integrators.ppb]`); the README, the
+//! scene-format page and docs/photon-mapping.md point here. "diagonal" is the scene's
+//! bounding-box diagonal.
+//!
+//! | parameter               | type    | meaning                                                   | default |
+//! |-------------------------|---------|-----------------------------------------------------------|---------|
+//! | `iterations`            | integer | passes (photon beams + one camera sample per pixel) to run, >= 1 | 32 (unlimited with `time`) |
+//! | `time`                  | float   | run until this many seconds have passed, > 0              | none    |
+//! | `photons_per_iteration` | integer | photons emitted in each pass, >= 1                        | 5000    |
+//! | `initial_beam_radius`   | float   | the photon beams' width r_1 in the first pass (world units), > 0 | 0.0287 x diagonal x photons_per_iteration^(-1/5) |
+//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic (`sppm`'s: 3 pixel footprints, within [1/1000, 1/50] of the diagonal) |
+//! | `alpha`                 | float   | the radius schedule's exponent, in (0, 1)                 | 0.7     |
+//! | `beam_type`             | string  | `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
+//! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 1-D across beams, in 2-D on surfaces) | `box` |
+//! | `cone_c`                | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1     |
+//! | `direct`                | string  | direct light at surfaces: `nee` (shadow rays) or `photons` | `nee`  |
+//! | `glossy_roughness`      | float   | glossy lobes smoother than this (microfacet alpha) are followed by the camera pass, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
+//!
+//! `[render] max_depth` bounds the scattering events of whole light paths; `[render] spp` is
+//! not used (each pass takes one new camera sample per pixel). With `time`, `iterations` (if
+//! given) is an upper bound. For `foton compare --time` the work is counted in iterations
+//! (`integrators.ppb.iterations`); `foton photons` draws one pass's surface photons
+//! (`iteration`) and the starts of its beams (`beams`).
+//!
+//! **A pass** (iteration i = 1, 2, ...) traces `photons_per_iteration` photons from their own
+//! random streams (foton-photonmap's photon pass). Their flights through media are recorded
+//! as photon beams (foton-photonmap's `beams`: `beam_type`), every one of them, first flights
+//! from the lights included: in a medium, beams count all scattered light, single scattering
+//! too. At diffuse surfaces the photons are stored as in `sppm` (all but L D with `direct =
+//! "nee"`). Then each pixel takes one camera path (core's `walk_to_diffuse`, through null
+//! boundaries, media and delta surfaces): along each medium segment the beam x beam estimate
+//!
+//! ```text
+//! sum_b Phi_b W_b(t_b) sigma_s(x_c) p(w_b . -w) Tr(x, x_c) K1(u_b, r_i) / sin(theta_b)
+//! ```
+//!
+//! (foton-photonmap's `beams` module derives it), at the visible point emission, direct light
+//! by a shadow ray (`direct = "nee"`) and the photons of the disc of radius R_i around it
+//! (`sppm`'s gather, shared in foton-photonmap's `progressive`), each weighted by the
+//! throughput before it. The pixel's value is the mean of its passes' estimates.
+//!
+//! **Radii** (Knaus and Zwicker 2011's probabilistic analysis, which Jarosz et al. 2011 apply
+//! to beams): pass i uses
+//!
+//! ```text
+//! r_i = r_1 prod_{j=1}^{i-1} (j + alpha) / (j + 1)        (beams: a 1-D kernel)
+//! R_i^2 = R_1^2 prod_{j=1}^{i-1} (j + alpha) / (j + 1)    (surfaces: a 2-D kernel)
+//! ```
+//!
+//! The 1-D estimate's variance grows as 1 / r and its bias as r^2, so the beam width itself
+//! (not its square) shrinks by the factor: the variance of pass i grows like i^(1 - alpha),
+//! slowly enough that the mean over n passes has variance ~ n^(-alpha), while its bias falls
+//! like n^(2 (alpha - 1)). **Why alpha = 0.7**: balancing the two gives the best asymptotic
+//! rate at alpha = 4/5 for beams and 2/3 for surfaces (squared error ~ n^(-4/5) and n^(-2/3));
+//! one alpha serves both here, and 0.7 lies between them (`sppm`'s default too), losing
+//! little on either. R_1 is the automatic radius of the pass's own visible point (or
+//! `initial_radius`), so passes are independent: any subset can be rendered apart and
+//! averaged (`foton render --part`, `foton merge`), and the sums are exact, so the parts
+//! merge into the whole render bit for bit.
+//!
+//! **Why 5000 photons a pass.** A camera ray's cost grows with the beams' total length times
+//! their width, and the width starts at the 1-D optimum for the pass's photons, so the cost of
+//! a pass is nearly proportional to its photons while its noise falls as 1 / photons^(4/5):
+//! many small passes shrink the width sooner and give more camera samples for the same
+//! time. On the foggy Cornell box at 64 x 64 (against `path` at 4096 spp): 32 passes of
+//! 20000 photons took 24.6 s (worst 16 x 16 block 2.6 % off), of 5000 5.6 s (3.7 %), 64 of
+//! 2000 4.1 s (2.6 %); below a few thousand photons the per-pass camera work dominates.
+//!
+//! **Each light path once**: in media by the beams (a light path scattering at x_c on the
+//! camera ray is the photon's path up to its beam plus that event), at surfaces L D by shadow
+//! rays (or photons) and everything else by the surface photons, which include those that
+//! scattered in media on the way. Camera rays leaving the scene in a medium are followed to
+//! the box around the scene (beams end there too).
+//!
+//! **Determinism**: photons and camera samples draw from streams keyed by the pass, the
+//! photon and the pixel; the beam BVH and the kd-tree are built in a fixed order; images are
+//! identical for any number of threads and any split into parts. Memory holds one pass's
+//! photons and beams at a time.
+
+use foton_core::direct::Direct;
+use foton_core::direct::{Mis, Scatter, estimate_direct};
+use foton_core::film::{Film, RadianceSum};
+use foton_core::integrator::{
+    Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
+};
+use foton_core::kernel::NormalizedKernel;
+use foton_core::props::Properties;
+use foton_core::render::{usable, warn_unusable, with_pool};
+use foton_core::sampling::{Sampler, splitmix64};
+use foton_core::scene::Scene;
+use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
+use foton_core::{Error, Result, Rgb, Vec3};
+use foton_photonmap::beams::{
+    Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
+};
+use foton_photonmap::map::{Photon, PhotonMap};
+use foton_photonmap::progressive::{auto_radius, gather_disc, global_radius2_scale, pixel_angle};
+use foton_photonmap::trace::{
+    PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons_and_beams,
+};
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+pub struct Ppb {
+    /// None: until `time` runs out.
+    pub iterations: Option<u64>,
+    pub time: Option<f64>,
+    pub photons_per_iteration: u64,
+    pub initial_beam_radius: f32,
+    pub initial_radius: Option<f32>,
+    pub alpha: f64,
+    pub beam_type: BeamKind,
+    pub kernel: NormalizedKernel,
+    /// The kernel's 1-D normalisation (`Kernel1d::norm`).
+    pub kernel_1d: f32,
+    pub direct: Direct,
+    pub max_depth: u32,
+    /// How camera paths treat glossy surfaces.
+    pub camera: CameraWalk,
+}
+
+/// Random stream of the camera passes.
+const STREAM_CAMERA: u64 = 0x7070_6263;
+
+/// One pass's photons: the surface map and the beams with this pass's width.
+struct Pass {
+    surface: PhotonMap,
+    beams: BeamMap,
+    /// R_i / R_1 for the surface gather.
+    surface_shrink: f64,
+}
+
+impl Ppb {
+    /// The photons pass `iteration` (0-based) stores at surfaces, and its beams.
+    fn trace(
+        &self,
+        scene: &Scene,
+        iteration: u64,
+        ctx: &RenderContext<'_>,
+    ) -> Result<(Vec<Photon>, Vec<Beam>)> {
+        let options = TraceOptions {
+            photons: self.photons_per_iteration,
+            max_depth: self.max_depth,
+            seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
+            stream: STREAM_GLOBAL,
+            stop_at_diffuse: false,
+            sobol_emission: TraceOptions::emission_for(scene.render.sampler),
+        };
+        let keep_direct = self.direct == Direct::Photons;
+        let (mut lists, beams) = trace_photons_and_beams(
+            scene,
+            &options,
+            ctx,
+            1,
+            |site, class| {
+                (site == Site::Surface && (class != PathClass::Direct || keep_direct)).then_some(0)
+            },
+            scene.has_media().then_some(self.beam_type),
+            |_| true,
+        )?;
+        Ok((lists.pop().unwrap_or_default(), beams))
+    }
+
+    fn pass(&self, scene: &Scene, iteration: u64, ctx: &RenderContext<'_>) -> Result<Pass> {
+        let (photons, beams) = self.trace(scene, iteration, ctx)?;
+        let scale = global_radius2_scale(iteration + 1, self.alpha);
+        let r = (self.initial_beam_radius as f64 * scale) as f32;
+        Ok(Pass {
+            surface: PhotonMap::build(photons),
+            beams: BeamMap::build(beams, r),
+            surface_shrink: scale.sqrt(),
+        })
+    }
+
+    /// Pass `iteration`'s estimate of the radiance through pixel `pixel` at (x, y).
+    #[allow(clippy::too_many_arguments)]
+    fn estimate(
+        &self,
+        scene: &Scene,
+        pass: &Pass,
+        iteration: u64,
+        (x, y): (u32, u32),
+        angle: f32,
+        rays: &mut u64,
+        bad_photons: &mut u64,
+    ) -> Rgb {
+        let seed = scene.render.seed;
+        let pixel = y as u64 * scene.film.width as u64 + x as u64;
+        let mut sampler = Sampler::with_keys(
+            scene.render.sampler,
+            &[seed, STREAM_CAMERA, pixel, iteration],
+            seed,
+            pixel,
+            iteration as u32,
+            self.iterations.unwrap_or(1) as u32,
+        );
+        let film = scene.film.filter.film_position(x, y, sampler.next_2d());
+        let ray = scene.camera.generate_ray(film);
+        let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
+        let grow = Vec3::splat(pass.beams.radius());
+        let bounds = (scene.bounds.0 - grow, scene.bounds.1 + grow);
+        let path = walk_to_diffuse(
+            scene,
+            ray,
+            self.camera,
+            &mut sampler,
+            rays,
+            |seg: &Segment, _m, bounces: u32, _: &mut Sampler, _: &mut u64| {
+                // The scattering event on the camera ray is one of the light path's.
+                let Some(medium) = seg.medium.filter(|_| bounces < self.max_depth) else {
+                    return Rgb::ZERO;
+                };
+                let start = seg.start();
+                let t_end = if seg.hit.is_some() {
+                    seg.length()
+                } else {
+                    exit_distance(&start, bounds)
+                };
+                if t_end.is_nan() || t_end <= 0.0 {
+                    return Rgb::ZERO;
+                }
+                let depth = self.max_depth - bounces;
+                pass.beams
+                    .in_scattered(scene, &kernel, &start, t_end, medium, depth)
+            },
+        );
+        let mut l = path.emitted;
+        if let Some(vp) = &path.visible {
+            let mut lv = Rgb::ZERO;
+            if self.direct == Direct::ShadowRays {
+                let at = Scatter::Surface {
+                    hit: &vp.hit,
+                    bsdf: &vp.bsdf,
+                };
+                lv += estimate_direct(
+                    scene,
+                    at,
+                    vp.wo,
+                    vp.medium,
+                    Mis::LightOnly,
+                    &mut sampler,
+                    rays,
+                );
+            }
+            let r1 = match self.initial_radius {
+                Some(r) => r as f64,
+                None => auto_radius(scene, angle, vp.distance),
+            };
+            let r = (r1 * pass.surface_shrink) as f32;
+            let g = gather_disc(
+                &pass.surface,
+                vp,
+                r,
+                self.max_depth - vp.bounces,
+                &self.kernel,
+            );
+            *bad_photons += g.bad;
+            let disc = std::f64::consts::PI * (r as f64) * (r as f64);
+            lv += (g.phi / disc).as_vec3();
+            l += vp.beta * lv;
+        }
+        l
+    }
+}
+
+/// The image after `iterations` passes: each pixel's exact sum of its passes' estimates, one
+/// sample per pass.
+fn film_of(sums: &[RadianceSum], width: u32, height: u32, iterations: u64) -> Film {
+    let mut film = Film::new(width, height);
+    let count = iterations.min(u32::MAX as u64) as u32;
+    for (i, sum) in sums.iter().enumerate().take((width * height) as usize) {
+        film.add_pixel(i, sum, count);
+    }
+    film
+}
+
+impl Integrator for Ppb {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        let (width, height) = (scene.film.width, scene.film.height);
+        // The passes to run: all of them, or this part's share (passes are independent).
+        let (first, last) = if ctx.part.is_whole() {
+            (0, self.iterations)
+        } else {
+            let Some(n) = self.iterations.filter(|_| self.time.is_none()) else {
+                return Err(Error::Render(format!(
+                    "part {}: ppb splits into parts only with a number of iterations (no time)",
+                    ctx.part
+                )));
+            };
+            let share = ctx.part.share(n);
+            (share.start, Some(share.end))
+        };
+        let mut sums = vec![RadianceSum::default(); width as usize * height as usize];
+        let angle = pixel_angle(scene);
+        let start = Instant::now();
+        let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
+        match (last, self.time) {
+            (Some(n), None) => ctx.progress.begin("iterations", n - first),
+            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
+            (None, None) => unreachable!("create() sets one"),
+        }
+        let mut done = first;
+        let mut photons_total = 0u64;
+        let rays = AtomicU64::new(0);
+        let mut seconds_reported = 0u64;
+        // Estimates and photon contributions that were not finite and non-negative, replaced
+        // by zero (one would stay in a pixel's sum for the rest of the render).
+        let (bad_samples, bad_photons) = (AtomicU64::new(0), AtomicU64::new(0));
+        loop {
+            if last.is_some_and(|n| done >= n)
+                || self
+                    .time
+                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+                || ctx.cancelled()
+            {
+                break;
+            }
+            let pass = self.pass(scene, done, &quiet)?;
+            if ctx.cancelled() {
+                // A pass with part of its photons would be biased: drop it.
+                break;
+            }
+            let iteration = done;
+            with_pool(ctx.threads, || {
+                sums.par_chunks_mut(width as usize)
+                    .enumerate()
+                    .for_each(|(y, row)| {
+                        let (mut row_rays, mut row_bad) = (0u64, 0u64);
+                        for (x, sum) in row.iter_mut().enumerate() {
+                            let l = self.estimate(
+                                scene,
+                                &pass,
+                                iteration,
+                                (x as u32, y as u32),
+                                angle,
+                                &mut row_rays,
+                                &mut row_bad,
+                            );
+                            if usable(l) {
+                                sum.add(l);
+                            } else {
+                                bad_samples.fetch_add(1, Ordering::Relaxed);
+                            }
+                        }
+                        rays.fetch_add(row_rays, Ordering::Relaxed);
+                        bad_photons.fetch_add(row_bad, Ordering::Relaxed);
+                    })
+            })?;
+            done += 1;
+            photons_total += self.photons_per_iteration;
+            ctx.progress.status(&format!(
+                "iteration {done}, {photons_total} photons, {} beams of width {:.5}",
+                pass.beams.len(),
+                pass.beams.radius()
+            ));
+            match self.time {
+                None => ctx.progress.advance(1),
+                Some(_) => {
+                    let s = start.elapsed().as_secs();
+                    ctx.progress.advance(s - seconds_reported);
+                    seconds_reported = s;
+                }
+            }
+            let kept = done - first;
+            ctx.progress
+                .checkpoint(kept, &|| film_of(&sums, width, height, kept));
+        }
+        ctx.progress.finish();
+        self.kernel.check_weights()?;
+        let bad = bad_samples.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "pass estimate(s)", "replaced by zero");
+        let bad = bad_photons.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "photon contribution(s)", "left out");
+        let mut film = film_of(&sums, width, height, done - first);
+        film.part = ctx.part;
+        film.rays = rays.load(Ordering::Relaxed);
+        film.iterations = done - first;
+        film.iterations_planned = last.map_or(0, |n| n - first);
+        film.photons = photons_total;
+        Ok(film)
+    }
+
+    fn name(&self) -> &str {
+        "ppb"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        let mut p = Vec::new();
+        if let Some(n) = self.iterations {
+            p.push(Parameter::int("iterations", n));
+        }
+        if let Some(t) = self.time {
+            p.push(Parameter::float("time", t));
+        }
+        p.push(Parameter::int(
+            "photons_per_iteration",
+            self.photons_per_iteration,
+        ));
+        p.push(Parameter::float(
+            "initial_beam_radius",
+            self.initial_beam_radius,
+        ));
+        p.push(match self.initial_radius {
+            Some(r) => Parameter::float("initial_radius", r),
+            None => Parameter::str("initial_radius", "auto"),
+        });
+        p.push(Parameter::float("alpha", self.alpha as f32));
+        p.push(Parameter::str("beam_type", self.beam_type.name()));
+        p.extend(self.kernel.parameters());
+        p.push(Parameter::str("direct", self.direct.name()));
+        p.push(Parameter::float(
+            "glossy_roughness",
+            self.camera.glossy_roughness,
+        ));
+        p
+    }
+
+    fn budget(&self) -> Budget {
+        Budget {
+            work: Work::Iterations {
+                key: "integrators.ppb.iterations".into(),
+            },
+            scaled: Vec::new(),
+        }
+    }
+
+    /// `iteration`: the surface photons of the first pass; `beams`: the starts of its beams.
+    fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
+        let (photons, beams) = self.trace(scene, 0, ctx)?;
+        let starts: Vec<Photon> = beams.iter().map(|b| b.as_photon()).collect();
+        Ok(vec![
+            foton_photonmap::view(
+                "iteration",
+                "one pass's surface photons (but L D with direct = \"nee\")",
+                self.photons_per_iteration,
+                &photons,
+            ),
+            foton_photonmap::view(
+                "beams",
+                "the starts of one pass's photon beams",
+                self.photons_per_iteration,
+                &starts,
+            ),
+        ])
+    }
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
+    let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
+    let time = props.f32_opt("time")?;
+    if let Some(t) = time
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(props.error(
+            "time",
+            format!("must be a positive number of seconds, found {t}"),
+        ));
+    }
+    let iterations = if props.has("iterations") || time.is_none() {
+        let n = props.u64("iterations", 32)?;
+        if n == 0 {
+            return Err(props.error("iterations", "must be at least 1"));
+        }
+        Some(n)
+    } else {
+        None
+    };
+    let photons_per_iteration = props.u64("photons_per_iteration", 5_000)?;
+    if photons_per_iteration == 0 {
+        return Err(props.error("photons_per_iteration", "must be at least 1"));
+    }
+    let positive_opt = |key: &str| -> Result<Option<f32>> {
+        let r = props.f32_opt(key)?;
+        if let Some(r) = r
+            && !(r > 0.0 && r.is_finite())
+        {
+            return Err(props.error(key, format!("must be positive, found {r}")));
+        }
+        Ok(r)
+    };
+    let initial_beam_radius = positive_opt("initial_beam_radius")?
+        .unwrap_or_else(|| default_beam_radius(diagonal, photons_per_iteration));
+    let initial_radius = positive_opt("initial_radius")?;
+    let alpha = props.f32("alpha", 0.7)?;
+    if !(alpha > 0.0 && alpha < 1.0) {
+        return Err(props.error("alpha", format!("must be in (0, 1), found {alpha}")));
+    }
+    let beam_type = read_beam_type(props)?;
+    let kernel = props.kernel("kernel", "box")?;
+    let kernel_1d = Kernel1d::norm(&kernel);
+    let direct = Direct::read(props)?;
+    Ok(Box::new(Ppb {
+        iterations,
+        time: time.map(f64::from),
+        photons_per_iteration,
+        initial_beam_radius,
+        initial_radius,
+        alpha: alpha as f64,
+        beam_type,
+        kernel,
+        kernel_1d,
+        direct,
+        max_depth: scene.render.max_depth,
+        camera: CameraWalk::read(props, scene)?,
+    }))
+}
+
+foton_core::declare_integrator!("ppb", "progressive photon beams (Jarosz et al.)", create);

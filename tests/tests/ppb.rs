@@ -1,0 +1,245 @@
+//! Progressive photon beams (`ppb`): the error against a converged path-traced image falls with
+//! passes, agreement with the path tracer on single scattering from a point light in fog,
+//! determinism across thread counts and parts, bad parameters.
+
+use foton_core::film::Film;
+use foton_tests::stats::{Tolerance, assert_blocks_agree, rel_err, rel_rmse};
+use foton_tests::{foton, foton_with_plugins, render_file, render_toml, repo_root, temp_dir};
+
+const VIEW: [&str; 2] = ["film.width=16", "film.height=16"];
+
+fn cornell_fog(set: &[&str], threads: usize) -> Film {
+    render_file(
+        &repo_root().join("scenes/cornell-fog.toml"),
+        &[&VIEW[..], set].concat(),
+        threads,
+    )
+}
+
+fn ppb_passes(passes: u64, seed: u64) -> Film {
+    let n = format!("integrators.ppb.iterations={passes}");
+    let seed = format!("render.seed={seed}");
+    cornell_fog(
+        &[
+            "render.integrator=ppb",
+            "integrators.ppb.photons_per_iteration=5000",
+            &n,
+            &seed,
+        ],
+        2,
+    )
+}
+
+/// The foggy Cornell box (fog, spheres, walls: beams in the fog, sppm's gather on the
+/// surfaces): the relative RMS error against the path tracer (4096 spp, whose own error is
+/// about 1 % per pixel) falls from 4 to 32 passes and the image converges to the path
+/// tracer's: mean within 2 %, blocks within 6 %.
+#[test]
+fn error_falls_with_passes_on_the_fog_box() {
+    let path = cornell_fog(&["render.integrator=path", "render.spp=4096"], 2);
+    let mut errors = Vec::new();
+    for passes in [4, 32] {
+        // Two seeds each: one render's error is itself noisy.
+        let e: f64 = [1, 2]
+            .iter()
+            .map(|&seed| rel_rmse(&ppb_passes(passes, seed), &path))
+            .sum::<f64>()
+            / 2.0;
+        errors.push(e);
+    }
+    eprintln!("relative RMS error after 4 and 32 passes: {errors:?}");
+    // Variance falls as n^-alpha and the bias with the radii: 8 times the passes must at least
+    // take off a third of the error (measured: see the README).
+    assert!(errors[1] < 0.67 * errors[0], "{errors:?}");
+    let film = ppb_passes(32, 1);
+    let (a, b) = (film.mean(), path.mean());
+    assert!(rel_err(a, b) < 0.02, "{a} against {b}");
+    assert_blocks_agree(
+        "ppb, 32 passes",
+        &film,
+        &path,
+        2,
+        Tolerance {
+            rel: 0.06,
+            z: 4.0,
+            floor: 0.0,
+        },
+    );
+}
+
+/// The point-light fog box of tests/tests/beams.rs (the light just above the view): at
+/// max_depth 1 the image is single scattering only, all of it from beams.
+fn point_light_fog(integrator: &str, max_depth: u32) -> String {
+    let mut s = foton_tests::header(integrator, 4096, max_depth, 24, 24);
+    s += &format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 36.0
+[materials.boundary]
+type = "null"
+[media.fog]
+type = "homogeneous"
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.6, 0.6, 0.6]
+phase = {{ type = "hg", g = 0.5 }}
+[[shapes]]
+type = "mesh"
+file = "{cube}"
+material = "boundary"
+interior = "fog"
+transform = {{ scale = [1.0, 1.6, 1.0] }}
+[[lights]]
+type = "point"
+position = [0.3, 1.5, -0.2]
+intensity = [2.0, 2.0, 2.0]
+[integrators.ppb]
+iterations = 16
+photons_per_iteration = 10000
+"#,
+        cube = repo_root().join("scenes/meshes/cube.obj").display()
+    );
+    s
+}
+
+/// Tolerances as in tests/tests/beams.rs (there with 200k photons in one pass; here 16
+/// passes of 10k, with shrinking beams): image mean within 3 %, 3 x 3 blocks within 8 % or
+/// 4 se.
+#[test]
+fn single_scattering_from_a_point_light_agrees_with_path() {
+    for max_depth in [1, 8] {
+        let path = render_toml("ppb-path", &point_light_fog("path", max_depth), &[], 2);
+        for kind in ["short", "long"] {
+            let set = format!("integrators.ppb.beam_type=\"{kind}\"");
+            let ppb = render_toml("ppb", &point_light_fog("ppb", max_depth), &[&set], 2);
+            let (a, b) = (ppb.mean(), path.mean());
+            eprintln!(
+                "max_depth {max_depth}, {kind} beams: ppb {a}, path {b}: {}",
+                rel_err(a, b)
+            );
+            assert!(rel_err(a, b) < 0.03, "{kind}: {a} against {b}");
+            assert_blocks_agree(
+                &format!("ppb, max_depth {max_depth}, {kind} beams"),
+                &ppb,
+                &path,
+                3,
+                Tolerance {
+                    rel: 0.08,
+                    z: 4.0,
+                    floor: 0.0,
+                },
+            );
+        }
+    }
+}
+
+#[test]
+fn identical_for_one_and_many_threads() {
+    let set = [
+        "render.integrator=ppb",
+        "integrators.ppb.iterations=3",
+        "integrators.ppb.photons_per_iteration=3000",
+    ];
+    let one = cornell_fog(&set, 1);
+    let many = cornell_fog(&set, 3);
+    assert_eq!(one.pixels(), many.pixels());
+    assert!(one.mean().x > 0.0);
+}
+
+/// Passes are independent (radii from the pass number, streams keyed by the pass): three
+/// parts merge into the whole render's EXR byte for byte; a time budget cannot be split.
+#[test]
+fn parts_merge_to_the_whole_render() {
+    let dir = temp_dir("ppb-parts");
+    let scene = repo_root().join("scenes/cornell-fog.toml");
+    let render = |extra: &[&str]| {
+        let mut args = vec![
+            "render",
+            scene.to_str().unwrap(),
+            "--integrator",
+            "ppb",
+            "-q",
+            "--set",
+            "film.width=12",
+            "--set",
+            "film.height=10",
+            "--set",
+            "integrators.ppb.iterations=5",
+            "--set",
+            "integrators.ppb.photons_per_iteration=2000",
+        ];
+        args.extend(extra);
+        foton_with_plugins(&args)
+    };
+    let whole = dir.join("whole.exr");
+    let run = render(&["--threads", "1", "-o", whole.to_str().unwrap()]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let parts: Vec<String> = (0..3)
+        .map(|i| {
+            let out = dir.join(format!("part-{i}.exr"));
+            let part = format!("{i}/3");
+            let run = render(&[
+                "--threads",
+                "2",
+                "--part",
+                &part,
+                "-o",
+                out.to_str().unwrap(),
+            ]);
+            assert_eq!(run.code, 0, "{}", run.stderr);
+            out.to_str().unwrap().to_string()
+        })
+        .collect();
+    let merged = dir.join("merged.exr");
+    let mut args = vec!["merge"];
+    args.extend(parts.iter().map(String::as_str));
+    args.extend(["-o", merged.to_str().unwrap()]);
+    let run = foton(&args);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(
+        std::fs::read(&whole).unwrap() == std::fs::read(&merged).unwrap(),
+        "the merged parts differ from the whole render"
+    );
+    let timed = render(&[
+        "--set",
+        "integrators.ppb.time=1",
+        "--part",
+        "0/2",
+        "-o",
+        dir.join("timed.exr").to_str().unwrap(),
+    ]);
+    assert_ne!(timed.code, 0);
+    assert!(
+        timed.stderr.contains("ppb splits into parts"),
+        "{}",
+        timed.stderr
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn bad_parameters_are_clear_errors() {
+    foton_tests::assert_refused(
+        "scenes/fog_box.toml",
+        "ppb",
+        &["film.width=8", "film.height=8"],
+        &[
+            ("integrators.ppb.iterations=0", "iterations"),
+            (
+                "integrators.ppb.photons_per_iteration=0",
+                "photons_per_iteration",
+            ),
+            (
+                "integrators.ppb.initial_beam_radius=0",
+                "initial_beam_radius",
+            ),
+            ("integrators.ppb.initial_radius=-1", "initial_radius"),
+            ("integrators.ppb.alpha=1.5", "alpha"),
+            ("integrators.ppb.beam_type=\"wide\"", "beam_type"),
+            ("integrators.ppb.time=0", "time"),
+            ("integrators.ppb.kernel=\"nope\"", "kernel"),
+        ],
+    );
+}
