@@ -508,6 +508,39 @@ mod tests {
         assert_eq!(ToneMap::from_name("aces"), None);
     }
 
+    /// A pixel is its mean sample plus its splat sum over the camera samples per pixel of the
+    /// whole film, taken as they were: an interrupted render (pixels with different counts)
+    /// scales its splats by the samples it took, and merged films add exactly.
+    #[test]
+    fn splats_are_scaled_by_the_samples_taken() {
+        let mut film = Film::new(2, 1);
+        let sum = |v: f32| {
+            let mut s = RadianceSum::ZERO;
+            s.add(Rgb::splat(v));
+            s
+        };
+        // Pixel 0 took 4 samples, pixel 1 only 2 (interrupted): 3 per pixel on average.
+        film.add_pixel(0, &sum(2.0), 4);
+        film.add_pixel(1, &sum(1.0), 2);
+        assert_eq!(film.pixel(1, 0), Rgb::splat(0.5));
+        film.add_splat(0, &sum(0.75));
+        film.add_splat(1, &sum(1.5));
+        assert_eq!(film.pixel(0, 0), Rgb::splat(0.5 + 0.25));
+        assert_eq!(film.pixel(1, 0), Rgb::splat(0.5 + 0.5));
+        // Two such films merged: sums, counts and splats add; the image is the same.
+        let mut merged = Film::new(2, 1);
+        merged.merge(&film);
+        merged.merge(&film);
+        assert_eq!(merged.pixels(), film.pixels());
+        assert_eq!(merged.splats()[1], {
+            let mut s = sum(1.5);
+            s.merge(&sum(1.5));
+            s
+        });
+        // A film without splats has no splat buffer.
+        assert!(Film::new(2, 1).splats().is_empty());
+    }
+
     #[test]
     fn srgb_decode_inverts_encode() {
         for i in 0..=1000 {
