@@ -41,9 +41,20 @@
 //! through glass (S D S paths: every connection meets a delta vertex), which photon mapping
 //! renders.
 //!
-//! Not supported, refused with an error: participating media (`path` and `vpm` render them)
-//! and `hide_emitters` (light paths connected to the camera would be blocked by emitters that
-//! camera rays pass through).
+//! Participating media along both subpaths (as Mitsuba 0.6's `bdpt`): each subpath tracks its
+//! medium through null boundaries (core's `RayWalk`), samples free-flight distances (one-sample
+//! spectral MIS over the channels of each event, `FreeFlight::weight`), and scattering events
+//! in a medium are vertices like surface ones (the phase function as their BSDF, a cosine of
+//! one in the densities); every connection, next-event shadow ray and connection to the camera
+//! carries the transmittance of the media and null boundaries it crosses
+//! (`Scene::transmittance`). The densities of the MIS weights leave out the free-flight
+//! probabilities (as pbrt-v3's do): the weights of a path's strategies still sum to one.
+//! Light tracing alone (`strategy = "light"` or `"s,1"`) has infinite variance in a medium
+//! around the pinhole (a vertex at distance d contributes as 1 / d^2); the full estimator
+//! weights it away there.
+//!
+//! Not supported, refused with an error: `hide_emitters` (light paths connected to the camera
+//! would be blocked by emitters that camera rays pass through).
 //!
 //! The subpaths and their MIS quantities are written to serve `vcm` too: with merging switched
 //! off its weights are these.
@@ -56,6 +67,7 @@ use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::integrator::{Integrator, Parameter, RenderContext};
 use foton_core::light::Light;
 use foton_core::material::TransportMode;
+use foton_core::medium::{self, Phase};
 use foton_core::props::Properties;
 use foton_core::render::{PixelSample, Splats, render_pixels_splatting};
 use foton_core::sampling::Sampler;
@@ -115,21 +127,96 @@ impl Strategy {
     }
 }
 
-/// A vertex of a subpath where it can be connected (its BSDF is not a delta).
+/// A vertex of a subpath where it can be connected: a surface whose BSDF is not a delta, or a
+/// scattering event in a medium.
 #[derive(Clone, Copy, Debug)]
 pub struct Vertex {
     pub p: Vec3,
-    /// Geometric normal (the primitive's orientation).
-    pub ng: Vec3,
+    pub at: At,
+    /// The medium the subpath arrived in (None: vacuum).
+    pub medium: Option<u32>,
     /// Unit direction back along the subpath (towards the camera, or where the light came from).
     pub wo: Vec3,
-    pub bsdf: Bsdf,
-    /// Throughput of the subpath up to this vertex (its own BSDF not included): radiance
+    /// Throughput of the subpath up to this vertex (its own scattering not included): radiance
     /// weights from the camera, flux over pdfs from the light.
     pub beta: Rgb,
     pub running: Running,
     /// Segments from the subpath's first vertex (the pinhole or the light).
     pub length: u32,
+}
+
+/// What scatters at a vertex.
+#[derive(Clone, Copy, Debug)]
+pub enum At {
+    Surface { hit: Hit, bsdf: Bsdf },
+    Medium { phase: Phase },
+}
+
+impl Vertex {
+    /// The normal a shadow ray's end is offset along (zero in a medium).
+    #[inline]
+    fn ng(&self) -> Vec3 {
+        match &self.at {
+            At::Surface { hit, .. } => hit.ng,
+            At::Medium { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// The cosine that turns a solid-angle density of reaching this vertex along `w` into a
+    /// density per unit area (per unit volume in a medium: 1).
+    #[inline]
+    fn cos(&self, w: Vec3) -> f32 {
+        match &self.at {
+            At::Surface { hit, .. } => hit.ng.dot(w).abs(),
+            At::Medium { .. } => 1.0,
+        }
+    }
+
+    /// The solid-angle density of sampling `wi` given `wo` here.
+    #[inline]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match &self.at {
+            At::Surface { bsdf, .. } => bsdf.pdf(wo, wi),
+            At::Medium { phase } => phase.eval(-wo.dot(wi)),
+        }
+    }
+
+    /// What a camera vertex scatters from `w` towards the camera: f(wo, w) |w.ns| at a
+    /// surface, the phase function in a medium.
+    #[inline]
+    fn f_camera(&self, w: Vec3) -> Rgb {
+        match &self.at {
+            At::Surface { bsdf, .. } => bsdf.eval(self.wo, w),
+            At::Medium { phase } => Rgb::splat(phase.eval(-self.wo.dot(w))),
+        }
+    }
+
+    /// What a light vertex sends along `w` (unit, away from it), per unit of its throughput:
+    /// at a surface f(w, wo) |w.ng| with the shading-normal correction of importance transport
+    /// (Veach 1997, section 5.3), f |wo.ns| |w.ng| / |wo.ng|, which `Bsdf::eval` (carrying
+    /// |wo.ns|) times |w.ng| / |wo.ng| gives; in a medium the phase function.
+    #[inline]
+    fn f_light(&self, w: Vec3) -> Rgb {
+        match &self.at {
+            At::Surface { hit, bsdf } => {
+                let cos_wo = hit.ng.dot(self.wo).abs();
+                if cos_wo == 0.0 {
+                    return Rgb::ZERO;
+                }
+                bsdf.eval(w, self.wo) * (hit.ng.dot(w).abs() / cos_wo)
+            }
+            At::Medium { phase } => Rgb::splat(phase.eval(-self.wo.dot(w))),
+        }
+    }
+
+    /// The medium a ray leaving the vertex along `w` travels in.
+    #[inline]
+    fn medium_towards(&self, scene: &Scene, w: Vec3) -> Option<u32> {
+        match &self.at {
+            At::Surface { hit, .. } => scene.medium_after(hit, w, self.medium),
+            At::Medium { .. } => self.medium,
+        }
+    }
 }
 
 /// A light subpath's first vertex on an area light, for s = 1, t = 1.
@@ -140,6 +227,27 @@ struct Origin {
     n: Vec3,
     /// pick x pdf_pos: its density per unit area.
     pdf: f32,
+    medium: Option<u32>,
+}
+
+/// Which end a subpath starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Camera,
+    Light,
+}
+
+/// What a light subpath needs at its first vertex: next-event estimation's density of its
+/// origin, seen from there.
+#[derive(Clone, Copy, Debug)]
+struct Emitted<'a> {
+    light: &'a Light,
+    pick: f32,
+    origin: Vec3,
+    n: Vec3,
+    dir: Vec3,
+    cos_light: f32,
+    emission_pdf: f32,
 }
 
 impl Bdpt {
@@ -167,10 +275,11 @@ impl Bdpt {
     }
 
     /// One camera sample: its own estimate (strategies t >= 2); what its light path brings to
-    /// the camera (t = 1) goes to `splats`.
+    /// the camera (t = 1) goes to `splats`. `light_media` is the medium each light emits into.
     pub fn sample(
         &self,
         scene: &Scene,
+        light_media: &[Option<u32>],
         ps: &PixelSample,
         sampler: &mut Sampler,
         splats: &mut Splats<'_>,
@@ -180,7 +289,7 @@ impl Bdpt {
         let mut camera = Vec::with_capacity(cap);
         let mut radiance = self.camera_subpath(scene, ps, sampler, &mut camera, rays);
         let mut light = Vec::with_capacity(cap);
-        let origin = self.light_subpath(scene, sampler, &mut light, rays);
+        let origin = self.light_subpath(scene, light_media, sampler, &mut light, rays);
 
         // ---- t = 1: light vertices connected to the pinhole, splatted ----
         if let Some(o) = origin {
@@ -220,20 +329,177 @@ impl Bdpt {
             // d_vcm starts as the t = 1 strategy's share: without it, no weight counts it.
             running.d_vcm = 0.0;
         }
+        let walk = RayWalk::camera(scene, ps.ray);
+        self.random_walk(
+            scene,
+            Side::Camera,
+            walk,
+            Rgb::ONE,
+            running,
+            None,
+            sampler,
+            vertices,
+            rays,
+        )
+    }
+
+    /// Traces a light subpath from a light chosen in proportion to power, keeping its
+    /// connectable vertices in `vertices`; returns its origin if it lies on an area light.
+    fn light_subpath(
+        &self,
+        scene: &Scene,
+        light_media: &[Option<u32>],
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+    ) -> Option<Origin> {
+        let u_light = sampler.next_f32();
+        let (u_pos, u_dir, u_shape) = (sampler.next_2d(), sampler.next_2d(), sampler.next_f32());
+        let (id, pick) = scene.sample_light(u_light)?;
+        let light = &scene.lights[id];
+        let e = light.sample_emission(u_pos, u_dir, u_shape);
+        let medium = light_media.get(id).copied().flatten();
+        let origin = matches!(light, Light::Area { .. }).then_some(Origin {
+            light: id,
+            p: e.origin,
+            n: e.n,
+            pdf: pick * e.pdf_pos,
+            medium,
+        });
+        let emission_pdf = pick * e.pdf_pos * e.pdf_dir;
+        if emission_pdf.is_nan() || emission_pdf <= 0.0 || e.le == Rgb::ZERO {
+            return origin;
+        }
+        let cos_light = if e.n == Vec3::ZERO {
+            1.0
+        } else {
+            e.n.dot(e.dir).abs()
+        };
+        let running = Running::light(emission_pdf, cos_light, light.is_delta());
+        let beta = e.le * (cos_light / emission_pdf);
+        let ray = Ray::new(offset_origin(e.origin, e.n, e.dir), e.dir);
+        let emitted = Emitted {
+            light,
+            pick,
+            origin: e.origin,
+            n: e.n,
+            dir: e.dir,
+            cos_light,
+            emission_pdf,
+        };
+        self.random_walk(
+            scene,
+            Side::Light,
+            RayWalk::new(ray, medium),
+            beta,
+            running,
+            Some(emitted),
+            sampler,
+            vertices,
+            rays,
+        );
+        origin
+    }
+
+    /// The random walk of a subpath (both sides): free flights through media, null boundaries
+    /// crossed, BSDFs and phase functions sampled, Russian roulette; the connectable vertices
+    /// go to `vertices` with their MIS quantities. A camera subpath also gathers the emission
+    /// it meets (s = 0), which it returns.
+    #[allow(clippy::too_many_arguments)]
+    fn random_walk(
+        &self,
+        scene: &Scene,
+        side: Side,
+        mut walk: RayWalk,
+        mut beta: Rgb,
+        mut running: Running,
+        emitted: Option<Emitted<'_>>,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+    ) -> Rgb {
+        let mode = match side {
+            Side::Camera => TransportMode::Radiance,
+            Side::Light => TransportMode::Importance,
+        };
+        let infinite = emitted.is_some_and(|e| e.light.is_infinite());
         let mut radiance = Rgb::ZERO;
-        let mut beta = Rgb::ONE;
-        let mut walk = RayWalk::camera(scene, ps.ray);
-        let mut prev = ps.ray.origin;
+        let mut prev = emitted.map_or(walk.ray.origin, |e| e.origin);
         let mut length = 0u32;
+        // The MIS update on reaching a vertex at `x` (cosine `cos`, 1 in a medium).
+        let arrive = |running: &mut Running, length: u32, x: Vec3, prev: Vec3, cos: f32| {
+            let dist2 = prev.distance_squared(x);
+            if length == 1
+                && let Some(e) = emitted
+            {
+                // Next-event estimation's density of the light's origin, seen from x.
+                let direct = e.pick
+                    * match e.light {
+                        Light::Area { .. } => {
+                            e.light.pdf_li(x, e.origin, e.n) * e.cos_light / dist2
+                        }
+                        l if l.is_delta() => 1.0,
+                        l => l.pdf_li(x, x - e.dir, Vec3::ZERO),
+                    };
+                running.first_hit(direct, e.emission_pdf);
+            }
+            running.arrive((length > 1 || !infinite).then_some(dist2), cos);
+        };
         loop {
             let seg = walk.segment(scene, rays);
+
+            // ---- Medium: free flight to a scattering event or to the surface ----
+            if let Some(m) = seg.interacting_medium(scene) {
+                // One-sample MIS over the channels of this event (FreeFlight::weight).
+                let channel = medium::channel(sampler.next_f32());
+                let flight =
+                    m.sample_free_flight(&seg.start(), seg.length(), channel, sampler.next_f32());
+                beta *= flight.weight();
+                if beta == Rgb::ZERO {
+                    break;
+                }
+                if flight.scattered {
+                    let x = seg.at(flight.t);
+                    length += 1;
+                    arrive(&mut running, length, x, prev, 1.0);
+                    if side == Side::Camera && length > self.max_depth {
+                        break;
+                    }
+                    let phase = m.phase();
+                    let wo = -seg.ray.dir;
+                    vertices.push(Vertex {
+                        p: x,
+                        at: At::Medium { phase },
+                        medium: walk.medium,
+                        wo,
+                        beta,
+                        running,
+                        length,
+                    });
+                    if side == Side::Light && length >= self.max_depth {
+                        break;
+                    }
+                    // ---- Phase-function sampling: p / pdf = 1 ----
+                    let (wi, pdf) = phase.sample(seg.ray.dir, sampler.next_2d());
+                    running.scatter(1.0, pdf, pdf, false);
+                    if !self.russian_roulette(length, &mut beta, sampler) {
+                        break;
+                    }
+                    prev = x;
+                    walk.scatter_in_medium(x, wi);
+                    continue;
+                }
+            }
+
             let Some(hit) = seg.hit else {
                 // ---- s = 0: the environment ----
-                length += 1;
-                if let Some((id, le)) = scene.escaped(seg.ray.dir) {
+                if side == Side::Camera
+                    && let Some((id, le)) = scene.escaped(seg.ray.dir)
+                {
+                    let t = length + 2;
                     let dir = seg.ray.dir;
-                    let w = self.weight(0, length + 1, || {
-                        if length == 1 {
+                    let w = self.weight(0, t, || {
+                        if length == 0 {
                             // No other strategy sees a light at infinity directly.
                             return 1.0;
                         }
@@ -254,11 +520,12 @@ impl Bdpt {
             };
             length += 1;
             let wo = -seg.ray.dir;
-            let dist2 = prev.distance_squared(hit.p);
-            running.arrive(Some(dist2), hit.ng.dot(wo));
+            arrive(&mut running, length, hit.p, prev, hit.ng.dot(wo));
 
             // ---- s = 0: an area light reached ----
-            if let Some((id, light)) = scene.area_light(&hit) {
+            if side == Side::Camera
+                && let Some((id, light)) = scene.area_light(&hit)
+            {
                 let le = light.emitted(hit.ng, wo);
                 if le != Rgb::ZERO {
                     let w = self.weight(0, length + 1, || {
@@ -270,33 +537,42 @@ impl Bdpt {
                         let direct = if length == 1 {
                             pick * pos
                         } else {
-                            pick * light.pdf_li(prev, hit.p, hit.ng) * hit.ng.dot(wo).abs() / dist2
+                            pick * light.pdf_li(prev, hit.p, hit.ng) * hit.ng.dot(wo).abs()
+                                / prev.distance_squared(hit.p)
                         };
                         weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
                     });
                     radiance += beta * le * w;
                 }
             }
-            if length > self.max_depth {
+            if side == Side::Camera && length > self.max_depth {
                 break;
             }
             if !bsdf.is_delta() {
                 vertices.push(Vertex {
                     p: hit.p,
-                    ng: hit.ng,
+                    at: At::Surface { hit, bsdf },
+                    medium: walk.medium,
                     wo,
-                    bsdf,
                     beta,
                     running,
                     length,
                 });
             }
+            if side == Side::Light && length >= self.max_depth {
+                break;
+            }
             // ---- BSDF sampling ----
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
+            let Some(bs) = bsdf.sample(wo, u, uc, mode) else {
                 break;
             };
-            scatter(&mut running, &bsdf, &hit, wo, bs.wi, bs.pdf, bs.delta);
+            let cos_out = hit.ng.dot(bs.wi);
+            if bs.delta {
+                running.scatter(cos_out, bs.pdf, bs.pdf, true);
+            } else {
+                running.scatter(cos_out, bsdf.pdf(wo, bs.wi), bsdf.pdf(bs.wi, wo), false);
+            }
             beta *= bs.weight;
             if beta == Rgb::ZERO || !self.russian_roulette(length, &mut beta, sampler) {
                 break;
@@ -305,96 +581,6 @@ impl Bdpt {
             walk.scatter_at_surface(scene, &hit, bs.wi);
         }
         radiance
-    }
-
-    /// Traces a light subpath from a light chosen in proportion to power, keeping its
-    /// connectable vertices in `vertices`; returns its origin if it lies on an area light.
-    fn light_subpath(
-        &self,
-        scene: &Scene,
-        sampler: &mut Sampler,
-        vertices: &mut Vec<Vertex>,
-        rays: &mut u64,
-    ) -> Option<Origin> {
-        let u_light = sampler.next_f32();
-        let (u_pos, u_dir, u_shape) = (sampler.next_2d(), sampler.next_2d(), sampler.next_f32());
-        let (id, pick) = scene.sample_light(u_light)?;
-        let light = &scene.lights[id];
-        let e = light.sample_emission(u_pos, u_dir, u_shape);
-        let origin = matches!(light, Light::Area { .. }).then_some(Origin {
-            light: id,
-            p: e.origin,
-            n: e.n,
-            pdf: pick * e.pdf_pos,
-        });
-        let emission_pdf = pick * e.pdf_pos * e.pdf_dir;
-        if emission_pdf.is_nan() || emission_pdf <= 0.0 || e.le == Rgb::ZERO {
-            return origin;
-        }
-        let infinite = light.is_infinite();
-        let cos_light = if e.n == Vec3::ZERO {
-            1.0
-        } else {
-            e.n.dot(e.dir).abs()
-        };
-        let mut running = Running::light(emission_pdf, cos_light, light.is_delta());
-        let mut beta = e.le * (cos_light / emission_pdf);
-        let mut walk = RayWalk::new(Ray::new(offset_origin(e.origin, e.n, e.dir), e.dir), None);
-        let mut prev = e.origin;
-        let mut length = 0u32;
-        loop {
-            let seg = walk.segment(scene, rays);
-            let Some(hit) = seg.hit else {
-                break;
-            };
-            let bsdf = match walk.reach(scene, &hit) {
-                Reached::Surface(bsdf) => bsdf,
-                Reached::Crossed => continue,
-                Reached::Ended => break,
-            };
-            length += 1;
-            let wo = -seg.ray.dir;
-            let dist2 = prev.distance_squared(hit.p);
-            if length == 1 {
-                // Next-event estimation's density of the origin, seen from here.
-                let direct = pick
-                    * match light {
-                        Light::Area { .. } => {
-                            light.pdf_li(hit.p, e.origin, e.n) * cos_light / dist2
-                        }
-                        _ if light.is_delta() => 1.0,
-                        _ => light.pdf_li(hit.p, hit.p - e.dir, Vec3::ZERO),
-                    };
-                running.first_hit(direct, emission_pdf);
-            }
-            running.arrive((length > 1 || !infinite).then_some(dist2), hit.ng.dot(wo));
-            if !bsdf.is_delta() {
-                vertices.push(Vertex {
-                    p: hit.p,
-                    ng: hit.ng,
-                    wo,
-                    bsdf,
-                    beta,
-                    running,
-                    length,
-                });
-            }
-            if length >= self.max_depth {
-                break;
-            }
-            let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Importance) else {
-                break;
-            };
-            scatter(&mut running, &bsdf, &hit, wo, bs.wi, bs.pdf, bs.delta);
-            beta *= bs.weight;
-            if beta == Rgb::ZERO || !self.russian_roulette(length, &mut beta, sampler) {
-                break;
-            }
-            prev = hit.p;
-            walk.scatter_at_surface(scene, &hit, bs.wi);
-        }
-        origin
     }
 
     /// t = 1 for a light vertex: connected to the pinhole and splatted on the pixels whose
@@ -408,18 +594,20 @@ impl Bdpt {
         let Some(cs) = camera.sample_wi(v.p) else {
             return;
         };
-        let f = light_vertex_f(v, cs.wi);
+        let f = v.f_light(cs.wi);
         if f == Rgb::ZERO {
             return;
         }
         *rays += 1;
-        if scene.occluded(v.p, v.ng, camera.position, Vec3::ZERO) {
+        let medium = v.medium_towards(scene, cs.wi);
+        let tr = scene.transmittance(v.p, v.ng(), camera.position, Vec3::ZERO, medium);
+        if tr == Rgb::ZERO {
             return;
         }
-        let base = v.beta * f * (cs.we / cs.pdf);
+        let base = v.beta * f * tr * (cs.we / cs.pdf);
         // The camera's density of having sampled v, per unit area there (filter aside).
-        let pdf_camera = camera.pdf_we(-cs.wi).1 * v.ng.dot(cs.wi).abs() / (cs.dist * cs.dist);
-        let pdf_rev = v.bsdf.pdf(cs.wi, v.wo);
+        let pdf_camera = camera.pdf_we(-cs.wi).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
+        let pdf_rev = v.pdf(cs.wi, v.wo);
         let (width, height) = (scene.film.width, scene.film.height);
         scene
             .film
@@ -447,11 +635,12 @@ impl Bdpt {
             return;
         }
         *rays += 1;
-        if scene.occluded(o.p, o.n, camera.position, Vec3::ZERO) {
+        let tr = scene.transmittance(o.p, o.n, camera.position, Vec3::ZERO, o.medium);
+        if tr == Rgb::ZERO {
             return;
         }
         let cos = o.n.dot(cs.wi).abs();
-        let base = le * (cos / o.pdf * cs.we / cs.pdf);
+        let base = le * tr * (cos / o.pdf * cs.we / cs.pdf);
         let pdf_camera = camera.pdf_we(-cs.wi).1 * cos / (cs.dist * cs.dist);
         // The only other strategy is the camera ray that reaches the point (s = 0, t = 2).
         let running = Running {
@@ -486,19 +675,21 @@ impl Bdpt {
         if ls.li == Rgb::ZERO || ls.pdf.is_nan() || ls.pdf <= 0.0 {
             return Rgb::ZERO;
         }
-        let (f, scatter_pdf) = c.bsdf.eval_pdf(c.wo, ls.wi);
+        let f = c.f_camera(ls.wi);
         if f == Rgb::ZERO {
             return Rgb::ZERO;
         }
         *rays += 1;
-        if scene.occluded(c.p, c.ng, ls.p, ls.n) {
+        let medium = c.medium_towards(scene, ls.wi);
+        let tr = scene.transmittance(c.p, c.ng(), ls.p, ls.n, medium);
+        if tr == Rgb::ZERO {
             return Rgb::ZERO;
         }
         let direct_pdf = pick * ls.pdf;
         let w = self.weight(1, t, || {
             let (pos, pdf_dir) = light.pdf_le(ls.n, -ls.wi);
             let emission_pdf = pick * pos * pdf_dir;
-            let cos_x = c.ng.dot(ls.wi).abs();
+            let cos_x = c.cos(ls.wi);
             // Emission's density of reaching c per unit area there, over next-event
             // estimation's of the light point per unit area on it (per solid angle for lights
             // at infinity; a point light's position is a discrete choice).
@@ -509,16 +700,16 @@ impl Bdpt {
                 }
                 _ => emission_pdf * cos_x / direct_pdf,
             };
-            let hit_pdf = if ls.delta { 0.0 } else { scatter_pdf };
+            let hit_pdf = if ls.delta { 0.0 } else { c.pdf(c.wo, ls.wi) };
             weight_direct(
                 &c.running,
                 hit_pdf,
                 direct_pdf,
                 emission_ratio,
-                c.bsdf.pdf(ls.wi, c.wo),
+                c.pdf(ls.wi, c.wo),
             )
         });
-        c.beta * f * ls.li * (w / direct_pdf)
+        c.beta * f * ls.li * tr * (w / direct_pdf)
     }
 
     /// s, t >= 2: camera vertex `c` connected with light vertex `v`.
@@ -533,30 +724,31 @@ impl Bdpt {
             return Rgb::ZERO;
         }
         let dir = d / dist2.sqrt();
-        let f_c = c.bsdf.eval(c.wo, dir);
+        let f_c = c.f_camera(dir);
         if f_c == Rgb::ZERO {
             return Rgb::ZERO;
         }
-        let f_v = light_vertex_f(v, -dir);
+        let f_v = v.f_light(-dir);
         if f_v == Rgb::ZERO {
             return Rgb::ZERO;
         }
         *rays += 1;
-        if scene.occluded(c.p, c.ng, v.p, v.ng) {
+        let medium = c.medium_towards(scene, dir);
+        let tr = scene.transmittance(c.p, c.ng(), v.p, v.ng(), medium);
+        if tr == Rgb::ZERO {
             return Rgb::ZERO;
         }
         let w = self.weight(s, t, || {
-            let (cos_c, cos_v) = (c.ng.dot(dir).abs(), v.ng.dot(dir).abs());
             weight_connect(
                 &c.running,
                 &v.running,
-                c.bsdf.pdf(c.wo, dir) * cos_v / dist2,
-                c.bsdf.pdf(dir, c.wo),
-                v.bsdf.pdf(v.wo, -dir) * cos_c / dist2,
-                v.bsdf.pdf(-dir, v.wo),
+                c.pdf(c.wo, dir) * v.cos(dir) / dist2,
+                c.pdf(dir, c.wo),
+                v.pdf(v.wo, -dir) * c.cos(dir) / dist2,
+                v.pdf(-dir, v.wo),
             )
         });
-        c.beta * f_c * f_v * v.beta * (w / dist2)
+        c.beta * f_c * f_v * v.beta * tr * (w / dist2)
     }
 
     /// Russian roulette past `rr_depth` scattering events, as the path tracer's: keeps the
@@ -574,43 +766,21 @@ impl Bdpt {
     }
 }
 
-/// What light vertex `v` sends along `w` (unit, away from it), per unit of its throughput:
-/// f(w, wo) |w.ng| with the shading-normal correction of importance transport (Veach 1997,
-/// section 5.3): f |wo.ns| |w.ng| / |wo.ng|, what `Bsdf::eval` (which carries |wo.ns|) times
-/// |w.ng| / |wo.ng| gives.
-#[inline]
-fn light_vertex_f(v: &Vertex, w: Vec3) -> Rgb {
-    let cos_wo = v.ng.dot(v.wo).abs();
-    if cos_wo == 0.0 {
-        return Rgb::ZERO;
-    }
-    v.bsdf.eval(w, v.wo) * (v.ng.dot(w).abs() / cos_wo)
-}
-
-/// The MIS update of a subpath that scatters at `hit` from `wo` to `wi` (sampled with density
-/// `pdf`, a delta or not).
-#[inline]
-fn scatter(
-    running: &mut Running,
-    bsdf: &Bsdf,
-    hit: &Hit,
-    wo: Vec3,
-    wi: Vec3,
-    pdf: f32,
-    delta: bool,
-) {
-    let cos_out = hit.ng.dot(wi);
-    if delta {
-        running.scatter(cos_out, pdf, pdf, true);
-    } else {
-        running.scatter(cos_out, bsdf.pdf(wo, wi), bsdf.pdf(wi, wo), false);
-    }
-}
-
 impl Integrator for Bdpt {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        // The medium each light emits into, found once (a few rays per medium boundary).
+        let light_media = (0..scene.lights.len())
+            .map(|i| {
+                scene.light_medium(i).map_err(|why| {
+                    Error::Render(format!(
+                        "{}: cannot tell which medium light {i} is in: {why}",
+                        scene.file.display()
+                    ))
+                })
+            })
+            .collect::<Result<Vec<_>>>()?;
         render_pixels_splatting(scene, ctx, |ps, sampler, splats, rays| {
-            self.sample(scene, ps, sampler, splats, rays)
+            self.sample(scene, &light_media, ps, sampler, splats, rays)
         })
     }
 
@@ -633,12 +803,6 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let light_image = props.bool("light_image", true)?;
     let strategy = Strategy::parse(props.string("strategy", "all")?)
         .map_err(|e| props.error("strategy", e))?;
-    if scene.has_media() {
-        return Err(Error::Usage(format!(
-            "{}: the scene has participating media, which `bdpt` does not render yet (use `path` or `vpm`)",
-            scene.file.display()
-        )));
-    }
     if scene.render.hide_emitters {
         return Err(Error::Usage(format!(
             "{}: `bdpt` does not render with hide_emitters (light paths connected to the camera \
