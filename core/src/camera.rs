@@ -97,23 +97,26 @@ impl Camera {
     }
 
     /// The importance We of a ray leaving the pinhole along `dir` (unit) and the film point it
-    /// goes through; None outside the image (see the module comment).
-    pub fn we(&self, dir: Vec3) -> Option<(f32, Vec2)> {
+    /// goes through; None outside the image widened by `margin` pixels on every side (see the
+    /// module comment: the reach of the reconstruction filter, [`FilterSampler::margin`]).
+    ///
+    /// [`FilterSampler::margin`]: crate::filter::FilterSampler::margin
+    pub fn we(&self, dir: Vec3, margin: f32) -> Option<(f32, Vec2)> {
         let cos = dir.dot(self.forward);
         if cos <= 0.0 {
             return None;
         }
-        let film = self.project(self.position + dir)?;
+        let film = self.project_within(self.position + dir, margin)?;
         let cos2 = cos * cos;
         Some((1.0 / (self.image_area() * cos2 * cos2), film))
     }
 
     /// The densities with which camera rays leave the pinhole along `dir` (unit): in position
-    /// 1 (a delta: the pinhole), in direction 1 / (A cos^3 theta) over the whole image (zero
-    /// outside it). pbrt-v4's `PDF_We`.
-    pub fn pdf_we(&self, dir: Vec3) -> (f32, f32) {
+    /// 1 (a delta: the pinhole), in direction 1 / (A cos^3 theta) (A the image's area at
+    /// distance 1), zero outside the image widened by `margin` pixels. pbrt-v4's `PDF_We`.
+    pub fn pdf_we(&self, dir: Vec3, margin: f32) -> (f32, f32) {
         let cos = dir.dot(self.forward);
-        if cos <= 0.0 || self.project(self.position + dir).is_none() {
+        if cos <= 0.0 || self.project_within(self.position + dir, margin).is_none() {
             return (1.0, 0.0);
         }
         (1.0, 1.0 / (self.image_area() * cos * cos * cos))
@@ -121,8 +124,9 @@ impl Camera {
 
     /// The connection from the point `p` to the pinhole (pbrt-v4's `SampleWi`): the direction,
     /// the importance of the ray through `p`, its density at `p`, and where on the film `p`
-    /// lands; None if `p` is behind the camera or projects outside the image.
-    pub fn sample_wi(&self, p: Vec3) -> Option<CameraSample> {
+    /// lands; None if `p` is behind the camera or projects outside the image widened by
+    /// `margin` pixels.
+    pub fn sample_wi(&self, p: Vec3, margin: f32) -> Option<CameraSample> {
         let d = self.position - p;
         let dist2 = d.length_squared();
         if dist2 == 0.0 {
@@ -130,7 +134,7 @@ impl Camera {
         }
         let dist = dist2.sqrt();
         let wi = d / dist;
-        let (we, film) = self.we(-wi)?;
+        let (we, film) = self.we(-wi, margin)?;
         let cos = (-wi).dot(self.forward);
         Some(CameraSample {
             wi,
@@ -145,6 +149,11 @@ impl Camera {
     /// The pixel (continuous film coordinates) a world point projects to, if it is in front
     /// of the camera and inside the image.
     pub fn project(&self, p: Vec3) -> Option<Vec2> {
+        self.project_within(p, 0.0)
+    }
+
+    /// [`Camera::project`] into the image widened by `margin` pixels on every side.
+    pub fn project_within(&self, p: Vec3, margin: f32) -> Option<Vec2> {
         let d = p - self.position;
         let z = d.dot(self.forward);
         if z <= 0.0 {
@@ -157,10 +166,10 @@ impl Camera {
             (sx + 1.0) * 0.5 * self.width as f32,
             (1.0 - sy) * 0.5 * self.height as f32,
         );
-        (film.x >= 0.0
-            && film.y >= 0.0
-            && film.x < self.width as f32
-            && film.y < self.height as f32)
+        (film.x >= -margin
+            && film.y >= -margin
+            && film.x < self.width as f32 + margin
+            && film.y < self.height as f32 + margin)
             .then_some(film)
     }
 }
@@ -240,9 +249,9 @@ mod tests {
         let (mut pdf_sum, mut we_sum) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let w = crate::sampling::uniform_sphere(rng.next_2d());
-            let (_, pdf) = cam.pdf_we(w);
+            let (_, pdf) = cam.pdf_we(w, 0.0);
             pdf_sum += pdf as f64;
-            if let Some((we, _)) = cam.we(w) {
+            if let Some((we, _)) = cam.we(w, 0.0) {
                 we_sum += (we * w.dot(cam.forward)) as f64;
             }
         }
@@ -258,11 +267,11 @@ mod tests {
         ] {
             let ray = cam.generate_ray(film);
             let p = ray.at(2.5);
-            let s = cam.sample_wi(p).unwrap();
+            let s = cam.sample_wi(p, 0.0).unwrap();
             assert!((s.film - film).length() < 1e-3);
             assert!((s.wi + ray.dir).length() < 1e-5);
             assert!((s.dist - 2.5).abs() < 1e-4);
-            let (_, pdf_dir) = cam.pdf_we(ray.dir);
+            let (_, pdf_dir) = cam.pdf_we(ray.dir, 0.0);
             assert!((s.we * s.cos / pdf_dir - 1.0).abs() < 1e-5);
             // Finite differences of the film position with the direction: the Jacobian.
             let h = 1e-3;
@@ -272,6 +281,11 @@ mod tests {
             let want = 1.0 / (64.0 * 48.0) / solid;
             assert!((pdf_dir / want - 1.0).abs() < 0.01, "{pdf_dir} vs {want}");
         }
-        assert!(cam.sample_wi(cam.position - cam.forward).is_none());
+        assert!(cam.sample_wi(cam.position - cam.forward, 0.0).is_none());
+        // Just outside the image: only within a margin.
+        let outside = cam.generate_ray(Vec2::new(-0.7, 10.0)).at(2.0);
+        assert!(cam.sample_wi(outside, 0.0).is_none());
+        let s = cam.sample_wi(outside, 1.0).unwrap();
+        assert!((s.film - Vec2::new(-0.7, 10.0)).length() < 1e-3);
     }
 }

@@ -101,6 +101,14 @@ impl FilterSampler {
         -self.radius + (i as f32 + t as f32) * (2.0 * self.radius / PIECES as f32)
     }
 
+    /// How far (pixels) outside the image the camera samples of its edge pixels reach: the
+    /// filter's radius past the pixel's half width. Light paths connected to the camera count
+    /// in that margin too ([`crate::camera::Camera::sample_wi`]), so that the edge pixels'
+    /// splats cover what their camera samples see.
+    pub fn margin(&self) -> f32 {
+        (self.radius - 0.5).max(0.0)
+    }
+
     /// The density of `sample_1d`'s offset `x` (piecewise constant, as tabulated).
     fn pdf_1d(&self, x: f32) -> f32 {
         if x.abs() >= self.radius {

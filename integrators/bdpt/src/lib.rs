@@ -319,7 +319,8 @@ impl Bdpt {
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
     ) -> Rgb {
-        let (_, pdf_we) = scene.camera.pdf_we(ps.ray.dir);
+        let margin = scene.film.filter.margin();
+        let (_, pdf_we) = scene.camera.pdf_we(ps.ray.dir, margin);
         let pdf_camera = ps.filter_pdf * pdf_we;
         if pdf_camera <= 0.0 {
             return Rgb::ZERO;
@@ -591,7 +592,8 @@ impl Bdpt {
             return;
         }
         let camera = &scene.camera;
-        let Some(cs) = camera.sample_wi(v.p) else {
+        let margin = scene.film.filter.margin();
+        let Some(cs) = camera.sample_wi(v.p, margin) else {
             return;
         };
         let f = v.f_light(cs.wi);
@@ -606,7 +608,7 @@ impl Bdpt {
         }
         let base = v.beta * f * tr * (cs.we / cs.pdf);
         // The camera's density of having sampled v, per unit area there (filter aside).
-        let pdf_camera = camera.pdf_we(-cs.wi).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
+        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
         let pdf_rev = v.pdf(cs.wi, v.wo);
         let (width, height) = (scene.film.width, scene.film.height);
         scene
@@ -627,7 +629,8 @@ impl Bdpt {
             return;
         }
         let camera = &scene.camera;
-        let Some(cs) = camera.sample_wi(o.p) else {
+        let margin = scene.film.filter.margin();
+        let Some(cs) = camera.sample_wi(o.p, margin) else {
             return;
         };
         let le = scene.lights[o.light].emitted(o.n, cs.wi);
@@ -641,7 +644,7 @@ impl Bdpt {
         }
         let cos = o.n.dot(cs.wi).abs();
         let base = le * tr * (cos / o.pdf * cs.we / cs.pdf);
-        let pdf_camera = camera.pdf_we(-cs.wi).1 * cos / (cs.dist * cs.dist);
+        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * cos / (cs.dist * cs.dist);
         // The only other strategy is the camera ray that reaches the point (s = 0, t = 2).
         let running = Running {
             d_vcm: mis(1.0 / o.pdf),
