@@ -1,7 +1,36 @@
-//! A pinhole camera with a vertical field of view.
+//! A pinhole camera with a vertical field of view, and its importance for estimators that
+//! trace paths from the lights (pbrt-v4's `PerspectiveCamera::We`, `PDF_We`, `SampleWi`).
+//!
+//! **Importance.** The importance is normalised over the whole image, as pbrt-v4's is: a
+//! camera ray's direction w, at angle theta from the optical axis, has the density
+//! `pdf_dir = 1 / (A cos^3 theta)` (A the area of the image on the plane at distance 1 in
+//! front of the pinhole: a uniform point of that plane, seen from the pinhole) and the
+//! importance `We = 1 / (A cos^4 theta)`, so that `We cos theta / pdf_dir = 1`. A light path
+//! vertex seen by the camera then contributes `We cos theta / d^2` times what it sends towards
+//! the pinhole to the point of the image it projects to; summed over one light path per camera
+//! sample, and divided by the camera samples per pixel, that is the image
+//! ([`crate::film::Film`]'s splats).
 
 use crate::geometry::Ray;
 use glam::{Vec2, Vec3};
+
+/// A connection from a point to the camera ([`Camera::sample_wi`]).
+#[derive(Clone, Copy, Debug)]
+pub struct CameraSample {
+    /// Unit direction from the point towards the pinhole.
+    pub wi: Vec3,
+    /// Distance from the point to the pinhole.
+    pub dist: f32,
+    /// The camera's importance We of the ray from the pinhole through the point.
+    pub we: f32,
+    /// The solid-angle density at the point of having sampled this direction: the pinhole is
+    /// a delta in position, so dist^2 / cos theta (pbrt-v4's pinhole: a lens of area one).
+    pub pdf: f32,
+    /// Where on the film the point lands (pixel units, (0, 0) the top-left corner).
+    pub film: Vec2,
+    /// cos theta: between the optical axis and the ray from the pinhole.
+    pub cos: f32,
+}
 
 #[derive(Clone, Debug)]
 pub struct Camera {
@@ -54,9 +83,77 @@ impl Camera {
         )
     }
 
+    /// Area of the image on the plane at distance 1 in front of the pinhole.
+    #[inline]
+    pub fn image_area(&self) -> f32 {
+        let aspect = self.width as f32 / self.height as f32;
+        4.0 * self.tan_half * self.tan_half * aspect
+    }
+
+    /// The optical axis (unit, from the pinhole into the scene).
+    #[inline]
+    pub fn forward(&self) -> Vec3 {
+        self.forward
+    }
+
+    /// The importance We of a ray leaving the pinhole along `dir` (unit) and the film point it
+    /// goes through; None outside the image widened by `margin` pixels on every side (see the
+    /// module comment: the reach of the reconstruction filter, [`FilterSampler::margin`]).
+    ///
+    /// [`FilterSampler::margin`]: crate::filter::FilterSampler::margin
+    pub fn we(&self, dir: Vec3, margin: f32) -> Option<(f32, Vec2)> {
+        let cos = dir.dot(self.forward);
+        if cos <= 0.0 {
+            return None;
+        }
+        let film = self.project_within(self.position + dir, margin)?;
+        let cos2 = cos * cos;
+        Some((1.0 / (self.image_area() * cos2 * cos2), film))
+    }
+
+    /// The densities with which camera rays leave the pinhole along `dir` (unit): in position
+    /// 1 (a delta: the pinhole), in direction 1 / (A cos^3 theta) (A the image's area at
+    /// distance 1), zero outside the image widened by `margin` pixels. pbrt-v4's `PDF_We`.
+    pub fn pdf_we(&self, dir: Vec3, margin: f32) -> (f32, f32) {
+        let cos = dir.dot(self.forward);
+        if cos <= 0.0 || self.project_within(self.position + dir, margin).is_none() {
+            return (1.0, 0.0);
+        }
+        (1.0, 1.0 / (self.image_area() * cos * cos * cos))
+    }
+
+    /// The connection from the point `p` to the pinhole (pbrt-v4's `SampleWi`): the direction,
+    /// the importance of the ray through `p`, its density at `p`, and where on the film `p`
+    /// lands; None if `p` is behind the camera or projects outside the image widened by
+    /// `margin` pixels.
+    pub fn sample_wi(&self, p: Vec3, margin: f32) -> Option<CameraSample> {
+        let d = self.position - p;
+        let dist2 = d.length_squared();
+        if dist2 == 0.0 {
+            return None;
+        }
+        let dist = dist2.sqrt();
+        let wi = d / dist;
+        let (we, film) = self.we(-wi, margin)?;
+        let cos = (-wi).dot(self.forward);
+        Some(CameraSample {
+            wi,
+            dist,
+            we,
+            pdf: dist2 / cos,
+            film,
+            cos,
+        })
+    }
+
     /// The pixel (continuous film coordinates) a world point projects to, if it is in front
     /// of the camera and inside the image.
     pub fn project(&self, p: Vec3) -> Option<Vec2> {
+        self.project_within(p, 0.0)
+    }
+
+    /// [`Camera::project`] into the image widened by `margin` pixels on every side.
+    pub fn project_within(&self, p: Vec3, margin: f32) -> Option<Vec2> {
         let d = p - self.position;
         let z = d.dot(self.forward);
         if z <= 0.0 {
@@ -69,10 +166,10 @@ impl Camera {
             (sx + 1.0) * 0.5 * self.width as f32,
             (1.0 - sy) * 0.5 * self.height as f32,
         );
-        (film.x >= 0.0
-            && film.y >= 0.0
-            && film.x < self.width as f32
-            && film.y < self.height as f32)
+        (film.x >= -margin
+            && film.y >= -margin
+            && film.x < self.width as f32 + margin
+            && film.y < self.height as f32 + margin)
             .then_some(film)
     }
 }
@@ -130,5 +227,65 @@ mod tests {
         assert_eq!(cam.project(cam.position - cam.forward), None);
         let outside = cam.generate_ray(Vec2::new(-10.0, 24.0)).at(2.0);
         assert_eq!(cam.project(outside), None);
+    }
+
+    /// The importance integrates to one over the image's directions (so that We cos / pdf_dir
+    /// = 1 for a camera ray), its density matches the uniform film position the pixel loop
+    /// draws, and `sample_wi` lands where `generate_ray` started.
+    #[test]
+    fn importance_is_normalised_and_consistent_with_camera_rays() {
+        let cam = Camera::new(
+            Vec3::new(0.3, 1.2, 3.0),
+            Vec3::new(-0.2, 0.8, 0.0),
+            Vec3::Y,
+            50.0,
+            64,
+            48,
+        );
+        // Monte Carlo over the sphere of directions: the integral of pdf_dir is 1, and so is
+        // the integral of We cos (the importance of the whole image).
+        let mut rng = crate::sampling::Rng::new(&[7]);
+        let n = 400_000;
+        let (mut pdf_sum, mut we_sum) = (0.0f64, 0.0f64);
+        for _ in 0..n {
+            let w = crate::sampling::uniform_sphere(rng.next_2d());
+            let (_, pdf) = cam.pdf_we(w, 0.0);
+            pdf_sum += pdf as f64;
+            if let Some((we, _)) = cam.we(w, 0.0) {
+                we_sum += (we * w.dot(cam.forward)) as f64;
+            }
+        }
+        let scale = 4.0 * std::f64::consts::PI / n as f64;
+        assert!((pdf_sum * scale - 1.0).abs() < 0.02, "{}", pdf_sum * scale);
+        assert!((we_sum * scale - 1.0).abs() < 0.02, "{}", we_sum * scale);
+        // A camera ray through a film point: the density of its direction when film points are
+        // uniform over the image is (1 / (W H)) |d film / d w| = 1 / (A cos^3).
+        for film in [
+            Vec2::new(3.5, 40.25),
+            Vec2::new(32.0, 24.0),
+            Vec2::new(60.0, 2.0),
+        ] {
+            let ray = cam.generate_ray(film);
+            let p = ray.at(2.5);
+            let s = cam.sample_wi(p, 0.0).unwrap();
+            assert!((s.film - film).length() < 1e-3);
+            assert!((s.wi + ray.dir).length() < 1e-5);
+            assert!((s.dist - 2.5).abs() < 1e-4);
+            let (_, pdf_dir) = cam.pdf_we(ray.dir, 0.0);
+            assert!((s.we * s.cos / pdf_dir - 1.0).abs() < 1e-5);
+            // Finite differences of the film position with the direction: the Jacobian.
+            let h = 1e-3;
+            let a = cam.generate_ray(film + Vec2::new(h, 0.0)).dir;
+            let b = cam.generate_ray(film + Vec2::new(0.0, h)).dir;
+            let solid = (a - ray.dir).cross(b - ray.dir).length() / (h * h);
+            let want = 1.0 / (64.0 * 48.0) / solid;
+            assert!((pdf_dir / want - 1.0).abs() < 0.01, "{pdf_dir} vs {want}");
+        }
+        assert!(cam.sample_wi(cam.position - cam.forward, 0.0).is_none());
+        // Just outside the image: only within a margin.
+        let outside = cam.generate_ray(Vec2::new(-0.7, 10.0)).at(2.0);
+        assert!(cam.sample_wi(outside, 0.0).is_none());
+        let s = cam.sample_wi(outside, 1.0).unwrap();
+        assert!((s.film - Vec2::new(-0.7, 10.0)).length() < 1e-3);
     }
 }

@@ -3,6 +3,13 @@
 //! sampled), and what an image file of it holds: linear EXR or sRGB PNG (the files themselves
 //! are written and read by foton-loader's `image`, so that core links no image codec).
 //!
+//! **Splats.** Contributions that light paths bring to the camera land on any pixel: they are
+//! summed apart, in a second exact buffer, and a pixel's value is its mean sample plus its
+//! splat sum over the camera samples per pixel of the whole film (pbrt-v4's `AddSplat` and
+//! `splatScale`; one light path per camera sample). Kept apart, the two sums merge exactly
+//! across parts ([`Film::merge`]), and an interrupted render scales its splats by the samples
+//! it actually took.
+//!
 //! An EXR holds the radiance as it is. A PNG holds display values: each linear value is
 //! scaled by the exposure and tone mapped into [0, 1] ([`DisplayTransform`]), then encoded with
 //! the sRGB curve. Every PNG foton writes goes through foton-loader's `write_image` so that the tools show
@@ -75,6 +82,9 @@ pub struct Film {
     pub height: u32,
     sum: Vec<RadianceSum>,
     count: Vec<u32>,
+    /// Splatted contributions (light paths connected to the camera, which land on any pixel):
+    /// exact sums as `sum`, empty for an integrator that does not splat. See [`Film::pixel`].
+    splat: Vec<RadianceSum>,
     /// The share of the render this film holds (set by the render loop from
     /// `RenderContext::part`; [`Part::WHOLE`] unless the render was asked for a part).
     pub part: Part,
@@ -98,6 +108,7 @@ impl Film {
             height,
             sum: vec![RadianceSum::ZERO; n],
             count: vec![0; n],
+            splat: Vec::new(),
             part: Part::WHOLE,
             rays: 0,
             iterations: 0,
@@ -107,15 +118,17 @@ impl Film {
     }
 
     /// A film from its per-pixel sums and sample counts (row-major), as a partial result
-    /// stores them. None if the lengths do not match the size.
+    /// stores them, and its splat sums (empty: none). None if the lengths do not match the
+    /// size.
     pub fn from_sums(
         width: u32,
         height: u32,
         sum: Vec<RadianceSum>,
         count: Vec<u32>,
+        splat: Vec<RadianceSum>,
     ) -> Option<Film> {
         let n = width as usize * height as usize;
-        if sum.len() != n || count.len() != n {
+        if sum.len() != n || count.len() != n || !(splat.is_empty() || splat.len() == n) {
             return None;
         }
         Some(Film {
@@ -123,8 +136,36 @@ impl Film {
             height,
             sum,
             count,
+            splat,
             ..Film::new(0, 0)
         })
+    }
+
+    /// Adds a splat sum to pixel `i` (pbrt-v4's `AddSplat`; the film keeps a splat buffer from
+    /// the first one on). Integer sums: the order splats arrive in does not matter.
+    pub fn add_splat(&mut self, i: usize, sum: &RadianceSum) {
+        if self.splat.is_empty() {
+            self.splat = vec![RadianceSum::ZERO; self.sum.len()];
+        }
+        self.splat[i].merge(sum);
+    }
+
+    /// The per-pixel splat sums, row-major; empty if nothing was splatted.
+    pub fn splats(&self) -> &[RadianceSum] {
+        &self.splat
+    }
+
+    /// What a splat sum is multiplied by in a pixel's value: one over the camera samples per
+    /// pixel taken over the whole image (pbrt-v4's `splatScale`), as their total over the
+    /// pixel count, so that an interrupted render, whose pixels hold different counts, scales
+    /// its splats by the samples actually taken (each camera sample traced one light path).
+    fn splat_scale(&self) -> f64 {
+        let total = self.total_samples();
+        if total == 0 {
+            0.0
+        } else {
+            self.sum.len() as f64 / total as f64
+        }
     }
 
     #[inline]
@@ -137,6 +178,16 @@ impl Film {
         let i = self.index(x, y);
         self.sum[i].add(radiance);
         self.count[i] += 1;
+    }
+
+    /// Adds another film's sums, counts and splats (merging parts).
+    pub fn merge(&mut self, other: &Film) {
+        for (i, (sum, n)) in other.sums().iter().zip(other.counts()).enumerate() {
+            self.add_pixel(i, sum, *n);
+        }
+        for (i, s) in other.splats().iter().enumerate() {
+            self.add_splat(i, s);
+        }
     }
 
     /// Adds a pixel's accumulated sum and count (used when merging tiles and parts).
@@ -173,27 +224,34 @@ impl Film {
     }
 
     /// Pixel value: the mean of its samples, each pixel divided by its own count (an
-    /// interrupted render has pixels with different counts); black without samples.
+    /// interrupted render has pixels with different counts; black without samples), plus its
+    /// splat sum times [`Film::splat_scale`].
     pub fn pixel(&self, x: u32, y: u32) -> Rgb {
-        self.pixel_at(self.index(x, y))
+        self.pixel_at(self.index(x, y), self.splat_scale())
     }
 
-    fn pixel_at(&self, i: usize) -> Rgb {
+    fn pixel_at(&self, i: usize, splat_scale: f64) -> Rgb {
         let n = self.count[i];
-        if n == 0 {
-            return Rgb::ZERO;
+        let mut v = [0.0f64; 3];
+        if n > 0 {
+            let s = self.sum[i].to_f64();
+            v = s.map(|s| s / n as f64);
         }
-        let s = self.sum[i].to_f64();
-        Rgb::new(
-            (s[0] / n as f64) as f32,
-            (s[1] / n as f64) as f32,
-            (s[2] / n as f64) as f32,
-        )
+        if let Some(splat) = self.splat.get(i) {
+            let s = splat.to_f64();
+            for c in 0..3 {
+                v[c] += s[c] * splat_scale;
+            }
+        }
+        Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32)
     }
 
     /// All pixels, row-major from the top-left.
     pub fn pixels(&self) -> Vec<Rgb> {
-        (0..self.sum.len()).map(|i| self.pixel_at(i)).collect()
+        let scale = self.splat_scale();
+        (0..self.sum.len())
+            .map(|i| self.pixel_at(i, scale))
+            .collect()
     }
 
     /// Mean of all pixel values.
@@ -448,6 +506,39 @@ mod tests {
             assert_eq!(ToneMap::from_name(name).unwrap().name(), name);
         }
         assert_eq!(ToneMap::from_name("aces"), None);
+    }
+
+    /// A pixel is its mean sample plus its splat sum over the camera samples per pixel of the
+    /// whole film, taken as they were: an interrupted render (pixels with different counts)
+    /// scales its splats by the samples it took, and merged films add exactly.
+    #[test]
+    fn splats_are_scaled_by_the_samples_taken() {
+        let mut film = Film::new(2, 1);
+        let sum = |v: f32| {
+            let mut s = RadianceSum::ZERO;
+            s.add(Rgb::splat(v));
+            s
+        };
+        // Pixel 0 took 4 samples, pixel 1 only 2 (interrupted): 3 per pixel on average.
+        film.add_pixel(0, &sum(2.0), 4);
+        film.add_pixel(1, &sum(1.0), 2);
+        assert_eq!(film.pixel(1, 0), Rgb::splat(0.5));
+        film.add_splat(0, &sum(0.75));
+        film.add_splat(1, &sum(1.5));
+        assert_eq!(film.pixel(0, 0), Rgb::splat(0.5 + 0.25));
+        assert_eq!(film.pixel(1, 0), Rgb::splat(0.5 + 0.5));
+        // Two such films merged: sums, counts and splats add; the image is the same.
+        let mut merged = Film::new(2, 1);
+        merged.merge(&film);
+        merged.merge(&film);
+        assert_eq!(merged.pixels(), film.pixels());
+        assert_eq!(merged.splats()[1], {
+            let mut s = sum(1.5);
+            s.merge(&sum(1.5));
+            s
+        });
+        // A film without splats has no splat buffer.
+        assert!(Film::new(2, 1).splats().is_empty());
     }
 
     #[test]

@@ -101,6 +101,64 @@ impl FilterSampler {
         -self.radius + (i as f32 + t as f32) * (2.0 * self.radius / PIECES as f32)
     }
 
+    /// How far (pixels) outside the image the camera samples of its edge pixels reach: the
+    /// filter's radius past the pixel's half width. Light paths connected to the camera count
+    /// in that margin too ([`crate::camera::Camera::sample_wi`]), so that the edge pixels'
+    /// splats cover what their camera samples see.
+    pub fn margin(&self) -> f32 {
+        (self.radius - 0.5).max(0.0)
+    }
+
+    /// The density of `sample_1d`'s offset `x` (piecewise constant, as tabulated).
+    fn pdf_1d(&self, x: f32) -> f32 {
+        if x.abs() >= self.radius {
+            return 0.0;
+        }
+        if self.filter == Filter::Box {
+            return 1.0;
+        }
+        let width = 2.0 * self.radius / PIECES as f32;
+        let i = (((x + self.radius) / width) as usize).min(PIECES - 1);
+        ((self.cdf[i + 1] - self.cdf[i]) / width as f64) as f32
+    }
+
+    /// The density (per unit film area, pixels^-2) with which [`FilterSampler::film_position`]
+    /// places a camera sample of pixel (x, y) at `film`: the filter h_xy(film) each camera
+    /// sample of the pixel estimates the image with. The box filter's is 1 inside the pixel.
+    pub fn pdf(&self, x: u32, y: u32, film: Vec2) -> f32 {
+        match self.filter {
+            Filter::Box => (film.x.floor() == x as f32 && film.y.floor() == y as f32) as u8 as f32,
+            _ => {
+                let d = film - Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+                self.pdf_1d(d.x) * self.pdf_1d(d.y)
+            }
+        }
+    }
+
+    /// Calls `f(x, y, h)` for every pixel of a `width` x `height` image whose filter covers the
+    /// film point `film`, with h = [`FilterSampler::pdf`] > 0: where a contribution found at
+    /// `film` by a path from the lights (a splat) lands. A pixel's value is the integral of
+    /// the image weighted by h; its camera samples estimate it by drawing positions with
+    /// density h (weight one each), a splat by weighting with h: the same pixel value, so the
+    /// two kinds of estimate add up (and MIS may weigh them against each other). With the box
+    /// filter a splat lands in the one pixel `film` lies in.
+    pub fn footprint(&self, film: Vec2, width: u32, height: u32, mut f: impl FnMut(u32, u32, f32)) {
+        let r = self.radius;
+        let range = |c: f32, n: u32| {
+            let lo = ((c - 0.5 - r).ceil() as i64).max(0);
+            let hi = ((c + r - 0.5).floor() as i64).min(n as i64 - 1);
+            lo..=hi
+        };
+        for y in range(film.y, height) {
+            for x in range(film.x, width) {
+                let h = self.pdf(x as u32, y as u32, film);
+                if h > 0.0 {
+                    f(x as u32, y as u32, h);
+                }
+            }
+        }
+    }
+
     /// Where in pixel (x, y) a camera sample goes, in film coordinates, from two uniform
     /// numbers. The box filter is the uniform jitter (x + u.x, y + u.y), exactly.
     #[inline]
@@ -109,6 +167,79 @@ impl FilterSampler {
         match self.filter {
             Filter::Box => corner + u,
             _ => corner + Vec2::splat(0.5) + Vec2::new(self.sample_1d(u.x), self.sample_1d(u.y)),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The density integrates to one over the pixel's support, matches a histogram of the
+    /// positions `film_position` draws, and `footprint` finds every pixel with h > 0.
+    #[test]
+    fn filter_density_matches_its_samples() {
+        for filter in [
+            Filter::Box,
+            Filter::Tent { radius: 1.5 },
+            Filter::Gaussian { stddev: 0.5 },
+        ] {
+            let fs = FilterSampler::new(filter.clone());
+            let (x, y) = (5u32, 7u32);
+            let r = fs.radius;
+            // Riemann sum over the support.
+            let steps = 400;
+            let cell = 2.0 * r / steps as f32;
+            let mut total = 0.0f64;
+            for i in 0..steps {
+                for j in 0..steps {
+                    let p = Vec2::new(
+                        x as f32 + 0.5 - r + (i as f32 + 0.5) * cell,
+                        y as f32 + 0.5 - r + (j as f32 + 0.5) * cell,
+                    );
+                    total += (fs.pdf(x, y, p) * cell * cell) as f64;
+                }
+            }
+            assert!((total - 1.0).abs() < 1e-3, "{filter:?}: {total}");
+            // Histogram of offsets along x against the 1-D density.
+            let mut rng = crate::sampling::Rng::new(&[11]);
+            let bins = 10;
+            let mut hist = vec![0u32; bins];
+            let n = 200_000;
+            for _ in 0..n {
+                let p = fs.film_position(x, y, rng.next_2d());
+                let d = p.x - (x as f32 + 0.5);
+                let b = (((d + r) / (2.0 * r)) * bins as f32) as usize;
+                hist[b.min(bins - 1)] += 1;
+            }
+            for (b, &h) in hist.iter().enumerate() {
+                let w = 2.0 * r / bins as f32;
+                let mut want = 0.0;
+                for k in 0..100 {
+                    let d = -r + (b as f32 + (k as f32 + 0.5) / 100.0) * w;
+                    want += fs.pdf_1d(d) * w / 100.0;
+                }
+                let got = h as f32 / n as f32;
+                let sigma = (want * (1.0 - want) / n as f32).sqrt();
+                assert!(
+                    (got - want).abs() < 5.0 * sigma + 1e-4,
+                    "{filter:?} bin {b}: {got} vs {want}"
+                );
+            }
+            // Every pixel around a point, by brute force, against the footprint.
+            let film = Vec2::new(3.3, 2.9);
+            let mut found = Vec::new();
+            fs.footprint(film, 8, 6, |px, py, h| found.push((px, py, h)));
+            let mut want = Vec::new();
+            for py in 0..6 {
+                for px in 0..8 {
+                    let h = fs.pdf(px, py, film);
+                    if h > 0.0 {
+                        want.push((px, py, h));
+                    }
+                }
+            }
+            assert_eq!(found, want, "{filter:?}");
         }
     }
 }

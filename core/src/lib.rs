@@ -39,7 +39,7 @@ pub mod value;
 pub mod walk;
 
 pub use error::{Error, Result};
-pub use glam::Vec3;
+pub use glam::{Vec2, Vec3};
 
 /// Linear RGB radiometric quantity (radiance, flux, reflectance...).
 pub type Rgb = glam::Vec3;

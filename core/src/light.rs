@@ -94,6 +94,15 @@ pub struct EmittedRay {
     /// Le cos / (pdf_pos pdf_dir): the flux carried by one emitted sample (before dividing by
     /// the number of samples and the light-selection probability).
     pub flux: Rgb,
+    /// What leaves along `dir`: radiance (area lights, lights at infinity: per unit area of
+    /// the disc they are emitted from; for a directional light, its irradiance) or intensity
+    /// (point and spot lights).
+    pub le: Rgb,
+    /// The densities of the sample, as [`Light::pdf_le`] gives them: of the origin (per unit
+    /// area; 1 for a point or spot light) and of the direction (per solid angle; 1 for a
+    /// directional light, whose direction is fixed).
+    pub pdf_pos: f32,
+    pub pdf_dir: f32,
 }
 
 /// The cone of directions a sphere subtends from a point outside it: sin^2 and 1 - cos of its
@@ -450,6 +459,9 @@ impl Light {
                 dir: crate::sampling::uniform_sphere(u_dir),
                 n: Vec3::ZERO,
                 flux: 4.0 * PI * *intensity,
+                le: *intensity,
+                pdf_pos: 1.0,
+                pdf_dir: crate::sampling::UNIFORM_SPHERE_PDF,
             },
             Light::Spot {
                 position,
@@ -467,6 +479,9 @@ impl Light {
                     dir,
                     n: Vec3::ZERO,
                     flux: *intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
+                    le: *intensity * falloff,
+                    pdf_pos: 1.0,
+                    pdf_dir: 1.0 / (2.0 * PI * (1.0 - cos_max)),
                 }
             }
             Light::Directional {
@@ -479,6 +494,9 @@ impl Light {
                 dir: *direction,
                 n: Vec3::ZERO,
                 flux: *irradiance * (PI * radius * radius),
+                le: *irradiance,
+                pdf_pos: 1.0 / (PI * radius * radius),
+                pdf_dir: 1.0,
             },
             Light::Constant {
                 radiance,
@@ -493,6 +511,9 @@ impl Light {
                     dir,
                     n: Vec3::ZERO,
                     flux: *radiance * (4.0 * PI * PI * radius * radius),
+                    le: *radiance,
+                    pdf_pos: 1.0 / (PI * radius * radius),
+                    pdf_dir: crate::sampling::UNIFORM_SPHERE_PDF,
                 }
             }
             Light::Envmap {
@@ -502,15 +523,18 @@ impl Light {
             } => {
                 // A direction by the map's density, then a uniform point of the disc facing
                 // it: L / (pdf_dir / (pi R^2)) (pbrt's ImageInfiniteLight::SampleLe).
-                let (dir, flux) = match map.sample(u_dir) {
-                    Some((wi, li, pdf)) => (-wi, li * (PI * radius * radius / pdf)),
-                    None => (-Vec3::Z, Rgb::ZERO),
+                let (dir, flux, le, pdf_dir) = match map.sample(u_dir) {
+                    Some((wi, li, pdf)) => (-wi, li * (PI * radius * radius / pdf), li, pdf),
+                    None => (-Vec3::Z, Rgb::ZERO, Rgb::ZERO, 0.0),
                 };
                 EmittedRay {
                     origin: disc_origin(dir, *centre, *radius, u_pos),
                     dir,
                     n: Vec3::ZERO,
                     flux,
+                    le,
+                    pdf_pos: 1.0 / (PI * radius * radius),
+                    pdf_dir,
                 }
             }
             Light::Area {
@@ -529,9 +553,52 @@ impl Light {
                     n,
                     // L cos / (1/A * cos/pi) = pi A L
                     flux: PI * *area * *radiance,
+                    le: *radiance,
+                    pdf_pos: 1.0 / *area,
+                    pdf_dir: local.z * std::f32::consts::FRAC_1_PI,
                 }
             }
         }
+    }
+
+    /// The densities with which [`Light::sample_emission`] emits a ray along `dir` (unit) from
+    /// a point with normal `n` on the light (pbrt-v4's `PDF_Le`): (per unit area of where it
+    /// starts, per solid angle of its direction). A point or spot light's position is a delta
+    /// (1); a directional light's direction is (1). A light at infinity starts its rays on the
+    /// disc of the scene's bounding sphere facing `dir`, whatever the origin. Zero for what
+    /// the light never emits (behind an area light, outside a spot's cone).
+    pub fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
+        match self {
+            Light::Point { .. } => (1.0, crate::sampling::UNIFORM_SPHERE_PDF),
+            Light::Spot { axis, cutoff, .. } => {
+                let cos_max = cutoff.cos();
+                let pdf = if axis.dot(dir) > cos_max {
+                    1.0 / (2.0 * PI * (1.0 - cos_max))
+                } else {
+                    0.0
+                };
+                (1.0, pdf)
+            }
+            Light::Directional { radius, .. } => (1.0 / (PI * radius * radius), 1.0),
+            Light::Constant { radius, .. } => (
+                1.0 / (PI * radius * radius),
+                crate::sampling::UNIFORM_SPHERE_PDF,
+            ),
+            Light::Envmap { map, radius, .. } => (1.0 / (PI * radius * radius), map.pdf(-dir)),
+            Light::Area { area, .. } => (
+                1.0 / *area,
+                n.dot(dir).max(0.0) * std::f32::consts::FRAC_1_PI,
+            ),
+        }
+    }
+
+    /// Whether the light is infinitely far (directional, constant, environment map): its
+    /// rays start on the scene's bounding disc, and a distance to it means nothing.
+    pub fn is_infinite(&self) -> bool {
+        matches!(
+            self,
+            Light::Directional { .. } | Light::Constant { .. } | Light::Envmap { .. }
+        )
     }
 }
 
@@ -558,4 +625,132 @@ fn towards(x: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
     }
     let dist = dist2.sqrt();
     Some((d / dist, dist, dist2))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sampling::{Rng, uniform_sphere};
+
+    fn lights() -> Vec<(&'static str, Light)> {
+        let mut out = vec![
+            (
+                "point",
+                Light::Point {
+                    position: Vec3::new(0.1, 0.2, 0.3),
+                    intensity: Rgb::new(1.0, 2.0, 3.0),
+                },
+            ),
+            (
+                "spot",
+                Light::Spot {
+                    position: Vec3::ZERO,
+                    axis: Vec3::new(0.3, -1.0, 0.2).normalize(),
+                    intensity: Rgb::splat(2.0),
+                    beam_width: 0.3,
+                    cutoff: 0.6,
+                },
+            ),
+            (
+                "directional",
+                Light::Directional {
+                    direction: Vec3::new(0.2, -1.0, 0.1).normalize(),
+                    irradiance: Rgb::splat(3.0),
+                    centre: Vec3::ONE,
+                    radius: 2.0,
+                },
+            ),
+            (
+                "constant",
+                Light::Constant {
+                    radiance: Rgb::splat(0.5),
+                    centre: Vec3::ZERO,
+                    radius: 3.0,
+                },
+            ),
+        ];
+        let quad = Shape::quad(
+            Vec3::new(-0.5, 1.0, -0.5),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.0, 0.0, 1.0),
+        );
+        let tri = Shape::Triangle {
+            p0: Vec3::ZERO,
+            e1: Vec3::X,
+            e2: Vec3::new(0.3, 0.0, 2.0),
+        };
+        let mut inward = Shape::sphere(Vec3::new(0.0, 2.0, 0.0), 0.5);
+        inward.flip();
+        for (name, shapes) in [
+            ("area quad", vec![quad]),
+            ("area quad + triangle", vec![quad, tri]),
+            ("area sphere", vec![Shape::sphere(Vec3::ZERO, 0.7)]),
+            ("area inward sphere", vec![inward]),
+            (
+                "area disk",
+                vec![Shape::disk(Vec3::ZERO, Vec3::X * 0.4, Vec3::Z * 0.4)],
+            ),
+        ] {
+            out.push((name, area_light(shapes, Rgb::new(2.0, 1.0, 0.5), 0)));
+        }
+        out
+    }
+
+    /// `sample_emission` reports the densities `pdf_le` gives for its ray, and its flux is
+    /// Le cos / (pdf_pos pdf_dir).
+    #[test]
+    fn emission_pdfs_match_the_samples() {
+        let mut rng = Rng::new(&[3]);
+        for (name, light) in lights() {
+            for _ in 0..2000 {
+                let e = light.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+                let (pos, dir) = light.pdf_le(e.n, e.dir);
+                assert!(
+                    (pos - e.pdf_pos).abs() <= 1e-5 * pos,
+                    "{name}: {pos} {}",
+                    e.pdf_pos
+                );
+                assert!(
+                    (dir - e.pdf_dir).abs() <= 2e-4 * dir,
+                    "{name}: {dir} {}",
+                    e.pdf_dir
+                );
+                let cos = if e.n == Vec3::ZERO {
+                    1.0
+                } else {
+                    e.n.dot(e.dir)
+                };
+                if e.pdf_dir > 0.0 {
+                    let flux = e.le * (cos / (e.pdf_pos * e.pdf_dir));
+                    assert!(
+                        (flux - e.flux).abs().max_element() <= 1e-3 * e.flux.max_element(),
+                        "{name}: {flux} {}",
+                        e.flux
+                    );
+                }
+            }
+        }
+    }
+
+    /// The direction density integrates to one over the sphere (Monte Carlo with uniform
+    /// directions), from any point of an area light; and the emitted power it implies,
+    /// the integral of Le cos over directions and area, is `power()`.
+    #[test]
+    fn emission_direction_pdfs_integrate_to_one() {
+        let mut rng = Rng::new(&[5]);
+        let n = 200_000;
+        for (name, light) in lights() {
+            if matches!(light, Light::Directional { .. }) {
+                continue; // a delta direction
+            }
+            let e = light.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+            let mut sum = 0.0f64;
+            for _ in 0..n {
+                let w = uniform_sphere(rng.next_2d());
+                sum += light.pdf_le(e.n, w).1 as f64;
+            }
+            let integral = sum * 4.0 * std::f64::consts::PI / n as f64;
+            assert!((integral - 1.0).abs() < 0.02, "{name}: {integral}");
+        }
+    }
 }

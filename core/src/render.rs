@@ -7,6 +7,17 @@
 //! n takes the samples [spp i / n, spp (i + 1) / n) of every pixel) sums to the whole render.
 //! Ctrl-C stops between pixels: every pixel keeps the samples it has and is divided by its own
 //! count.
+//!
+//! **Splats.** An integrator that also traces paths from the lights ([`render_pixels_splatting`])
+//! adds what they bring to the camera to any pixel ([`Splats::add`]). Each tile keeps its splats
+//! as exact fixed-point sums ([`RadianceSum`]) in a short list and adds them to one image-sized
+//! splat buffer under a lock when the list fills and when the tile ends. Integer addition is
+//! associative and commutative, so the buffer holds the same bits whatever order the tiles and
+//! threads add in: the image stays bit-identical for any thread count (a per-thread buffer
+//! would too, at one image of memory per thread; floating-point atomics would not). A tile's
+//! splats come from the camera samples of the pixels it finished, so after Ctrl-C the splat
+//! buffer holds the light paths of exactly the samples the film counts, and the film scales it
+//! by those ([`Film::pixel`]).
 
 use crate::Rgb;
 use crate::error::{Error, Result};
@@ -15,7 +26,9 @@ use crate::geometry::Ray;
 use crate::integrator::RenderContext;
 use crate::sampling::Sampler;
 use crate::scene::{RenderSettings, Scene};
+use glam::Vec2;
 use rayon::prelude::*;
+use std::sync::Mutex;
 use std::sync::atomic::{AtomicU64, Ordering};
 
 pub const TILE: u32 = 16;
@@ -44,6 +57,63 @@ pub fn pixel_sampler(
     Sampler::new(settings.sampler, settings.seed, pixel, sample, settings.spp)
 }
 
+/// One camera sample as the pixel loop draws it.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelSample {
+    pub ray: Ray,
+    /// The pixel it estimates.
+    pub x: u32,
+    pub y: u32,
+    /// Where on the film the ray starts (pixel units), drawn from the reconstruction filter.
+    pub film: Vec2,
+    /// The filter's density at `film` for this pixel ([`crate::filter::FilterSampler::pdf`]).
+    pub filter_pdf: f32,
+}
+
+/// Where a render's light paths add what they bring to the camera (see the module comment).
+pub struct Splats<'a> {
+    width: u32,
+    pending: Vec<(u32, RadianceSum)>,
+    buffer: Option<&'a Mutex<Vec<RadianceSum>>>,
+    bad: u64,
+}
+
+/// Splats a tile keeps before it adds them to the shared buffer.
+const SPLAT_BATCH: usize = 4096;
+
+impl Splats<'_> {
+    /// Adds `value` to pixel (x, y)'s splat sum. The film multiplies the sum by one over the
+    /// camera samples per pixel ([`Film::pixel`]): a splat is one light path's estimate of
+    /// the pixel, scaled as a camera sample's radiance is. A value that is not [`usable`] is
+    /// dropped (and counted in the render's warning).
+    #[inline]
+    pub fn add(&mut self, x: u32, y: u32, value: Rgb) {
+        if !usable(value) {
+            self.bad += 1;
+            return;
+        }
+        if value == Rgb::ZERO {
+            return;
+        }
+        let mut sum = RadianceSum::ZERO;
+        sum.add(value);
+        self.pending.push((y * self.width + x, sum));
+        if self.pending.len() >= SPLAT_BATCH {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        if let Some(buffer) = self.buffer {
+            let mut buffer = buffer.lock().unwrap_or_else(|e| e.into_inner());
+            for (i, sum) in self.pending.drain(..) {
+                buffer[i as usize].merge(&sum);
+            }
+        }
+        self.pending.clear();
+    }
+}
+
 /// Renders `scene.render.spp` samples per pixel, or the share of them `ctx.part` names;
 /// `radiance` estimates the radiance arriving along a camera ray and adds the rays it traced to
 /// its last argument (for statistics). The film position is drawn from the scene's
@@ -51,6 +121,34 @@ pub fn pixel_sampler(
 pub fn render_pixels<F>(scene: &Scene, ctx: &RenderContext<'_>, radiance: F) -> Result<Film>
 where
     F: Fn(&Ray, &mut Sampler, &mut u64) -> Rgb + Sync,
+{
+    render_loop(scene, ctx, false, |sample, sampler, _, rays| {
+        radiance(&sample.ray, sampler, rays)
+    })
+}
+
+/// [`render_pixels`] for an integrator that also splats (light tracing, bidirectional path
+/// tracing): `radiance` gets the whole camera sample and a [`Splats`] to add contributions to
+/// any pixel, and returns the camera sample's own estimate. The film then has a splat buffer.
+pub fn render_pixels_splatting<F>(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    radiance: F,
+) -> Result<Film>
+where
+    F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut u64) -> Rgb + Sync,
+{
+    render_loop(scene, ctx, true, radiance)
+}
+
+fn render_loop<F>(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    splatting: bool,
+    radiance: F,
+) -> Result<Film>
+where
+    F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut u64) -> Rgb + Sync,
 {
     let (width, height) = (scene.film.width, scene.film.height);
     let share = ctx.part.share(scene.render.spp as u64);
@@ -61,7 +159,13 @@ where
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
     let bad_samples = AtomicU64::new(0);
+    let bad_splats = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
+    let splat_buffer = Mutex::new(if splatting {
+        vec![RadianceSum::ZERO; width as usize * height as usize]
+    } else {
+        Vec::new()
+    });
     ctx.progress.begin(
         "pixels",
         width as u64 * height as u64 * (spp - first) as u64,
@@ -73,6 +177,7 @@ where
             ctx.part, scene.render.spp, scene.render.spp
         ));
     }
+    let filter = &scene.film.filter;
     let mut done = first;
     while done < spp && !ctx.cancelled() {
         let batch = (done - first).max(1).min(spp - done);
@@ -83,6 +188,12 @@ where
                 .map(|&(x0, y0)| {
                     let mut out = Vec::with_capacity((TILE * TILE) as usize);
                     let mut tile_rays = 0u64;
+                    let mut splats = Splats {
+                        width,
+                        pending: Vec::new(),
+                        buffer: splatting.then_some(&splat_buffer),
+                        bad: 0,
+                    };
                     for y in y0..(y0 + TILE).min(height) {
                         if ctx.cancelled() {
                             break;
@@ -91,9 +202,16 @@ where
                             let mut sum = RadianceSum::ZERO;
                             for s in s0..s1 {
                                 let mut sampler = pixel_sampler(&scene.render, width, x, y, s);
-                                let at = scene.film.filter.film_position(x, y, sampler.next_2d());
-                                let ray = scene.camera.generate_ray(at);
-                                let mut l = radiance(&ray, &mut sampler, &mut tile_rays);
+                                let at = filter.film_position(x, y, sampler.next_2d());
+                                let sample = PixelSample {
+                                    ray: scene.camera.generate_ray(at),
+                                    x,
+                                    y,
+                                    film: at,
+                                    filter_pdf: filter.pdf(x, y, at),
+                                };
+                                let mut l =
+                                    radiance(&sample, &mut sampler, &mut splats, &mut tile_rays);
                                 if !usable(l) {
                                     bad_samples.fetch_add(1, Ordering::Relaxed);
                                     l = Rgb::ZERO;
@@ -103,6 +221,8 @@ where
                             out.push((film.index(x, y), sum, s1 - s0));
                         }
                     }
+                    splats.flush();
+                    bad_splats.fetch_add(splats.bad, Ordering::Relaxed);
                     rays.fetch_add(tile_rays, Ordering::Relaxed);
                     ctx.progress.rays(tile_rays);
                     ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
@@ -116,12 +236,24 @@ where
         done = s1;
     }
     ctx.progress.finish();
+    if splatting {
+        let buffer = splat_buffer.into_inner().unwrap_or_else(|e| e.into_inner());
+        for (i, sum) in buffer.iter().enumerate() {
+            film.add_splat(i, sum);
+        }
+    }
     film.rays = rays.load(Ordering::Relaxed);
     warn_unusable(
         ctx,
         bad_samples.load(Ordering::Relaxed),
         "sample(s)",
         "replaced by zero",
+    );
+    warn_unusable(
+        ctx,
+        bad_splats.load(Ordering::Relaxed),
+        "splat(s)",
+        "dropped",
     );
     Ok(film)
 }

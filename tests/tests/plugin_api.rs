@@ -15,6 +15,7 @@ const API_HISTORY: &[(u32, &str)] = &[
     (2, "89a1756a6d9e7e27"),
     (3, "d7d1a31965b3deb3"),
     (4, "4ec6c05c6b1adb2a"),
+    (5, "4340326f85839737"),
 ];
 
 /// The code of a Rust file: comments (`//` to the end of the line, outside strings) and

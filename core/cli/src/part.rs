@@ -5,7 +5,10 @@
 //! `N` (u32) and, per colour channel, the film's fixed-point sum (an i128,
 //! [`RadianceSum`]) as four u32 words `sum.R.0` (least significant) to `sum.R.3`. Integer sums
 //! add associatively, so the merged sums, and the image made from them, are bit for bit those
-//! of the render done in one process. The header carries what decides whether parts belong
+//! of the render done in one process. A film with splats (light paths connected to the camera,
+//! `bdpt`) stores its splat sums the same way, `splat.R.0` to `splat.B.3`: they are added
+//! apart from the pixels' own sums, and the merged image scales them by the samples of all the
+//! parts together, as the render in one process does (`Film::pixel`). The header carries what decides whether parts belong
 //! together (attributes `foton.*`, below): the scene's content hash, the integrator with its
 //! parameters, the seed, the build of foton, the part I/N, and how much of its share the part
 //! did (an interrupted part says so).
@@ -28,7 +31,9 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// The version of the part file layout (attribute `foton.format`).
-pub const FORMAT: &str = "foton-part 1";
+/// 2 added the splat channels: a foton that read only format 1 would merge a splatting part
+/// without its splats, so format 1 parts are refused (render them again).
+pub const FORMAT: &str = "foton-part 2";
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
@@ -121,7 +126,10 @@ impl PartInfo {
         if format != FORMAT {
             return Err(Error::io(
                 path,
-                format!("a part in format `{format}`; this foton reads `{FORMAT}`"),
+                format!(
+                    "a part in format `{format}`; this foton reads `{FORMAT}` (parts written by \
+                     another version of foton cannot be merged: render them again)"
+                ),
             ));
         }
         let field = |key: &str| {
@@ -262,6 +270,22 @@ pub fn write_part(
             ));
         }
     }
+    for (c, name) in CHANNELS.iter().enumerate() {
+        if film.splats().is_empty() {
+            break;
+        }
+        for word in 0..4 {
+            let words = film
+                .splats()
+                .iter()
+                .map(|s| (s.0[c] >> (32 * word)) as u32)
+                .collect();
+            channels.push(AnyChannel::new(
+                format!("splat.{name}.{word}").as_str(),
+                FlatSamples::U32(words),
+            ));
+        }
+    }
     channels.push(AnyChannel::new(
         "N",
         FlatSamples::U32(film.counts().to_vec()),
@@ -362,7 +386,24 @@ pub fn read_part_film(path: &Path, info: &PartInfo) -> FotonResult<Film> {
         }
     }
     let counts = channel("N")?.clone();
-    Film::from_sums(info.width, info.height, sums, counts)
+    let has_splats = layer
+        .channel_data
+        .list
+        .iter()
+        .any(|c| c.name.bytes().starts_with(b"splat."));
+    let mut splats = Vec::new();
+    if has_splats {
+        splats = vec![RadianceSum::ZERO; n];
+        for (c, name) in CHANNELS.iter().enumerate() {
+            for word in 0..4 {
+                let words = channel(&format!("splat.{name}.{word}"))?;
+                for (s, &w) in splats.iter_mut().zip(words) {
+                    s.0[c] |= ((w as u128) << (32 * word)) as i128;
+                }
+            }
+        }
+    }
+    Film::from_sums(info.width, info.height, sums, counts, splats)
         .ok_or_else(|| Error::io(path, "damaged part: channels of the wrong size"))
 }
 
@@ -446,9 +487,7 @@ pub(super) fn run(
     let mut film = Film::new(f.width, f.height);
     for (path, info) in parts.values() {
         let part = read_part_film(path, info)?;
-        for (i, (sum, n)) in part.sums().iter().zip(part.counts()).enumerate() {
-            film.add_pixel(i, sum, *n);
-        }
+        film.merge(&part);
     }
     film.write(&a.output, &f.display())?;
     if !missing.is_empty() {

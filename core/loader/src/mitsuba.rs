@@ -1032,12 +1032,12 @@ impl Reader {
                 }
             }
             "bdpt" => {
-                self.ignored(
-                    &mut o,
-                    "light_image",
-                    &|p| matches!(p, Prop::Bool(false)),
-                    "ignored (no light image: foton's bdpt adds no light-tracing image)",
-                );
+                // lightImage = false: no strategy connects light paths to the camera.
+                if !o.boolean("light_image", true)? {
+                    params.push(("light_image", Value::Bool(false)));
+                }
+                // sampleDirect changes how often next-event strategies are taken, not the
+                // image: foton's bdpt takes every strategy once per camera sample.
                 self.ignored(
                     &mut o,
                     "sample_direct",

@@ -15,7 +15,7 @@ use std::ffi::{CStr, c_char};
 
 /// Version of the integrator plugin interface (bumped on any change of the declaration or of
 /// the traits that cross the boundary).
-pub const PLUGIN_API_VERSION: u32 = 4;
+pub const PLUGIN_API_VERSION: u32 = 5;
 /// Version of the C kernel interface.
 pub const KERNEL_API_VERSION: u32 = 1;
 
