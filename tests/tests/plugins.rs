@@ -91,7 +91,10 @@ fn the_panicking_fixture_is_not_found_beside_the_real_plugins() {
         .map(|p| p.name.clone())
         .collect();
     names.sort();
-    assert_eq!(names, ["bdpt", "normals", "path", "photon", "ppb", "sppm", "vpm"]);
+    assert_eq!(
+        names,
+        ["bdpt", "normals", "path", "photon", "ppb", "sppm", "vpm"]
+    );
     let built = plugin_dir().join(format!(
         "{}panicky_fixture{}",
         std::env::consts::DLL_PREFIX,
