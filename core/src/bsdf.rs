@@ -110,6 +110,27 @@ pub enum Lobe {
     RoughPlastic(RoughPlastic),
 }
 
+/// The diffuse lobe's f |cos theta_i| from the cosines of `wo` and `wi` with the normal:
+/// both on one side, and that side the front unless `twosided`.
+#[inline]
+fn diffuse_eval(reflectance: Rgb, twosided: bool, cos_o: f32, cos_i: f32) -> Rgb {
+    if cos_o * cos_i > 0.0 && (twosided || cos_o > 0.0) {
+        reflectance * (FRAC_1_PI * cos_i.abs())
+    } else {
+        Rgb::ZERO
+    }
+}
+
+/// The diffuse lobe's pdf (cosine-weighted), as [`diffuse_eval`].
+#[inline]
+fn diffuse_pdf(twosided: bool, cos_o: f32, cos_i: f32) -> f32 {
+    if cos_o * cos_i > 0.0 && (twosided || cos_o > 0.0) {
+        cos_i.abs() * FRAC_1_PI
+    } else {
+        0.0
+    }
+}
+
 #[inline]
 fn reflect_local(w: Vec3) -> Vec3 {
     Vec3::new(-w.x, -w.y, w.z)
@@ -136,13 +157,7 @@ impl Lobe {
             Lobe::Diffuse {
                 reflectance,
                 twosided,
-            } => {
-                if wo.z * wi.z > 0.0 && (twosided || wo.z > 0.0) {
-                    reflectance * (FRAC_1_PI * wi.z.abs())
-                } else {
-                    Rgb::ZERO
-                }
-            }
+            } => diffuse_eval(reflectance, twosided, wo.z, wi.z),
             Lobe::RoughConductor(l) => l.eval(wo, wi, TransportMode::Radiance),
             Lobe::RoughDielectric(l) => l.eval(wo, wi, TransportMode::Radiance),
             Lobe::Plastic(l) => l.eval(wo, wi, TransportMode::Radiance),
@@ -155,9 +170,7 @@ impl Lobe {
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match *self {
-            Lobe::Diffuse { twosided, .. } if wo.z * wi.z > 0.0 && (twosided || wo.z > 0.0) => {
-                wi.z.abs() * FRAC_1_PI
-            }
+            Lobe::Diffuse { twosided, .. } => diffuse_pdf(twosided, wo.z, wi.z),
             Lobe::RoughConductor(l) => l.pdf(wo, wi),
             Lobe::RoughDielectric(l) => l.pdf(wo, wi),
             Lobe::Plastic(l) => l.pdf(wo, wi),
@@ -304,6 +317,16 @@ impl Bsdf {
         self.lobe.is_delta()
     }
 
+    /// The cosines of `wo` and `wi` with the shading normal, for a lobe that needs nothing
+    /// else of the frame (the diffuse lobe is isotropic and flat: eval and pdf depend on the
+    /// directions' z alone). Two dot products instead of the six of [`Bsdf::local`]: most
+    /// surfaces of most scenes are diffuse, and each path vertex evaluates them once per
+    /// light sample. `twosided` mirroring is left to the lobe (its own flag).
+    #[inline]
+    fn cosines(&self, wo: Vec3, wi: Vec3) -> (f32, f32) {
+        (wo.dot(self.frame.n), wi.dot(self.frame.n))
+    }
+
     /// `wo` and `wi` in the local frame, both mirrored to the upper side for a two-sided
     /// BSDF seen from below.
     #[inline]
@@ -319,6 +342,14 @@ impl Bsdf {
     /// f(wo, wi) |cos theta_i| (radiance: the cosine from the shading normal).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        if let Lobe::Diffuse {
+            reflectance,
+            twosided,
+        } = self.lobe
+        {
+            let (cos_o, cos_i) = self.cosines(wo, wi);
+            return diffuse_eval(reflectance, twosided || self.twosided, cos_o, cos_i);
+        }
         let (wo, wi) = self.local(wo, wi);
         self.lobe.eval(wo, wi)
     }
@@ -338,6 +369,18 @@ impl Bsdf {
     /// directions taken to the local frame once.
     #[inline]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        if let Lobe::Diffuse {
+            reflectance,
+            twosided,
+        } = self.lobe
+        {
+            let (cos_o, cos_i) = self.cosines(wo, wi);
+            let twosided = twosided || self.twosided;
+            return (
+                diffuse_eval(reflectance, twosided, cos_o, cos_i),
+                diffuse_pdf(twosided, cos_o, cos_i),
+            );
+        }
         let (wo, wi) = self.local(wo, wi);
         (self.lobe.eval(wo, wi), self.lobe.pdf(wo, wi))
     }
@@ -345,6 +388,10 @@ impl Bsdf {
     /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        if let Lobe::Diffuse { twosided, .. } = self.lobe {
+            let (cos_o, cos_i) = self.cosines(wo, wi);
+            return diffuse_pdf(twosided || self.twosided, cos_o, cos_i);
+        }
         let (wo, wi) = self.local(wo, wi);
         self.lobe.pdf(wo, wi)
     }
@@ -353,7 +400,12 @@ impl Bsdf {
     /// shading-normal correction (module comment).
     #[inline]
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<BsdfSample> {
-        let mut local_wo = self.frame.to_local(wo);
+        // The diffuse lobe reads only wo's cosine (see `Bsdf::cosines`).
+        let mut local_wo = if let Lobe::Diffuse { .. } = self.lobe {
+            Vec3::new(0.0, 0.0, wo.dot(self.frame.n))
+        } else {
+            self.frame.to_local(wo)
+        };
         let below = self.twosided && local_wo.z < 0.0;
         if below {
             local_wo.z = -local_wo.z;
@@ -414,6 +466,46 @@ mod tests {
         }
         let f = Frame::from_normal_tangent(Vec3::Z, Vec3::new(2.0, 0.0, 1.0));
         assert!((f.s - Vec3::X).length() < 1e-6);
+    }
+
+    /// The diffuse lobe's shortcut (cosines with the normal, no local frame) gives exactly
+    /// what the lobe gives in the local frame, from both sides, one- and two-sided.
+    #[test]
+    fn diffuse_shortcut_matches_the_local_frame() {
+        let mut rng = crate::sampling::Rng::new(&[7]);
+        let mut dir = || crate::sampling::uniform_sphere(rng.next_2d());
+        for twosided_lobe in [false, true] {
+            for twosided in [false, true] {
+                let n = dir();
+                let bsdf = Bsdf {
+                    lobe: Lobe::Diffuse {
+                        reflectance: Rgb::new(0.7, 0.4, 0.2),
+                        twosided: twosided_lobe,
+                    },
+                    frame: Frame::from_normal_tangent(n, dir()),
+                    ng: n,
+                    twosided,
+                };
+                for _ in 0..200 {
+                    let (wo, wi) = (dir(), dir());
+                    let (lo, li) = bsdf.local(wo, wi);
+                    let (f, pdf) = bsdf.eval_pdf(wo, wi);
+                    assert_eq!(f, bsdf.lobe.eval(lo, li));
+                    assert_eq!(pdf, bsdf.lobe.pdf(lo, li));
+                    assert_eq!(bsdf.eval(wo, wi), f);
+                    assert_eq!(bsdf.pdf(wo, wi), pdf);
+                    // A sampled direction's weight and pdf are those eval and pdf give it.
+                    let u = Vec2::new(0.37, 0.81);
+                    if let Some(s) = bsdf.sample(wo, u, 0.5, TransportMode::Radiance) {
+                        let (f, pdf) = bsdf.eval_pdf(wo, s.wi);
+                        assert!((s.pdf - pdf).abs() < 1e-5, "{} {pdf}", s.pdf);
+                        assert!((s.weight * s.pdf - f).abs().max_element() < 1e-5);
+                    } else {
+                        assert_eq!(bsdf.pdf(wo, wo), 0.0);
+                    }
+                }
+            }
+        }
     }
 
     #[test]

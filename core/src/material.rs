@@ -331,7 +331,13 @@ impl Material {
     /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
     #[inline]
     pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
-        let at = |t: &Texture| t.eval(sp.uv);
+        // Constant colours without the call: `Texture::eval` is too large to be inlined, and
+        // most colours of most scenes are constants (a call per colour per hit cost about 1%
+        // of the path tracer's instructions on the Cornell box).
+        let at = |t: &Texture| match t {
+            Texture::Constant(c) => *c,
+            _ => t.eval(sp.uv),
+        };
         let lobe = match self {
             Material::Diffuse {
                 reflectance,

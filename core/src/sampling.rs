@@ -132,6 +132,8 @@ impl Sampler {
 
     /// As [`Sampler::new`], with the independent stream keyed by `keys` (integrators that
     /// separate their streams with an extra key, as `sppm`'s camera pass does).
+    // Inlined so that the hash over the keys unrolls for the caller's fixed number of keys.
+    #[inline]
     pub fn with_keys(
         kind: SamplerKind,
         keys: &[u64],

@@ -369,6 +369,11 @@ impl Scene {
         if self.lights.is_empty() || self.light_distribution.total() <= 0.0 {
             return None;
         }
+        // One light (most test scenes, every Cornell box): no search of the distribution,
+        // which was a call per path vertex.
+        if self.lights.len() == 1 {
+            return Some((0, self.light_distribution.pmf(0)));
+        }
         Some(self.light_distribution.sample(u))
     }
 

@@ -69,7 +69,18 @@ impl Scene {
     /// volumes touching, a volume sharing a face with its container) are crossed together:
     /// every such boundary through the point is found, and the innermost one entered wins, or
     /// if none is entered, the outermost one left.
+    #[inline]
     pub fn medium_after(&self, hit: &Hit, dir: Vec3, current: Option<u32>) -> Option<u32> {
+        // Without media no surface is an interface: no call per bounce (about 1.5% of the path
+        // tracer's instructions on the Cornell box).
+        if !self.has_media {
+            return current;
+        }
+        self.medium_across(hit, dir, current)
+    }
+
+    /// [`Scene::medium_after`] in a scene with media.
+    fn medium_across(&self, hit: &Hit, dir: Vec3, current: Option<u32>) -> Option<u32> {
         let object = self.primitive(hit).object as usize;
         let Some(own) = self.interfaces[object] else {
             return current;
