@@ -28,7 +28,7 @@ def test_dicts_merge_key_by_key():
     assert scene.integrator == "photon"
     assert scene.parameters["k"] == 7
     # Merged: the other keys of the table stay.
-    assert scene.parameters["global_photons"] == 200000
+    assert scene.parameters["global_photons"] == 1000000
 
 
 def test_dotted_keys_and_dicts_make_the_same_scene():
@@ -87,7 +87,7 @@ def test_params_go_to_the_scenes_integrator_by_default():
     a = scene.render(spp=1, params={"k": 5}, progress=False)
     assert "k = 5" in scene.last_render["integrator"]
     b = scene.render(spp=1, progress=False)
-    assert "k = 50" in scene.last_render["integrator"]
+    assert "k = 200" in scene.last_render["integrator"]
     assert not np.array_equal(a, b)
 
 
