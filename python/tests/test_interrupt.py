@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import faulthandler
 import os
 import signal
 import sys
@@ -23,8 +24,22 @@ def long_render_scene():
     return foton.load(BOX, **{"film.width": 64, "film.height": 48})
 
 
+@pytest.fixture(autouse=True)
+def no_hang():
+    """A render that a lost signal leaves running ends the test process with every thread's
+    traceback after a minute, instead of hanging CI."""
+    faulthandler.dump_traceback_later(60, exit=True)
+    yield
+    faulthandler.cancel_dump_traceback_later()
+
+
 def sigint_after(seconds: float) -> threading.Timer:
-    """SIGINT to this process from another thread, as a terminal's Ctrl-C would send it."""
+    """SIGINT to this process from another thread, as a terminal's Ctrl-C would send it.
+
+    Python's own SIGINT handler is installed first: a process started in the background by a
+    shell without job control (`cmd &` in a script, nohup) inherits SIGINT ignored, Python then
+    keeps it ignored, and the signal would never reach the render (the test hung that way)."""
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     timer = threading.Timer(seconds, os.kill, (os.getpid(), signal.SIGINT))
     timer.start()
     return timer
