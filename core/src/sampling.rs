@@ -204,13 +204,17 @@ impl Sampler {
         (p, (key >> 32) as u32)
     }
 
-    /// [`shuffled_index`] of the sample's index with `seed`, from the reversed index kept in
-    /// the sampler: the two scrambles share their outer bit reversal (it is linear over xor),
-    /// which leaves one reversal where there were four. The same bits; the Sobol sampler's
-    /// cost is mostly these reversals (x86 has no instruction for them).
+    /// The low 24 bits of [`shuffled_index`] of the sample's index with `seed`, from the
+    /// reversed index kept in the sampler: the two scrambles share their outer bit reversal
+    /// (it is linear over xor), which leaves one reversal where there were four. The Sobol
+    /// sampler's cost is mostly these reversals (x86 has no instruction for them). Only the
+    /// low 24 bits of the index matter: a point keeps the top 24 bits of its 32-bit fraction
+    /// ([`unit_f32`]), which are the low 24 of what the scramble hashes (bit-reversed), and each
+    /// bit of the hash depends only on the bits below it; the Sobol matrices' reversed columns
+    /// past 23 have no bits below 24.
     #[inline]
     fn sobol_index(&self, seed: u32) -> u32 {
-        (laine_karras(self.index_reversed, seed) ^ laine_karras(0, seed)).reverse_bits()
+        reverse_24(laine_karras(self.index_reversed, seed) ^ laine_karras(0, seed))
     }
 
     fn next_1d_structured(&mut self) -> f32 {
@@ -225,7 +229,7 @@ impl Sampler {
                 // = owen_scramble(sobol_dimension(i, 0), seed): dimension 0 reverses the
                 // index's bits and the scramble reverses them back before hashing.
                 let i = self.sobol_index(key as u32);
-                unit_f32(laine_karras(i, (key >> 32) as u32).reverse_bits())
+                reversed_unit_f32(laine_karras(i, (key >> 32) as u32))
             }
         }
     }
@@ -258,8 +262,8 @@ impl Sampler {
                 // owen_scramble(sobol_dimension(i, d), s) with the bit reversals that cancel
                 // left out (see `sobol_dimension_reversed`).
                 Vec2::new(
-                    unit_f32(laine_karras(i, sx).reverse_bits()),
-                    unit_f32(laine_karras(sobol_dimension_reversed(i, 1), sy).reverse_bits()),
+                    reversed_unit_f32(laine_karras(i, sx)),
+                    reversed_unit_f32(laine_karras(sobol_dimension_reversed(i, 1), sy)),
                 )
             }
         }
@@ -433,6 +437,31 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 #[inline]
 pub fn shuffled_index(index: u32, seed: u32) -> u32 {
     owen_scramble(index, seed) ^ owen_scramble(0, seed)
+}
+
+/// Bit reversal of each byte, for [`reverse_24`].
+static REVERSED_BYTES: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).reverse_bits();
+        i += 1;
+    }
+    t
+};
+
+/// `x.reverse_bits() & 0xFF_FFFF`: the top 24 bits of `x` reversed, by three byte lookups
+/// (cheaper than the 32-bit reversal's shifts and masks).
+#[inline]
+fn reverse_24(x: u32) -> u32 {
+    let r = |shift: u32| REVERSED_BYTES[((x >> shift) & 0xFF) as usize] as u32;
+    r(24) | (r(16) << 8) | (r(8) << 16)
+}
+
+/// `unit_f32(y.reverse_bits())`: the float of the reversal of `y`'s low 24 bits.
+#[inline]
+fn reversed_unit_f32(y: u32) -> f32 {
+    reverse_24(y << 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A 32-bit fraction as a float in [0, 1).
@@ -718,6 +747,11 @@ mod tests {
                 assert_eq!(
                     laine_karras(i, s).reverse_bits(),
                     owen_scramble(sobol_dimension(i, 0), s)
+                );
+                assert_eq!(reverse_24(s), s.reverse_bits() & 0xFF_FFFF);
+                assert_eq!(
+                    reversed_unit_f32(s).to_bits(),
+                    unit_f32(s.reverse_bits()).to_bits()
                 );
             }
         }
