@@ -116,6 +116,8 @@ pub struct Sampler {
     pixel_key: u64,
     /// The sample's index within its pixel.
     index: u32,
+    /// `index` with its bits reversed (`sobol` only; see [`Sampler::sobol_index`]).
+    index_reversed: u32,
     /// Samples the pixel takes in all (strata per dimension).
     spp: u32,
     /// The next dimension to hand out.
@@ -152,6 +154,7 @@ impl Sampler {
                 splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
             },
             index,
+            index_reversed: index.reverse_bits(),
             spp: spp.max(1),
             dimension: 0,
         }
@@ -201,6 +204,19 @@ impl Sampler {
         (p, (key >> 32) as u32)
     }
 
+    /// The low 24 bits of [`shuffled_index`] of the sample's index with `seed`, from the
+    /// reversed index kept in the sampler: the two scrambles share their outer bit reversal
+    /// (it is linear over xor), which leaves one reversal where there were four. The Sobol
+    /// sampler's cost is mostly these reversals (x86 has no instruction for them). Only the
+    /// low 24 bits of the index matter: a point keeps the top 24 bits of its 32-bit fraction
+    /// ([`unit_f32`]), which are the low 24 of what the scramble hashes (bit-reversed), and each
+    /// bit of the hash depends only on the bits below it; the Sobol matrices' reversed columns
+    /// past 23 have no bits below 24.
+    #[inline]
+    fn sobol_index(&self, seed: u32) -> u32 {
+        reverse_24(laine_karras(self.index_reversed, seed) ^ laine_karras(0, seed))
+    }
+
     fn next_1d_structured(&mut self) -> f32 {
         let key = self.dimension_key();
         match self.kind {
@@ -210,8 +226,10 @@ impl Sampler {
                 ((stratum as f32 + offset) / self.spp as f32).min(ONE_MINUS_EPSILON)
             }
             _ => {
-                let i = shuffled_index(self.index, key as u32);
-                unit_f32(owen_scramble(sobol_dimension(i, 0), (key >> 32) as u32))
+                // = owen_scramble(sobol_dimension(i, 0), seed): dimension 0 reverses the
+                // index's bits and the scramble reverses them back before hashing.
+                let i = self.sobol_index(key as u32);
+                reversed_unit_f32(laine_karras(i, (key >> 32) as u32))
             }
         }
     }
@@ -239,11 +257,13 @@ impl Sampler {
                 // independent of one another and each is as well stratified as the first.
                 // One 64-bit hash gives the three 32-bit seeds (the third by an odd multiplier:
                 // the scramble's hash needs distinct seeds, not independent bits).
-                let i = shuffled_index(self.index, key as u32);
+                let i = self.sobol_index(key as u32);
                 let (sx, sy) = ((key >> 32) as u32, (key >> 16) as u32 ^ 0x9E37_79B9);
+                // owen_scramble(sobol_dimension(i, d), s) with the bit reversals that cancel
+                // left out (see `sobol_dimension_reversed`).
                 Vec2::new(
-                    unit_f32(owen_scramble(sobol_dimension(i, 0), sx)),
-                    unit_f32(owen_scramble(sobol_dimension(i, 1), sy)),
+                    reversed_unit_f32(laine_karras(i, sx)),
+                    reversed_unit_f32(laine_karras(sobol_dimension_reversed(i, 1), sy)),
                 )
             }
         }
@@ -362,6 +382,35 @@ pub fn sobol_dimension(mut index: u32, dimension: usize) -> u32 {
     x
 }
 
+/// The generator matrices with each column's bits reversed: by linearity over xor,
+/// `sobol_dimension_reversed(i, d)` is `sobol_dimension(i, d).reverse_bits()`, which is what
+/// Owen scrambling hashes, without reversing at run time.
+static SOBOL_MATRICES_REVERSED: [[u32; 32]; SOBOL_DIMENSIONS] = {
+    let mut m = SOBOL_MATRICES;
+    let mut d = 0;
+    while d < SOBOL_DIMENSIONS {
+        let mut k = 0;
+        while k < 32 {
+            m[d][k] = m[d][k].reverse_bits();
+            k += 1;
+        }
+        d += 1;
+    }
+    m
+};
+
+/// [`sobol_dimension`] with its bits reversed (see [`SOBOL_MATRICES_REVERSED`]).
+#[inline]
+fn sobol_dimension_reversed(mut index: u32, dimension: usize) -> u32 {
+    let matrix = &SOBOL_MATRICES_REVERSED[dimension];
+    let mut x = 0;
+    while index != 0 {
+        x ^= matrix[index.trailing_zeros() as usize];
+        index &= index - 1;
+    }
+    x
+}
+
 /// Laine and Karras' hash, improved by Vegdahl ("Building a better LK hash", 2021): a
 /// permutation of 32-bit numbers in which each bit depends only on the bits below it.
 #[inline]
@@ -388,6 +437,31 @@ pub fn owen_scramble(x: u32, seed: u32) -> u32 {
 #[inline]
 pub fn shuffled_index(index: u32, seed: u32) -> u32 {
     owen_scramble(index, seed) ^ owen_scramble(0, seed)
+}
+
+/// Bit reversal of each byte, for [`reverse_24`].
+static REVERSED_BYTES: [u8; 256] = {
+    let mut t = [0u8; 256];
+    let mut i = 0;
+    while i < 256 {
+        t[i] = (i as u8).reverse_bits();
+        i += 1;
+    }
+    t
+};
+
+/// `x.reverse_bits() & 0xFF_FFFF`: the top 24 bits of `x` reversed, by three byte lookups
+/// (cheaper than the 32-bit reversal's shifts and masks).
+#[inline]
+fn reverse_24(x: u32) -> u32 {
+    let r = |shift: u32| REVERSED_BYTES[((x >> shift) & 0xFF) as usize] as u32;
+    r(24) | (r(16) << 8) | (r(8) << 16)
+}
+
+/// `unit_f32(y.reverse_bits())`: the float of the reversal of `y`'s low 24 bits.
+#[inline]
+fn reversed_unit_f32(y: u32) -> f32 {
+    reverse_24(y << 8) as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A 32-bit fraction as a float in [0, 1).
@@ -657,6 +731,51 @@ impl Distribution2D {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The Sobol sampler's shortened arithmetic gives the points of the plain composition
+    /// `owen_scramble(sobol_dimension(shuffled_index(index, s), d), s')`.
+    #[test]
+    fn sobol_sampler_matches_the_plain_composition() {
+        let mut rng = Rng::new(&[7]);
+        for d in 0..SOBOL_DIMENSIONS {
+            for _ in 0..2000 {
+                let (i, s) = (rng.next_u32() >> (rng.next_u32() % 32), rng.next_u32());
+                assert_eq!(
+                    sobol_dimension_reversed(i, d),
+                    sobol_dimension(i, d).reverse_bits()
+                );
+                assert_eq!(
+                    laine_karras(i, s).reverse_bits(),
+                    owen_scramble(sobol_dimension(i, 0), s)
+                );
+                assert_eq!(reverse_24(s), s.reverse_bits() & 0xFF_FFFF);
+                assert_eq!(
+                    reversed_unit_f32(s).to_bits(),
+                    unit_f32(s.reverse_bits()).to_bits()
+                );
+            }
+        }
+        for spp in [1, 5, 64, 1000] {
+            for index in (0..3 * spp).step_by(7) {
+                let mut sampler = Sampler::new(SamplerKind::Sobol, 3, 12345, index, spp);
+                let mut plain = sampler.clone();
+                for dim in 0..20 {
+                    let key = plain.dimension_key();
+                    let i = shuffled_index(index, key as u32);
+                    let (sx, sy) = ((key >> 32) as u32, (key >> 16) as u32 ^ 0x9E37_79B9);
+                    if dim % 3 == 0 {
+                        let x = unit_f32(owen_scramble(sobol_dimension(i, 0), sx));
+                        assert_eq!(sampler.next_f32().to_bits(), x.to_bits());
+                    } else {
+                        let x = unit_f32(owen_scramble(sobol_dimension(i, 0), sx));
+                        let y = unit_f32(owen_scramble(sobol_dimension(i, 1), sy));
+                        let u = sampler.next_2d();
+                        assert_eq!((u.x.to_bits(), u.y.to_bits()), (x.to_bits(), y.to_bits()));
+                    }
+                }
+            }
+        }
+    }
 
     #[test]
     fn distribution_never_picks_zero_weight() {

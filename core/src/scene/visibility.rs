@@ -143,6 +143,9 @@ impl Scene {
 
     /// Whether the segment between two surface points is blocked by anything but null
     /// boundaries. The ends are offset along their normals (a zero normal: no offset).
+    // Inlined: the shadow ray's set-up is a few vector operations on values the caller has in
+    // registers, and a call per shadow ray cost 6 % of the path tracer's instructions.
+    #[inline]
     pub fn occluded(&self, p0: Vec3, n0: Vec3, p1: Vec3, n1: Vec3) -> bool {
         let (from, to) = shadow_ends(p0, n0, p1, n1);
         let seg = to - from;
