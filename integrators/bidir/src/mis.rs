@@ -243,6 +243,26 @@ mod tests {
     /// computed by brute force from the full path densities.
     #[test]
     fn the_weights_of_all_strategies_of_a_path_sum_to_one() {
+        check_weights(None);
+    }
+
+    /// The same with merging (`vcm`): the connections and the merges at every vertex x_1 ...
+    /// x_{k-1} (a camera subpath x0..x_i merged with a light subpath x_k..x_i, of density the
+    /// connection's times eta_VCM p_light(x_i), tech. rep. section 4) of every path share one,
+    /// each its power-heuristic share, for merges of little and of much weight.
+    #[test]
+    fn the_weights_of_all_connections_and_merges_of_a_path_sum_to_one() {
+        for eta in [0.05f32, 1.3, 40.0] {
+            check_weights(Some(eta));
+        }
+    }
+
+    /// `eta`: eta_VCM = pi r^2 N of the merges (None: connections only).
+    fn check_weights(eta: Option<f32>) {
+        let f = eta.map_or(Factors::CONNECT, |e| Factors {
+            vm: mis(e),
+            vc: mis(1.0 / e),
+        });
         let camera = Camera::new(
             Vec3::new(0.0, 1.0, 4.0),
             Vec3::new(0.0, 1.0, 0.0),
@@ -313,7 +333,10 @@ mod tests {
                     let light: f64 = rev[t..=k].iter().map(|&p| p as f64).product();
                     camera * light
                 };
-                let total: f64 = (0..=k).map(|s| density(s).powi(2)).sum();
+                // The merge at x_i (1 <= i < k): x_i sampled from both sides, counted eta times.
+                let merge = |i: usize| density(k - i) * rev[i] as f64 * eta.unwrap_or(0.0) as f64;
+                let total: f64 = (0..=k).map(|s| density(s).powi(2)).sum::<f64>()
+                    + (1..k).map(|i| merge(i).powi(2)).sum::<f64>();
 
                 // The running quantities along the camera subpath (x1 .. x_{k-1}).
                 let mut cam = vec![Running::default(); k + 1];
@@ -328,7 +351,7 @@ mod tests {
                             diffuse_pdf(ns[i], wi),
                             diffuse_pdf(ns[i], wo),
                             false,
-                            &Factors::CONNECT,
+                            &f,
                         );
                     }
                 }
@@ -336,7 +359,7 @@ mod tests {
                 let mut lig = vec![Running::default(); k + 1];
                 let cos_light = cos(k, dir(k, k - 1));
                 let emission = pick / area * diffuse_pdf(ns[k], dir(k, k - 1));
-                let mut r = Running::light(emission, cos_light, false, &Factors::CONNECT);
+                let mut r = Running::light(emission, cos_light, false, &f);
                 lig[k] = Running {
                     d_vcm: mis(area / pick),
                     d_vc: 0.0,
@@ -355,7 +378,7 @@ mod tests {
                             diffuse_pdf(ns[i], wi),
                             diffuse_pdf(ns[i], wo),
                             false,
-                            &Factors::CONNECT,
+                            &f,
                         );
                     }
                 }
@@ -378,7 +401,10 @@ mod tests {
                         } else {
                             diffuse_pdf(ns[1], dir(1, 2))
                         };
-                        weight_to_camera(&Factors::CONNECT, &lig[1], camera_pdf, rev_pdf)
+                        // The light's own point seen by the camera (k = 1) is no stored vertex: no
+                        // merge builds that path (the integrator's `splat_origin`).
+                        let f = if k == 1 { Factors::CONNECT } else { f };
+                        weight_to_camera(&f, &lig[1], camera_pdf, rev_pdf)
                     } else if s == 1 {
                         // Next-event estimation from x_{k-1} to x_k.
                         let c = k - 1;
@@ -388,7 +414,7 @@ mod tests {
                         let emission = pick / area * diffuse_pdf(ns[k], -wi);
                         let ratio = emission * cos(c, wi) / (direct_w * cos(k, wi));
                         weight_direct(
-                            &Factors::CONNECT,
+                            &f,
                             &cam[c],
                             scatter_pdf,
                             direct_w,
@@ -401,7 +427,7 @@ mod tests {
                         let d = dir(c, l);
                         let dd = d2(c, l);
                         weight_connect(
-                            &Factors::CONNECT,
+                            &f,
                             &cam[c],
                             &lig[l],
                             diffuse_pdf(ns[c], d) * cos(l, d) / dd,
@@ -413,13 +439,28 @@ mod tests {
                     let want = density(s).powi(2) / total;
                     assert!(
                         (w as f64 - want).abs() < 2e-3 * want.max(1e-3),
-                        "k = {k}, (s, t) = ({s}, {t}): weight {w} vs power heuristic {want}"
+                        "eta {eta:?}, k = {k}, (s, t) = ({s}, {t}): weight {w} vs power heuristic {want}"
+                    );
+                    sum += w as f64;
+                }
+                for i in (1..k).filter(|_| eta.is_some()) {
+                    let w = weight_merge(
+                        &f,
+                        &cam[i],
+                        &lig[i],
+                        diffuse_pdf(ns[i], dir(i, i + 1)),
+                        diffuse_pdf(ns[i], dir(i, i - 1)),
+                    );
+                    let want = merge(i).powi(2) / total;
+                    assert!(
+                        (w as f64 - want).abs() < 2e-3 * want.max(1e-3),
+                        "eta {eta:?}, k = {k}, merge at x_{i}: weight {w} vs power heuristic {want}"
                     );
                     sum += w as f64;
                 }
                 assert!(
                     (sum - 1.0).abs() < 2e-3,
-                    "k = {k}: the weights sum to {sum}"
+                    "eta {eta:?}, k = {k}: the weights sum to {sum}"
                 );
             }
         }
