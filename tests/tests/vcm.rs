@@ -241,6 +241,40 @@ fn vcm_agrees_with_path_on_a_caustic() {
     assert_blocks_agree("vcm against path, caustic", &film, &path, 4, tolerance);
 }
 
+/// `hide_emitters` as `path` renders it (camera rays pass through emitters until they first
+/// scatter): the ceiling light and a white emitting sphere in the middle of the view hidden,
+/// the wall behind the sphere seen through it.
+#[test]
+fn vcm_hides_emitters_as_path_does() {
+    let scene = cornell("white", "glass").replace(
+        "emission = [5.0, 5.0, 5.0]",
+        "emission = [5.0, 5.0, 5.0]\n\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 1.0, 0.2]\nradius = 0.2\nmaterial = \"white\"\nemission = [4.0, 4.0, 4.0]",
+    );
+    let radius = 0.02;
+    let hide = "render.hide_emitters=true".to_string();
+    let path = render(&scene, "path", &["render.spp=4096".into(), hide.clone()]);
+    let film = render(
+        &scene,
+        "vcm",
+        &[
+            "integrators.vcm.iterations=256".into(),
+            format!("integrators.vcm.radius={radius}"),
+            hide,
+        ],
+    );
+    let tolerance = Tolerance {
+        rel: merge_bias(radius, BLOCK),
+        ..Z
+    };
+    assert_blocks_agree(
+        "vcm against path, hide_emitters",
+        &film,
+        &path,
+        4,
+        tolerance,
+    );
+}
+
 /// The same image bit for bit (pixel sums, counts and splat sums) on 1, 2 and 3 threads.
 #[test]
 fn vcm_is_the_same_for_any_thread_count() {
@@ -318,8 +352,7 @@ fn vcm_parts_merge_to_the_whole_render() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Media (merging is on surfaces only), bad parameters and hide_emitters are refused with the
-/// reason; for media, the integrators that render them are named.
+/// Media (merging is on surfaces only) and bad parameters are refused with the reason; for media, the integrators that render them are named.
 #[test]
 fn vcm_refuses_what_it_does_not_render() {
     foton_tests::assert_refused(
@@ -337,7 +370,6 @@ fn vcm_refuses_what_it_does_not_render() {
             ("integrators.vcm.radius=0", "radius"),
             ("integrators.vcm.alpha=1.5", "alpha"),
             ("integrators.vcm.iterations=0", "iterations"),
-            ("render.hide_emitters=true", "hide_emitters"),
         ],
     );
 }

@@ -53,8 +53,12 @@
 //! around the pinhole (a vertex at distance d contributes as 1 / d^2); the full estimator
 //! weights it away there.
 //!
-//! Not supported, refused with an error: `hide_emitters` (light paths connected to the camera
-//! would be blocked by emitters that camera rays pass through).
+//! `hide_emitters` (Mitsuba's, as `path` renders it): camera rays pass through emitters until
+//! they first scatter, so the s = 0, t = 2 strategy never meets one; the light's own point is
+//! not splatted (s = 1, t = 1), and a light vertex's connection to the camera (t = 1) passes
+//! through emitters as the camera ray would and is not made from a point on an emitter (the
+//! camera sees through those). Refused with participating media (that connection would have to
+//! carry the media's transmittance past the emitters).
 //!
 //! The subpaths, the connections and their MIS quantities live in `foton-bidir`
 //! (integrators/bidir), which `vcm` shares: this crate reads the parameters and runs core's
@@ -102,10 +106,11 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let light_image = props.bool("light_image", true)?;
     let strategy = Strategy::parse(props.string("strategy", "all")?)
         .map_err(|e| props.error("strategy", e))?;
-    if scene.render.hide_emitters {
+    if scene.render.hide_emitters && scene.has_media() {
         return Err(Error::Usage(format!(
-            "{}: `bdpt` does not render with hide_emitters (light paths connected to the camera \
-             would be blocked by the emitters camera rays pass through): use `path`",
+            "{}: `bdpt` does not render hide_emitters in a scene with participating media \
+             (a light path connected to the camera would have to pass emitters and media as a \
+             camera ray does): use `path`",
             scene.file.display()
         )));
     }

@@ -625,9 +625,15 @@ impl Bidir {
         if f == Rgb::ZERO {
             return;
         }
-        *rays += 1;
-        let medium = v.medium_towards(scene, cs.wi);
-        let tr = scene.transmittance(v.p, v.ng(), camera.position, Vec3::ZERO, medium);
+        let tr = if scene.render.hide_emitters {
+            // Camera rays pass through emitters until they first scatter: so does this
+            // connection, the camera subpath's first segment seen from its other end.
+            Rgb::splat(seen_past_emitters(scene, v, rays) as u8 as f32)
+        } else {
+            *rays += 1;
+            let medium = v.medium_towards(scene, cs.wi);
+            scene.transmittance(v.p, v.ng(), camera.position, Vec3::ZERO, medium)
+        };
         if tr == Rgb::ZERO {
             return;
         }
@@ -656,7 +662,9 @@ impl Bidir {
         splats: &mut impl SplatSink,
         rays: &mut u64,
     ) {
-        if self.weight(1, 1, || 1.0) == 0.0 {
+        // With hide_emitters the camera does not see emitters directly (their s = 0, t = 2
+        // twin never happens either: camera rays pass through them).
+        if self.weight(1, 1, || 1.0) == 0.0 || scene.render.hide_emitters {
             return;
         }
         let camera = &scene.camera;
@@ -819,4 +827,39 @@ pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
             })
         })
         .collect()
+}
+
+/// Whether light vertex `v` is seen from the pinhole by a camera ray that passes through
+/// emitters (`hide_emitters`, core's `RayWalk::camera`): what it meets before `v` is all null
+/// boundaries or emitters, and `v` is not on an emitter itself (the camera sees through those).
+/// Surfaces only: `hide_emitters` with media is refused.
+fn seen_past_emitters(scene: &Scene, v: &Vertex, rays: &mut u64) -> bool {
+    let At::Surface { hit: vh, .. } = &v.at else {
+        return false;
+    };
+    if scene.object(vh).light.is_some() {
+        return false;
+    }
+    let origin = scene.camera.position;
+    let to = v.p - origin;
+    let dist = to.length();
+    let mut walk = RayWalk::camera(scene, Ray::new(origin, to / dist));
+    loop {
+        let seg = walk.segment(scene, rays);
+        let Some(hit) = seg.hit else {
+            return false;
+        };
+        match walk.reach(scene, &hit) {
+            // The first surface that scatters must be v's: its primitive, near v (each
+            // crossing offsets the ray a little off the line, which moves the hit at grazing
+            // angles, so a tolerance of a few parts per thousand of the distance).
+            Reached::Surface(_) => {
+                return hit.prim == vh.prim
+                    && std::ptr::eq(scene.object(&hit), scene.object(vh))
+                    && hit.p.distance_squared(v.p) <= (5e-3 * dist).powi(2);
+            }
+            Reached::Ended => return false,
+            Reached::Crossed => {}
+        }
+    }
 }

@@ -53,8 +53,9 @@
 //! of iterations, no `time`) and `foton merge` adds the parts exactly. Ctrl-C drops the
 //! iteration under way: the image holds whole iterations.
 //!
-//! **Not supported**, refused with an error: participating media (`bdpt` and `vpm` render them)
-//! and `hide_emitters`.
+//! `hide_emitters` as `bdpt` (camera rays pass through emitters until they first scatter, and
+//! so do light vertices' connections to the camera). **Not supported**, refused with an error:
+//! participating media (`bdpt` and `vpm` render them).
 
 pub mod grid;
 
@@ -575,13 +576,6 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `vcm` does not render (merging is on \
              surfaces only): use `bdpt` or `vpm`",
-            scene.file.display()
-        )));
-    }
-    if scene.render.hide_emitters {
-        return Err(Error::Usage(format!(
-            "{}: `vcm` does not render with hide_emitters (light paths connected to the camera \
-             would be blocked by the emitters camera rays pass through): use `path`",
             scene.file.display()
         )));
     }
