@@ -5,7 +5,7 @@
 //!
 //! * the subpath vertex ([`Vertex`]) and the random walk of both subpaths (camera and light)
 //!   with the running MIS quantities of Georgiev et al.'s implementation notes (module
-//!   [`mis`]: `d_vcm`, `d_vc`, `d_vm`);
+//!   [`mis`](mod@mis): `d_vcm`, `d_vc`, `d_vm`);
 //! * the connection strategies of Veach's bidirectional path tracer: s = 0 (the camera subpath
 //!   reaches an emitter), s = 1 (next-event estimation), t = 1 (a light vertex connected to the
 //!   pinhole and splatted), s, t >= 2 (a light vertex connected with a camera vertex), each

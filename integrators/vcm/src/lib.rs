@@ -42,7 +42,10 @@
 //! **Modes** (SmallVCM's): `bpt` keeps only connections (the estimator of `bdpt`, with one
 //! light path per camera sample); `ppm` keeps only merges: the camera subpath passes through
 //! delta vertices to its first connectable one and merges there, unweighted, and emitters count
-//! only when seen directly or through delta vertices (direct light comes from merging too);
+//! only when seen directly or through delta vertices (direct light comes from merging too).
+//! As SmallVCM's, it cannot split a material with both a delta and a non-delta part (the
+//! smooth coat of `plastic`): the camera path stops at such a surface and merges with its
+//! non-delta part alone, leaving out what the coat reflects; `vcm` mode renders it all;
 //! `lt` splats the light subpaths' vertices alone (`bdpt`'s `strategy = "light"`).
 //!
 //! **Determinism and parts.** Iteration i's light subpath of pixel p and its camera sample
