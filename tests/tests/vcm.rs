@@ -373,3 +373,41 @@ fn vcm_refuses_what_it_does_not_render() {
         ],
     );
 }
+
+/// Cancelling a render (what Ctrl-C does) keeps whole iterations: the film it returns is, bit
+/// for bit, the render of that many iterations (every pixel counts them all, and the splats
+/// are those of the same light paths), never one with part of an iteration.
+#[test]
+fn a_cancelled_vcm_render_is_a_whole_number_of_iterations() {
+    use foton_core::integrator::{NoProgress, RenderContext};
+    use std::sync::atomic::{AtomicBool, Ordering};
+    let dir = temp_dir("vcm-cancel");
+    let file = write(&dir, "scene.toml", &cornell("glass", "white"));
+    let prepare = |iterations: u64| {
+        let sets = [
+            "render.integrator=\"vcm\"".to_string(),
+            format!("integrators.vcm.iterations={iterations}"),
+        ];
+        foton_cli::prepare(&file, &sets, &[foton_tests::plugin_dir()], true).unwrap()
+    };
+    let long = prepare(1_000_000);
+    let cancel = AtomicBool::new(false);
+    let film = std::thread::scope(|s| {
+        s.spawn(|| {
+            std::thread::sleep(std::time::Duration::from_millis(700));
+            cancel.store(true, Ordering::SeqCst);
+        });
+        let ctx = RenderContext::new(2, &cancel, &NoProgress);
+        long.integrator.render(&long.scene, &ctx).unwrap()
+    });
+    let n = film.iterations;
+    assert!(n >= 1, "no iteration in 0.7 s");
+    assert!(film.counts().iter().all(|&c| c as u64 == n));
+    let whole = prepare(n);
+    let never = AtomicBool::new(false);
+    let ctx = RenderContext::new(1, &never, &NoProgress);
+    let reference = whole.integrator.render(&whole.scene, &ctx).unwrap();
+    assert_eq!(film.sums(), reference.sums(), "{n} iterations");
+    assert_eq!(film.splats(), reference.splats(), "{n} iterations");
+    let _ = std::fs::remove_dir_all(&dir);
+}
