@@ -5,8 +5,9 @@
 //!   direct light too);
 //! * the full estimator agrees with `bdpt` on a diffuse box and with `path` on a caustic one (a
 //!   glass sphere over a diffuse floor, lit by an area light the path tracer can hit);
-//! * the image is the same bit for bit for any thread count, and parts merge to the whole
-//!   render exactly;
+//! * with `hide_emitters` it agrees with `path` rendering the same;
+//! * the image is the same bit for bit for any thread count, parts merge to the whole render
+//!   exactly, and a cancelled render keeps whole iterations;
 //! * a scene with participating media is refused with the integrators that render it.
 //!
 //! Block means are compared within z standard errors of the pixel-wise difference
