@@ -527,9 +527,30 @@ fn bdpt_refuses_what_it_does_not_render() {
                 "expected \"all\", \"light\" or \"s,t\"",
             ),
             ("integrators.bdpt.strategy=\"1,x\"", "strategy"),
-            ("render.hide_emitters=true", "hide_emitters"),
         ],
     );
+    foton_tests::assert_refused(
+        "scenes/cornell-fog.toml",
+        "bdpt",
+        &[],
+        &[("render.hide_emitters=true", "hide_emitters")],
+    );
+}
+
+/// `hide_emitters` (Mitsuba's, as `path` renders it: camera rays pass through emitters until
+/// they first scatter): the ceiling light and a white emitting sphere in the middle of the
+/// view are hidden, the wall behind the sphere is seen through it, and light tracing's
+/// connections to the camera pass through them too. bdpt agrees with path.
+#[test]
+fn bdpt_hides_emitters_as_path_does() {
+    let lights = format!(
+        "{CEILING_LIGHT}\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 1.0, 0.2]\nradius = 0.2\nmaterial = \"white\"\nemission = [4.0, 4.0, 4.0]\n"
+    );
+    let scene = cornell("white", "white", "", &lights);
+    let hide = ["render.hide_emitters=true".to_string()];
+    let reference = render("bdpt-hide", &scene, "path", 2048, &hide);
+    let film = render("bdpt-hide", &scene, "bdpt", 128, &hide);
+    assert_blocks_agree("bdpt against path, hide_emitters", &film, &reference, 4, Z);
 }
 
 /// Participating media along both subpaths: a coloured fog filling the box (the camera in it,

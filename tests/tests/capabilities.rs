@@ -22,7 +22,9 @@ fn prepared(integrator: &str, sets: &[String]) -> foton_cli::Prepared {
 /// `describe()` is built from them.
 #[test]
 fn parameters_are_the_keys_of_the_integrators_table_and_round_trip() {
-    for name in ["path", "bdpt", "photon", "sppm", "vpm", "ppb", "normals"] {
+    for name in [
+        "path", "bdpt", "vcm", "photon", "sppm", "vpm", "ppb", "normals",
+    ] {
         let p = prepared(name, &[]);
         assert_eq!(p.integrator.name(), name);
         let params = p.integrator.parameters();

@@ -93,7 +93,9 @@ fn the_panicking_fixture_is_not_found_beside_the_real_plugins() {
     names.sort();
     assert_eq!(
         names,
-        ["bdpt", "normals", "path", "photon", "ppb", "sppm", "vpm"]
+        [
+            "bdpt", "normals", "path", "photon", "ppb", "sppm", "vcm", "vpm"
+        ]
     );
     let built = plugin_dir().join(format!(
         "{}panicky_fixture{}",

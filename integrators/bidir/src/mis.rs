@@ -1,7 +1,8 @@
-//! The MIS weights of bidirectional path tracing in O(1) per connection: the running
-//! quantities of Georgiev et al.'s implementation notes ("Implementing vertex connection and
-//! merging", 2012; SmallVCM), `d_vcm` and `d_vc`, with merging switched off (VCM's `d_vm` and
-//! its weight factor are zero), which are exactly Veach's bidirectional weights.
+//! The MIS weights of bidirectional path tracing and of vertex connection and merging in O(1)
+//! per connection or merge: the running quantities of Georgiev et al.'s implementation notes
+//! ("Implementing vertex connection and merging", 2012; SmallVCM), `d_vcm`, `d_vc` and `d_vm`.
+//! With merging switched off ([`Factors::CONNECT`]: both factors zero) the weights are exactly
+//! Veach's bidirectional ones and `d_vm` is not used.
 //!
 //! Every subpath vertex carries two numbers from which the sum over all strategies that would
 //! have sampled more of its subpath's vertices from the other side is one multiply-add away;
@@ -15,8 +16,14 @@
 //! Russian roulette is left out of the densities (as pbrt-v4 does): the weights of the
 //! strategies of a path still sum to one, which is what unbiasedness needs.
 //!
-//! With `vcm`, the same quantities gain the merging terms; these functions are written so that
-//! the vertex type and the updates carry over.
+//! **Merging** (tech. rep. section 4): a merge of a light vertex with a camera vertex within
+//! radius r is counted as a strategy whose density is the connection's times the acceptance
+//! probability pi r^2 p(x) (p the density of the light vertex at the camera vertex's
+//! position), with n_VM = N light paths per iteration against n_VC = 1 light path per
+//! connection: eta_VCM = pi r^2 N. A connection's weight gains eta_VCM^2 for the merge that
+//! would have built the same path ([`Factors::vm`]), a merge's counts each connection with
+//! 1 / eta_VCM^2 ([`Factors::vc`]). `d_vm` accumulates, as `d_vc` does for connections, the
+//! merges at earlier vertices.
 
 /// The power heuristic's exponent applied to a pdf ratio.
 #[inline]
@@ -29,6 +36,33 @@ pub fn mis(x: f32) -> f32 {
 pub struct Running {
     pub d_vcm: f32,
     pub d_vc: f32,
+    /// The merges at earlier vertices (0 without merging).
+    pub d_vm: f32,
+}
+
+/// The merging terms of the weights (SmallVCM's `mMisVmWeightFactor`, `mMisVcWeightFactor`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Factors {
+    /// mis(eta_VCM) when merges are used, else 0: what a connection counts a merge as.
+    pub vm: f32,
+    /// mis(1 / eta_VCM) when connections are used, else 0: what a merge counts a connection
+    /// (and the vertex's own d_vcm share) as.
+    pub vc: f32,
+}
+
+impl Factors {
+    /// Connections only (`bdpt`, `vcm`'s `bpt` mode).
+    pub const CONNECT: Factors = Factors { vm: 0.0, vc: 0.0 };
+
+    /// One iteration of `vcm` with merge radius `radius` and `light_paths` light subpaths:
+    /// eta_VCM = pi r^2 N (tech. rep. eq. 20, with n_VC = 1 and n_VM = N).
+    pub fn vcm(radius: f32, light_paths: f32, connect: bool, merge: bool) -> Factors {
+        let eta = std::f32::consts::PI * radius * radius * light_paths;
+        Factors {
+            vm: if merge { mis(eta) } else { 0.0 },
+            vc: if connect { mis(1.0 / eta) } else { 0.0 },
+        }
+    }
 }
 
 impl Running {
@@ -40,6 +74,7 @@ impl Running {
         Running {
             d_vcm: mis(1.0 / pdf_camera),
             d_vc: 0.0,
+            d_vm: 0.0,
         }
     }
 
@@ -48,14 +83,18 @@ impl Running {
     /// infinity), `delta` for lights no path can hit (point, spot, directional). `d_vcm` is set
     /// at the first hit ([`Running::first_hit`]): next-event estimation's density of the origin
     /// depends on the point it is seen from.
-    pub fn light(emission_pdf: f32, cos_light: f32, delta: bool) -> Running {
+    /// `factors.vc` starts `d_vm`: merging at the first vertex a light path reaches stands for
+    /// the light's own emission, which only the connection strategies sample otherwise.
+    pub fn light(emission_pdf: f32, cos_light: f32, delta: bool, factors: &Factors) -> Running {
+        let d_vc = if delta {
+            0.0
+        } else {
+            mis(cos_light / emission_pdf)
+        };
         Running {
             d_vcm: 0.0,
-            d_vc: if delta {
-                0.0
-            } else {
-                mis(cos_light / emission_pdf)
-            },
+            d_vc,
+            d_vm: d_vc * factors.vc,
         }
     }
 
@@ -76,18 +115,30 @@ impl Running {
         let c = mis(cos.abs());
         self.d_vcm /= c;
         self.d_vc /= c;
+        self.d_vm /= c;
     }
 
     /// The subpath scatters at this vertex: `cos_out` the cosine of the sampled direction with
     /// the geometric normal, `pdf_dir` its solid-angle density, `pdf_rev` the density of the
     /// reverse (the direction back, given the sampled one); a `delta` sample has equal
     /// forward and reverse probabilities, which cancel.
-    pub fn scatter(&mut self, cos_out: f32, pdf_dir: f32, pdf_rev: f32, delta: bool) {
+    /// (tech. rep. eqs. 34-36; the factors' terms are zero without merging).
+    pub fn scatter(
+        &mut self,
+        cos_out: f32,
+        pdf_dir: f32,
+        pdf_rev: f32,
+        delta: bool,
+        factors: &Factors,
+    ) {
         if delta {
             self.d_vcm = 0.0;
             self.d_vc *= mis(cos_out.abs());
+            self.d_vm *= mis(cos_out.abs());
         } else {
-            self.d_vc = mis(cos_out.abs() / pdf_dir) * (self.d_vc * mis(pdf_rev) + self.d_vcm);
+            let g = mis(cos_out.abs() / pdf_dir);
+            self.d_vc = g * (self.d_vc * mis(pdf_rev) + self.d_vcm + factors.vm);
+            self.d_vm = g * (self.d_vm * mis(pdf_rev) + self.d_vcm * factors.vc + 1.0);
             self.d_vcm = mis(1.0 / pdf_dir);
         }
     }
@@ -109,6 +160,7 @@ pub fn weight_emitter_hit(camera: &Running, direct_pdf: f32, emission_pdf: f32) 
 /// next-event estimation's per unit area on the light, `pdf_rev` the camera vertex's density of
 /// sampling back towards the camera given the light direction.
 pub fn weight_direct(
+    factors: &Factors,
     camera: &Running,
     scatter_pdf: f32,
     direct_pdf: f32,
@@ -116,7 +168,7 @@ pub fn weight_direct(
     pdf_rev: f32,
 ) -> f32 {
     let w_light = mis(scatter_pdf / direct_pdf);
-    let w_camera = mis(emission_ratio) * (camera.d_vcm + camera.d_vc * mis(pdf_rev));
+    let w_camera = mis(emission_ratio) * (factors.vm + camera.d_vcm + camera.d_vc * mis(pdf_rev));
     1.0 / (w_light + 1.0 + w_camera)
 }
 
@@ -124,6 +176,7 @@ pub fn weight_direct(
 /// vertex's density (per unit area at the other vertex) of having sampled the other; `*_rev_pdf`
 /// its solid-angle density of sampling back along its own subpath, given the connection.
 pub fn weight_connect(
+    factors: &Factors,
     camera: &Running,
     light: &Running,
     camera_dir_pdf: f32,
@@ -131,17 +184,42 @@ pub fn weight_connect(
     light_dir_pdf: f32,
     light_rev_pdf: f32,
 ) -> f32 {
-    let w_light = mis(camera_dir_pdf) * (light.d_vcm + light.d_vc * mis(light_rev_pdf));
-    let w_camera = mis(light_dir_pdf) * (camera.d_vcm + camera.d_vc * mis(camera_rev_pdf));
+    let w_light =
+        mis(camera_dir_pdf) * (factors.vm + light.d_vcm + light.d_vc * mis(light_rev_pdf));
+    let w_camera =
+        mis(light_dir_pdf) * (factors.vm + camera.d_vcm + camera.d_vc * mis(camera_rev_pdf));
     1.0 / (w_light + 1.0 + w_camera)
 }
 
 /// The weight of connecting a light vertex to the camera (t = 1): `camera_pdf` the camera's
 /// density (filter x `pdf_we`, per unit area at the vertex) of having sampled it,
 /// `light_rev_pdf` the vertex's solid-angle density of sampling back along its subpath.
-pub fn weight_to_camera(light: &Running, camera_pdf: f32, light_rev_pdf: f32) -> f32 {
-    let w_light = mis(camera_pdf) * (light.d_vcm + light.d_vc * mis(light_rev_pdf));
+pub fn weight_to_camera(
+    factors: &Factors,
+    light: &Running,
+    camera_pdf: f32,
+    light_rev_pdf: f32,
+) -> f32 {
+    let w_light = mis(camera_pdf) * (factors.vm + light.d_vcm + light.d_vc * mis(light_rev_pdf));
     1.0 / (w_light + 1.0)
+}
+
+/// The weight of merging a light vertex with a camera vertex (tech. rep. eqs. 37-39):
+/// `camera_dir_pdf` the camera vertex's solid-angle density of sampling the light vertex's
+/// incoming direction (the connection that would have continued the camera subpath),
+/// `camera_rev_pdf` its density of sampling back along the camera subpath given that direction.
+/// The merged path's light vertex stands in for the camera vertex, so the light side counts
+/// the camera vertex's density through the light vertex's `d_vm`.
+pub fn weight_merge(
+    factors: &Factors,
+    camera: &Running,
+    light: &Running,
+    camera_dir_pdf: f32,
+    camera_rev_pdf: f32,
+) -> f32 {
+    let w_light = light.d_vcm * factors.vc + light.d_vm * mis(camera_dir_pdf);
+    let w_camera = camera.d_vcm * factors.vc + camera.d_vm * mis(camera_rev_pdf);
+    1.0 / (w_light + 1.0 + w_camera)
 }
 
 #[cfg(test)]
@@ -165,6 +243,26 @@ mod tests {
     /// computed by brute force from the full path densities.
     #[test]
     fn the_weights_of_all_strategies_of_a_path_sum_to_one() {
+        check_weights(None);
+    }
+
+    /// The same with merging (`vcm`): the connections and the merges at every vertex x_1 ...
+    /// x_{k-1} (a camera subpath x0..x_i merged with a light subpath x_k..x_i, of density the
+    /// connection's times eta_VCM p_light(x_i), tech. rep. section 4) of every path share one,
+    /// each its power-heuristic share, for merges of little and of much weight.
+    #[test]
+    fn the_weights_of_all_connections_and_merges_of_a_path_sum_to_one() {
+        for eta in [0.05f32, 1.3, 40.0] {
+            check_weights(Some(eta));
+        }
+    }
+
+    /// `eta`: eta_VCM = pi r^2 N of the merges (None: connections only).
+    fn check_weights(eta: Option<f32>) {
+        let f = eta.map_or(Factors::CONNECT, |e| Factors {
+            vm: mis(e),
+            vc: mis(1.0 / e),
+        });
         let camera = Camera::new(
             Vec3::new(0.0, 1.0, 4.0),
             Vec3::new(0.0, 1.0, 0.0),
@@ -235,7 +333,10 @@ mod tests {
                     let light: f64 = rev[t..=k].iter().map(|&p| p as f64).product();
                     camera * light
                 };
-                let total: f64 = (0..=k).map(|s| density(s).powi(2)).sum();
+                // The merge at x_i (1 <= i < k): x_i sampled from both sides, counted eta times.
+                let merge = |i: usize| density(k - i) * rev[i] as f64 * eta.unwrap_or(0.0) as f64;
+                let total: f64 = (0..=k).map(|s| density(s).powi(2)).sum::<f64>()
+                    + (1..k).map(|i| merge(i).powi(2)).sum::<f64>();
 
                 // The running quantities along the camera subpath (x1 .. x_{k-1}).
                 let mut cam = vec![Running::default(); k + 1];
@@ -250,6 +351,7 @@ mod tests {
                             diffuse_pdf(ns[i], wi),
                             diffuse_pdf(ns[i], wo),
                             false,
+                            &f,
                         );
                     }
                 }
@@ -257,10 +359,11 @@ mod tests {
                 let mut lig = vec![Running::default(); k + 1];
                 let cos_light = cos(k, dir(k, k - 1));
                 let emission = pick / area * diffuse_pdf(ns[k], dir(k, k - 1));
-                let mut r = Running::light(emission, cos_light, false);
+                let mut r = Running::light(emission, cos_light, false, &f);
                 lig[k] = Running {
                     d_vcm: mis(area / pick),
                     d_vc: 0.0,
+                    d_vm: 0.0,
                 };
                 for i in (1..k).rev() {
                     if i == k - 1 {
@@ -275,6 +378,7 @@ mod tests {
                             diffuse_pdf(ns[i], wi),
                             diffuse_pdf(ns[i], wo),
                             false,
+                            &f,
                         );
                     }
                 }
@@ -297,7 +401,10 @@ mod tests {
                         } else {
                             diffuse_pdf(ns[1], dir(1, 2))
                         };
-                        weight_to_camera(&lig[1], camera_pdf, rev_pdf)
+                        // The light's own point seen by the camera (k = 1) is no stored vertex: no
+                        // merge builds that path (the integrator's `splat_origin`).
+                        let f = if k == 1 { Factors::CONNECT } else { f };
+                        weight_to_camera(&f, &lig[1], camera_pdf, rev_pdf)
                     } else if s == 1 {
                         // Next-event estimation from x_{k-1} to x_k.
                         let c = k - 1;
@@ -307,6 +414,7 @@ mod tests {
                         let emission = pick / area * diffuse_pdf(ns[k], -wi);
                         let ratio = emission * cos(c, wi) / (direct_w * cos(k, wi));
                         weight_direct(
+                            &f,
                             &cam[c],
                             scatter_pdf,
                             direct_w,
@@ -319,6 +427,7 @@ mod tests {
                         let d = dir(c, l);
                         let dd = d2(c, l);
                         weight_connect(
+                            &f,
                             &cam[c],
                             &lig[l],
                             diffuse_pdf(ns[c], d) * cos(l, d) / dd,
@@ -330,13 +439,28 @@ mod tests {
                     let want = density(s).powi(2) / total;
                     assert!(
                         (w as f64 - want).abs() < 2e-3 * want.max(1e-3),
-                        "k = {k}, (s, t) = ({s}, {t}): weight {w} vs power heuristic {want}"
+                        "eta {eta:?}, k = {k}, (s, t) = ({s}, {t}): weight {w} vs power heuristic {want}"
+                    );
+                    sum += w as f64;
+                }
+                for i in (1..k).filter(|_| eta.is_some()) {
+                    let w = weight_merge(
+                        &f,
+                        &cam[i],
+                        &lig[i],
+                        diffuse_pdf(ns[i], dir(i, i + 1)),
+                        diffuse_pdf(ns[i], dir(i, i - 1)),
+                    );
+                    let want = merge(i).powi(2) / total;
+                    assert!(
+                        (w as f64 - want).abs() < 2e-3 * want.max(1e-3),
+                        "eta {eta:?}, k = {k}, merge at x_{i}: weight {w} vs power heuristic {want}"
                     );
                     sum += w as f64;
                 }
                 assert!(
                     (sum - 1.0).abs() < 2e-3,
-                    "k = {k}: the weights sum to {sum}"
+                    "eta {eta:?}, k = {k}: the weights sum to {sum}"
                 );
             }
         }

@@ -1,0 +1,865 @@
+//! # foton-bidir: the bidirectional machinery `bdpt` and `vcm` share
+//!
+//! A library crate, not a plugin (a plugin crate cannot link another: each cdylib exports the
+//! plugin declaration), as `foton-photonmap` is for the photon mappers. It holds:
+//!
+//! * the subpath vertex ([`Vertex`]) and the random walk of both subpaths (camera and light)
+//!   with the running MIS quantities of Georgiev et al.'s implementation notes (module
+//!   [`mis`](mod@mis): `d_vcm`, `d_vc`, `d_vm`);
+//! * the connection strategies of Veach's bidirectional path tracer: s = 0 (the camera subpath
+//!   reaches an emitter), s = 1 (next-event estimation), t = 1 (a light vertex connected to the
+//!   pinhole and splatted), s, t >= 2 (a light vertex connected with a camera vertex), each
+//!   weighted in O(1) by the power heuristic;
+//! * the weight of a merge (vertex merging, `vcm`), [`mis::weight_merge`].
+//!
+//! [`Bidir`] is the estimator's configuration: `bdpt` uses it with merging off
+//! ([`mis::Factors::CONNECT`]: the weights are Veach's), `vcm` with the factors of each
+//! iteration's merge radius ([`mis::Factors::vcm`]). With merging off every operation is the
+//! one `bdpt` did before the crate existed (adding a zero factor changes no bit), so `bdpt`'s
+//! images are bit-identical.
+//!
+//! Vertices on delta surfaces (mirror, smooth glass; the smooth coat of a plastic when it was
+//! the part sampled) are passed through by sampling and never connected or merged. Point, spot
+//! and directional lights are never hit: their paths are found by the strategies with s >= 1.
+//! Participating media along both subpaths (as Mitsuba 0.6's `bdpt`): see `bdpt`'s crate doc.
+
+pub mod mis;
+
+use foton_core::bsdf::Bsdf;
+use foton_core::error::Error;
+use foton_core::geometry::{Hit, Ray, offset_origin};
+use foton_core::light::Light;
+use foton_core::material::TransportMode;
+use foton_core::medium::{self, Phase};
+use foton_core::render::{PixelSample, Splats};
+use foton_core::sampling::Sampler;
+use foton_core::scene::Scene;
+use foton_core::walk::{RayWalk, Reached};
+use foton_core::{Result, Rgb, Vec3};
+use mis::{
+    Factors, Running, mis, weight_connect, weight_direct, weight_emitter_hit, weight_to_camera,
+};
+
+/// The bidirectional estimator: which strategies it uses and how they are weighted.
+#[derive(Clone, Copy, Debug)]
+pub struct Bidir {
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub strategy: Strategy,
+    pub light_image: bool,
+    /// The merging terms of the MIS weights (zero without merging).
+    pub factors: Factors,
+    /// Connections (s >= 1) are used; false in `vcm`'s `ppm` mode.
+    pub connect: bool,
+    /// Camera subpaths stop at their first connectable vertex, and emitters count only when
+    /// reached through delta vertices alone (`vcm`'s `ppm` mode, SmallVCM's `kPpm`).
+    pub first_vertex_only: bool,
+}
+
+/// Where the contributions of light paths connected to the camera (t = 1) go: the splatting
+/// film of core's pixel loop ([`Splats`]) or an integrator's own buffer.
+pub trait SplatSink {
+    /// Adds `value` to pixel (x, y).
+    fn add(&mut self, x: u32, y: u32, value: Rgb);
+}
+
+impl SplatSink for Splats<'_> {
+    #[inline]
+    fn add(&mut self, x: u32, y: u32, value: Rgb) {
+        Splats::add(self, x, y, value)
+    }
+}
+
+/// Which strategies a render uses (the `strategy` parameter).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategy {
+    /// Every strategy, weighted by MIS (`"all"`).
+    All,
+    /// Only the strategy with s light and t camera vertices, unweighted (`"s,t"`).
+    Only(u32, u32),
+    /// Only the strategies with t = 1, unweighted: a light tracer (`"light"`).
+    Light,
+}
+
+impl Strategy {
+    /// Reads `"all"`, `"light"` or `"s,t"` (s >= 0, t >= 1, s + t >= 2).
+    pub fn parse(text: &str) -> std::result::Result<Strategy, String> {
+        match text.trim() {
+            "all" => return Ok(Strategy::All),
+            "light" => return Ok(Strategy::Light),
+            _ => {}
+        }
+        let bad = || {
+            format!(
+                "expected \"all\", \"light\" or \"s,t\" (s >= 0 light vertices, t >= 1 camera \
+                 vertices, s + t >= 2), found \"{text}\""
+            )
+        };
+        let (s, t) = text.split_once(',').ok_or_else(bad)?;
+        let s: u32 = s.trim().parse().map_err(|_| bad())?;
+        let t: u32 = t.trim().parse().map_err(|_| bad())?;
+        if t == 0 || s + t < 2 {
+            return Err(bad());
+        }
+        Ok(Strategy::Only(s, t))
+    }
+
+    /// The value as a scene file writes it.
+    pub fn name(self) -> String {
+        match self {
+            Strategy::All => "all".into(),
+            Strategy::Light => "light".into(),
+            Strategy::Only(s, t) => format!("{s},{t}"),
+        }
+    }
+}
+
+/// A vertex of a subpath where it can be connected: a surface whose BSDF is not a delta, or a
+/// scattering event in a medium.
+#[derive(Clone, Copy, Debug)]
+pub struct Vertex {
+    pub p: Vec3,
+    pub at: At,
+    /// The medium the subpath arrived in (None: vacuum).
+    pub medium: Option<u32>,
+    /// Unit direction back along the subpath (towards the camera, or where the light came from).
+    pub wo: Vec3,
+    /// Throughput of the subpath up to this vertex (its own scattering not included): radiance
+    /// weights from the camera, flux over pdfs from the light.
+    pub beta: Rgb,
+    pub running: Running,
+    /// Segments from the subpath's first vertex (the pinhole or the light).
+    pub length: u32,
+}
+
+/// What scatters at a vertex.
+#[derive(Clone, Copy, Debug)]
+pub enum At {
+    Surface { hit: Hit, bsdf: Bsdf },
+    Medium { phase: Phase },
+}
+
+impl Vertex {
+    /// The normal a shadow ray's end is offset along (zero in a medium).
+    #[inline]
+    pub fn ng(&self) -> Vec3 {
+        match &self.at {
+            At::Surface { hit, .. } => hit.ng,
+            At::Medium { .. } => Vec3::ZERO,
+        }
+    }
+
+    /// The cosine that turns a solid-angle density of reaching this vertex along `w` into a
+    /// density per unit area (per unit volume in a medium: 1).
+    #[inline]
+    pub fn cos(&self, w: Vec3) -> f32 {
+        match &self.at {
+            At::Surface { hit, .. } => hit.ng.dot(w).abs(),
+            At::Medium { .. } => 1.0,
+        }
+    }
+
+    /// The solid-angle density of sampling `wi` given `wo` here.
+    #[inline]
+    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match &self.at {
+            At::Surface { bsdf, .. } => bsdf.pdf(wo, wi),
+            At::Medium { phase } => phase.eval(-wo.dot(wi)),
+        }
+    }
+
+    /// What a camera vertex scatters from `w` towards the camera: f(wo, w) |w.ns| at a
+    /// surface, the phase function in a medium.
+    #[inline]
+    pub fn f_camera(&self, w: Vec3) -> Rgb {
+        match &self.at {
+            At::Surface { bsdf, .. } => bsdf.eval(self.wo, w),
+            At::Medium { phase } => Rgb::splat(phase.eval(-self.wo.dot(w))),
+        }
+    }
+
+    /// What a light vertex sends along `w` (unit, away from it), per unit of its throughput:
+    /// at a surface f(w, wo) |w.ng| with the shading-normal correction of importance transport
+    /// (Veach 1997, section 5.3), f |wo.ns| |w.ng| / |wo.ng|, which `Bsdf::eval` (carrying
+    /// |wo.ns|) times |w.ng| / |wo.ng| gives; in a medium the phase function.
+    #[inline]
+    pub fn f_light(&self, w: Vec3) -> Rgb {
+        match &self.at {
+            At::Surface { hit, bsdf } => {
+                let cos_wo = hit.ng.dot(self.wo).abs();
+                if cos_wo == 0.0 {
+                    return Rgb::ZERO;
+                }
+                bsdf.eval(w, self.wo) * (hit.ng.dot(w).abs() / cos_wo)
+            }
+            At::Medium { phase } => Rgb::splat(phase.eval(-self.wo.dot(w))),
+        }
+    }
+
+    /// The medium a ray leaving the vertex along `w` travels in.
+    #[inline]
+    pub fn medium_towards(&self, scene: &Scene, w: Vec3) -> Option<u32> {
+        match &self.at {
+            At::Surface { hit, .. } => scene.medium_after(hit, w, self.medium),
+            At::Medium { .. } => self.medium,
+        }
+    }
+}
+
+/// A light subpath's first vertex on an area light, for s = 1, t = 1.
+#[derive(Clone, Copy, Debug)]
+pub struct Origin {
+    light: usize,
+    p: Vec3,
+    n: Vec3,
+    /// pick x pdf_pos: its density per unit area.
+    pdf: f32,
+    medium: Option<u32>,
+}
+
+/// Which end a subpath starts from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Side {
+    Camera,
+    Light,
+}
+
+/// What a light subpath needs at its first vertex: next-event estimation's density of its
+/// origin, seen from there.
+#[derive(Clone, Copy, Debug)]
+struct Emitted<'a> {
+    light: &'a Light,
+    pick: f32,
+    origin: Vec3,
+    n: Vec3,
+    dir: Vec3,
+    cos_light: f32,
+    emission_pdf: f32,
+}
+
+impl Bidir {
+    /// Veach's bidirectional path tracer (`bdpt`): connections only, merging off.
+    pub fn new(max_depth: u32, rr_depth: u32, strategy: Strategy, light_image: bool) -> Self {
+        Bidir {
+            max_depth,
+            rr_depth,
+            strategy,
+            light_image,
+            factors: Factors::CONNECT,
+            connect: true,
+            first_vertex_only: false,
+        }
+    }
+
+    /// The weight of strategy (s, t): 0 if it is not rendered (beyond `max_depth`, or another
+    /// strategy was asked for), 1 when it is rendered alone, else `mis_weight()`.
+    #[inline]
+    fn weight(&self, s: u32, t: u32, mis_weight: impl FnOnce() -> f32) -> f32 {
+        if s + t > self.max_depth.saturating_add(2)
+            || (t == 1 && !self.light_image)
+            || (s >= 1 && !self.connect)
+        {
+            return 0.0;
+        }
+        match self.strategy {
+            Strategy::All => mis_weight(),
+            Strategy::Only(s0, t0) => ((s, t) == (s0, t0)) as u8 as f32,
+            Strategy::Light => (t == 1) as u8 as f32,
+        }
+    }
+
+    /// The weight of a camera subpath of t vertices reaching an emitter (s = 0); `specular`:
+    /// every scattering before was a delta sample. Without connections (`ppm` mode) only
+    /// such paths count, unweighted: the others are found by merging (SmallVCM's `kPpm`).
+    #[inline]
+    fn weight_emitter(&self, t: u32, specular: bool, mis_weight: impl FnOnce() -> f32) -> f32 {
+        if !self.connect {
+            let counted = specular && t <= self.max_depth.saturating_add(2);
+            return counted as u8 as f32;
+        }
+        self.weight(0, t, mis_weight)
+    }
+
+    /// One camera sample: its own estimate (strategies t >= 2); what its light path brings to
+    /// the camera (t = 1) goes to `splats`. `light_media` is the medium each light emits into.
+    pub fn sample(
+        &self,
+        scene: &Scene,
+        light_media: &[Option<u32>],
+        ps: &PixelSample,
+        sampler: &mut Sampler,
+        splats: &mut impl SplatSink,
+        rays: &mut u64,
+    ) -> Rgb {
+        let cap = (self.max_depth as usize + 2).min(32);
+        let mut camera = Vec::with_capacity(cap);
+        let mut radiance = self.camera_subpath(scene, ps, sampler, &mut camera, rays);
+        let mut light = Vec::with_capacity(cap);
+        let origin = self.light_subpath(scene, light_media, sampler, &mut light, rays);
+
+        // ---- t = 1: light vertices connected to the pinhole, splatted ----
+        if let Some(o) = origin {
+            self.splat_origin(scene, &o, splats, rays);
+        }
+        for v in &light {
+            self.splat_vertex(scene, v, splats, rays);
+        }
+
+        // ---- s >= 1, t >= 2: connections from each camera vertex ----
+        for c in &camera {
+            radiance += self.direct(scene, c, sampler, rays);
+            for v in &light {
+                radiance += self.connect(scene, c, v, rays);
+            }
+        }
+        radiance
+    }
+
+    /// Traces the camera subpath from `ps`, keeping its connectable vertices in `vertices`, and
+    /// returns the emission it meets (s = 0).
+    pub fn camera_subpath(
+        &self,
+        scene: &Scene,
+        ps: &PixelSample,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+    ) -> Rgb {
+        let margin = scene.film.filter.margin();
+        let (_, pdf_we) = scene.camera.pdf_we(ps.ray.dir, margin);
+        let pdf_camera = ps.filter_pdf * pdf_we;
+        if pdf_camera <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let mut running = Running::camera(pdf_camera);
+        if !self.light_image {
+            // d_vcm starts as the t = 1 strategy's share: without it, no weight counts it.
+            running.d_vcm = 0.0;
+        }
+        let walk = RayWalk::camera(scene, ps.ray);
+        self.random_walk(
+            scene,
+            Side::Camera,
+            walk,
+            Rgb::ONE,
+            running,
+            None,
+            sampler,
+            vertices,
+            rays,
+        )
+    }
+
+    /// Traces a light subpath from a light chosen in proportion to power, keeping its
+    /// connectable vertices in `vertices`; returns its origin if it lies on an area light.
+    pub fn light_subpath(
+        &self,
+        scene: &Scene,
+        light_media: &[Option<u32>],
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+    ) -> Option<Origin> {
+        let u_light = sampler.next_f32();
+        let (u_pos, u_dir, u_shape) = (sampler.next_2d(), sampler.next_2d(), sampler.next_f32());
+        let (id, pick) = scene.sample_light(u_light)?;
+        let light = &scene.lights[id];
+        let e = light.sample_emission(u_pos, u_dir, u_shape);
+        let medium = light_media.get(id).copied().flatten();
+        let origin = matches!(light, Light::Area { .. }).then_some(Origin {
+            light: id,
+            p: e.origin,
+            n: e.n,
+            pdf: pick * e.pdf_pos,
+            medium,
+        });
+        let emission_pdf = pick * e.pdf_pos * e.pdf_dir;
+        if emission_pdf.is_nan() || emission_pdf <= 0.0 || e.le == Rgb::ZERO {
+            return origin;
+        }
+        let cos_light = if e.n == Vec3::ZERO {
+            1.0
+        } else {
+            e.n.dot(e.dir).abs()
+        };
+        let running = Running::light(emission_pdf, cos_light, light.is_delta(), &self.factors);
+        let beta = e.le * (cos_light / emission_pdf);
+        let ray = Ray::new(offset_origin(e.origin, e.n, e.dir), e.dir);
+        let emitted = Emitted {
+            light,
+            pick,
+            origin: e.origin,
+            n: e.n,
+            dir: e.dir,
+            cos_light,
+            emission_pdf,
+        };
+        self.random_walk(
+            scene,
+            Side::Light,
+            RayWalk::new(ray, medium),
+            beta,
+            running,
+            Some(emitted),
+            sampler,
+            vertices,
+            rays,
+        );
+        origin
+    }
+
+    /// The random walk of a subpath (both sides): free flights through media, null boundaries
+    /// crossed, BSDFs and phase functions sampled, Russian roulette; the connectable vertices
+    /// go to `vertices` with their MIS quantities. A camera subpath also gathers the emission
+    /// it meets (s = 0), which it returns.
+    #[allow(clippy::too_many_arguments)]
+    fn random_walk(
+        &self,
+        scene: &Scene,
+        side: Side,
+        mut walk: RayWalk,
+        mut beta: Rgb,
+        mut running: Running,
+        emitted: Option<Emitted<'_>>,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+    ) -> Rgb {
+        let mode = match side {
+            Side::Camera => TransportMode::Radiance,
+            Side::Light => TransportMode::Importance,
+        };
+        let infinite = emitted.is_some_and(|e| e.light.is_infinite());
+        let mut radiance = Rgb::ZERO;
+        let mut prev = emitted.map_or(walk.ray.origin, |e| e.origin);
+        let mut length = 0u32;
+        // Every scattering so far was a delta sample (ppm mode counts only such emitter hits).
+        let mut specular = true;
+        // The MIS update on reaching a vertex at `x` (cosine `cos`, 1 in a medium).
+        let arrive = |running: &mut Running, length: u32, x: Vec3, prev: Vec3, cos: f32| {
+            let dist2 = prev.distance_squared(x);
+            if length == 1
+                && let Some(e) = emitted
+            {
+                // Next-event estimation's density of the light's origin, seen from x.
+                let direct = e.pick
+                    * match e.light {
+                        Light::Area { .. } => {
+                            e.light.pdf_li(x, e.origin, e.n) * e.cos_light / dist2
+                        }
+                        l if l.is_delta() => 1.0,
+                        l => l.pdf_li(x, x - e.dir, Vec3::ZERO),
+                    };
+                running.first_hit(direct, e.emission_pdf);
+            }
+            running.arrive((length > 1 || !infinite).then_some(dist2), cos);
+        };
+        loop {
+            let seg = walk.segment(scene, rays);
+
+            // ---- Medium: free flight to a scattering event or to the surface ----
+            if let Some(m) = seg.interacting_medium(scene) {
+                // One-sample MIS over the channels of this event (FreeFlight::weight).
+                let channel = medium::channel(sampler.next_f32());
+                let flight =
+                    m.sample_free_flight(&seg.start(), seg.length(), channel, sampler.next_f32());
+                beta *= flight.weight();
+                if beta == Rgb::ZERO {
+                    break;
+                }
+                if flight.scattered {
+                    let x = seg.at(flight.t);
+                    length += 1;
+                    arrive(&mut running, length, x, prev, 1.0);
+                    if side == Side::Camera && length > self.max_depth {
+                        break;
+                    }
+                    let phase = m.phase();
+                    let wo = -seg.ray.dir;
+                    vertices.push(Vertex {
+                        p: x,
+                        at: At::Medium { phase },
+                        medium: walk.medium,
+                        wo,
+                        beta,
+                        running,
+                        length,
+                    });
+                    if side == Side::Light && length >= self.max_depth {
+                        break;
+                    }
+                    // ---- Phase-function sampling: p / pdf = 1 ----
+                    let (wi, pdf) = phase.sample(seg.ray.dir, sampler.next_2d());
+                    specular = false;
+                    running.scatter(1.0, pdf, pdf, false, &self.factors);
+                    if !self.russian_roulette(length, &mut beta, sampler) {
+                        break;
+                    }
+                    prev = x;
+                    walk.scatter_in_medium(x, wi);
+                    continue;
+                }
+            }
+
+            let Some(hit) = seg.hit else {
+                // ---- s = 0: the environment ----
+                if side == Side::Camera
+                    && let Some((id, le)) = scene.escaped(seg.ray.dir)
+                {
+                    let t = length + 2;
+                    let dir = seg.ray.dir;
+                    let w = self.weight_emitter(t, specular, || {
+                        if length == 0 {
+                            // No other strategy sees a light at infinity directly.
+                            return 1.0;
+                        }
+                        let light = &scene.lights[id as usize];
+                        let pick = scene.light_pmf(id as usize);
+                        let direct = pick * light.pdf_li(prev, prev + dir, Vec3::ZERO);
+                        let (pos, pdf_dir) = light.pdf_le(Vec3::ZERO, -dir);
+                        weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
+                    });
+                    radiance += beta * le * w;
+                }
+                break;
+            };
+            let bsdf = match walk.reach(scene, &hit) {
+                Reached::Surface(bsdf) => bsdf,
+                Reached::Crossed => continue,
+                Reached::Ended => break,
+            };
+            length += 1;
+            let wo = -seg.ray.dir;
+            arrive(&mut running, length, hit.p, prev, hit.ng.dot(wo));
+
+            // ---- s = 0: an area light reached ----
+            if side == Side::Camera
+                && let Some((id, light)) = scene.area_light(&hit)
+            {
+                let le = light.emitted(hit.ng, wo);
+                if le != Rgb::ZERO {
+                    let w = self.weight_emitter(length + 1, specular, || {
+                        let pick = scene.light_pmf(id as usize);
+                        let (pos, pdf_dir) = light.pdf_le(hit.ng, wo);
+                        // The point sampled by the other strategy that ends here: next-event
+                        // estimation from the previous vertex, or, seen from the camera, the
+                        // light's emission connected to the camera (s = 1, t = 1).
+                        let direct = if length == 1 {
+                            pick * pos
+                        } else {
+                            pick * light.pdf_li(prev, hit.p, hit.ng) * hit.ng.dot(wo).abs()
+                                / prev.distance_squared(hit.p)
+                        };
+                        weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
+                    });
+                    radiance += beta * le * w;
+                }
+            }
+            if side == Side::Camera && length > self.max_depth {
+                break;
+            }
+            if !bsdf.is_delta() {
+                vertices.push(Vertex {
+                    p: hit.p,
+                    at: At::Surface { hit, bsdf },
+                    medium: walk.medium,
+                    wo,
+                    beta,
+                    running,
+                    length,
+                });
+                if side == Side::Camera && self.first_vertex_only {
+                    break;
+                }
+            }
+            if side == Side::Light && length >= self.max_depth {
+                break;
+            }
+            // ---- BSDF sampling ----
+            let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+            let Some(bs) = bsdf.sample(wo, u, uc, mode) else {
+                break;
+            };
+            let cos_out = hit.ng.dot(bs.wi);
+            specular &= bs.delta;
+            if bs.delta {
+                running.scatter(cos_out, bs.pdf, bs.pdf, true, &self.factors);
+            } else {
+                running.scatter(
+                    cos_out,
+                    bsdf.pdf(wo, bs.wi),
+                    bsdf.pdf(bs.wi, wo),
+                    false,
+                    &self.factors,
+                );
+            }
+            beta *= bs.weight;
+            if beta == Rgb::ZERO || !self.russian_roulette(length, &mut beta, sampler) {
+                break;
+            }
+            prev = hit.p;
+            walk.scatter_at_surface(scene, &hit, bs.wi);
+        }
+        radiance
+    }
+
+    /// t = 1 for a light vertex: connected to the pinhole and splatted on the pixels whose
+    /// filter covers where it lands.
+    pub fn splat_vertex(
+        &self,
+        scene: &Scene,
+        v: &Vertex,
+        splats: &mut impl SplatSink,
+        rays: &mut u64,
+    ) {
+        let s = v.length + 1;
+        if self.weight(s, 1, || 1.0) == 0.0 {
+            return;
+        }
+        let camera = &scene.camera;
+        let margin = scene.film.filter.margin();
+        let Some(cs) = camera.sample_wi(v.p, margin) else {
+            return;
+        };
+        let f = v.f_light(cs.wi);
+        if f == Rgb::ZERO {
+            return;
+        }
+        let tr = if scene.render.hide_emitters {
+            // Camera rays pass through emitters until they first scatter: so does this
+            // connection, the camera subpath's first segment seen from its other end.
+            Rgb::splat(seen_past_emitters(scene, v, rays) as u8 as f32)
+        } else {
+            *rays += 1;
+            let medium = v.medium_towards(scene, cs.wi);
+            scene.transmittance(v.p, v.ng(), camera.position, Vec3::ZERO, medium)
+        };
+        if tr == Rgb::ZERO {
+            return;
+        }
+        let base = v.beta * f * tr * (cs.we / cs.pdf);
+        // The camera's density of having sampled v, per unit area there (filter aside).
+        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
+        let pdf_rev = v.pdf(cs.wi, v.wo);
+        let (width, height) = (scene.film.width, scene.film.height);
+        scene
+            .film
+            .filter
+            .footprint(cs.film, width, height, |x, y, h| {
+                let w = self.weight(s, 1, || {
+                    weight_to_camera(&self.factors, &v.running, h * pdf_camera, pdf_rev)
+                });
+                splats.add(x, y, base * (h * w));
+            });
+    }
+
+    /// s = 1, t = 1: a point of an area light connected to the pinhole (the light seen
+    /// directly, as light tracing finds it).
+    pub fn splat_origin(
+        &self,
+        scene: &Scene,
+        o: &Origin,
+        splats: &mut impl SplatSink,
+        rays: &mut u64,
+    ) {
+        // With hide_emitters the camera does not see emitters directly (their s = 0, t = 2
+        // twin never happens either: camera rays pass through them).
+        if self.weight(1, 1, || 1.0) == 0.0 || scene.render.hide_emitters {
+            return;
+        }
+        let camera = &scene.camera;
+        let margin = scene.film.filter.margin();
+        let Some(cs) = camera.sample_wi(o.p, margin) else {
+            return;
+        };
+        let le = scene.lights[o.light].emitted(o.n, cs.wi);
+        if le == Rgb::ZERO {
+            return;
+        }
+        *rays += 1;
+        let tr = scene.transmittance(o.p, o.n, camera.position, Vec3::ZERO, o.medium);
+        if tr == Rgb::ZERO {
+            return;
+        }
+        let cos = o.n.dot(cs.wi).abs();
+        let base = le * tr * (cos / o.pdf * cs.we / cs.pdf);
+        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * cos / (cs.dist * cs.dist);
+        // The only other strategy is the camera ray that reaches the point (s = 0, t = 2): no
+        // merge builds this path (a light's origin is no stored vertex).
+        let running = Running {
+            d_vcm: mis(1.0 / o.pdf),
+            d_vc: 0.0,
+            d_vm: 0.0,
+        };
+        let (width, height) = (scene.film.width, scene.film.height);
+        scene
+            .film
+            .filter
+            .footprint(cs.film, width, height, |x, y, h| {
+                let w = self.weight(1, 1, || {
+                    weight_to_camera(&Factors::CONNECT, &running, h * pdf_camera, 0.0)
+                });
+                splats.add(x, y, base * (h * w));
+            });
+    }
+
+    /// s = 1: next-event estimation from camera vertex `c`.
+    pub fn direct(&self, scene: &Scene, c: &Vertex, sampler: &mut Sampler, rays: &mut u64) -> Rgb {
+        let u_light = sampler.next_f32();
+        let (u, uc) = (sampler.next_2d(), sampler.next_f32());
+        let t = c.length + 1;
+        if self.weight(1, t, || 1.0) == 0.0 {
+            return Rgb::ZERO;
+        }
+        let Some((id, pick)) = scene.sample_light(u_light) else {
+            return Rgb::ZERO;
+        };
+        let light = &scene.lights[id];
+        let Some(ls) = light.sample_li(c.p, u, uc) else {
+            return Rgb::ZERO;
+        };
+        if ls.li == Rgb::ZERO || ls.pdf.is_nan() || ls.pdf <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let f = c.f_camera(ls.wi);
+        if f == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        let medium = c.medium_towards(scene, ls.wi);
+        let tr = scene.transmittance(c.p, c.ng(), ls.p, ls.n, medium);
+        if tr == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let direct_pdf = pick * ls.pdf;
+        let w = self.weight(1, t, || {
+            let (pos, pdf_dir) = light.pdf_le(ls.n, -ls.wi);
+            let emission_pdf = pick * pos * pdf_dir;
+            let cos_x = c.cos(ls.wi);
+            // Emission's density of reaching c per unit area there, over next-event
+            // estimation's of the light point per unit area on it (per solid angle for lights
+            // at infinity; a point light's position is a discrete choice).
+            let emission_ratio = match light {
+                Light::Area { .. } => emission_pdf * cos_x / (direct_pdf * ls.n.dot(ls.wi).abs()),
+                Light::Point { .. } | Light::Spot { .. } => {
+                    emission_pdf * cos_x / (pick * ls.dist * ls.dist)
+                }
+                _ => emission_pdf * cos_x / direct_pdf,
+            };
+            let hit_pdf = if ls.delta { 0.0 } else { c.pdf(c.wo, ls.wi) };
+            weight_direct(
+                &self.factors,
+                &c.running,
+                hit_pdf,
+                direct_pdf,
+                emission_ratio,
+                c.pdf(ls.wi, c.wo),
+            )
+        });
+        c.beta * f * ls.li * tr * (w / direct_pdf)
+    }
+
+    /// s, t >= 2: camera vertex `c` connected with light vertex `v`.
+    pub fn connect(&self, scene: &Scene, c: &Vertex, v: &Vertex, rays: &mut u64) -> Rgb {
+        let (s, t) = (v.length + 1, c.length + 1);
+        if self.weight(s, t, || 1.0) == 0.0 {
+            return Rgb::ZERO;
+        }
+        let d = v.p - c.p;
+        let dist2 = d.length_squared();
+        if dist2.is_nan() || dist2 <= 0.0 {
+            return Rgb::ZERO;
+        }
+        let dir = d / dist2.sqrt();
+        let f_c = c.f_camera(dir);
+        if f_c == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let f_v = v.f_light(-dir);
+        if f_v == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        *rays += 1;
+        let medium = c.medium_towards(scene, dir);
+        let tr = scene.transmittance(c.p, c.ng(), v.p, v.ng(), medium);
+        if tr == Rgb::ZERO {
+            return Rgb::ZERO;
+        }
+        let w = self.weight(s, t, || {
+            weight_connect(
+                &self.factors,
+                &c.running,
+                &v.running,
+                c.pdf(c.wo, dir) * v.cos(dir) / dist2,
+                c.pdf(dir, c.wo),
+                v.pdf(v.wo, -dir) * c.cos(dir) / dist2,
+                v.pdf(-dir, v.wo),
+            )
+        });
+        c.beta * f_c * f_v * v.beta * tr * (w / dist2)
+    }
+
+    /// Russian roulette past `rr_depth` scattering events, as the path tracer's: keeps the
+    /// throughput's expectation. False if the subpath ends.
+    fn russian_roulette(&self, depth: u32, beta: &mut Rgb, sampler: &mut Sampler) -> bool {
+        if depth < self.rr_depth {
+            return true;
+        }
+        let survive = beta.max_element().min(0.95);
+        if survive <= 0.0 || sampler.next_f32() >= survive {
+            return false;
+        }
+        *beta /= survive;
+        true
+    }
+}
+
+/// The medium each light emits into (None: vacuum), found once per render (a few rays per
+/// medium boundary): what [`Bidir::light_subpath`] takes.
+pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
+    (0..scene.lights.len())
+        .map(|i| {
+            scene.light_medium(i).map_err(|why| {
+                Error::Render(format!(
+                    "{}: cannot tell which medium light {i} is in: {why}",
+                    scene.file.display()
+                ))
+            })
+        })
+        .collect()
+}
+
+/// Whether light vertex `v` is seen from the pinhole by a camera ray that passes through
+/// emitters (`hide_emitters`, core's `RayWalk::camera`): what it meets before `v` is all null
+/// boundaries or emitters, and `v` is not on an emitter itself (the camera sees through those).
+/// Surfaces only: `hide_emitters` with media is refused.
+fn seen_past_emitters(scene: &Scene, v: &Vertex, rays: &mut u64) -> bool {
+    let At::Surface { hit: vh, .. } = &v.at else {
+        return false;
+    };
+    if scene.object(vh).light.is_some() {
+        return false;
+    }
+    let origin = scene.camera.position;
+    let to = v.p - origin;
+    let dist = to.length();
+    let mut walk = RayWalk::camera(scene, Ray::new(origin, to / dist));
+    loop {
+        let seg = walk.segment(scene, rays);
+        let Some(hit) = seg.hit else {
+            return false;
+        };
+        match walk.reach(scene, &hit) {
+            // The first surface that scatters must be v's: its primitive, near v (each
+            // crossing offsets the ray a little off the line, which moves the hit at grazing
+            // angles, so a tolerance of a few parts per thousand of the distance).
+            Reached::Surface(_) => {
+                return hit.prim == vh.prim
+                    && std::ptr::eq(scene.object(&hit), scene.object(vh))
+                    && hit.p.distance_squared(v.p) <= (5e-3 * dist).powi(2);
+            }
+            Reached::Ended => return false,
+            Reached::Crossed => {}
+        }
+    }
+}

@@ -1,0 +1,633 @@
+//! # `vcm`: vertex connection and merging (Georgiev, Křivánek, Davidovič and Slusallek 2012)
+//!
+//! This table is the one list of the parameters (`[integrators.vcm]`); the README and the
+//! scene-format page point here.
+//!
+//! | parameter    | type    | meaning                                                          | default |
+//! |--------------|---------|------------------------------------------------------------------|---------|
+//! | `iterations` | integer | light + camera passes to run, >= 1                               | 64 (unlimited with `time`) |
+//! | `time`       | float   | run until this many seconds have passed, > 0                     | none    |
+//! | `radius`     | float   | the first iteration's merge radius r_1 (world units), > 0        | 0.003 x the radius of the scene's bounding sphere (SmallVCM's) |
+//! | `alpha`      | float   | the radius schedule's exponent, r_i = r_1 i^((alpha - 1) / 2), in (0, 1] | 0.75 |
+//! | `mode`       | string  | `vcm` (connections and merges), `bpt` (connections only: `bdpt`'s estimator), `ppm` (merges only, SmallVCM's progressive photon mapping), `lt` (light tracing alone) | `vcm` |
+//! | `rr_depth`   | integer | scattering events of a subpath before Russian roulette may end it | 5      |
+//!
+//! `[render] max_depth` bounds the scattering events of a whole path, as `bdpt`'s and the path
+//! tracer's do; `[render] spp` is not used (each iteration takes one camera sample per pixel).
+//! With `time`, `iterations` (if given) is an upper bound. For `foton compare --time` the work
+//! is counted in iterations (`integrators.vcm.iterations`).
+//!
+//! **An iteration** (SmallVCM's `VertexCM::RunIteration`): one light subpath per pixel (N = W x H
+//! of them) is traced and its connectable vertices (not on delta surfaces) are kept in a hashed
+//! grid (module `grid`); then every pixel traces a camera subpath which, at each vertex,
+//!
+//! * connects as `bdpt` does with the pixel's own light subpath (foton-bidir: s = 0 emitters
+//!   reached, s = 1 next-event estimation, s, t >= 2 vertex connections, and t = 1, the light
+//!   subpath's vertices connected to the camera and splatted onto the film);
+//! * merges with every light vertex of the iteration within the radius r_i: the density
+//!   estimate L = beta_camera sum_v K(|x - x_v|) f(w_o, w_v) beta_v / N, with the
+//!   Epanechnikov kernel K(d) = 2 / (pi r^2) (1 - d^2 / r^2) (integrates to one over the disc);
+//!   a light vertex counts if its surface is the camera vertex's (geometric normals within
+//!   about 25 degrees, no farther from the tangent plane than r / 4, as `sppm`'s gather disc).
+//!
+//! Connections and merges are weighted together by the power heuristic (tech. rep. eqs. 37-39)
+//! with the running quantities d_vcm, d_vc, d_vm (foton-bidir's `mis`): a merge counts as a
+//! strategy whose density is a connection's times the acceptance probability pi r^2 p, with N
+//! light paths merged against one connected. So each kind of path is rendered by what samples
+//! it best: diffuse interreflection by connections (as `bdpt`), caustics seen directly or
+//! through glass (S D S paths, which no connection samples) by merges (as photon mapping).
+//! The radius shrinks as r_i = r_1 i^((alpha - 1)/2): the merges' bias vanishes while their
+//! variance stays bounded; the image converges to the path tracer's.
+//!
+//! **Modes** (SmallVCM's): `bpt` keeps only connections (the estimator of `bdpt`, with one
+//! light path per camera sample); `ppm` keeps only merges: the camera subpath passes through
+//! delta vertices to its first connectable one and merges there, unweighted, and emitters count
+//! only when seen directly or through delta vertices (direct light comes from merging too).
+//! As SmallVCM's, it cannot split a material with both a delta and a non-delta part (the
+//! smooth coat of `plastic`): the camera path stops at such a surface and merges with its
+//! non-delta part alone, leaving out what the coat reflects; `vcm` mode renders it all;
+//! `lt` splats the light subpaths' vertices alone (`bdpt`'s `strategy = "light"`).
+//!
+//! **Determinism and parts.** Iteration i's light subpath of pixel p and its camera sample
+//! draw from random streams keyed by (seed, p, i) alone, the grid is filled in pixel order and
+//! each pixel sums its merges in a fixed order, and pixel and splat sums are exact fixed-point
+//! sums: the image is bit-identical for any thread count. The radius depends on the iteration's
+//! number alone, so iterations are independent: `--part I/N` renders a share of them (a number
+//! of iterations, no `time`) and `foton merge` adds the parts exactly. Ctrl-C drops the
+//! iteration under way: the image holds whole iterations.
+//!
+//! `hide_emitters` as `bdpt` (camera rays pass through emitters until they first scatter, and
+//! so do light vertices' connections to the camera). **Not supported**, refused with an error:
+//! participating media (`bdpt` and `vpm` render them).
+
+pub mod grid;
+
+use foton_bidir::mis::{Factors, weight_merge};
+use foton_bidir::{At, Bidir, Origin, SplatSink, Strategy, Vertex, light_media};
+use foton_core::error::Error;
+use foton_core::film::{Film, RadianceSum};
+use foton_core::integrator::{Budget, Integrator, Parameter, RenderContext, Work};
+use foton_core::props::Properties;
+use foton_core::render::{PixelSample, usable, warn_unusable, with_pool};
+use foton_core::sampling::Sampler;
+use foton_core::scene::Scene;
+use foton_core::{Result, Rgb};
+use grid::HashGrid;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// Which estimators an iteration uses (`mode`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Connections and merges, weighted together.
+    Vcm,
+    /// Connections only: bidirectional path tracing.
+    Bpt,
+    /// Merges only, at the camera path's first connectable vertex: progressive photon mapping.
+    Ppm,
+    /// Light vertices connected to the camera only: light tracing.
+    Lt,
+}
+
+impl Mode {
+    pub const NAMES: [&'static str; 4] = ["vcm", "bpt", "ppm", "lt"];
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Vcm => "vcm",
+            Mode::Bpt => "bpt",
+            Mode::Ppm => "ppm",
+            Mode::Lt => "lt",
+        }
+    }
+
+    fn connects(self) -> bool {
+        matches!(self, Mode::Vcm | Mode::Bpt | Mode::Lt)
+    }
+
+    fn merges(self) -> bool {
+        matches!(self, Mode::Vcm | Mode::Ppm)
+    }
+}
+
+pub struct Vcm {
+    /// None: until `time` runs out.
+    pub iterations: Option<u64>,
+    pub time: Option<f64>,
+    /// r_1, world units.
+    pub radius: f32,
+    /// Whether `radius` was given (else it is the automatic one, reported as such).
+    pub radius_given: bool,
+    pub alpha: f32,
+    pub mode: Mode,
+    pub max_depth: u32,
+    pub rr_depth: u32,
+}
+
+/// Random streams of the two passes (keys beside the seed, pixel and iteration).
+const STREAM_LIGHT: u64 = 0x7663_6d6c;
+const STREAM_CAMERA: u64 = 0x7663_6d63;
+
+/// How far from the camera vertex's tangent plane a light vertex may lie and still be merged,
+/// in units of the radius (`sppm`'s disc, foton-photonmap's `DISC_THICKNESS`).
+const DISC_THICKNESS: f32 = 0.25;
+
+/// The Epanechnikov kernel on the disc of radius r (squared: `r2`), normalised to integrate
+/// to one over it: K(d) = 2 / (pi r^2) (1 - d^2 / r^2).
+#[inline]
+pub fn epanechnikov(d2: f32, r2: f32) -> f32 {
+    if d2 >= r2 {
+        return 0.0;
+    }
+    2.0 * std::f32::consts::FRAC_1_PI / r2 * (1.0 - d2 / r2)
+}
+
+/// The merge radius of iteration `iteration` (1-based): r_1 i^((alpha - 1) / 2) (SmallVCM's
+/// schedule, tech. rep. section 5.3).
+pub fn radius_of(r1: f32, alpha: f32, iteration: u64) -> f32 {
+    let r = r1 as f64 * (iteration as f64).powf((alpha as f64 - 1.0) / 2.0);
+    (r as f32).max(1e-7)
+}
+
+/// One iteration's light subpaths: their vertices in pixel order, where each pixel's end, and
+/// each pixel's origin on an area light.
+struct LightPaths {
+    vertices: Vec<Vertex>,
+    ends: Vec<u32>,
+    origins: Vec<Option<Origin>>,
+}
+
+impl LightPaths {
+    fn of(&self, pixel: usize) -> &[Vertex] {
+        let start = if pixel == 0 { 0 } else { self.ends[pixel - 1] };
+        &self.vertices[start as usize..self.ends[pixel] as usize]
+    }
+}
+
+/// Splats of one row of pixels, as exact sums per pixel index.
+struct RowSplats(Vec<(u32, RadianceSum)>, u32, u64);
+
+impl SplatSink for RowSplats {
+    #[inline]
+    fn add(&mut self, x: u32, y: u32, value: Rgb) {
+        if !usable(value) {
+            self.2 += 1;
+            return;
+        }
+        if value == Rgb::ZERO {
+            return;
+        }
+        let mut s = RadianceSum::ZERO;
+        s.add(value);
+        self.0.push((y * self.1 + x, s));
+    }
+}
+
+/// What one row of the camera pass gives back.
+struct Row {
+    sums: Vec<RadianceSum>,
+    splats: RowSplats,
+    rays: u64,
+    bad: u64,
+}
+
+impl Vcm {
+    /// The estimator of iteration `iteration` (1-based): its radius and weights.
+    fn estimator(&self, scene: &Scene, iteration: u64) -> (Bidir, f32) {
+        let radius = radius_of(self.radius, self.alpha, iteration);
+        let light_paths = (scene.film.width as f32) * (scene.film.height as f32);
+        let mut bidir = Bidir::new(self.max_depth, self.rr_depth, Strategy::All, true);
+        bidir.factors = Factors::vcm(
+            radius,
+            light_paths,
+            self.mode.connects(),
+            self.mode.merges(),
+        );
+        if self.mode == Mode::Bpt || self.mode == Mode::Lt {
+            bidir.factors = Factors::CONNECT;
+        }
+        if self.mode == Mode::Lt {
+            bidir.strategy = Strategy::Light;
+        }
+        bidir.connect = self.mode.connects();
+        bidir.first_vertex_only = self.mode == Mode::Ppm;
+        (bidir, radius)
+    }
+
+    fn sampler(&self, scene: &Scene, stream: u64, pixel: u64, iteration: u64) -> Sampler {
+        let seed = scene.render.seed;
+        // The structured samplers' patterns are keyed by the seed: the two passes get their own.
+        Sampler::with_keys(
+            scene.render.sampler,
+            &[seed, stream, pixel, iteration],
+            seed ^ stream,
+            pixel,
+            iteration as u32,
+            self.iterations.unwrap_or(1) as u32,
+        )
+    }
+
+    /// Traces one light subpath per pixel.
+    fn light_pass(
+        &self,
+        scene: &Scene,
+        bidir: &Bidir,
+        media: &[Option<u32>],
+        iteration: u64,
+    ) -> (LightPaths, u64) {
+        let (width, height) = (scene.film.width, scene.film.height);
+        // Each row's paths (its ends counted from the row's first vertex), then joined in row
+        // order: the same vertices in the same order whatever the thread count.
+        let rows: Vec<(LightPaths, u64)> = (0..height)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = LightPaths {
+                    vertices: Vec::new(),
+                    ends: Vec::with_capacity(width as usize),
+                    origins: Vec::with_capacity(width as usize),
+                };
+                let mut rays = 0u64;
+                for x in 0..width {
+                    let pixel = y as u64 * width as u64 + x as u64;
+                    let mut sampler = self.sampler(scene, STREAM_LIGHT, pixel, iteration);
+                    let origin = bidir.light_subpath(
+                        scene,
+                        media,
+                        &mut sampler,
+                        &mut row.vertices,
+                        &mut rays,
+                    );
+                    row.origins.push(origin);
+                    row.ends.push(row.vertices.len() as u32);
+                }
+                (row, rays)
+            })
+            .collect();
+        let mut paths = LightPaths {
+            vertices: Vec::new(),
+            ends: Vec::with_capacity(width as usize * height as usize),
+            origins: Vec::with_capacity(width as usize * height as usize),
+        };
+        let mut rays = 0;
+        for (row, r) in rows {
+            let base = paths.vertices.len() as u32;
+            paths.ends.extend(row.ends.iter().map(|e| e + base));
+            paths.vertices.extend(row.vertices);
+            paths.origins.extend(row.origins);
+            rays += r;
+        }
+        (paths, rays)
+    }
+
+    /// The camera pass: every pixel's camera subpath, its connections with its own light
+    /// subpath (whose t = 1 splats it also makes) and its merges.
+    #[allow(clippy::too_many_arguments)]
+    fn camera_pass(
+        &self,
+        scene: &Scene,
+        bidir: &Bidir,
+        lights: &LightPaths,
+        grid: Option<&HashGrid>,
+        radius: f32,
+        iteration: u64,
+    ) -> Vec<Row> {
+        let (width, height) = (scene.film.width, scene.film.height);
+        let filter = &scene.film.filter;
+        let light_paths = width as f32 * height as f32;
+        (0..height)
+            .into_par_iter()
+            .map(|y| {
+                let mut row = Row {
+                    sums: Vec::with_capacity(width as usize),
+                    splats: RowSplats(Vec::new(), width, 0),
+                    rays: 0,
+                    bad: 0,
+                };
+                let mut camera = Vec::new();
+                for x in 0..width {
+                    let pixel = y as usize * width as usize + x as usize;
+                    let mut sampler = self.sampler(scene, STREAM_CAMERA, pixel as u64, iteration);
+                    let rays = &mut row.rays;
+                    // ---- t = 1: this pixel's light subpath connected to the camera ----
+                    if self.mode.connects() {
+                        if let Some(o) = &lights.origins[pixel] {
+                            bidir.splat_origin(scene, o, &mut row.splats, rays);
+                        }
+                        for v in lights.of(pixel) {
+                            bidir.splat_vertex(scene, v, &mut row.splats, rays);
+                        }
+                    }
+                    let mut l = Rgb::ZERO;
+                    if self.mode != Mode::Lt {
+                        let at = filter.film_position(x, y, sampler.next_2d());
+                        let ps = PixelSample {
+                            ray: scene.camera.generate_ray(at),
+                            x,
+                            y,
+                            film: at,
+                            filter_pdf: filter.pdf(x, y, at),
+                        };
+                        camera.clear();
+                        l = bidir.camera_subpath(scene, &ps, &mut sampler, &mut camera, rays);
+                        for c in &camera {
+                            if self.mode.connects() {
+                                // ---- s >= 1, t >= 2: connections ----
+                                l += bidir.direct(scene, c, &mut sampler, rays);
+                                for v in lights.of(pixel) {
+                                    l += bidir.connect(scene, c, v, rays);
+                                }
+                            }
+                            if let Some(grid) = grid {
+                                // ---- merges ----
+                                l += self.merge(bidir, c, &lights.vertices, grid, radius)
+                                    / light_paths;
+                            }
+                        }
+                    }
+                    if !usable(l) {
+                        row.bad += 1;
+                        l = Rgb::ZERO;
+                    }
+                    let mut sum = RadianceSum::ZERO;
+                    sum.add(l);
+                    row.sums.push(sum);
+                }
+                row
+            })
+            .collect()
+    }
+
+    /// The merges of camera vertex `c` with the light vertices within `radius`: sum_v
+    /// K f beta_c beta_v w_v (divided by the light path count by the caller).
+    fn merge(
+        &self,
+        bidir: &Bidir,
+        c: &Vertex,
+        vertices: &[Vertex],
+        grid: &HashGrid,
+        radius: f32,
+    ) -> Rgb {
+        let At::Surface { hit, bsdf } = &c.at else {
+            return Rgb::ZERO;
+        };
+        let r2 = radius * radius;
+        let thickness = DISC_THICKNESS * radius;
+        let mut sum = Rgb::ZERO;
+        grid.within(c.p, |i, d2| {
+            let v = &vertices[i];
+            // A merged path has l + m - 1 scattering events (l, m the two subpaths' segments).
+            if v.length + c.length > self.max_depth.saturating_add(1) {
+                return;
+            }
+            let At::Surface { hit: vh, .. } = &v.at else {
+                return;
+            };
+            // The same surface: normals within about 25 degrees (either side: the BSDF tells
+            // reflection from transmission), close to the tangent plane.
+            if vh.ng.dot(hit.ng).abs() <= 0.9 || (v.p - c.p).dot(hit.ng).abs() > thickness {
+                return;
+            }
+            let f = bsdf.eval_density(c.wo, v.wo);
+            if f == Rgb::ZERO {
+                return;
+            }
+            let w = if self.mode == Mode::Ppm {
+                1.0
+            } else {
+                weight_merge(
+                    &bidir.factors,
+                    &c.running,
+                    &v.running,
+                    bsdf.pdf(c.wo, v.wo),
+                    bsdf.pdf(v.wo, c.wo),
+                )
+            };
+            sum += f * v.beta * (epanechnikov(d2, r2) * w);
+        });
+        c.beta * sum
+    }
+}
+
+impl Integrator for Vcm {
+    fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        let (width, height) = (scene.film.width, scene.film.height);
+        // The iterations to run (0-based): all of them, or this part's share.
+        let (first, last) = if ctx.part.is_whole() {
+            (0, self.iterations)
+        } else {
+            let Some(n) = self.iterations.filter(|_| self.time.is_none()) else {
+                return Err(Error::Render(format!(
+                    "part {}: vcm splits into parts only with a number of iterations (no time)",
+                    ctx.part
+                )));
+            };
+            let share = ctx.part.share(n);
+            (share.start, Some(share.end))
+        };
+        let media = light_media(scene)?;
+        let mut film = Film::new(width, height);
+        let start = Instant::now();
+        match (last, self.time) {
+            (Some(n), None) => ctx.progress.begin("iterations", n - first),
+            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
+            (None, None) => unreachable!("create() sets one"),
+        }
+        let (bad_samples, bad_splats) = (AtomicU64::new(0), AtomicU64::new(0));
+        let mut done = first;
+        let mut rays = 0u64;
+        let mut seconds_reported = 0u64;
+        loop {
+            if last.is_some_and(|n| done >= n)
+                || self
+                    .time
+                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+                || ctx.cancelled()
+            {
+                break;
+            }
+            let (bidir, radius) = self.estimator(scene, done + 1);
+            let rows = with_pool(ctx.threads, || {
+                let (lights, light_rays) = self.light_pass(scene, &bidir, &media, done);
+                let grid = self.mode.merges().then(|| {
+                    HashGrid::build(lights.vertices.iter().map(|v| v.p).collect(), radius)
+                });
+                let rows = self.camera_pass(scene, &bidir, &lights, grid.as_ref(), radius, done);
+                (rows, light_rays)
+            })?;
+            if ctx.cancelled() {
+                // An iteration cut short would leave pixels without their sample: drop it.
+                break;
+            }
+            let (rows, mut iteration_rays) = rows;
+            for (y, row) in rows.into_iter().enumerate() {
+                let y0 = y * width as usize;
+                for (x, sum) in row.sums.iter().enumerate() {
+                    film.add_pixel(y0 + x, sum, 1);
+                }
+                for (i, s) in &row.splats.0 {
+                    film.add_splat(*i as usize, s);
+                }
+                iteration_rays += row.rays;
+                bad_samples.fetch_add(row.bad, Ordering::Relaxed);
+                bad_splats.fetch_add(row.splats.2, Ordering::Relaxed);
+            }
+            done += 1;
+            ctx.progress
+                .status(&format!("iteration {done}, radius {radius:.5}"));
+            ctx.progress.rays(iteration_rays);
+            rays += iteration_rays;
+            match self.time {
+                None => ctx.progress.advance(1),
+                Some(_) => {
+                    let s = start.elapsed().as_secs();
+                    ctx.progress.advance(s - seconds_reported);
+                    seconds_reported = s;
+                }
+            }
+            ctx.progress.checkpoint(done - first, &|| film.clone());
+        }
+        ctx.progress.finish();
+        let bad = bad_samples.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "camera sample(s)", "replaced by zero");
+        let bad = bad_splats.load(Ordering::Relaxed);
+        warn_unusable(ctx, bad, "splat(s)", "dropped");
+        film.part = ctx.part;
+        film.rays = rays;
+        film.iterations = done - first;
+        film.iterations_planned = last.map_or(0, |n| n - first);
+        Ok(film)
+    }
+
+    fn name(&self) -> &str {
+        "vcm"
+    }
+
+    fn parameters(&self) -> Vec<Parameter> {
+        let mut p = Vec::new();
+        if let Some(n) = self.iterations {
+            p.push(Parameter::int("iterations", n));
+        }
+        if let Some(t) = self.time {
+            p.push(Parameter::float("time", t));
+        }
+        p.push(if self.radius_given {
+            Parameter::float("radius", self.radius)
+        } else {
+            Parameter::str("radius", "auto")
+        });
+        p.push(Parameter::float("alpha", self.alpha));
+        p.push(Parameter::str("mode", self.mode.name()));
+        p.push(Parameter::int("rr_depth", self.rr_depth));
+        p
+    }
+
+    fn budget(&self) -> Budget {
+        Budget {
+            work: Work::Iterations {
+                key: "integrators.vcm.iterations".into(),
+            },
+            scaled: Vec::new(),
+        }
+    }
+}
+
+/// SmallVCM's default first radius: 0.003 x the radius of the scene's bounding sphere.
+pub fn auto_radius(scene: &Scene) -> f32 {
+    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
+    (0.003 * 0.5 * diagonal).max(1e-6)
+}
+
+/// Reads the parameters (see the table above).
+pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
+    let time = props.f32_opt("time")?;
+    if let Some(t) = time
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(props.error(
+            "time",
+            format!("must be a positive number of seconds, found {t}"),
+        ));
+    }
+    let iterations = if props.has("iterations") || time.is_none() {
+        let n = props.u64("iterations", 64)?;
+        if n == 0 {
+            return Err(props.error("iterations", "must be at least 1"));
+        }
+        Some(n)
+    } else {
+        None
+    };
+    let radius = props.f32_opt("radius")?;
+    if let Some(r) = radius
+        && !(r > 0.0 && r.is_finite())
+    {
+        return Err(props.error("radius", format!("must be positive, found {r}")));
+    }
+    let alpha = props.f32("alpha", 0.75)?;
+    if !(alpha > 0.0 && alpha <= 1.0) {
+        return Err(props.error("alpha", format!("must be in (0, 1], found {alpha}")));
+    }
+    let mode = match props.choice("mode", &Mode::NAMES, "vcm")? {
+        "bpt" => Mode::Bpt,
+        "ppm" => Mode::Ppm,
+        "lt" => Mode::Lt,
+        _ => Mode::Vcm,
+    };
+    let rr_depth = props.u32("rr_depth", 5)?;
+    if scene.has_media() {
+        return Err(Error::Usage(format!(
+            "{}: the scene has participating media, which `vcm` does not render (merging is on \
+             surfaces only): use `bdpt` or `vpm`",
+            scene.file.display()
+        )));
+    }
+    Ok(Box::new(Vcm {
+        iterations,
+        time: time.map(f64::from),
+        radius: radius.unwrap_or_else(|| auto_radius(scene)),
+        radius_given: radius.is_some(),
+        alpha,
+        mode,
+        max_depth: scene.render.max_depth,
+        rr_depth,
+    }))
+}
+
+foton_core::declare_integrator!(
+    "vcm",
+    "vertex connection and merging (Georgiev et al., MIS of bdpt and photon mapping)",
+    create
+);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The Epanechnikov kernel integrates to one over its disc, for any radius (midpoint rule
+    /// in the radius: 2 pi int_0^r K(d) d dd), and is zero outside.
+    #[test]
+    fn the_epanechnikov_kernel_integrates_to_one_over_the_disc() {
+        for r in [1e-3f32, 0.05, 1.0, 30.0] {
+            let n = 20_000;
+            let h = r as f64 / n as f64;
+            let integral: f64 = (0..n)
+                .map(|i| {
+                    let d = (i as f64 + 0.5) * h;
+                    2.0 * std::f64::consts::PI * d * epanechnikov((d * d) as f32, r * r) as f64 * h
+                })
+                .sum();
+            assert!((integral - 1.0).abs() < 1e-4, "r = {r}: {integral}");
+            assert_eq!(epanechnikov(r * r * 1.0001, r * r), 0.0);
+        }
+    }
+
+    /// The schedule: r_1 at the first iteration, r_1 i^((alpha - 1) / 2) after.
+    #[test]
+    fn the_radius_shrinks_as_the_schedule_says() {
+        assert_eq!(radius_of(0.1, 0.75, 1), 0.1);
+        let r = radius_of(0.1, 0.75, 16);
+        assert!((r - 0.1 * 16f32.powf(-0.125)).abs() < 1e-7, "{r}");
+        assert_eq!(radius_of(0.1, 1.0, 1000), 0.1);
+    }
+}
