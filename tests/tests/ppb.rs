@@ -14,6 +14,8 @@ fn ppb_passes(passes: u64, seed: u64) -> Film {
         &[
             "render.integrator=ppb",
             "integrators.ppb.photons_per_iteration=5000",
+            // Surface photons of their own (the defaults' kind), few: 16 x 16 pixels.
+            "integrators.ppb.surface_photons=20000",
             &n,
             &seed,
         ],
@@ -61,7 +63,7 @@ fn error_falls_with_passes_on_the_fog_box() {
 /// The point-light fog box of tests/tests/beams.rs (the light just above the view, shared in
 /// foton_tests): at max_depth 1 the image is single scattering only, all of it from beams.
 fn point_light_fog(integrator: &str, max_depth: u32) -> String {
-    let ppb = "[integrators.ppb]\niterations = 16\nphotons_per_iteration = 10000";
+    let ppb = "[integrators.ppb]\niterations = 16\nphotons_per_iteration = 10000\nsurface_photons = 10000";
     let hg = "{ type = \"hg\", g = 0.5 }";
     foton_tests::point_light_fog(integrator, 4096, max_depth, hg, ppb)
 }
@@ -103,6 +105,7 @@ fn identical_for_one_and_many_threads() {
         "render.integrator=ppb",
         "integrators.ppb.iterations=3",
         "integrators.ppb.photons_per_iteration=3000",
+        "integrators.ppb.surface_photons=6000",
     ];
     let one = cornell_fog(&set, 1);
     let many = cornell_fog(&set, 3);
@@ -131,6 +134,8 @@ fn parts_merge_to_the_whole_render() {
             "integrators.ppb.iterations=5",
             "--set",
             "integrators.ppb.photons_per_iteration=2000",
+            "--set",
+            "integrators.ppb.surface_photons=4000",
         ];
         args.extend(extra);
         foton_with_plugins(&args)
@@ -193,6 +198,7 @@ fn bad_parameters_are_clear_errors() {
                 "integrators.ppb.photons_per_iteration=0",
                 "photons_per_iteration",
             ),
+            ("integrators.ppb.surface_photons=10", "surface_photons"),
             (
                 "integrators.ppb.initial_beam_radius=0",
                 "initial_beam_radius",

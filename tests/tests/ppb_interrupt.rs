@@ -14,11 +14,12 @@ use std::sync::atomic::Ordering;
 use std::time::Duration;
 
 /// The foggy Cornell box at 16 x 16 with `ppb`, small passes.
-const SET: [&str; 5] = [
+const SET: [&str; 6] = [
     "render.integrator=\"ppb\"",
     "film.width=16",
     "film.height=16",
     "integrators.ppb.photons_per_iteration=2000",
+    "integrators.ppb.surface_photons=4000",
     "render.seed=3",
 ];
 

@@ -8,9 +8,10 @@
 //! |-------------------------|---------|-----------------------------------------------------------|---------|
 //! | `iterations`            | integer | passes (photon beams + one camera sample per pixel) to run, >= 1 | 32 (unlimited with `time`) |
 //! | `time`                  | float   | run until this many seconds have passed, > 0              | none    |
-//! | `photons_per_iteration` | integer | photons emitted in each pass, >= 1                        | 5000    |
+//! | `photons_per_iteration` | integer | photons emitted in each pass for the photon beams, >= 1   | 2500    |
+//! | `surface_photons`       | integer | photons emitted in each pass for the surface estimate, >= `photons_per_iteration` (equal: the beams' own photons, one trace) | 100000 (or `photons_per_iteration` if larger) |
 //! | `initial_beam_radius`   | float   | the photon beams' width r_1 in the first pass (world units), > 0 | 0.0287 x diagonal x photons_per_iteration^(-1/5) |
-//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic (`sppm`'s: 3 pixel footprints, within [1/1000, 1/50] of the diagonal) |
+//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 1.25 pixel footprints at the pass's visible point, within [1/1000, 1/50] of the diagonal |
 //! | `alpha`                 | float   | the radius schedule's exponent, in (0, 1)                 | 0.7     |
 //! | `beam_type`             | string  | `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 1-D across beams, in 2-D on surfaces) | `box` |
@@ -60,13 +61,18 @@
 //! averaged (`foton render --part`, `foton merge`), and the sums are exact, so the parts
 //! merge into the whole render bit for bit.
 //!
-//! **Why 5000 photons a pass.** A camera ray's cost grows with the beams' total length times
-//! their width, and the width starts at the 1-D optimum for the pass's photons, so the cost of
-//! a pass is nearly proportional to its photons while its noise falls as 1 / photons^(4/5):
-//! many small passes shrink the width sooner and give more camera samples for the same
-//! time. On the foggy Cornell box at 64 x 64 (against `path` at 4096 spp): 32 passes of
-//! 20000 photons took 24.6 s (worst 16 x 16 block 2.6 % off), of 5000 5.6 s (3.7 %), 64 of
-//! 2000 4.1 s (2.6 %); below a few thousand photons the per-pass camera work dominates.
+//! **Why 2500 beam photons and 100000 surface photons a pass** (measured: the README's
+//! table). A camera ray's cost grows with the beams' total length times their width, and the
+//! width starts at the 1-D optimum for the pass's photons, so the cost of a pass is nearly
+//! proportional to its beam photons (to the power 4/5); surface photons cost only their
+//! tracing and a disc gather per pixel. On the fog scenes the worst 16 x 16 blocks were never
+//! in the fog: they were the dim surfaces lit by indirect light alone (the ceiling) and the
+//! corners, where a disc reaches past the wall's edge. With the beams' photons alone at the
+//! surfaces (5000 a pass) the ceiling's noise decided the image (worst block 12.8 % on the
+//! foggy Cornell box at 256 x 256, whatever the beams' width or kind); 100000 surface photons
+//! take its noise away for about a tenth more time, and then a smaller first radius (1.25
+//! footprints instead of `sppm`'s 3) takes the corners' bias down. The beams then afford
+//! fewer photons (2500): the same error in three quarters of the time.
 //!
 //! **Each light path once**: in media by the beams (a light path scattering at x_c on the
 //! camera ray is the photon's path up to its beam plus that event), at surfaces L D by shadow
@@ -99,13 +105,15 @@ use foton_photonmap::progressive::{
     run_passes,
 };
 use foton_photonmap::trace::{
-    PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons_and_beams,
+    PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons, trace_photons_and_beams,
 };
 use rayon::prelude::*;
 
 pub struct Ppb {
     /// `iterations`, `time`, `photons_per_iteration`.
     pub passes: PassBudget,
+    /// Photons traced for the surface estimate in each pass (the beams' own, or more).
+    pub surface_photons: u64,
     pub initial_beam_radius: f32,
     pub initial_radius: Option<f32>,
     pub alpha: f64,
@@ -122,6 +130,12 @@ pub struct Ppb {
 /// Random stream of the camera passes.
 const STREAM_CAMERA: u64 = 0x7070_6263;
 
+/// The automatic first surface radius in pixel footprints (README: measured).
+pub const FOOTPRINTS: f64 = 1.25;
+
+/// Random stream of the surface photons when they are a trace of their own.
+const STREAM_SURFACE: u64 = 0x7070_6273;
+
 /// One pass's photons: the surface map and the beams with this pass's width.
 struct Pass {
     surface: PhotonMap,
@@ -131,33 +145,49 @@ struct Pass {
 }
 
 impl Ppb {
-    /// The photons pass `iteration` (0-based) stores at surfaces, and its beams.
+    /// The photons pass `iteration` (0-based) stores at surfaces, and its beams. With as many
+    /// surface photons as beam photons one trace gives both; with more, the surface photons
+    /// are a trace of their own (another random stream), the beams' trace stores none.
     fn trace(
         &self,
         scene: &Scene,
         iteration: u64,
         ctx: &RenderContext<'_>,
     ) -> Result<(Vec<Photon>, Vec<Beam>)> {
-        let options = TraceOptions {
-            photons: self.passes.photons_per_iteration,
+        let options = |photons, stream| TraceOptions {
+            photons,
             max_depth: self.max_depth,
             seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
-            stream: STREAM_GLOBAL,
+            stream,
             stop_at_diffuse: false,
             sobol_emission: TraceOptions::emission_for(scene.render.sampler),
         };
         let keep_direct = self.direct == Direct::Photons;
+        let shared = self.surface_photons == self.passes.photons_per_iteration;
         let (mut lists, beams) = trace_photons_and_beams(
             scene,
-            &options,
+            &options(self.passes.photons_per_iteration, STREAM_GLOBAL),
             ctx,
             1,
             |site, class| {
-                (site == Site::Surface && (class != PathClass::Direct || keep_direct)).then_some(0)
+                (shared && site == Site::Surface && (class != PathClass::Direct || keep_direct))
+                    .then_some(0)
             },
             scene.has_media().then_some(self.beam_type),
             |_| true,
         )?;
+        if !shared {
+            lists = trace_photons(
+                scene,
+                &options(self.surface_photons, STREAM_SURFACE),
+                ctx,
+                1,
+                |site, class| {
+                    (site == Site::Surface && (class != PathClass::Direct || keep_direct))
+                        .then_some(0)
+                },
+            )?;
+        }
         Ok((lists.pop().unwrap_or_default(), beams))
     }
 
@@ -244,7 +274,7 @@ impl Ppb {
             }
             let r1 = match self.initial_radius {
                 Some(r) => r as f64,
-                None => auto_radius(scene, angle, vp.distance),
+                None => auto_radius(scene, angle, vp.distance, FOOTPRINTS),
             };
             let r = (r1 * pass.surface_shrink) as f32;
             let g = gather_disc(
@@ -364,6 +394,7 @@ impl Integrator for Ppb {
 
     fn parameters(&self) -> Vec<Parameter> {
         let mut p = self.passes.parameters();
+        p.push(Parameter::int("surface_photons", self.surface_photons));
         p.push(Parameter::float(
             "initial_beam_radius",
             self.initial_beam_radius,
@@ -411,7 +442,7 @@ impl Integrator for Ppb {
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
     let diagonal = foton_photonmap::surface::diagonal(scene);
-    let passes = PassBudget::read(props, 32, 5_000)?;
+    let passes = PassBudget::read(props, 32, 2_500)?;
     let positive_opt = |key: &str| -> Result<Option<f32>> {
         let r = props.f32_opt(key)?;
         if let Some(r) = r
@@ -421,6 +452,17 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         }
         Ok(r)
     };
+    let surface_photons =
+        props.u64("surface_photons", passes.photons_per_iteration.max(100_000))?;
+    if surface_photons < passes.photons_per_iteration {
+        return Err(props.error(
+            "surface_photons",
+            format!(
+                "must be at least photons_per_iteration ({}), found {surface_photons}",
+                passes.photons_per_iteration
+            ),
+        ));
+    }
     let initial_beam_radius = positive_opt("initial_beam_radius")?
         .unwrap_or_else(|| default_beam_radius(diagonal, passes.photons_per_iteration));
     let initial_radius = positive_opt("initial_radius")?;
@@ -434,6 +476,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let direct = Direct::read(props)?;
     Ok(Box::new(Ppb {
         passes,
+        surface_photons,
         initial_beam_radius,
         initial_radius,
         alpha: alpha as f64,

@@ -92,7 +92,7 @@ use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::progressive::{
-    PassBudget, Passes, Tally, auto_radius, gather_disc, pixel_angle, run_passes,
+    PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc, pixel_angle, run_passes,
 };
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use glam::DVec3;
@@ -276,7 +276,7 @@ impl Sppm {
     fn first_radius(&self, scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
         match self.initial_radius {
             Some(r) => r as f64,
-            None => auto_radius(scene, pixel_angle, distance),
+            None => auto_radius(scene, pixel_angle, distance, SPPM_FOOTPRINTS),
         }
     }
 }
