@@ -146,6 +146,62 @@ output = "out.exr"
     )
 }
 
+/// The point-light fog box of the photon-beam tests (tests/tests/beams.rs, ppb.rs): a fog box
+/// [-1, 1] x [-1.6, 1.6] x [-1, 1] behind a null boundary with a point light inside, nothing
+/// else, 24 x 24 pixels: the camera (in vacuum) sees only light scattered by the fog. The light
+/// sits just above the field of view: in view it would be a singularity (in-scattered
+/// radiance ~ 1 / distance of the ray from it; a camera ray passing within the beam width of
+/// it crosses every beam that leaves it) whose pixel alone made the image mean vary by +-5 %
+/// from seed to seed. `phase` as in TOML; `tables`: TOML appended (the integrator's table).
+pub fn point_light_fog(
+    integrator: &str,
+    spp: u32,
+    max_depth: u32,
+    phase: &str,
+    tables: &str,
+) -> String {
+    let mut s = header(integrator, spp, max_depth, 24, 24);
+    s += &format!(
+        r#"
+[camera]
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 36.0
+[materials.boundary]
+type = "null"
+[media.fog]
+type = "homogeneous"
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.6, 0.6, 0.6]
+phase = {phase}
+[[shapes]]
+type = "mesh"
+file = "{cube}"
+material = "boundary"
+interior = "fog"
+transform = {{ scale = [1.0, 1.6, 1.0] }}
+[[lights]]
+type = "point"
+position = [0.3, 1.5, -0.2]
+intensity = [2.0, 2.0, 2.0]
+{tables}
+"#,
+        cube = repo_root().join("scenes/meshes/cube.obj").display()
+    );
+    s
+}
+
+/// `scenes/cornell-fog.toml` at 16 x 16 pixels with `set` (dotted overrides) on `threads`.
+pub fn cornell_fog_16(set: &[&str], threads: usize) -> Film {
+    let view = ["film.width=16", "film.height=16"];
+    render_file(
+        &repo_root().join("scenes/cornell-fog.toml"),
+        &[&view[..], set].concat(),
+        threads,
+    )
+}
+
 /// A course scene (`scenes/NAME`) with its point light replaced by a small area light (0.5 x
 /// 0.5, radiance 20, just below the ceiling), written to a temporary folder, so that the path
 /// tracer can render its caustics too (through BSDF-sampled rays that reach the light through

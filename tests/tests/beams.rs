@@ -184,47 +184,11 @@ fn one_beam_against_its_analytic_in_scattered_radiance() {
     }
 }
 
-/// A fog box [-1, 1] x [-1.6, 1.6] x [-1, 1] behind a null boundary with a point light
-/// inside, nothing else: the camera (in vacuum) sees only light scattered by the fog. The
-/// light sits just above the field of view: in view it would be a singularity (in-scattered
-/// radiance ~ 1 / distance of the ray from it; a camera ray passing within the beam width of
-/// it crosses every beam that leaves it) whose pixel alone made the image mean vary by +-5 %
-/// from seed to seed. `phase` as in TOML.
+/// The shared point-light fog box (foton_tests::point_light_fog) with vpm's surface budget
+/// kept small: there are no surfaces to light.
 fn point_light_fog(integrator: &str, spp: u32, max_depth: u32, phase: &str) -> String {
-    let mut s = header(integrator, spp, max_depth, 24, 24);
-    s += &format!(
-        r#"
-[camera]
-position = [0.0, 0.0, 4.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 36.0
-[materials.boundary]
-type = "null"
-[media.fog]
-type = "homogeneous"
-sigma_a = [0.1, 0.1, 0.1]
-sigma_s = [0.6, 0.6, 0.6]
-phase = {phase}
-[[shapes]]
-type = "mesh"
-file = "{cube}"
-material = "boundary"
-interior = "fog"
-transform = {{ scale = [1.0, 1.6, 1.0] }}
-[[lights]]
-type = "point"
-position = [0.3, 1.5, -0.2]
-intensity = [2.0, 2.0, 2.0]
-[integrators.vpm]
-global_photons = 1000
-caustic_photons = 0
-"#,
-        cube = foton_tests::repo_root()
-            .join("scenes/meshes/cube.obj")
-            .display()
-    );
-    s
+    let vpm = "[integrators.vpm]\nglobal_photons = 1000\ncaustic_photons = 0";
+    foton_tests::point_light_fog(integrator, spp, max_depth, phase, vpm)
 }
 
 /// vpm's beams against the path tracer on the point-light fog cube. `direct = "photons"`:

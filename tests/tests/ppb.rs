@@ -3,18 +3,9 @@
 //! determinism across thread counts and parts, bad parameters.
 
 use foton_core::film::Film;
+use foton_tests::cornell_fog_16 as cornell_fog;
 use foton_tests::stats::{Tolerance, assert_blocks_agree, rel_err, rel_rmse};
-use foton_tests::{foton, foton_with_plugins, render_file, render_toml, repo_root, temp_dir};
-
-const VIEW: [&str; 2] = ["film.width=16", "film.height=16"];
-
-fn cornell_fog(set: &[&str], threads: usize) -> Film {
-    render_file(
-        &repo_root().join("scenes/cornell-fog.toml"),
-        &[&VIEW[..], set].concat(),
-        threads,
-    )
-}
+use foton_tests::{foton, foton_with_plugins, render_toml, repo_root, temp_dir};
 
 fn ppb_passes(passes: u64, seed: u64) -> Film {
     let n = format!("integrators.ppb.iterations={passes}");
@@ -23,6 +14,8 @@ fn ppb_passes(passes: u64, seed: u64) -> Film {
         &[
             "render.integrator=ppb",
             "integrators.ppb.photons_per_iteration=5000",
+            // Surface photons of their own (the defaults' kind), few: 16 x 16 pixels.
+            "integrators.ppb.surface_photons=20000",
             &n,
             &seed,
         ],
@@ -67,41 +60,12 @@ fn error_falls_with_passes_on_the_fog_box() {
     );
 }
 
-/// The point-light fog box of tests/tests/beams.rs (the light just above the view): at
-/// max_depth 1 the image is single scattering only, all of it from beams.
+/// The point-light fog box of tests/tests/beams.rs (the light just above the view, shared in
+/// foton_tests): at max_depth 1 the image is single scattering only, all of it from beams.
 fn point_light_fog(integrator: &str, max_depth: u32) -> String {
-    let mut s = foton_tests::header(integrator, 4096, max_depth, 24, 24);
-    s += &format!(
-        r#"
-[camera]
-position = [0.0, 0.0, 4.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 36.0
-[materials.boundary]
-type = "null"
-[media.fog]
-type = "homogeneous"
-sigma_a = [0.1, 0.1, 0.1]
-sigma_s = [0.6, 0.6, 0.6]
-phase = {{ type = "hg", g = 0.5 }}
-[[shapes]]
-type = "mesh"
-file = "{cube}"
-material = "boundary"
-interior = "fog"
-transform = {{ scale = [1.0, 1.6, 1.0] }}
-[[lights]]
-type = "point"
-position = [0.3, 1.5, -0.2]
-intensity = [2.0, 2.0, 2.0]
-[integrators.ppb]
-iterations = 16
-photons_per_iteration = 10000
-"#,
-        cube = repo_root().join("scenes/meshes/cube.obj").display()
-    );
-    s
+    let ppb = "[integrators.ppb]\niterations = 16\nphotons_per_iteration = 10000\nsurface_photons = 10000";
+    let hg = "{ type = \"hg\", g = 0.5 }";
+    foton_tests::point_light_fog(integrator, 4096, max_depth, hg, ppb)
 }
 
 /// Tolerances as in tests/tests/beams.rs (there with 200k photons in one pass; here 16
@@ -141,6 +105,7 @@ fn identical_for_one_and_many_threads() {
         "render.integrator=ppb",
         "integrators.ppb.iterations=3",
         "integrators.ppb.photons_per_iteration=3000",
+        "integrators.ppb.surface_photons=6000",
     ];
     let one = cornell_fog(&set, 1);
     let many = cornell_fog(&set, 3);
@@ -169,6 +134,8 @@ fn parts_merge_to_the_whole_render() {
             "integrators.ppb.iterations=5",
             "--set",
             "integrators.ppb.photons_per_iteration=2000",
+            "--set",
+            "integrators.ppb.surface_photons=4000",
         ];
         args.extend(extra);
         foton_with_plugins(&args)
@@ -231,6 +198,7 @@ fn bad_parameters_are_clear_errors() {
                 "integrators.ppb.photons_per_iteration=0",
                 "photons_per_iteration",
             ),
+            ("integrators.ppb.surface_photons=10", "surface_photons"),
             (
                 "integrators.ppb.initial_beam_radius=0",
                 "initial_beam_radius",

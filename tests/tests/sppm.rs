@@ -2,6 +2,7 @@
 //! tracer, the white furnace, determinism, parameters.
 
 use foton_core::film::Film;
+use foton_photonmap::progressive::PassBudget;
 use foton_sppm::PixelStats;
 use foton_tests::stats::{Tolerance, assert_blocks_agree, rel_err, rel_rmse};
 use foton_tests::{
@@ -332,9 +333,11 @@ fn a_nan_photon_does_not_poison_a_pixel() {
     for schedule in [RadiusSchedule::Pixel, RadiusSchedule::Global] {
         let render = |band: f64| {
             let sppm = Sppm {
-                iterations: Some(4),
-                time: None,
-                photons_per_iteration: 20_000,
+                passes: PassBudget {
+                    iterations: Some(4),
+                    time: None,
+                    photons_per_iteration: 20_000,
+                },
                 initial_radius: None,
                 alpha: 0.7,
                 kernel: NormalizedKernel::new(Box::new(Banded { band })).unwrap(),

@@ -74,19 +74,17 @@ use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, Rende
 use foton_core::kernel::NormalizedKernel;
 use foton_core::material::TransportMode;
 use foton_core::props::Properties;
-use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, first_surface, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb, Vec3};
-use foton_photonmap::map::Estimate;
-use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
+use foton_photonmap::surface::{
+    SurfaceMaps, SurfaceParams, render_with_maps, surface_views, trace_surface_photons,
+};
 
 pub struct PhotonMapper {
-    pub global_photons: u64,
-    pub caustic_photons: u64,
-    pub k: usize,
-    pub max_radius: f32,
+    /// `global_photons`, `caustic_photons`, `k`, `max_radius`.
+    pub surface: SurfaceParams,
     pub kernel: NormalizedKernel,
     pub direct: Direct,
     pub final_gather: bool,
@@ -110,28 +108,17 @@ struct Vertex<'a> {
 const MAX_SPECULAR: u32 = 64;
 
 impl PhotonMapper {
-    fn budgets(&self) -> Budgets {
-        Budgets {
-            global: self.global_photons,
-            caustic: self.caustic_photons,
-            max_depth: self.max_depth,
-        }
-    }
-
-    fn estimate(&self) -> Estimate<'_> {
-        Estimate {
-            k: self.k,
-            max_radius: self.max_radius,
-            kernel: &self.kernel,
-        }
-    }
-
     /// The photon pass: traces both budgets and builds the maps (foton-photonmap's surface
     /// maps; the direct map only when direct light or final gathering reads it).
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<SurfaceMaps> {
         let need_direct = self.direct == Direct::Photons || self.final_gather;
-        let lists =
-            trace_surface_photons(scene, ctx, &self.budgets(), need_direct, self.final_gather)?;
+        let lists = trace_surface_photons(
+            scene,
+            ctx,
+            &self.surface.budgets(self.max_depth),
+            need_direct,
+            self.final_gather,
+        )?;
         if lists[2].is_empty() && !scene.lights.is_empty() {
             ctx.progress
                 .warn("no photon reached a second diffuse surface: the indirect map is empty");
@@ -206,7 +193,13 @@ impl PhotonMapper {
                     _ if m.is_delta() => break,
                     _ => {
                         let depth = budget - b;
-                        let l = maps.reflected_by_all(&self.estimate(), &m, &y, wo_y, depth);
+                        let l = maps.reflected_by_all(
+                            &self.surface.estimate(&self.kernel),
+                            &m,
+                            &y,
+                            wo_y,
+                            depth,
+                        );
                         sum += beta * l / (1.0 - p_delta);
                         break;
                     }
@@ -232,7 +225,7 @@ impl PhotonMapper {
         };
         // Photons here may have taken the scattering events the camera path has left.
         let depth = self.max_depth - vp.bounces;
-        let estimate = self.estimate();
+        let estimate = self.surface.estimate(&self.kernel);
         let mut l = maps.reflected_at(
             scene,
             &vp,
@@ -258,15 +251,13 @@ impl PhotonMapper {
 
 impl Integrator for PhotonMapper {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let maps = self.build_maps(scene, ctx)?;
-        if ctx.cancelled() {
-            return Ok(Film::new(scene.film.width, scene.film.height));
-        }
-        let film = render_pixels(scene, ctx, |ray, sampler, rays| {
-            self.li(scene, &maps, *ray, sampler, rays)
-        })?;
-        self.kernel.check_weights()?;
-        Ok(film)
+        render_with_maps(
+            scene,
+            ctx,
+            &self.kernel,
+            || self.build_maps(scene, ctx),
+            |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+        )
     }
 
     fn name(&self) -> &str {
@@ -274,12 +265,7 @@ impl Integrator for PhotonMapper {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        let mut p = vec![
-            Parameter::int("global_photons", self.global_photons),
-            Parameter::int("caustic_photons", self.caustic_photons),
-            Parameter::int("k", self.k),
-            Parameter::float("max_radius", self.max_radius),
-        ];
+        let mut p = self.surface.parameters();
         p.extend(self.kernel.parameters());
         p.extend([
             Parameter::str("direct", self.direct.name()),
@@ -293,16 +279,7 @@ impl Integrator for PhotonMapper {
     fn budget(&self) -> Budget {
         Budget {
             work: Work::Samples,
-            scaled: vec![
-                (
-                    "integrators.photon.global_photons".into(),
-                    self.global_photons,
-                ),
-                (
-                    "integrators.photon.caustic_photons".into(),
-                    self.caustic_photons,
-                ),
-            ],
+            scaled: self.surface.scaled("photon"),
         }
     }
 
@@ -310,68 +287,20 @@ impl Integrator for PhotonMapper {
     /// a render keeps the direct ones only for `direct = "photons"` or final gathering), and
     /// `caustic`: the L S+ D photons of the caustic budget.
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
-        let [mut global, caustic, indirect] =
-            trace_surface_photons(scene, ctx, &self.budgets(), true, false)?;
-        global.extend(indirect);
-        Ok(vec![
-            foton_photonmap::view(
-                "global",
-                if self.caustic_photons > 0 {
-                    "L D and paths with a diffuse bounce, of the global budget"
-                } else {
-                    "every path of the global budget (no caustic map)"
-                },
-                self.global_photons,
-                &global,
-            ),
-            foton_photonmap::view(
-                "caustic",
-                "L S+ D photons of the caustic budget",
-                self.caustic_photons,
-                &caustic,
-            ),
-        ])
+        let lists = trace_surface_photons(
+            scene,
+            ctx,
+            &self.surface.budgets(self.max_depth),
+            true,
+            false,
+        )?;
+        Ok(surface_views(&self.surface, lists).to_vec())
     }
-}
-
-/// Default largest estimate radius: 1/20 of the scene's bounding-box diagonal.
-pub fn default_max_radius(scene: &Scene) -> f32 {
-    let d = (scene.bounds.1 - scene.bounds.0).length();
-    if d > 0.0 { d / 20.0 } else { 1.0 }
 }
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    let global_photons = props.u64("global_photons", 200_000)?;
-    if global_photons == 0 {
-        return Err(props.error("global_photons", "must be at least 1"));
-    }
-    let caustic_photons = props.u64("caustic_photons", 100_000)?;
-    let k = props.u32("k", 50)? as usize;
-    if k < 2 {
-        // The k-th photon lies on the boundary of the estimate's disc and is not summed
-        // (docs/photon-mapping.md): k = 1 would leave nothing to sum.
-        return Err(props.error(
-            "k",
-            format!("must be at least 2, found {k} (the k-th nearest photon only sets the radius: the estimate sums the k - 1 inside it)"),
-        ));
-    }
-    check_k(
-        props,
-        "k",
-        k,
-        &[
-            ("global", "global_photons", global_photons),
-            ("caustic", "caustic_photons", caustic_photons),
-        ],
-    )?;
-    let max_radius = props.f32("max_radius", default_max_radius(scene))?;
-    if max_radius <= 0.0 {
-        return Err(props.error(
-            "max_radius",
-            format!("must be positive, found {max_radius}"),
-        ));
-    }
+    let surface = SurfaceParams::read(props, scene)?;
     let kernel = props.kernel("kernel", "box")?;
     let direct = Direct::read(props)?;
     let final_gather = props.bool("final_gather", false)?;
@@ -386,10 +315,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         )));
     }
     Ok(Box::new(PhotonMapper {
-        global_photons,
-        caustic_photons,
-        k,
-        max_radius,
+        surface,
         kernel,
         direct,
         final_gather,

@@ -15,8 +15,13 @@
 //!   [`map::DISC_THICKNESS`] (1/4) of the radius are not counted.
 //! - [`beams`]: photon beams (each photon flight through a medium, short or long), their BVH
 //!   and the beam x beam estimate with a 1-D kernel (Jarosz et al. 2011), for `vpm` and `ppb`;
-//! - [`progressive`]: what `sppm` and `ppb` share: Knaus and Zwicker's radius schedule, the
-//!   automatic first radius, the disc gather at a visible point.
+//! - [`progressive`]: what `sppm` and `ppb` share: the pass loop (`run_passes`: iterations or
+//!   a time budget, parts, Ctrl-C, checkpoints; each plugin gives only its per-pass estimator,
+//!   a `Passes`) and its parameters (`PassBudget`), Knaus and Zwicker's radius schedule, the
+//!   automatic first radius, the disc gather at a visible point;
+//! - [`surface`]: Jensen's surface maps and what `photon` and `vpm` share: their passes, the
+//!   estimate at a visible point, the parameters of the surface maps (`SurfaceParams`) and the
+//!   one-pass render (`render_with_maps`).
 //!
 //! Nothing here crosses the plugin boundary: the host never sees a `PhotonMap`. What the
 //! `foton photons` tool draws comes back through `Integrator::photon_maps` as core's plain

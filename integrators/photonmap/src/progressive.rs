@@ -1,14 +1,217 @@
-//! What the progressive integrators (`sppm`, `ppb`) share: the global radius schedule of
-//! Knaus and Zwicker, the automatic first radius from a pixel's footprint, and the gather of
-//! one iteration's photons on a disc around a camera path's visible point.
+//! What the progressive integrators (`sppm`, `ppb`) share: the pass loop ([`run_passes`]:
+//! iterations or a time budget, a part's share of the passes, Ctrl-C, checkpoints, progress)
+//! with the parameters that drive it ([`PassBudget`]), the global radius schedule of Knaus
+//! and Zwicker, the automatic first radius from a pixel's footprint, and the gather of one
+//! iteration's photons on a disc around a camera path's visible point. Each plugin keeps only
+//! its per-pass estimator (a [`Passes`]).
 
 use crate::map::{DISC_THICKNESS, PhotonMap};
 use foton_core::Rgb;
+use foton_core::error::{Error, Result};
+use foton_core::film::Film;
+use foton_core::integrator::{Budget, NoProgress, Parameter, RenderContext, Work};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::render::usable;
+use foton_core::props::Properties;
+use foton_core::render::{usable, warn_unusable};
 use foton_core::scene::Scene;
 use foton_core::walk::VisiblePoint;
 use glam::{DVec3, Vec2};
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::time::Instant;
+
+/// How many passes a progressive integrator runs and how many photons each traces: the
+/// `iterations`, `time` and `photons_per_iteration` of its table, read and checked here once.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PassBudget {
+    /// Passes to run; `None`: until `time` runs out.
+    pub iterations: Option<u64>,
+    /// Seconds to run for (with `iterations`, an upper bound on the passes).
+    pub time: Option<f64>,
+    pub photons_per_iteration: u64,
+}
+
+impl PassBudget {
+    /// Reads `time`, `iterations` (default `iterations` unless `time` is given alone) and
+    /// `photons_per_iteration`.
+    pub fn read(props: &Properties<'_>, iterations: u64, photons: u64) -> Result<PassBudget> {
+        let time = props.f32_opt("time")?;
+        if let Some(t) = time
+            && !(t > 0.0 && t.is_finite())
+        {
+            return Err(props.error(
+                "time",
+                format!("must be a positive number of seconds, found {t}"),
+            ));
+        }
+        let iterations = if props.has("iterations") || time.is_none() {
+            let n = props.u64("iterations", iterations)?;
+            if n == 0 {
+                return Err(props.error("iterations", "must be at least 1"));
+            }
+            Some(n)
+        } else {
+            None
+        };
+        let photons_per_iteration = props.u64("photons_per_iteration", photons)?;
+        if photons_per_iteration == 0 {
+            return Err(props.error("photons_per_iteration", "must be at least 1"));
+        }
+        Ok(PassBudget {
+            iterations,
+            time: time.map(f64::from),
+            photons_per_iteration,
+        })
+    }
+
+    /// The parameters as `Integrator::parameters` lists them.
+    pub fn parameters(&self) -> Vec<Parameter> {
+        let mut p = Vec::new();
+        if let Some(n) = self.iterations {
+            p.push(Parameter::int("iterations", n));
+        }
+        if let Some(t) = self.time {
+            p.push(Parameter::float("time", t));
+        }
+        p.push(Parameter::int(
+            "photons_per_iteration",
+            self.photons_per_iteration,
+        ));
+        p
+    }
+
+    /// `foton compare --time` counts a progressive integrator's work in passes.
+    pub fn budget(plugin: &str) -> Budget {
+        Budget {
+            work: Work::Iterations {
+                key: format!("integrators.{plugin}.iterations"),
+            },
+            scaled: Vec::new(),
+        }
+    }
+
+    /// The passes `[first, last)` this render runs: all of them (`last` `None` with a time
+    /// budget), or the part's share. Passes are split into parts only with a number of
+    /// iterations and no time, and only if `splittable` (else its reason, the error).
+    fn range(
+        &self,
+        plugin: &str,
+        ctx: &RenderContext<'_>,
+        splittable: std::result::Result<(), String>,
+    ) -> Result<(u64, Option<u64>)> {
+        if ctx.part.is_whole() {
+            return Ok((0, self.iterations));
+        }
+        let part = ctx.part;
+        splittable.map_err(|why| Error::Render(format!("part {part}: {why}")))?;
+        let Some(n) = self.iterations.filter(|_| self.time.is_none()) else {
+            return Err(Error::Render(format!(
+                "part {part}: {plugin} splits into parts only with a number of iterations (no time)"
+            )));
+        };
+        let share = part.share(n);
+        Ok((share.start, Some(share.end)))
+    }
+}
+
+/// A progressive integrator's passes: what one pass adds to the pixels, and the image they
+/// make. The loop around them is [`run_passes`].
+pub trait Passes {
+    /// Runs pass `iteration` (0-based: the same number whichever part runs it) and adds its
+    /// estimates to the pixels. `Ok(None)` when the render was cancelled before the pass was
+    /// complete: nothing is added (a pass with part of its photons would be biased).
+    /// Otherwise the progress bar's status line. `quiet` is the context for work that
+    /// should not report progress of its own (the photon pass).
+    fn pass(&mut self, iteration: u64, quiet: &RenderContext<'_>) -> Result<Option<String>>;
+
+    /// The image after `passes` passes (each pixel's mean over them).
+    fn film(&self, passes: u64) -> Film;
+
+    /// What the passes have counted so far.
+    fn tally(&self) -> &Tally;
+}
+
+/// What the passes count across threads: rays, and estimates or photon contributions that
+/// were not finite and non-negative (left out: one would stay in a pixel's sum for the rest
+/// of the render).
+#[derive(Debug, Default)]
+pub struct Tally {
+    pub rays: AtomicU64,
+    pub bad_samples: AtomicU64,
+    pub bad_photons: AtomicU64,
+}
+
+impl Tally {
+    pub fn add(counter: &AtomicU64, n: u64) {
+        if n > 0 {
+            counter.fetch_add(n, Ordering::Relaxed);
+        }
+    }
+}
+
+/// The pass loop of a progressive integrator: runs the passes `budget` and the part ask for
+/// (until `time` runs out with a time budget, or Ctrl-C), reports progress, writes
+/// checkpoints (`--checkpoint`: the image after the passes so far), and returns the image of
+/// the passes done with its counts (part, iterations, rays, photons). The caller checks its
+/// kernel's weights after it. `samples` names what
+/// a bad pixel estimate is in the warnings; `splittable` says whether the passes may be split
+/// into parts (passes independent of each other).
+pub fn run_passes(
+    plugin: &str,
+    budget: &PassBudget,
+    ctx: &RenderContext<'_>,
+    splittable: std::result::Result<(), String>,
+    samples: &str,
+    passes: &mut impl Passes,
+) -> Result<Film> {
+    let (first, last) = budget.range(plugin, ctx, splittable)?;
+    let start = Instant::now();
+    let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
+    match (last, budget.time) {
+        (Some(n), None) => ctx.progress.begin("iterations", n - first),
+        (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
+        (None, None) => unreachable!("PassBudget::read sets one"),
+    }
+    let mut done = first;
+    let mut seconds_reported = 0u64;
+    loop {
+        if last.is_some_and(|n| done >= n)
+            || budget
+                .time
+                .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
+            || ctx.cancelled()
+        {
+            break;
+        }
+        let Some(status) = passes.pass(done, &quiet)? else {
+            break;
+        };
+        done += 1;
+        ctx.progress.status(&status);
+        match budget.time {
+            None => ctx.progress.advance(1),
+            Some(_) => {
+                let s = start.elapsed().as_secs();
+                ctx.progress.advance(s - seconds_reported);
+                seconds_reported = s;
+            }
+        }
+        let kept = done - first;
+        ctx.progress.checkpoint(kept, &|| passes.film(kept));
+    }
+    ctx.progress.finish();
+    let tally = passes.tally();
+    let bad = tally.bad_samples.load(Ordering::Relaxed);
+    warn_unusable(ctx, bad, samples, "replaced by zero");
+    let bad = tally.bad_photons.load(Ordering::Relaxed);
+    warn_unusable(ctx, bad, "photon contribution(s)", "left out");
+    let mut film = passes.film(done - first);
+    film.part = ctx.part;
+    film.rays = tally.rays.load(Ordering::Relaxed);
+    film.iterations = done - first;
+    film.iterations_planned = last.map_or(0, |n| n - first);
+    film.photons = (done - first) * budget.photons_per_iteration;
+    Ok(film)
+}
 
 /// Knaus and Zwicker's radius schedule: the factor prod_{j=1}^{i-1} (j + alpha) / (j + 1) of
 /// iteration i (1-based). It falls like i^(alpha - 1). Applied to r^2 for a 2-D kernel
@@ -32,13 +235,18 @@ pub fn pixel_angle(scene: &Scene) -> f32 {
 }
 
 /// The automatic first gather radius of a pixel whose visible point lies `distance` along
-/// the camera path: three times the pixel's footprint there, kept within [1/1000, 1/50] of the
-/// scene's bounding-box diagonal (a few pixels wide, so that early iterations find photons,
-/// and small against the scene; an infinite distance gets the largest).
-pub fn auto_radius(scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
+/// the camera path: `footprints` times the pixel's footprint there, kept within [1/1000, 1/50]
+/// of the scene's bounding-box diagonal (a few pixels wide, so that early iterations find
+/// photons, and small against the scene; an infinite distance gets the largest). `sppm` takes
+/// 3 footprints ([`SPPM_FOOTPRINTS`]); `ppb`, whose passes gather from many more surface
+/// photons, fewer (its README).
+pub fn auto_radius(scene: &Scene, pixel_angle: f32, distance: f32, footprints: f64) -> f64 {
     let diagonal = (scene.bounds.1 - scene.bounds.0).length().max(1e-6) as f64;
-    (3.0 * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
+    (footprints * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
 }
+
+/// `sppm`'s automatic first radius in pixel footprints.
+pub const SPPM_FOOTPRINTS: f64 = 3.0;
 
 /// One gather: the (kernel-weighted) photon count and the reflected flux.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -16,9 +16,12 @@ use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions,
 use foton_core::bsdf::Bsdf;
 use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
 use foton_core::error::Result;
-use foton_core::geometry::Hit;
-use foton_core::integrator::RenderContext;
+use foton_core::film::Film;
+use foton_core::geometry::{Hit, Ray};
+use foton_core::integrator::{Parameter, PhotonMapView, RenderContext};
+use foton_core::kernel::NormalizedKernel;
 use foton_core::props::Properties;
+use foton_core::render::render_pixels;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::VisiblePoint;
@@ -82,6 +85,168 @@ pub fn trace_surface_photons(
         global_caustic
     };
     Ok([direct, caustic, indirect])
+}
+
+/// The parameters of the surface maps and their estimate, which `photon` and `vpm` read
+/// alike (their tables list them): `global_photons`, `caustic_photons`, `k`, `max_radius`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceParams {
+    pub global_photons: u64,
+    pub caustic_photons: u64,
+    /// Photons per estimate (the k-th sets the radius).
+    pub k: usize,
+    /// The largest estimate radius.
+    pub max_radius: f32,
+}
+
+impl SurfaceParams {
+    /// Reads and checks them; the defaults: 200 000 global and 100 000 caustic photons,
+    /// k = 50, a largest radius of 1/20 of the scene's bounding-box diagonal.
+    pub fn read(props: &Properties<'_>, scene: &Scene) -> Result<SurfaceParams> {
+        let global_photons = props.u64("global_photons", 200_000)?;
+        if global_photons == 0 {
+            return Err(props.error("global_photons", "must be at least 1"));
+        }
+        let caustic_photons = props.u64("caustic_photons", 100_000)?;
+        let k = read_k(props, "k")?;
+        check_k(
+            props,
+            "k",
+            k,
+            &[
+                ("global", "global_photons", global_photons),
+                ("caustic", "caustic_photons", caustic_photons),
+            ],
+        )?;
+        let max_radius = read_positive(props, "max_radius", diagonal(scene) / 20.0)?;
+        Ok(SurfaceParams {
+            global_photons,
+            caustic_photons,
+            k,
+            max_radius,
+        })
+    }
+
+    pub fn budgets(&self, max_depth: u32) -> Budgets {
+        Budgets {
+            global: self.global_photons,
+            caustic: self.caustic_photons,
+            max_depth,
+        }
+    }
+
+    pub fn estimate<'a>(&self, kernel: &'a NormalizedKernel) -> Estimate<'a> {
+        Estimate {
+            k: self.k,
+            max_radius: self.max_radius,
+            kernel,
+        }
+    }
+
+    /// The parameters as `Integrator::parameters` lists them.
+    pub fn parameters(&self) -> Vec<Parameter> {
+        vec![
+            Parameter::int("global_photons", self.global_photons),
+            Parameter::int("caustic_photons", self.caustic_photons),
+            Parameter::int("k", self.k),
+            Parameter::float("max_radius", self.max_radius),
+        ]
+    }
+
+    /// The photon budgets `foton compare --time` scales with the time (`Budget::scaled`).
+    pub fn scaled(&self, plugin: &str) -> Vec<(String, u64)> {
+        vec![
+            (
+                format!("integrators.{plugin}.global_photons"),
+                self.global_photons,
+            ),
+            (
+                format!("integrators.{plugin}.caustic_photons"),
+                self.caustic_photons,
+            ),
+        ]
+    }
+}
+
+/// The scene's bounding-box diagonal, the unit of the default radii and steps (1 for an
+/// empty scene).
+pub fn diagonal(scene: &Scene) -> f32 {
+    let d = (scene.bounds.1 - scene.bounds.0).length();
+    if d > 0.0 { d } else { 1.0 }
+}
+
+/// Reads an estimate's photon count `key`: at least 2, since the k-th nearest photon lies on
+/// the boundary of the estimate's disc and is not summed (docs/photon-mapping.md): k = 1
+/// would leave nothing to sum.
+pub fn read_k(props: &Properties<'_>, key: &str) -> Result<usize> {
+    let k = props.u32(key, 50)? as usize;
+    if k < 2 {
+        return Err(props.error(
+            key,
+            format!("must be at least 2, found {k} (the k-th nearest photon only sets the radius: the estimate sums the k - 1 inside it)"),
+        ));
+    }
+    Ok(k)
+}
+
+/// Reads a length or step `key` that must be positive and finite.
+pub fn read_positive(props: &Properties<'_>, key: &str, default: f32) -> Result<f32> {
+    let x = props.f32(key, default)?;
+    if !(x > 0.0 && x.is_finite()) {
+        return Err(props.error(key, format!("must be positive, found {x}")));
+    }
+    Ok(x)
+}
+
+/// The surface maps as `foton photons` draws them, from the lists of
+/// [`trace_surface_photons`] (with the direct list kept): `global`, the direct and indirect
+/// photons of the global budget (Jensen's global map; a render keeps the direct ones only
+/// when something reads them), and `caustic`, the L S+ D photons of the caustic budget.
+pub fn surface_views(
+    params: &SurfaceParams,
+    [mut global, caustic, indirect]: [Vec<Photon>; 3],
+) -> [PhotonMapView; 2] {
+    global.extend(indirect);
+    [
+        crate::view(
+            "global",
+            if params.caustic_photons > 0 {
+                "L D and paths with a diffuse bounce, of the global budget"
+            } else {
+                "every surface path of the global budget (no caustic map)"
+            },
+            params.global_photons,
+            &global,
+        ),
+        crate::view(
+            "caustic",
+            "L S+ D photons of the caustic budget",
+            params.caustic_photons,
+            &caustic,
+        ),
+    ]
+}
+
+/// The render of the one-pass photon mappers (`photon`, `vpm`): build the maps (`build`: the
+/// photon passes), then every pixel's samples through the shared pixel loop (`li`: the
+/// radiance along a camera ray), and check the kernel's weights. Cancelled during the photon
+/// passes, the image is black.
+pub fn render_with_maps<M: Sync>(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    kernel: &NormalizedKernel,
+    build: impl FnOnce() -> Result<M>,
+    li: impl Fn(&M, Ray, &mut Sampler, &mut u64) -> Rgb + Sync,
+) -> Result<Film> {
+    let maps = build()?;
+    if ctx.cancelled() {
+        return Ok(Film::new(scene.film.width, scene.film.height));
+    }
+    let film = render_pixels(scene, ctx, |ray, sampler, rays| {
+        li(&maps, *ray, sampler, rays)
+    })?;
+    kernel.check_weights()?;
+    Ok(film)
 }
 
 /// An error if an estimate's `k` (parameter `key`) exceeds a photon budget it is drawn from:

@@ -8,9 +8,10 @@
 //! |-------------------------|---------|-----------------------------------------------------------|---------|
 //! | `iterations`            | integer | passes (photon beams + one camera sample per pixel) to run, >= 1 | 32 (unlimited with `time`) |
 //! | `time`                  | float   | run until this many seconds have passed, > 0              | none    |
-//! | `photons_per_iteration` | integer | photons emitted in each pass, >= 1                        | 5000    |
+//! | `photons_per_iteration` | integer | photons emitted in each pass for the photon beams, >= 1   | 2500    |
+//! | `surface_photons`       | integer | photons emitted in each pass for the surface estimate, >= `photons_per_iteration` (equal: the beams' own photons, one trace) | 100000 (or `photons_per_iteration` if larger) |
 //! | `initial_beam_radius`   | float   | the photon beams' width r_1 in the first pass (world units), > 0 | 0.0287 x diagonal x photons_per_iteration^(-1/5) |
-//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic (`sppm`'s: 3 pixel footprints, within [1/1000, 1/50] of the diagonal) |
+//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 1.25 pixel footprints at the pass's visible point, within [1/1000, 1/50] of the diagonal |
 //! | `alpha`                 | float   | the radius schedule's exponent, in (0, 1)                 | 0.7     |
 //! | `beam_type`             | string  | `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 1-D across beams, in 2-D on surfaces) | `box` |
@@ -60,13 +61,18 @@
 //! averaged (`foton render --part`, `foton merge`), and the sums are exact, so the parts
 //! merge into the whole render bit for bit.
 //!
-//! **Why 5000 photons a pass.** A camera ray's cost grows with the beams' total length times
-//! their width, and the width starts at the 1-D optimum for the pass's photons, so the cost of
-//! a pass is nearly proportional to its photons while its noise falls as 1 / photons^(4/5):
-//! many small passes shrink the width sooner and give more camera samples for the same
-//! time. On the foggy Cornell box at 64 x 64 (against `path` at 4096 spp): 32 passes of
-//! 20000 photons took 24.6 s (worst 16 x 16 block 2.6 % off), of 5000 5.6 s (3.7 %), 64 of
-//! 2000 4.1 s (2.6 %); below a few thousand photons the per-pass camera work dominates.
+//! **Why 2500 beam photons and 100000 surface photons a pass** (measured: the README's
+//! table). A camera ray's cost grows with the beams' total length times their width, and the
+//! width starts at the 1-D optimum for the pass's photons, so the cost of a pass is nearly
+//! proportional to its beam photons (to the power 4/5); surface photons cost only their
+//! tracing and a disc gather per pixel. On the fog scenes the worst 16 x 16 blocks were never
+//! in the fog: they were the dim surfaces lit by indirect light alone (the ceiling) and the
+//! corners, where a disc reaches past the wall's edge. With the beams' photons alone at the
+//! surfaces (5000 a pass) the ceiling's noise decided the image (worst block 12.8 % on the
+//! foggy Cornell box at 256 x 256, whatever the beams' width or kind); 100000 surface photons
+//! take its noise away for about a tenth more time, and then a smaller first radius (1.25
+//! footprints instead of `sppm`'s 3) takes the corners' bias down. The beams then afford
+//! fewer photons (2500): the same error in three quarters of the time.
 //!
 //! **Each light path once**: in media by the beams (a light path scattering at x_c on the
 //! camera ray is the photon's path up to its beam plus that event), at surfaces L D by shadow
@@ -82,33 +88,32 @@
 use foton_core::direct::Direct;
 use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{
-    Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
-};
+use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext};
 use foton_core::kernel::NormalizedKernel;
 use foton_core::props::Properties;
-use foton_core::render::{usable, warn_unusable, with_pool};
+use foton_core::render::{usable, with_pool};
 use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
-use foton_core::{Error, Result, Rgb, Vec3};
+use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
 use foton_photonmap::map::{Photon, PhotonMap};
-use foton_photonmap::progressive::{auto_radius, gather_disc, global_radius2_scale, pixel_angle};
+use foton_photonmap::progressive::{
+    PassBudget, Passes, Tally, auto_radius, gather_disc, global_radius2_scale, pixel_angle,
+    run_passes,
+};
 use foton_photonmap::trace::{
-    PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons_and_beams,
+    PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons, trace_photons_and_beams,
 };
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 pub struct Ppb {
-    /// None: until `time` runs out.
-    pub iterations: Option<u64>,
-    pub time: Option<f64>,
-    pub photons_per_iteration: u64,
+    /// `iterations`, `time`, `photons_per_iteration`.
+    pub passes: PassBudget,
+    /// Photons traced for the surface estimate in each pass (the beams' own, or more).
+    pub surface_photons: u64,
     pub initial_beam_radius: f32,
     pub initial_radius: Option<f32>,
     pub alpha: f64,
@@ -125,6 +130,12 @@ pub struct Ppb {
 /// Random stream of the camera passes.
 const STREAM_CAMERA: u64 = 0x7070_6263;
 
+/// The automatic first surface radius in pixel footprints (README: measured).
+pub const FOOTPRINTS: f64 = 1.25;
+
+/// Random stream of the surface photons when they are a trace of their own.
+const STREAM_SURFACE: u64 = 0x7070_6273;
+
 /// One pass's photons: the surface map and the beams with this pass's width.
 struct Pass {
     surface: PhotonMap,
@@ -134,33 +145,49 @@ struct Pass {
 }
 
 impl Ppb {
-    /// The photons pass `iteration` (0-based) stores at surfaces, and its beams.
+    /// The photons pass `iteration` (0-based) stores at surfaces, and its beams. With as many
+    /// surface photons as beam photons one trace gives both; with more, the surface photons
+    /// are a trace of their own (another random stream), the beams' trace stores none.
     fn trace(
         &self,
         scene: &Scene,
         iteration: u64,
         ctx: &RenderContext<'_>,
     ) -> Result<(Vec<Photon>, Vec<Beam>)> {
-        let options = TraceOptions {
-            photons: self.photons_per_iteration,
+        let options = |photons, stream| TraceOptions {
+            photons,
             max_depth: self.max_depth,
             seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
-            stream: STREAM_GLOBAL,
+            stream,
             stop_at_diffuse: false,
             sobol_emission: TraceOptions::emission_for(scene.render.sampler),
         };
         let keep_direct = self.direct == Direct::Photons;
+        let shared = self.surface_photons == self.passes.photons_per_iteration;
         let (mut lists, beams) = trace_photons_and_beams(
             scene,
-            &options,
+            &options(self.passes.photons_per_iteration, STREAM_GLOBAL),
             ctx,
             1,
             |site, class| {
-                (site == Site::Surface && (class != PathClass::Direct || keep_direct)).then_some(0)
+                (shared && site == Site::Surface && (class != PathClass::Direct || keep_direct))
+                    .then_some(0)
             },
             scene.has_media().then_some(self.beam_type),
             |_| true,
         )?;
+        if !shared {
+            lists = trace_photons(
+                scene,
+                &options(self.surface_photons, STREAM_SURFACE),
+                ctx,
+                1,
+                |site, class| {
+                    (site == Site::Surface && (class != PathClass::Direct || keep_direct))
+                        .then_some(0)
+                },
+            )?;
+        }
         Ok((lists.pop().unwrap_or_default(), beams))
     }
 
@@ -195,7 +222,7 @@ impl Ppb {
             seed,
             pixel,
             iteration as u32,
-            self.iterations.unwrap_or(1) as u32,
+            self.passes.iterations.unwrap_or(1) as u32,
         );
         let film = scene.film.filter.film_position(x, y, sampler.next_2d());
         let ray = scene.camera.generate_ray(film);
@@ -247,7 +274,7 @@ impl Ppb {
             }
             let r1 = match self.initial_radius {
                 Some(r) => r as f64,
-                None => auto_radius(scene, angle, vp.distance),
+                None => auto_radius(scene, angle, vp.distance, FOOTPRINTS),
             };
             let r = (r1 * pass.surface_shrink) as f32;
             let g = gather_disc(
@@ -266,120 +293,98 @@ impl Ppb {
     }
 }
 
-/// The image after `iterations` passes: each pixel's exact sum of its passes' estimates, one
-/// sample per pass.
-fn film_of(sums: &[RadianceSum], width: u32, height: u32, iterations: u64) -> Film {
-    let mut film = Film::new(width, height);
-    let count = iterations.min(u32::MAX as u64) as u32;
-    for (i, sum) in sums.iter().enumerate().take((width * height) as usize) {
-        film.add_pixel(i, sum, count);
+/// The passes of one render: each pixel's exact sum of its passes' estimates, one sample per
+/// pass.
+struct PpbPasses<'a> {
+    ppb: &'a Ppb,
+    scene: &'a Scene,
+    sums: Vec<RadianceSum>,
+    angle: f32,
+    tally: &'a Tally,
+}
+
+impl Passes for PpbPasses<'_> {
+    fn pass(&mut self, iteration: u64, quiet: &RenderContext<'_>) -> Result<Option<String>> {
+        let (ppb, scene, tally) = (self.ppb, self.scene, self.tally);
+        let pass = ppb.pass(scene, iteration, quiet)?;
+        if quiet.cancelled() {
+            return Ok(None);
+        }
+        let (width, angle) = (scene.film.width as usize, self.angle);
+        with_pool(quiet.threads, || {
+            self.sums
+                .par_chunks_mut(width)
+                .enumerate()
+                .for_each(|(y, row)| {
+                    let (mut row_rays, mut row_bad, mut row_unusable) = (0u64, 0u64, 0u64);
+                    for (x, sum) in row.iter_mut().enumerate() {
+                        let l = ppb.estimate(
+                            scene,
+                            &pass,
+                            iteration,
+                            (x as u32, y as u32),
+                            angle,
+                            &mut row_rays,
+                            &mut row_bad,
+                        );
+                        if usable(l) {
+                            sum.add(l);
+                        } else {
+                            row_unusable += 1;
+                        }
+                    }
+                    Tally::add(&tally.rays, row_rays);
+                    Tally::add(&tally.bad_photons, row_bad);
+                    Tally::add(&tally.bad_samples, row_unusable);
+                })
+        })?;
+        let photons = (iteration + 1) * ppb.passes.photons_per_iteration;
+        Ok(Some(format!(
+            "iteration {}, {photons} photons, {} beams of width {:.5}",
+            iteration + 1,
+            pass.beams.len(),
+            pass.beams.radius()
+        )))
     }
-    film
+
+    fn tally(&self) -> &Tally {
+        self.tally
+    }
+
+    fn film(&self, passes: u64) -> Film {
+        let (width, height) = (self.scene.film.width, self.scene.film.height);
+        let mut film = Film::new(width, height);
+        let count = passes.min(u32::MAX as u64) as u32;
+        for (i, sum) in self.sums.iter().enumerate() {
+            film.add_pixel(i, sum, count);
+        }
+        film
+    }
 }
 
 impl Integrator for Ppb {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let (width, height) = (scene.film.width, scene.film.height);
-        // The passes to run: all of them, or this part's share (passes are independent).
-        let (first, last) = if ctx.part.is_whole() {
-            (0, self.iterations)
-        } else {
-            let Some(n) = self.iterations.filter(|_| self.time.is_none()) else {
-                return Err(Error::Render(format!(
-                    "part {}: ppb splits into parts only with a number of iterations (no time)",
-                    ctx.part
-                )));
-            };
-            let share = ctx.part.share(n);
-            (share.start, Some(share.end))
+        let tally = Tally::default();
+        let mut passes = PpbPasses {
+            ppb: self,
+            scene,
+            sums: vec![
+                RadianceSum::default();
+                scene.film.width as usize * scene.film.height as usize
+            ],
+            angle: pixel_angle(scene),
+            tally: &tally,
         };
-        let mut sums = vec![RadianceSum::default(); width as usize * height as usize];
-        let angle = pixel_angle(scene);
-        let start = Instant::now();
-        let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
-        match (last, self.time) {
-            (Some(n), None) => ctx.progress.begin("iterations", n - first),
-            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
-            (None, None) => unreachable!("create() sets one"),
-        }
-        let mut done = first;
-        let mut photons_total = 0u64;
-        let rays = AtomicU64::new(0);
-        let mut seconds_reported = 0u64;
-        // Estimates and photon contributions that were not finite and non-negative, replaced
-        // by zero (one would stay in a pixel's sum for the rest of the render).
-        let (bad_samples, bad_photons) = (AtomicU64::new(0), AtomicU64::new(0));
-        loop {
-            if last.is_some_and(|n| done >= n)
-                || self
-                    .time
-                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
-                || ctx.cancelled()
-            {
-                break;
-            }
-            let pass = self.pass(scene, done, &quiet)?;
-            if ctx.cancelled() {
-                // A pass with part of its photons would be biased: drop it.
-                break;
-            }
-            let iteration = done;
-            with_pool(ctx.threads, || {
-                sums.par_chunks_mut(width as usize)
-                    .enumerate()
-                    .for_each(|(y, row)| {
-                        let (mut row_rays, mut row_bad) = (0u64, 0u64);
-                        for (x, sum) in row.iter_mut().enumerate() {
-                            let l = self.estimate(
-                                scene,
-                                &pass,
-                                iteration,
-                                (x as u32, y as u32),
-                                angle,
-                                &mut row_rays,
-                                &mut row_bad,
-                            );
-                            if usable(l) {
-                                sum.add(l);
-                            } else {
-                                bad_samples.fetch_add(1, Ordering::Relaxed);
-                            }
-                        }
-                        rays.fetch_add(row_rays, Ordering::Relaxed);
-                        bad_photons.fetch_add(row_bad, Ordering::Relaxed);
-                    })
-            })?;
-            done += 1;
-            photons_total += self.photons_per_iteration;
-            ctx.progress.status(&format!(
-                "iteration {done}, {photons_total} photons, {} beams of width {:.5}",
-                pass.beams.len(),
-                pass.beams.radius()
-            ));
-            match self.time {
-                None => ctx.progress.advance(1),
-                Some(_) => {
-                    let s = start.elapsed().as_secs();
-                    ctx.progress.advance(s - seconds_reported);
-                    seconds_reported = s;
-                }
-            }
-            let kept = done - first;
-            ctx.progress
-                .checkpoint(kept, &|| film_of(&sums, width, height, kept));
-        }
-        ctx.progress.finish();
+        // Passes are independent (r_1 from each pass's own visible point): any split works.
+        let film = run_passes(
+            "ppb",
+            &self.passes,
+            ctx,
+            Ok(()),
+            "pass estimate(s)",
+            &mut passes,
+        )?;
         self.kernel.check_weights()?;
-        let bad = bad_samples.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "pass estimate(s)", "replaced by zero");
-        let bad = bad_photons.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "photon contribution(s)", "left out");
-        let mut film = film_of(&sums, width, height, done - first);
-        film.part = ctx.part;
-        film.rays = rays.load(Ordering::Relaxed);
-        film.iterations = done - first;
-        film.iterations_planned = last.map_or(0, |n| n - first);
-        film.photons = photons_total;
         Ok(film)
     }
 
@@ -388,17 +393,8 @@ impl Integrator for Ppb {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        let mut p = Vec::new();
-        if let Some(n) = self.iterations {
-            p.push(Parameter::int("iterations", n));
-        }
-        if let Some(t) = self.time {
-            p.push(Parameter::float("time", t));
-        }
-        p.push(Parameter::int(
-            "photons_per_iteration",
-            self.photons_per_iteration,
-        ));
+        let mut p = self.passes.parameters();
+        p.push(Parameter::int("surface_photons", self.surface_photons));
         p.push(Parameter::float(
             "initial_beam_radius",
             self.initial_beam_radius,
@@ -419,12 +415,7 @@ impl Integrator for Ppb {
     }
 
     fn budget(&self) -> Budget {
-        Budget {
-            work: Work::Iterations {
-                key: "integrators.ppb.iterations".into(),
-            },
-            scaled: Vec::new(),
-        }
+        PassBudget::budget("ppb")
     }
 
     /// `iteration`: the surface photons of the first pass; `beams`: the starts of its beams.
@@ -435,13 +426,13 @@ impl Integrator for Ppb {
             foton_photonmap::view(
                 "iteration",
                 "one pass's surface photons (but L D with direct = \"nee\")",
-                self.photons_per_iteration,
+                self.passes.photons_per_iteration,
                 &photons,
             ),
             foton_photonmap::view(
                 "beams",
                 "the starts of one pass's photon beams",
-                self.photons_per_iteration,
+                self.passes.photons_per_iteration,
                 &starts,
             ),
         ])
@@ -450,30 +441,8 @@ impl Integrator for Ppb {
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
-    let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
-    let time = props.f32_opt("time")?;
-    if let Some(t) = time
-        && !(t > 0.0 && t.is_finite())
-    {
-        return Err(props.error(
-            "time",
-            format!("must be a positive number of seconds, found {t}"),
-        ));
-    }
-    let iterations = if props.has("iterations") || time.is_none() {
-        let n = props.u64("iterations", 32)?;
-        if n == 0 {
-            return Err(props.error("iterations", "must be at least 1"));
-        }
-        Some(n)
-    } else {
-        None
-    };
-    let photons_per_iteration = props.u64("photons_per_iteration", 5_000)?;
-    if photons_per_iteration == 0 {
-        return Err(props.error("photons_per_iteration", "must be at least 1"));
-    }
+    let diagonal = foton_photonmap::surface::diagonal(scene);
+    let passes = PassBudget::read(props, 32, 2_500)?;
     let positive_opt = |key: &str| -> Result<Option<f32>> {
         let r = props.f32_opt(key)?;
         if let Some(r) = r
@@ -483,8 +452,19 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         }
         Ok(r)
     };
+    let surface_photons =
+        props.u64("surface_photons", passes.photons_per_iteration.max(100_000))?;
+    if surface_photons < passes.photons_per_iteration {
+        return Err(props.error(
+            "surface_photons",
+            format!(
+                "must be at least photons_per_iteration ({}), found {surface_photons}",
+                passes.photons_per_iteration
+            ),
+        ));
+    }
     let initial_beam_radius = positive_opt("initial_beam_radius")?
-        .unwrap_or_else(|| default_beam_radius(diagonal, photons_per_iteration));
+        .unwrap_or_else(|| default_beam_radius(diagonal, passes.photons_per_iteration));
     let initial_radius = positive_opt("initial_radius")?;
     let alpha = props.f32("alpha", 0.7)?;
     if !(alpha > 0.0 && alpha < 1.0) {
@@ -495,9 +475,8 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let kernel_1d = Kernel1d::norm(&kernel);
     let direct = Direct::read(props)?;
     Ok(Box::new(Ppb {
-        iterations,
-        time: time.map(f64::from),
-        photons_per_iteration,
+        passes,
+        surface_photons,
         initial_beam_radius,
         initial_radius,
         alpha: alpha as f64,

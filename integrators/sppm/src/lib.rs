@@ -82,30 +82,26 @@
 use foton_core::direct::Direct;
 use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{
-    Budget, Integrator, NoProgress, Parameter, PhotonMapView, RenderContext, Work,
-};
+use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext};
 use foton_core::kernel::NormalizedKernel;
 use foton_core::props::Properties;
-use foton_core::render::{usable, warn_unusable, with_pool};
+use foton_core::render::{usable, with_pool};
 use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
 use foton_core::{Error, Result, Rgb};
 use foton_photonmap::map::PhotonMap;
-use foton_photonmap::progressive::{auto_radius, gather_disc, pixel_angle};
+use foton_photonmap::progressive::{
+    PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc, pixel_angle, run_passes,
+};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use glam::DVec3;
 use rayon::prelude::*;
 use std::f64::consts::PI;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 pub struct Sppm {
-    /// None: until `time` runs out.
-    pub iterations: Option<u64>,
-    pub time: Option<f64>,
-    pub photons_per_iteration: u64,
+    /// `iterations`, `time`, `photons_per_iteration`.
+    pub passes: PassBudget,
     pub initial_radius: Option<f32>,
     pub alpha: f64,
     pub kernel: NormalizedKernel,
@@ -211,7 +207,7 @@ impl Sppm {
                             seed,
                             pixel,
                             iteration as u32,
-                            self.iterations.unwrap_or(1) as u32,
+                            self.passes.iterations.unwrap_or(1) as u32,
                         );
                         let film = scene.film.filter.film_position(x, y, sampler.next_2d());
                         let ray = scene.camera.generate_ray(film);
@@ -260,7 +256,7 @@ impl Sppm {
         ctx: &RenderContext<'_>,
     ) -> Result<Vec<foton_photonmap::Photon>> {
         let options = TraceOptions {
-            photons: self.photons_per_iteration,
+            photons: self.passes.photons_per_iteration,
             max_depth: self.max_depth,
             seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
             stream: STREAM_GLOBAL,
@@ -280,196 +276,178 @@ impl Sppm {
     fn first_radius(&self, scene: &Scene, pixel_angle: f32, distance: f32) -> f64 {
         match self.initial_radius {
             Some(r) => r as f64,
-            None => auto_radius(scene, pixel_angle, distance),
+            None => auto_radius(scene, pixel_angle, distance, SPPM_FOOTPRINTS),
         }
     }
 }
 
-/// The image after `iterations` iterations: under the global schedule each pixel's exact sum
-/// of per-iteration estimates, one sample per iteration; under the pixel schedule the
-/// progressive estimate as one sample.
-fn film_of(
-    stats: &[PixelStats],
-    schedule: RadiusSchedule,
-    width: u32,
-    height: u32,
-    iterations: u64,
-) -> Film {
-    let mut film = Film::new(width, height);
-    for y in 0..height {
-        for x in 0..width {
-            let i = (y * width + x) as usize;
-            match schedule {
-                RadiusSchedule::Pixel => {
-                    film.set_pixel(x, y, stats[i].radiance(iterations).as_vec3())
-                }
-                RadiusSchedule::Global => {
-                    film.add_pixel(i, &stats[i].sum, iterations.min(u32::MAX as u64) as u32)
+/// The passes of one render: each pixel's progressive statistics.
+struct SppmPasses<'a> {
+    sppm: &'a Sppm,
+    scene: &'a Scene,
+    stats: Vec<PixelStats>,
+    angle: f32,
+    tally: &'a Tally,
+    /// Whether a pass has run (a part that starts later first needs the radii r_1).
+    started: bool,
+}
+
+impl Passes for SppmPasses<'_> {
+    fn pass(&mut self, iteration: u64, quiet: &RenderContext<'_>) -> Result<Option<String>> {
+        let (sppm, scene, angle, tally) = (self.sppm, self.scene, self.angle, self.tally);
+        let global = sppm.schedule == RadiusSchedule::Global;
+        let mut rays = 0u64;
+        if global && iteration > 0 && !self.started {
+            // r_1 comes from the first iteration's camera sample: a part that starts later
+            // traces that camera pass for its radii alone.
+            let camera = with_pool(quiet.threads, || sppm.camera_pass(scene, 0, &mut rays))?;
+            for (st, cs) in self.stats.iter_mut().zip(&camera) {
+                st.radius = sppm.first_radius(scene, angle, cs.distance());
+            }
+        }
+        self.started = true;
+        let camera = with_pool(quiet.threads, || {
+            sppm.camera_pass(scene, iteration, &mut rays)
+        })?;
+        Tally::add(&tally.rays, rays);
+        let photons = sppm.iteration_photons(scene, iteration, quiet)?;
+        if quiet.cancelled() {
+            return Ok(None);
+        }
+        let map = PhotonMap::build(photons);
+        let alpha = sppm.alpha;
+        // r_i / r_1 of this iteration under the global schedule, the same for every pixel.
+        let global_shrink = global_radius2_scale(iteration + 1, alpha).sqrt();
+        with_pool(quiet.threads, || {
+            self.stats
+                .par_iter_mut()
+                .zip(camera.par_iter())
+                .for_each(|(st, cs)| {
+                    let ld = if usable(cs.ld) {
+                        cs.ld
+                    } else {
+                        Tally::add(&tally.bad_samples, 1);
+                        Rgb::ZERO
+                    };
+                    if global && iteration == 0 {
+                        // r_1 from the first iteration's camera sample alone (a pixel
+                        // without a visible point there gets the largest automatic one),
+                        // so that every iteration's radius is a function of its number.
+                        st.radius = sppm.first_radius(scene, angle, cs.distance());
+                    }
+                    let Some(vp) = &cs.visible else {
+                        match sppm.schedule {
+                            RadiusSchedule::Pixel => st.ld += ld.as_dvec3(),
+                            RadiusSchedule::Global => st.sum.add(ld),
+                        }
+                        return;
+                    };
+                    if st.radius == 0.0 {
+                        st.radius = sppm.first_radius(scene, angle, vp.distance);
+                    }
+                    let r = if global {
+                        (st.radius * global_shrink) as f32
+                    } else {
+                        st.radius as f32
+                    };
+                    let disc = std::f32::consts::PI * r * r;
+                    // No light path longer than max_depth, as in the path tracer; a
+                    // disc, as the k-nearest estimates gather from (foton-photonmap).
+                    let depth = sppm.max_depth - vp.bounces;
+                    let g = gather_disc(&map, vp, r, depth, &sppm.kernel);
+                    Tally::add(&tally.bad_photons, g.bad);
+                    let (m, phi) = (g.m, g.phi * vp.beta.as_dvec3());
+                    match sppm.schedule {
+                        RadiusSchedule::Pixel => {
+                            st.ld += ld.as_dvec3();
+                            st.update(alpha, m, phi);
+                        }
+                        RadiusSchedule::Global => {
+                            // This iteration's estimate: its direct light and reflected
+                            // radiance tau / (pi r^2) with its own radius; iterations
+                            // are averaged.
+                            let l = ld.as_dvec3() + phi / disc as f64;
+                            st.sum.add_f64(l.to_array());
+                        }
+                    }
+                })
+        })?;
+        let done = iteration + 1;
+        let (sum_r, lit) = self
+            .stats
+            .iter()
+            .filter(|s| s.radius > 0.0)
+            .fold((0.0, 0u64), |(s, n), st| (s + st.radius, n + 1));
+        let shrink = match sppm.schedule {
+            RadiusSchedule::Pixel => 1.0,
+            RadiusSchedule::Global => global_radius2_scale(done, alpha).sqrt(),
+        };
+        Ok(Some(format!(
+            "iteration {done}, {} photons, mean radius {:.4}",
+            done * sppm.passes.photons_per_iteration,
+            shrink * sum_r / lit.max(1) as f64
+        )))
+    }
+
+    /// Under the global schedule each pixel's exact sum of per-iteration estimates, one
+    /// sample per iteration; under the pixel schedule the progressive estimate as one sample.
+    fn tally(&self) -> &Tally {
+        self.tally
+    }
+
+    fn film(&self, iterations: u64) -> Film {
+        let (width, height) = (self.scene.film.width, self.scene.film.height);
+        let mut film = Film::new(width, height);
+        for y in 0..height {
+            for x in 0..width {
+                let i = (y * width + x) as usize;
+                match self.sppm.schedule {
+                    RadiusSchedule::Pixel => {
+                        film.set_pixel(x, y, self.stats[i].radiance(iterations).as_vec3())
+                    }
+                    RadiusSchedule::Global => film.add_pixel(
+                        i,
+                        &self.stats[i].sum,
+                        iterations.min(u32::MAX as u64) as u32,
+                    ),
                 }
             }
         }
+        film
     }
-    film
 }
 
 impl Integrator for Sppm {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let (width, height) = (scene.film.width, scene.film.height);
-        let global = self.schedule == RadiusSchedule::Global;
-        // The iterations to run: all of them, or this part's share.
-        let (first, last) = if ctx.part.is_whole() {
-            (0, self.iterations)
-        } else {
-            let Some(n) = self.iterations.filter(|_| self.time.is_none() && global) else {
-                return Err(Error::Render(format!(
-                    "part {}: sppm splits into parts only with radius_schedule = \"global\" and a \
-                     number of iterations (no time): under the pixel schedule each iteration's \
-                     radius depends on the photons of the iterations before it, so iterations \
-                     cannot be rendered apart",
-                    ctx.part
-                )));
-            };
-            let share = ctx.part.share(n);
-            (share.start, Some(share.end))
+        let tally = Tally::default();
+        let mut passes = SppmPasses {
+            sppm: self,
+            scene,
+            stats: vec![
+                PixelStats::default();
+                scene.film.width as usize * scene.film.height as usize
+            ],
+            angle: pixel_angle(scene),
+            tally: &tally,
+            started: false,
         };
-        let mut stats = vec![PixelStats::default(); width as usize * height as usize];
-        let angle = pixel_angle(scene);
-        let start = Instant::now();
-        let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
-        match (last, self.time) {
-            (Some(n), None) => ctx.progress.begin("iterations", n - first),
-            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
-            (None, None) => unreachable!("create() sets one"),
-        }
-        let mut done = first;
-        let mut photons_total = 0u64;
-        let mut rays = 0u64;
-        let mut seconds_reported = 0u64;
-        // Camera samples and photon contributions that were not finite and non-negative,
-        // replaced by zero: one would stay in a pixel's statistics for the rest of the render.
-        let (bad_samples, bad_photons) = (AtomicU64::new(0), AtomicU64::new(0));
-        if global && first > 0 {
-            // r_1 comes from the first iteration's camera sample: a part that starts later
-            // traces that camera pass for its radii alone.
-            let camera = with_pool(ctx.threads, || self.camera_pass(scene, 0, &mut rays))?;
-            for (st, cs) in stats.iter_mut().zip(&camera) {
-                st.radius = self.first_radius(scene, angle, cs.distance());
-            }
-        }
-        loop {
-            if last.is_some_and(|n| done >= n)
-                || self
-                    .time
-                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
-                || ctx.cancelled()
-            {
-                break;
-            }
-            let camera = with_pool(ctx.threads, || self.camera_pass(scene, done, &mut rays))?;
-            let photons = self.iteration_photons(scene, done, &quiet)?;
-            if ctx.cancelled() {
-                // An iteration with part of its photons would be biased: drop it.
-                break;
-            }
-            let map = PhotonMap::build(photons);
-            let alpha = self.alpha;
-            // r_i / r_1 of this iteration under the global schedule, the same for every pixel.
-            let global_shrink = global_radius2_scale(done + 1, alpha).sqrt();
-            with_pool(ctx.threads, || {
-                stats
-                    .par_iter_mut()
-                    .zip(camera.par_iter())
-                    .for_each(|(st, cs)| {
-                        let ld = if usable(cs.ld) {
-                            cs.ld
-                        } else {
-                            bad_samples.fetch_add(1, Ordering::Relaxed);
-                            Rgb::ZERO
-                        };
-                        if global && done == 0 {
-                            // r_1 from the first iteration's camera sample alone (a pixel
-                            // without a visible point there gets the largest automatic one),
-                            // so that every iteration's radius is a function of its number.
-                            st.radius = self.first_radius(scene, angle, cs.distance());
-                        }
-                        let Some(vp) = &cs.visible else {
-                            match self.schedule {
-                                RadiusSchedule::Pixel => st.ld += ld.as_dvec3(),
-                                RadiusSchedule::Global => st.sum.add(ld),
-                            }
-                            return;
-                        };
-                        if st.radius == 0.0 {
-                            st.radius = self.first_radius(scene, angle, vp.distance);
-                        }
-                        let r = if global {
-                            (st.radius * global_shrink) as f32
-                        } else {
-                            st.radius as f32
-                        };
-                        let disc = std::f32::consts::PI * r * r;
-                        // No light path longer than max_depth, as in the path tracer; a
-                        // disc, as the k-nearest estimates gather from (foton-photonmap).
-                        let depth = self.max_depth - vp.bounces;
-                        let g = gather_disc(&map, vp, r, depth, &self.kernel);
-                        if g.bad > 0 {
-                            bad_photons.fetch_add(g.bad, Ordering::Relaxed);
-                        }
-                        let (m, phi) = (g.m, g.phi * vp.beta.as_dvec3());
-                        match self.schedule {
-                            RadiusSchedule::Pixel => {
-                                st.ld += ld.as_dvec3();
-                                st.update(alpha, m, phi);
-                            }
-                            RadiusSchedule::Global => {
-                                // This iteration's estimate: its direct light and reflected
-                                // radiance tau / (pi r^2) with its own radius; iterations
-                                // are averaged.
-                                let l = ld.as_dvec3() + phi / disc as f64;
-                                st.sum.add_f64(l.to_array());
-                            }
-                        }
-                    })
-            })?;
-            done += 1;
-            photons_total += self.photons_per_iteration;
-            let (sum_r, lit) = stats
-                .iter()
-                .filter(|s| s.radius > 0.0)
-                .fold((0.0, 0u64), |(s, n), st| (s + st.radius, n + 1));
-            let shrink = match self.schedule {
-                RadiusSchedule::Pixel => 1.0,
-                RadiusSchedule::Global => global_radius2_scale(done, self.alpha).sqrt(),
-            };
-            ctx.progress.status(&format!(
-                "iteration {done}, {photons_total} photons, mean radius {:.4}",
-                shrink * sum_r / lit.max(1) as f64
-            ));
-            match self.time {
-                None => ctx.progress.advance(1),
-                Some(_) => {
-                    let s = start.elapsed().as_secs();
-                    ctx.progress.advance(s - seconds_reported);
-                    seconds_reported = s;
-                }
-            }
-            let kept = done - first;
-            ctx.progress.checkpoint(kept, &|| {
-                film_of(&stats, self.schedule, width, height, kept)
-            });
-        }
-        ctx.progress.finish();
+        let splittable = match self.schedule {
+            RadiusSchedule::Global => Ok(()),
+            RadiusSchedule::Pixel => Err("sppm splits into parts only with radius_schedule = \
+                 \"global\" and a number of iterations (no time): under the pixel schedule each \
+                 iteration's radius depends on the photons of the iterations before it, so \
+                 iterations cannot be rendered apart"
+                .to_string()),
+        };
+        let film = run_passes(
+            "sppm",
+            &self.passes,
+            ctx,
+            splittable,
+            "camera sample(s)",
+            &mut passes,
+        )?;
         self.kernel.check_weights()?;
-        let bad = bad_samples.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "camera sample(s)", "replaced by zero");
-        let bad = bad_photons.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "photon contribution(s)", "left out");
-        let mut film = film_of(&stats, self.schedule, width, height, done - first);
-        film.part = ctx.part;
-        film.rays = rays;
-        film.iterations = done - first;
-        film.iterations_planned = last.map_or(0, |n| n - first);
-        film.photons = photons_total;
         Ok(film)
     }
 
@@ -478,17 +456,7 @@ impl Integrator for Sppm {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        let mut p = Vec::new();
-        if let Some(n) = self.iterations {
-            p.push(Parameter::int("iterations", n));
-        }
-        if let Some(t) = self.time {
-            p.push(Parameter::float("time", t));
-        }
-        p.push(Parameter::int(
-            "photons_per_iteration",
-            self.photons_per_iteration,
-        ));
+        let mut p = self.passes.parameters();
         p.push(match self.initial_radius {
             Some(r) => Parameter::float("initial_radius", r),
             None => Parameter::str("initial_radius", "auto"),
@@ -511,12 +479,7 @@ impl Integrator for Sppm {
     }
 
     fn budget(&self) -> Budget {
-        Budget {
-            work: Work::Iterations {
-                key: "integrators.sppm.iterations".into(),
-            },
-            scaled: Vec::new(),
-        }
+        PassBudget::budget("sppm")
     }
 
     /// `iteration`: the photons the first iteration stores (those of every iteration are
@@ -530,7 +493,7 @@ impl Integrator for Sppm {
             } else {
                 "one iteration's photons but L D (shadow rays count those)"
             },
-            self.photons_per_iteration,
+            self.passes.photons_per_iteration,
             &photons,
         )])
     }
@@ -538,28 +501,7 @@ impl Integrator for Sppm {
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    let time = props.f32_opt("time")?;
-    if let Some(t) = time
-        && !(t > 0.0 && t.is_finite())
-    {
-        return Err(props.error(
-            "time",
-            format!("must be a positive number of seconds, found {t}"),
-        ));
-    }
-    let iterations = if props.has("iterations") || time.is_none() {
-        let n = props.u64("iterations", 64)?;
-        if n == 0 {
-            return Err(props.error("iterations", "must be at least 1"));
-        }
-        Some(n)
-    } else {
-        None
-    };
-    let photons_per_iteration = props.u64("photons_per_iteration", 100_000)?;
-    if photons_per_iteration == 0 {
-        return Err(props.error("photons_per_iteration", "must be at least 1"));
-    }
+    let passes = PassBudget::read(props, 64, 100_000)?;
     let initial_radius = props.f32_opt("initial_radius")?;
     if let Some(r) = initial_radius
         && !(r > 0.0 && r.is_finite())
@@ -583,9 +525,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         )));
     }
     Ok(Box::new(Sppm {
-        iterations,
-        time: time.map(f64::from),
-        photons_per_iteration,
+        passes,
         initial_radius,
         alpha: alpha as f64,
         kernel,

@@ -107,7 +107,7 @@ use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, Rende
 use foton_core::kernel::NormalizedKernel;
 use foton_core::medium::Medium;
 use foton_core::props::Properties;
-use foton_core::render::{render_pixels, with_pool};
+use foton_core::render::with_pool;
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
@@ -116,7 +116,10 @@ use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
-use foton_photonmap::surface::{Budgets, SurfaceMaps, check_k, trace_surface_photons};
+use foton_photonmap::surface::{
+    SurfaceMaps, SurfaceParams, check_k, diagonal, read_k, read_positive, render_with_maps,
+    surface_views, trace_surface_photons,
+};
 use foton_photonmap::trace::{
     PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons_and_beams,
 };
@@ -143,11 +146,9 @@ impl VolumeEstimate {
 }
 
 pub struct Vpm {
-    pub global_photons: u64,
-    pub caustic_photons: u64,
+    /// `global_photons`, `caustic_photons`, `k`, `max_radius`.
+    pub surface: SurfaceParams,
     pub volume_photons: u64,
-    pub k: usize,
-    pub max_radius: f32,
     pub k_volume: usize,
     pub max_radius_volume: f32,
     pub step: f32,
@@ -194,11 +195,7 @@ impl Vpm {
         ctx: &RenderContext<'_>,
         keep_direct: bool,
     ) -> Result<PassLists> {
-        let budgets = Budgets {
-            global: self.global_photons,
-            caustic: self.caustic_photons,
-            max_depth: self.max_depth,
-        };
+        let budgets = self.surface.budgets(self.max_depth);
         let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
         let photons_direct = self.direct == Direct::Photons;
         let (volume, beams) = if self.volume_photons > 0 && scene.has_media() {
@@ -276,14 +273,6 @@ impl Vpm {
             beams,
             bounds: (lo - grow, hi + grow),
         })
-    }
-
-    fn surface_estimate(&self) -> Estimate<'_> {
-        Estimate {
-            k: self.k,
-            max_radius: self.max_radius,
-            kernel: &self.kernel,
-        }
     }
 
     /// The in-scattering integral along the segment `seg` through medium `m` (the radiance
@@ -441,7 +430,7 @@ impl Vpm {
             return path.emitted;
         };
         let depth = self.max_depth - vp.bounces;
-        let estimate = self.surface_estimate();
+        let estimate = self.surface.estimate(&self.kernel);
         let l = maps.surface.reflected_at(
             scene,
             &vp,
@@ -458,15 +447,13 @@ impl Vpm {
 
 impl Integrator for Vpm {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let maps = self.build_maps(scene, ctx)?;
-        if ctx.cancelled() {
-            return Ok(Film::new(scene.film.width, scene.film.height));
-        }
-        let film = render_pixels(scene, ctx, |ray, sampler, rays| {
-            self.li(scene, &maps, *ray, sampler, rays)
-        })?;
-        self.kernel.check_weights()?;
-        Ok(film)
+        render_with_maps(
+            scene,
+            ctx,
+            &self.kernel,
+            || self.build_maps(scene, ctx),
+            |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+        )
     }
 
     fn name(&self) -> &str {
@@ -474,16 +461,13 @@ impl Integrator for Vpm {
     }
 
     fn parameters(&self) -> Vec<Parameter> {
-        let mut p = vec![
-            Parameter::int("global_photons", self.global_photons),
-            Parameter::int("caustic_photons", self.caustic_photons),
+        let mut p = self.surface.parameters();
+        p.extend([
             Parameter::int("volume_photons", self.volume_photons),
-            Parameter::int("k", self.k),
             Parameter::int("k_volume", self.k_volume),
-            Parameter::float("max_radius", self.max_radius),
             Parameter::float("max_radius_volume", self.max_radius_volume),
             Parameter::float("step", self.step),
-        ];
+        ]);
         p.extend(self.kernel.parameters());
         p.extend([
             Parameter::str("direct", self.direct.name()),
@@ -502,41 +486,26 @@ impl Integrator for Vpm {
     fn budget(&self) -> Budget {
         Budget {
             work: Work::Samples,
-            scaled: ["global_photons", "caustic_photons", "volume_photons"]
-                .into_iter()
-                .zip([
-                    self.global_photons,
-                    self.caustic_photons,
-                    self.volume_photons,
-                ])
-                .map(|(key, n)| (format!("integrators.vpm.{key}"), n))
-                .collect(),
+            scaled: {
+                let mut scaled = self.surface.scaled("vpm");
+                scaled.push(("integrators.vpm.volume_photons".into(), self.volume_photons));
+                scaled
+            },
         }
     }
 
     /// `global` (direct and indirect surface photons of the global budget), `caustic` (L S+ D
     /// surface photons of the caustic budget) and `volume` (the volume map as rendered).
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
-        let ([mut global, caustic, indirect], mut volume, beams) =
-            self.trace_lists(scene, ctx, true)?;
+        let (surface, mut volume, beams) = self.trace_lists(scene, ctx, true)?;
         if self.estimate == VolumeEstimate::Beams {
             // A beam is drawn at its start.
             volume = beams.iter().map(|b| b.as_photon()).collect();
         }
-        global.extend(indirect);
+        let [global, caustic] = surface_views(&self.surface, surface);
         Ok(vec![
-            foton_photonmap::view(
-                "global",
-                "surface photons of the global budget",
-                self.global_photons,
-                &global,
-            ),
-            foton_photonmap::view(
-                "caustic",
-                "L S+ D surface photons of the caustic budget",
-                self.caustic_photons,
-                &caustic,
-            ),
+            global,
+            caustic,
             foton_photonmap::view(
                 "volume",
                 "photons at scattering events in media, of the volume budget",
@@ -549,43 +518,17 @@ impl Integrator for Vpm {
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
-    let diagonal = if diagonal > 0.0 { diagonal } else { 1.0 };
-    let count = |key: &str, default: u64, min: u64| -> Result<u64> {
-        let n = props.u64(key, default)?;
-        if n < min {
-            return Err(props.error(key, format!("must be at least {min}, found {n}")));
-        }
-        Ok(n)
-    };
-    let positive = |key: &str, default: f32| -> Result<f32> {
-        let x = props.f32(key, default)?;
-        if !(x > 0.0 && x.is_finite()) {
-            return Err(props.error(key, format!("must be positive, found {x}")));
-        }
-        Ok(x)
-    };
-    let global_photons = count("global_photons", 200_000, 1)?;
-    let caustic_photons = count("caustic_photons", 100_000, 0)?;
-    let volume_photons = count("volume_photons", 200_000, 0)?;
-    let k = count("k", 50, 2)? as usize;
-    let k_volume = count("k_volume", 50, 2)? as usize;
-    check_k(
-        props,
-        "k",
-        k,
-        &[
-            ("global", "global_photons", global_photons),
-            ("caustic", "caustic_photons", caustic_photons),
-        ],
-    )?;
+    let diagonal = diagonal(scene);
+    let surface = SurfaceParams::read(props, scene)?;
+    let volume_photons = props.u64("volume_photons", 200_000)?;
+    let k_volume = read_k(props, "k_volume")?;
     check_k(
         props,
         "k_volume",
         k_volume,
         &[("volume", "volume_photons", volume_photons)],
     )?;
-    let max_radius = positive("max_radius", diagonal / 20.0)?;
+    let positive = |key: &str, default: f32| read_positive(props, key, default);
     let max_radius_volume = positive("max_radius_volume", diagonal / 20.0)?;
     let step = positive("step", diagonal / 100.0)?;
     let kernel = props.kernel("kernel", "box")?;
@@ -611,11 +554,8 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     };
     let kernel_1d = Kernel1d::norm(&kernel);
     Ok(Box::new(Vpm {
-        global_photons,
-        caustic_photons,
+        surface,
         volume_photons,
-        k,
-        max_radius,
         k_volume,
         max_radius_volume,
         step,
