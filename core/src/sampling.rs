@@ -577,6 +577,28 @@ pub fn uniform_triangle(u: Vec2) -> (f32, f32) {
     (1.0 - su, u.y * su)
 }
 
+/// Russian roulette past `rr_depth` scattering events (the path tracer's rule, shared by every
+/// integrator that walks paths): survives with probability max(beta) (at most 0.95) and
+/// divides the throughput by it, which keeps its expectation and ends dim paths. False if the
+/// path ends; draws one number only past `rr_depth`.
+#[inline]
+pub fn russian_roulette(
+    depth: u32,
+    rr_depth: u32,
+    beta: &mut crate::Rgb,
+    sampler: &mut Sampler,
+) -> bool {
+    if depth < rr_depth {
+        return true;
+    }
+    let survive = beta.max_element().min(0.95);
+    if survive <= 0.0 || sampler.next_f32() >= survive {
+        return false;
+    }
+    *beta /= survive;
+    true
+}
+
 /// Veach's power heuristic with beta = 2 (one sample from each strategy).
 #[inline]
 pub fn power_heuristic(pdf_f: f32, pdf_g: f32) -> f32 {

@@ -3,7 +3,7 @@
 //! facing it, and path and photon mapping agreeing under it with a shadow.
 
 use foton_core::scene::Scene;
-use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, light_media, trace_one};
+use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, trace_one};
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
 use foton_tests::{header, render_toml, temp_dir, write};
 use glam::{DVec3, Vec2, Vec3};
@@ -99,7 +99,7 @@ fn photons_deliver_irradiance_times_area() {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = light_media(&scene).unwrap();
+    let media = scene.emission_media().unwrap();
     let mut total = DVec3::ZERO;
     for i in 0..opts.photons {
         trace_one(&scene, &opts, &media, i, |p, _, _| {

@@ -4,7 +4,7 @@
 //! point of the sphere. An envmap of a constant image L is the same environment, sampled and
 //! emitted through its image's distribution.
 
-use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, light_media, trace_one};
+use foton_photonmap::trace::{STREAM_GLOBAL, TraceOptions, trace_one};
 use foton_tests::{header, region_mean, render_toml, temp_dir, write};
 use glam::{DVec3, Vec3};
 use std::path::PathBuf;
@@ -149,7 +149,7 @@ fn environment_photons(light: &str) {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = light_media(&scene).unwrap();
+    let media = scene.emission_media().unwrap();
     let mut total = DVec3::ZERO;
     for i in 0..opts.photons {
         trace_one(&scene, &opts, &media, i, |p, _, _| {

@@ -6,9 +6,7 @@ use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
 use foton_core::scene::Scene;
 use foton_photonmap::map::{Estimate, PhotonMap};
-use foton_photonmap::trace::{
-    PathClass, STREAM_GLOBAL, TraceOptions, light_media, trace_one, trace_photons,
-};
+use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_one, trace_photons};
 use foton_tests::stats::{Tolerance, assert_blocks_agree, assert_blocks_agree_by, rel_err};
 use foton_tests::{
     header, region_mean, render_file, render_toml, repo_root, temp_dir, with_area_light, write,
@@ -76,7 +74,7 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = light_media(&scene).unwrap();
+    let media = scene.emission_media().unwrap();
     let mut sum = DVec3::ZERO;
     let mut count = 0;
     for i in 0..opts.photons {

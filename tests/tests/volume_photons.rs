@@ -2,9 +2,7 @@
 //! absorbed or escaped in the right proportion.
 
 use foton_core::scene::Scene;
-use foton_photonmap::trace::{
-    PathClass, STREAM_GLOBAL, Site, TraceOptions, light_media, trace_one,
-};
+use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_one};
 use foton_tests::{header, temp_dir, write};
 use glam::DVec3;
 
@@ -57,7 +55,7 @@ fn balance(scene: &Scene, albedo: f64, photons: u64) -> (f64, f64, u64) {
         stop_at_diffuse: false,
         sobol_emission: false,
     };
-    let media = light_media(scene).unwrap();
+    let media = scene.emission_media().unwrap();
     assert_eq!(media, vec![Some(0)], "the light is in the fog");
     let (mut escaped, mut absorbed, mut events) = (DVec3::ZERO, DVec3::ZERO, 0);
     for i in 0..photons {

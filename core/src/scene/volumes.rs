@@ -58,6 +58,21 @@ impl Scene {
         self.medium_at(e.origin + e.n * (1e-3 * scale))
     }
 
+    /// The medium each light emits into ([`Scene::light_medium`] for every light), found once
+    /// per render (a few rays per medium boundary) by whatever starts paths at the lights.
+    pub fn emission_media(&self) -> crate::error::Result<Vec<Option<u32>>> {
+        (0..self.lights.len())
+            .map(|i| {
+                self.light_medium(i).map_err(|why| {
+                    crate::error::Error::Render(format!(
+                        "{}: cannot tell which medium light {i} is in: {why}",
+                        self.file.display()
+                    ))
+                })
+            })
+            .collect()
+    }
+
     /// The medium on the side of the surface at `hit` that `dir` points into: the medium a
     /// ray crossing the surface along `dir` enters, or the one a ray leaving the surface
     /// along `dir` (reflected, or a shadow ray) travels in. `current` is the medium the path

@@ -66,7 +66,7 @@
 
 pub use foton_bidir::{Strategy, mis};
 
-use foton_bidir::{Bidir, light_media};
+use foton_bidir::Bidir;
 use foton_core::Result;
 use foton_core::error::Error;
 use foton_core::film::Film;
@@ -80,7 +80,7 @@ pub struct Bdpt(pub Bidir);
 
 impl Integrator for Bdpt {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let light_media = light_media(scene)?;
+        let light_media = scene.emission_media()?;
         render_pixels_splatting(scene, ctx, |ps, sampler, splats, rays| {
             self.0
                 .sample(scene, &light_media, ps, sampler, splats, rays)

@@ -26,16 +26,15 @@
 pub mod mis;
 
 use foton_core::bsdf::Bsdf;
-use foton_core::error::Error;
 use foton_core::geometry::{Hit, Ray, offset_origin};
 use foton_core::light::Light;
 use foton_core::material::TransportMode;
 use foton_core::medium::{self, Phase};
 use foton_core::render::{PixelSample, Splats};
-use foton_core::sampling::Sampler;
+use foton_core::sampling::{Sampler, russian_roulette};
 use foton_core::scene::Scene;
 use foton_core::walk::{RayWalk, Reached};
-use foton_core::{Result, Rgb, Vec3};
+use foton_core::{Rgb, Vec3};
 use mis::{
     Factors, Running, mis, weight_connect, weight_direct, weight_emitter_hit, weight_to_camera,
 };
@@ -492,7 +491,7 @@ impl Bidir {
                     let (wi, pdf) = phase.sample(seg.ray.dir, sampler.next_2d());
                     specular = false;
                     running.scatter(1.0, pdf, pdf, false, &self.factors);
-                    if !self.russian_roulette(length, &mut beta, sampler) {
+                    if !russian_roulette(length, self.rr_depth, &mut beta, sampler) {
                         break;
                     }
                     prev = x;
@@ -594,7 +593,7 @@ impl Bidir {
                 );
             }
             beta *= bs.weight;
-            if beta == Rgb::ZERO || !self.russian_roulette(length, &mut beta, sampler) {
+            if beta == Rgb::ZERO || !russian_roulette(length, self.rr_depth, &mut beta, sampler) {
                 break;
             }
             prev = hit.p;
@@ -798,35 +797,6 @@ impl Bidir {
         });
         c.beta * f_c * f_v * v.beta * tr * (w / dist2)
     }
-
-    /// Russian roulette past `rr_depth` scattering events, as the path tracer's: keeps the
-    /// throughput's expectation. False if the subpath ends.
-    fn russian_roulette(&self, depth: u32, beta: &mut Rgb, sampler: &mut Sampler) -> bool {
-        if depth < self.rr_depth {
-            return true;
-        }
-        let survive = beta.max_element().min(0.95);
-        if survive <= 0.0 || sampler.next_f32() >= survive {
-            return false;
-        }
-        *beta /= survive;
-        true
-    }
-}
-
-/// The medium each light emits into (None: vacuum), found once per render (a few rays per
-/// medium boundary): what [`Bidir::light_subpath`] takes.
-pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
-    (0..scene.lights.len())
-        .map(|i| {
-            scene.light_medium(i).map_err(|why| {
-                Error::Render(format!(
-                    "{}: cannot tell which medium light {i} is in: {why}",
-                    scene.file.display()
-                ))
-            })
-        })
-        .collect()
 }
 
 /// Whether light vertex `v` is seen from the pinhole by a camera ray that passes through

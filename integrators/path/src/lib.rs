@@ -49,7 +49,7 @@ use foton_core::material::TransportMode;
 use foton_core::medium::HeroChannel;
 use foton_core::props::Properties;
 use foton_core::render::render_pixels;
-use foton_core::sampling::{Sampler, power_heuristic};
+use foton_core::sampling::{Sampler, power_heuristic, russian_roulette};
 use foton_core::scene::Scene;
 use foton_core::walk::{RayWalk, Reached};
 use foton_core::{Result, Rgb, Vec3, film::Film};
@@ -117,7 +117,7 @@ impl PathTracer {
                     prev_pdf = pdf;
                     prev_p = x;
                     depth += 1;
-                    if !self.russian_roulette(depth, &mut beta, sampler) {
+                    if !russian_roulette(depth, self.rr_depth, &mut beta, sampler) {
                         break;
                     }
                     walk.scatter_in_medium(x, wi);
@@ -185,26 +185,12 @@ impl PathTracer {
             prev_pdf = bs.pdf;
             prev_p = hit.p;
             depth += 1;
-            if !self.russian_roulette(depth, &mut beta, sampler) {
+            if !russian_roulette(depth, self.rr_depth, &mut beta, sampler) {
                 break;
             }
             walk.scatter_at_surface(scene, &hit, bs.wi);
         }
         radiance
-    }
-
-    /// Russian roulette past `rr_depth`: keeps the throughput's expectation and ends dim
-    /// paths. False if the path ends.
-    fn russian_roulette(&self, depth: u32, beta: &mut Rgb, sampler: &mut Sampler) -> bool {
-        if depth < self.rr_depth {
-            return true;
-        }
-        let survive = beta.max_element().min(0.95);
-        if survive <= 0.0 || sampler.next_f32() >= survive {
-            return false;
-        }
-        *beta /= survive;
-        true
     }
 }
 

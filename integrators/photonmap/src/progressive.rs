@@ -30,35 +30,43 @@ pub struct PassBudget {
     pub photons_per_iteration: u64,
 }
 
+/// Reads a progressive integrator's `time` (seconds, > 0) and `iterations` (>= 1; `default`
+/// unless `time` is given alone, then unlimited), with their errors: what `sppm`, `ppb` and
+/// `vcm` read alike.
+pub fn read_passes(props: &Properties<'_>, default: u64) -> Result<(Option<u64>, Option<f64>)> {
+    let time = props.f32_opt("time")?;
+    if let Some(t) = time
+        && !(t > 0.0 && t.is_finite())
+    {
+        return Err(props.error(
+            "time",
+            format!("must be a positive number of seconds, found {t}"),
+        ));
+    }
+    let iterations = if props.has("iterations") || time.is_none() {
+        let n = props.u64("iterations", default)?;
+        if n == 0 {
+            return Err(props.error("iterations", "must be at least 1"));
+        }
+        Some(n)
+    } else {
+        None
+    };
+    Ok((iterations, time.map(f64::from)))
+}
+
 impl PassBudget {
     /// Reads `time`, `iterations` (default `iterations` unless `time` is given alone) and
     /// `photons_per_iteration`.
     pub fn read(props: &Properties<'_>, iterations: u64, photons: u64) -> Result<PassBudget> {
-        let time = props.f32_opt("time")?;
-        if let Some(t) = time
-            && !(t > 0.0 && t.is_finite())
-        {
-            return Err(props.error(
-                "time",
-                format!("must be a positive number of seconds, found {t}"),
-            ));
-        }
-        let iterations = if props.has("iterations") || time.is_none() {
-            let n = props.u64("iterations", iterations)?;
-            if n == 0 {
-                return Err(props.error("iterations", "must be at least 1"));
-            }
-            Some(n)
-        } else {
-            None
-        };
+        let (iterations, time) = read_passes(props, iterations)?;
         let photons_per_iteration = props.u64("photons_per_iteration", photons)?;
         if photons_per_iteration == 0 {
             return Err(props.error("photons_per_iteration", "must be at least 1"));
         }
         Ok(PassBudget {
             iterations,
-            time: time.map(f64::from),
+            time,
             photons_per_iteration,
         })
     }

@@ -11,7 +11,7 @@
 use crate::beams::{Beam, BeamKind, exit_distance};
 use crate::map::Photon;
 use foton_core::Rgb;
-use foton_core::error::{Error, Result};
+use foton_core::error::Result;
 use foton_core::geometry::{Ray, offset_origin};
 use foton_core::integrator::RenderContext;
 use foton_core::material::TransportMode;
@@ -77,23 +77,8 @@ pub enum Site {
     Volume,
 }
 
-/// The medium each light sits in (None: vacuum), for photons to start in
-/// ([`Scene::light_medium`]).
-pub fn light_media(scene: &Scene) -> Result<Vec<Option<u32>>> {
-    (0..scene.lights.len())
-        .map(|i| {
-            scene.light_medium(i).map_err(|why| {
-                Error::Render(format!(
-                    "{}: cannot tell which medium light {i} is in: {why}",
-                    scene.file.display()
-                ))
-            })
-        })
-        .collect()
-}
-
 /// Traces one photon, calling `store(photon, site, class)` at every diffuse surface hit and
-/// every scattering event in a medium. `light_media` is [`light_media`] of the scene.
+/// every scattering event in a medium. `light_media` is [`Scene::emission_media`].
 ///
 /// In a medium the photon samples a free-flight distance (spectral MIS over the colour
 /// channels along its whole path, as the path tracer); at a scattering event it is stored
@@ -310,7 +295,7 @@ pub fn trace_photons_and_beams(
     beams: Option<BeamKind>,
     keep_beam: impl Fn(PathClass) -> bool + Sync,
 ) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
-    let media = light_media(scene)?;
+    let media = scene.emission_media()?;
     ctx.progress.begin("photons", opts.photons);
     let chunks = opts.photons.div_ceil(CHUNK);
     let parts: Vec<(Vec<Vec<Photon>>, Vec<Beam>)> = with_pool(ctx.threads, || {

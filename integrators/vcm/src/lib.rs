@@ -63,7 +63,7 @@
 pub mod grid;
 
 use foton_bidir::mis::{Factors, weight_merge};
-use foton_bidir::{At, Bidir, Origin, SplatSink, Strategy, Vertex, light_media};
+use foton_bidir::{At, Bidir, Origin, SplatSink, Strategy, Vertex};
 use foton_core::error::Error;
 use foton_core::film::{Film, RadianceSum};
 use foton_core::integrator::{Budget, Integrator, Parameter, RenderContext, Work};
@@ -72,6 +72,7 @@ use foton_core::render::{PixelSample, usable, warn_unusable, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Result, Rgb};
+use foton_photonmap::progressive::read_passes;
 use grid::HashGrid;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -425,7 +426,7 @@ impl Integrator for Vcm {
             let share = ctx.part.share(n);
             (share.start, Some(share.end))
         };
-        let media = light_media(scene)?;
+        let media = scene.emission_media()?;
         let mut film = Film::new(width, height);
         let start = Instant::now();
         match (last, self.time) {
@@ -540,24 +541,7 @@ pub fn auto_radius(scene: &Scene) -> f32 {
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    let time = props.f32_opt("time")?;
-    if let Some(t) = time
-        && !(t > 0.0 && t.is_finite())
-    {
-        return Err(props.error(
-            "time",
-            format!("must be a positive number of seconds, found {t}"),
-        ));
-    }
-    let iterations = if props.has("iterations") || time.is_none() {
-        let n = props.u64("iterations", 64)?;
-        if n == 0 {
-            return Err(props.error("iterations", "must be at least 1"));
-        }
-        Some(n)
-    } else {
-        None
-    };
+    let (iterations, time) = read_passes(props, 64)?;
     let radius = props.f32_opt("radius")?;
     if let Some(r) = radius
         && !(r > 0.0 && r.is_finite())
@@ -584,7 +568,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }
     Ok(Box::new(Vcm {
         iterations,
-        time: time.map(f64::from),
+        time,
         radius: radius.unwrap_or_else(|| auto_radius(scene)),
         radius_given: radius.is_some(),
         alpha,
