@@ -31,25 +31,26 @@ fn ppb_passes(passes: u64, seed: u64) -> Film {
 fn error_falls_with_passes_on_the_fog_box() {
     let path = cornell_fog(&["render.integrator=path", "render.spp=4096"], 2);
     let mut errors = Vec::new();
+    let mut films = Vec::new();
     for passes in [4, 32] {
         // Two seeds each: one render's error is itself noisy.
-        let e: f64 = [1, 2]
-            .iter()
-            .map(|&seed| rel_rmse(&ppb_passes(passes, seed), &path))
-            .sum::<f64>()
-            / 2.0;
+        films = [1, 2].iter().map(|&seed| ppb_passes(passes, seed)).collect();
+        let e = films.iter().map(|f| rel_rmse(f, &path)).sum::<f64>() / 2.0;
         errors.push(e);
     }
     eprintln!("relative RMS error after 4 and 32 passes: {errors:?}");
     // Variance falls as n^-alpha and the bias with the radii: 8 times the passes must at least
     // take off a third of the error (measured: see the README).
     assert!(errors[1] < 0.67 * errors[0], "{errors:?}");
-    let film = ppb_passes(32, 1);
-    let (a, b) = (film.mean(), path.mean());
+    // The mean over both seeds: one 32-pass render's mean still moves by a few percent from
+    // seed to seed (its low-frequency blotches): a 2 % bound on one seed would test the seed.
+    let a = (films[0].mean() + films[1].mean()) / 2.0;
+    let b = path.mean();
     assert!(rel_err(a, b) < 0.02, "{a} against {b}");
+    let film = &films[0];
     assert_blocks_agree(
         "ppb, 32 passes",
-        &film,
+        film,
         &path,
         2,
         Tolerance {

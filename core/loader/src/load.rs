@@ -314,7 +314,7 @@ fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings>
 
 /// `[render] sampler` and, for `stratified`, `jitter`.
 fn read_sampler(t: &Properties<'_>) -> Result<SamplerKind> {
-    let name = t.choice("sampler", &SamplerKind::NAMES, "independent")?;
+    let name = t.choice("sampler", &SamplerKind::NAMES, "sobol")?;
     let jitter = t.bool("jitter", true)?;
     let kind = SamplerKind::from_name(name, jitter).expect("a name of SamplerKind::NAMES");
     if t.has("jitter") && !matches!(kind, SamplerKind::Stratified { .. }) {

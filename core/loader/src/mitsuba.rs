@@ -81,6 +81,12 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
     if !r.lights.is_empty() {
         root.insert("lights", at(Value::Array(std::mem::take(&mut r.lights)), 0));
     }
+    // Mitsuba samples independently when a file names no sampler; foton's TOML default
+    // (sobol) would render such a file with other noise than Mitsuba's.
+    let render = table_mut(&mut root, "render");
+    if render.get("sampler").is_none() {
+        render.insert("sampler", at(Value::Str("independent".into()), 0));
+    }
     let film = table_mut(&mut root, "film");
     if film.get("output").is_none() {
         let stem = path
