@@ -275,8 +275,8 @@ fn film_line(path: &Path, what: &str) -> usize {
 /// Every sampler Mitsuba has is read: its sample count is the spp; foton's own samplers
 /// (independent, stratified, sobol) are taken as they are, the others rendered by the nearest
 /// foton has (multijitter by stratified, the low-discrepancy ones by sobol) with a warning
-/// naming the sampler and its line, an error with --strict. An unknown sampler is an error
-/// that suggests the close name.
+/// naming the sampler and its line, an error with --strict; none is `independent`, Mitsuba's
+/// default. An unknown sampler is an error that suggests the close name.
 #[test]
 fn samplers_map_to_the_nearest_foton_sampler() {
     let dir = temp_dir("samplers");
@@ -308,6 +308,10 @@ fn samplers_map_to_the_nearest_foton_sampler() {
         let strict = foton(&["convert", s(&xml), "-o", s(&dir.join("x.toml")), "--strict"]);
         assert_eq!(strict.code == 0, exact, "{}", strict.stderr);
     }
+    // A file that names no sampler samples independently, as in Mitsuba (foton's own
+    // TOML default, sobol, would give the file other noise than Mitsuba's).
+    let (toml, _) = convert(&dir, "none.xml", &scene_with("", "", FILM, ""), &[]);
+    assert!(toml.contains("sampler = \"independent\""), "{toml}");
     // A stratified sampler's jitter is foton's.
     let s_ = r#"<sampler type="stratified"><integer name="sampleCount" value="4"/><boolean name="jitter" value="false"/></sampler>"#;
     let (toml, _) = convert(&dir, "centred.xml", &scene_with("", s_, FILM, ""), &[]);

@@ -34,7 +34,10 @@ fn error_falls_with_passes_on_the_fog_box() {
     let mut films = Vec::new();
     for passes in [4, 32] {
         // Two seeds each: one render's error is itself noisy.
-        films = [1, 2].iter().map(|&seed| ppb_passes(passes, seed)).collect();
+        films = [1, 2]
+            .iter()
+            .map(|&seed| ppb_passes(passes, seed))
+            .collect();
         let e = films.iter().map(|f| rel_rmse(f, &path)).sum::<f64>() / 2.0;
         errors.push(e);
     }

@@ -422,3 +422,23 @@ fn unknown_samplers_are_refused_with_a_suggestion() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A TOML scene that names no sampler renders with `sobol` (the default: less error at equal
+/// time, measured in docs/PERFORMANCE.md), and `foton check` says which sampler renders.
+#[test]
+fn sobol_is_the_toml_default_and_check_names_it() {
+    let scene = foton_tests::repo_root().join("scenes/cornell-box.toml");
+    let text = std::fs::read_to_string(&scene).unwrap();
+    assert!(!text.contains("sampler"), "the scene must not name one");
+    let scene = scene.to_str().unwrap();
+    let run = foton_tests::foton_with_plugins(&["check", scene]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    assert!(run.stdout.contains("64 spp (sobol)"), "{}", run.stdout);
+    let set = "render.sampler=\"independent\"";
+    let run = foton_tests::foton_with_plugins(&["check", scene, "--set", set]);
+    assert!(
+        run.stdout.contains("64 spp (independent)"),
+        "{}",
+        run.stdout
+    );
+}

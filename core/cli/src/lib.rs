@@ -746,10 +746,11 @@ fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     let _ = writeln!(out, "integrator {}", p.integrator.describe());
     let _ = writeln!(
         out,
-        "render     {}x{}, {} spp, seed {}, max_depth {} -> {}",
+        "render     {}x{}, {} spp ({}), seed {}, max_depth {} -> {}",
         s.film.width,
         s.film.height,
         s.render.spp,
+        s.render.sampler.name(),
         s.render.seed,
         s.render.max_depth,
         s.film.output.display()
