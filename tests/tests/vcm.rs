@@ -276,7 +276,9 @@ fn vcm_hides_emitters_as_path_does() {
     );
 }
 
-/// The same image bit for bit (pixel sums, counts and splat sums) on 1, 2 and 3 threads.
+/// The same image bit for bit (pixel sums, counts and splat sums) on 1, 2 and 3 threads; the
+/// work the summary reports is the same too: the iterations, and one light subpath per pixel
+/// and iteration as its photons.
 #[test]
 fn vcm_is_the_same_for_any_thread_count() {
     let scene = cornell("glass", "white");
@@ -293,7 +295,13 @@ fn vcm_is_the_same_for_any_thread_count() {
         .map(|&threads| render_file(&file, &sets, threads))
         .collect();
     assert!(films[0].splats().iter().any(|s| s.0[0] > 0), "vcm splats");
+    let light_paths = 4 * SIZE as u64 * SIZE as u64;
+    for f in &films {
+        assert_eq!((f.iterations, f.photons), (4, light_paths));
+        assert!(f.rays > light_paths, "rays: {}", f.rays);
+    }
     for f in &films[1..] {
+        assert_eq!(f.rays, films[0].rays);
         assert_eq!(f.sums(), films[0].sums());
         assert_eq!(f.counts(), films[0].counts());
         assert_eq!(f.splats(), films[0].splats());
