@@ -4,7 +4,8 @@
 //! * in `ppm` mode (merges only) it agrees with `sppm` rendering the same paths (photons for
 //!   direct light too);
 //! * the full estimator agrees with `bdpt` on a diffuse box and with `path` on a caustic one (a
-//!   glass sphere over a diffuse floor, lit by an area light the path tracer can hit);
+//!   glass sphere over a diffuse floor, lit by an area light the path tracer can hit) and on
+//!   glossy materials with a caustic (scenes/glossy-caustic.xml);
 //! * with `hide_emitters` it agrees with `path` rendering the same;
 //! * the image is the same bit for bit for any thread count, parts merge to the whole render
 //!   exactly, and a cancelled render keeps whole iterations;
@@ -242,6 +243,40 @@ fn vcm_agrees_with_path_on_a_caustic() {
     assert_blocks_agree("vcm against path, caustic", &film, &path, 4, tolerance);
 }
 
+/// Glossy light and a caustic at once (scenes/glossy-caustic.xml, a Mitsuba 3 file: a GGX gold
+/// sphere, a rough-plastic back wall, a smooth glass sphere and its caustic, a small light):
+/// merges and connections through rough conductors and rough plastic, weighted together,
+/// agree with the path tracer. A block of the 4 x 4 grid spans 8 of 32 pixels, about 0.5 world
+/// units at the floor's front and more behind: the radius allowance uses 0.5.
+#[test]
+fn vcm_agrees_with_path_on_glossy_materials_and_a_caustic() {
+    let file = foton_tests::repo_root().join("scenes/glossy-caustic.xml");
+    let radius = 0.02;
+    let size = [format!("film.width={SIZE}"), format!("film.height={SIZE}")];
+    let sets = |extra: &[String]| -> Vec<String> { size.iter().chain(extra).cloned().collect() };
+    let film = |sets: Vec<String>| {
+        let refs: Vec<&str> = sets.iter().map(String::as_str).collect();
+        render_file(&file, &refs, 2)
+    };
+    let path = film(sets(&["render.spp=4096".into()]));
+    let vcm = film(sets(&[
+        "render.integrator=\"vcm\"".into(),
+        "integrators.vcm.iterations=256".into(),
+        format!("integrators.vcm.radius={radius}"),
+    ]));
+    let tolerance = Tolerance {
+        rel: merge_bias(radius, 0.5),
+        ..Z
+    };
+    assert_blocks_agree(
+        "vcm against path, glossy-caustic.xml",
+        &vcm,
+        &path,
+        4,
+        tolerance,
+    );
+}
+
 /// `hide_emitters` as `path` renders it (camera rays pass through emitters until they first
 /// scatter): the ceiling light and a white emitting sphere in the middle of the view hidden,
 /// the wall behind the sphere seen through it.
@@ -276,7 +311,9 @@ fn vcm_hides_emitters_as_path_does() {
     );
 }
 
-/// The same image bit for bit (pixel sums, counts and splat sums) on 1, 2 and 3 threads.
+/// The same image bit for bit (pixel sums, counts and splat sums) on 1, 2 and 3 threads; the
+/// work the summary reports is the same too: the iterations, and one light subpath per pixel
+/// and iteration as its photons.
 #[test]
 fn vcm_is_the_same_for_any_thread_count() {
     let scene = cornell("glass", "white");
@@ -293,7 +330,13 @@ fn vcm_is_the_same_for_any_thread_count() {
         .map(|&threads| render_file(&file, &sets, threads))
         .collect();
     assert!(films[0].splats().iter().any(|s| s.0[0] > 0), "vcm splats");
+    let light_paths = 4 * SIZE as u64 * SIZE as u64;
+    for f in &films {
+        assert_eq!((f.iterations, f.photons), (4, light_paths));
+        assert!(f.rays > light_paths, "rays: {}", f.rays);
+    }
     for f in &films[1..] {
+        assert_eq!(f.rays, films[0].rays);
         assert_eq!(f.sums(), films[0].sums());
         assert_eq!(f.counts(), films[0].counts());
         assert_eq!(f.splats(), films[0].splats());

@@ -1,4 +1,4 @@
-//! What the progressive integrators (`sppm`, `ppb`) share: the pass loop ([`run_passes`]:
+//! What the progressive integrators (`sppm`, `ppb`, `vcm`) share: the pass loop ([`run_passes`]:
 //! iterations or a time budget, a part's share of the passes, Ctrl-C, checkpoints, progress)
 //! with the parameters that drive it ([`PassBudget`]), the global radius schedule of Knaus
 //! and Zwicker, the automatic first radius from a pixel's footprint, and the gather of one
@@ -27,6 +27,7 @@ pub struct PassBudget {
     pub iterations: Option<u64>,
     /// Seconds to run for (with `iterations`, an upper bound on the passes).
     pub time: Option<f64>,
+    /// Photons (for `vcm`: light subpaths) each pass traces: the summary's count.
     pub photons_per_iteration: u64,
 }
 
@@ -138,14 +139,15 @@ pub trait Passes {
     fn tally(&self) -> &Tally;
 }
 
-/// What the passes count across threads: rays, and estimates or photon contributions that
-/// were not finite and non-negative (left out: one would stay in a pixel's sum for the rest
-/// of the render).
+/// What the passes count across threads: rays, and estimates, photon contributions or splats
+/// (light paths connected to the camera) that were not finite and non-negative (left out: one
+/// would stay in a pixel's sum for the rest of the render).
 #[derive(Debug, Default)]
 pub struct Tally {
     pub rays: AtomicU64,
     pub bad_samples: AtomicU64,
     pub bad_photons: AtomicU64,
+    pub bad_splats: AtomicU64,
 }
 
 impl Tally {
@@ -181,6 +183,7 @@ pub fn run_passes(
     }
     let mut done = first;
     let mut seconds_reported = 0u64;
+    let mut rays_reported = 0u64;
     loop {
         if last.is_some_and(|n| done >= n)
             || budget
@@ -195,6 +198,9 @@ pub fn run_passes(
         };
         done += 1;
         ctx.progress.status(&status);
+        let rays = passes.tally().rays.load(Ordering::Relaxed);
+        ctx.progress.rays(rays - rays_reported);
+        rays_reported = rays;
         match budget.time {
             None => ctx.progress.advance(1),
             Some(_) => {
@@ -212,6 +218,8 @@ pub fn run_passes(
     warn_unusable(ctx, bad, samples, "replaced by zero");
     let bad = tally.bad_photons.load(Ordering::Relaxed);
     warn_unusable(ctx, bad, "photon contribution(s)", "left out");
+    let bad = tally.bad_splats.load(Ordering::Relaxed);
+    warn_unusable(ctx, bad, "splat(s)", "dropped");
     let mut film = passes.film(done - first);
     film.part = ctx.part;
     film.rays = tally.rays.load(Ordering::Relaxed);

@@ -54,7 +54,10 @@
 //! sums: the image is bit-identical for any thread count. The radius depends on the iteration's
 //! number alone, so iterations are independent: `--part I/N` renders a share of them (a number
 //! of iterations, no `time`) and `foton merge` adds the parts exactly. Ctrl-C drops the
-//! iteration under way: the image holds whole iterations.
+//! iteration under way: the image holds whole iterations. The loop around the iterations
+//! (`iterations` or `time`, the part's share, Ctrl-C, checkpoints, progress) is
+//! foton-photonmap's `progressive::run_passes`, as `sppm`'s and `ppb`'s; the summary line
+//! counts each iteration's W x H light subpaths as its photons.
 //!
 //! `hide_emitters` as `bdpt` (camera rays pass through emitters until they first scatter, and
 //! so do light vertices' connections to the camera). **Not supported**, refused with an error:
@@ -66,17 +69,15 @@ use foton_bidir::mis::{Factors, weight_merge};
 use foton_bidir::{At, Bidir, Origin, SplatSink, Strategy, Vertex};
 use foton_core::error::Error;
 use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{Budget, Integrator, Parameter, RenderContext, Work};
+use foton_core::integrator::{Budget, Integrator, Parameter, RenderContext};
 use foton_core::props::Properties;
-use foton_core::render::{PixelSample, usable, warn_unusable, with_pool};
+use foton_core::render::{PixelSample, usable, with_pool};
 use foton_core::sampling::Sampler;
 use foton_core::scene::Scene;
 use foton_core::{Result, Rgb};
-use foton_photonmap::progressive::read_passes;
+use foton_photonmap::progressive::{PassBudget, Passes, Tally, read_passes, run_passes};
 use grid::HashGrid;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
 
 /// Which estimators an iteration uses (`mode`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -113,9 +114,9 @@ impl Mode {
 }
 
 pub struct Vcm {
-    /// None: until `time` runs out.
-    pub iterations: Option<u64>,
-    pub time: Option<f64>,
+    /// `iterations` and `time`; a pass traces one light subpath per pixel (the summary counts
+    /// them as its photons).
+    pub passes: PassBudget,
     /// r_1, world units.
     pub radius: f32,
     /// Whether `radius` was given (else it is the automatic one, reported as such).
@@ -225,7 +226,7 @@ impl Vcm {
             seed ^ stream,
             pixel,
             iteration as u32,
-            self.iterations.unwrap_or(1) as u32,
+            self.passes.iterations.unwrap_or(1) as u32,
         )
     }
 
@@ -410,94 +411,87 @@ impl Vcm {
     }
 }
 
+/// The passes of one render (foton-photonmap's `run_passes` runs them): the film the
+/// iterations add their pixel samples and splats to.
+struct VcmPasses<'a> {
+    vcm: &'a Vcm,
+    scene: &'a Scene,
+    media: Vec<Option<u32>>,
+    film: Film,
+    tally: Tally,
+}
+
+impl Passes for VcmPasses<'_> {
+    /// Iteration `iteration` (0-based): the light pass, the grid of its vertices, the camera
+    /// pass; its pixel sums and splats go to the film.
+    fn pass(&mut self, iteration: u64, quiet: &RenderContext<'_>) -> Result<Option<String>> {
+        let (vcm, scene) = (self.vcm, self.scene);
+        let (bidir, radius) = vcm.estimator(scene, iteration + 1);
+        let media = &self.media;
+        let (rows, mut rays) = with_pool(quiet.threads, || {
+            let (lights, light_rays) = vcm.light_pass(scene, &bidir, media, iteration);
+            let grid = vcm
+                .mode
+                .merges()
+                .then(|| HashGrid::build(lights.vertices.iter().map(|v| v.p).collect(), radius));
+            let rows = vcm.camera_pass(scene, &bidir, &lights, grid.as_ref(), radius, iteration);
+            (rows, light_rays)
+        })?;
+        if quiet.cancelled() {
+            // An iteration cut short would leave pixels without their sample: drop it.
+            return Ok(None);
+        }
+        let width = scene.film.width as usize;
+        for (y, row) in rows.into_iter().enumerate() {
+            let y0 = y * width;
+            for (x, sum) in row.sums.iter().enumerate() {
+                self.film.add_pixel(y0 + x, sum, 1);
+            }
+            for (i, s) in &row.splats.0 {
+                self.film.add_splat(*i as usize, s);
+            }
+            rays += row.rays;
+            Tally::add(&self.tally.bad_samples, row.bad);
+            Tally::add(&self.tally.bad_splats, row.splats.2);
+        }
+        Tally::add(&self.tally.rays, rays);
+        let done = iteration + 1;
+        Ok(Some(format!(
+            "iteration {done}, {} light paths, radius {radius:.5}",
+            done * vcm.passes.photons_per_iteration
+        )))
+    }
+
+    /// The film holds the exact sums: each pixel's mean over its samples, the splats scaled
+    /// by the samples taken.
+    fn film(&self, _passes: u64) -> Film {
+        self.film.clone()
+    }
+
+    fn tally(&self) -> &Tally {
+        &self.tally
+    }
+}
+
 impl Integrator for Vcm {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        let (width, height) = (scene.film.width, scene.film.height);
-        // The iterations to run (0-based): all of them, or this part's share.
-        let (first, last) = if ctx.part.is_whole() {
-            (0, self.iterations)
-        } else {
-            let Some(n) = self.iterations.filter(|_| self.time.is_none()) else {
-                return Err(Error::Render(format!(
-                    "part {}: vcm splits into parts only with a number of iterations (no time)",
-                    ctx.part
-                )));
-            };
-            let share = ctx.part.share(n);
-            (share.start, Some(share.end))
+        let mut passes = VcmPasses {
+            vcm: self,
+            scene,
+            media: scene.emission_media()?,
+            film: Film::new(scene.film.width, scene.film.height),
+            tally: Tally::default(),
         };
-        let media = scene.emission_media()?;
-        let mut film = Film::new(width, height);
-        let start = Instant::now();
-        match (last, self.time) {
-            (Some(n), None) => ctx.progress.begin("iterations", n - first),
-            (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),
-            (None, None) => unreachable!("create() sets one"),
-        }
-        let (bad_samples, bad_splats) = (AtomicU64::new(0), AtomicU64::new(0));
-        let mut done = first;
-        let mut rays = 0u64;
-        let mut seconds_reported = 0u64;
-        loop {
-            if last.is_some_and(|n| done >= n)
-                || self
-                    .time
-                    .is_some_and(|t| start.elapsed().as_secs_f64() >= t)
-                || ctx.cancelled()
-            {
-                break;
-            }
-            let (bidir, radius) = self.estimator(scene, done + 1);
-            let rows = with_pool(ctx.threads, || {
-                let (lights, light_rays) = self.light_pass(scene, &bidir, &media, done);
-                let grid = self.mode.merges().then(|| {
-                    HashGrid::build(lights.vertices.iter().map(|v| v.p).collect(), radius)
-                });
-                let rows = self.camera_pass(scene, &bidir, &lights, grid.as_ref(), radius, done);
-                (rows, light_rays)
-            })?;
-            if ctx.cancelled() {
-                // An iteration cut short would leave pixels without their sample: drop it.
-                break;
-            }
-            let (rows, mut iteration_rays) = rows;
-            for (y, row) in rows.into_iter().enumerate() {
-                let y0 = y * width as usize;
-                for (x, sum) in row.sums.iter().enumerate() {
-                    film.add_pixel(y0 + x, sum, 1);
-                }
-                for (i, s) in &row.splats.0 {
-                    film.add_splat(*i as usize, s);
-                }
-                iteration_rays += row.rays;
-                bad_samples.fetch_add(row.bad, Ordering::Relaxed);
-                bad_splats.fetch_add(row.splats.2, Ordering::Relaxed);
-            }
-            done += 1;
-            ctx.progress
-                .status(&format!("iteration {done}, radius {radius:.5}"));
-            ctx.progress.rays(iteration_rays);
-            rays += iteration_rays;
-            match self.time {
-                None => ctx.progress.advance(1),
-                Some(_) => {
-                    let s = start.elapsed().as_secs();
-                    ctx.progress.advance(s - seconds_reported);
-                    seconds_reported = s;
-                }
-            }
-            ctx.progress.checkpoint(done - first, &|| film.clone());
-        }
-        ctx.progress.finish();
-        let bad = bad_samples.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "camera sample(s)", "replaced by zero");
-        let bad = bad_splats.load(Ordering::Relaxed);
-        warn_unusable(ctx, bad, "splat(s)", "dropped");
-        film.part = ctx.part;
-        film.rays = rays;
-        film.iterations = done - first;
-        film.iterations_planned = last.map_or(0, |n| n - first);
-        Ok(film)
+        // Iteration i's radius and random streams depend on i alone: any share of them can
+        // be rendered apart.
+        run_passes(
+            "vcm",
+            &self.passes,
+            ctx,
+            Ok(()),
+            "camera sample(s)",
+            &mut passes,
+        )
     }
 
     fn name(&self) -> &str {
@@ -506,10 +500,10 @@ impl Integrator for Vcm {
 
     fn parameters(&self) -> Vec<Parameter> {
         let mut p = Vec::new();
-        if let Some(n) = self.iterations {
+        if let Some(n) = self.passes.iterations {
             p.push(Parameter::int("iterations", n));
         }
-        if let Some(t) = self.time {
+        if let Some(t) = self.passes.time {
             p.push(Parameter::float("time", t));
         }
         p.push(if self.radius_given {
@@ -524,12 +518,7 @@ impl Integrator for Vcm {
     }
 
     fn budget(&self) -> Budget {
-        Budget {
-            work: Work::Iterations {
-                key: "integrators.vcm.iterations".into(),
-            },
-            scaled: Vec::new(),
-        }
+        PassBudget::budget("vcm")
     }
 }
 
@@ -566,9 +555,13 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
             scene.file.display()
         )));
     }
+    let light_paths = scene.film.width as u64 * scene.film.height as u64;
     Ok(Box::new(Vcm {
-        iterations,
-        time,
+        passes: PassBudget {
+            iterations,
+            time,
+            photons_per_iteration: light_paths,
+        },
         radius: radius.unwrap_or_else(|| auto_radius(scene)),
         radius_given: radius.is_some(),
         alpha,
