@@ -88,7 +88,8 @@ pub fn trace_surface_photons(
 }
 
 /// The parameters of the surface maps and their estimate, which `photon` and `vpm` read
-/// alike (their tables list them): `global_photons`, `caustic_photons`, `k`, `max_radius`.
+/// alike (their tables list them): `global_photons`, `caustic_photons`, `k`, `max_radius`;
+/// each plugin has its own defaults ([`SurfaceDefaults`]).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct SurfaceParams {
     pub global_photons: u64,
@@ -99,16 +100,42 @@ pub struct SurfaceParams {
     pub max_radius: f32,
 }
 
+/// What a plugin's `global_photons`, `caustic_photons` and `k` default to (`max_radius`
+/// defaults to 1/20 of the scene's bounding-box diagonal for both).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SurfaceDefaults {
+    pub global_photons: u64,
+    pub caustic_photons: u64,
+    pub k: u32,
+}
+
+impl SurfaceDefaults {
+    /// `photon`'s: 200 000 global and 100 000 caustic photons, k = 50.
+    pub const PHOTON: SurfaceDefaults = SurfaceDefaults {
+        global_photons: 200_000,
+        caustic_photons: 100_000,
+        k: 50,
+    };
+}
+
 impl SurfaceParams {
-    /// Reads and checks them; the defaults: 200 000 global and 100 000 caustic photons,
-    /// k = 50, a largest radius of 1/20 of the scene's bounding-box diagonal.
+    /// Reads and checks them with `photon`'s defaults ([`SurfaceDefaults::PHOTON`]).
     pub fn read(props: &Properties<'_>, scene: &Scene) -> Result<SurfaceParams> {
-        let global_photons = props.u64("global_photons", 200_000)?;
+        SurfaceParams::read_with(props, scene, SurfaceDefaults::PHOTON)
+    }
+
+    /// Reads and checks them with the plugin's own defaults.
+    pub fn read_with(
+        props: &Properties<'_>,
+        scene: &Scene,
+        defaults: SurfaceDefaults,
+    ) -> Result<SurfaceParams> {
+        let global_photons = props.u64("global_photons", defaults.global_photons)?;
         if global_photons == 0 {
             return Err(props.error("global_photons", "must be at least 1"));
         }
-        let caustic_photons = props.u64("caustic_photons", 100_000)?;
-        let k = read_k(props, "k")?;
+        let caustic_photons = props.u64("caustic_photons", defaults.caustic_photons)?;
+        let k = read_k(props, "k", defaults.k)?;
         check_k(
             props,
             "k",
@@ -178,8 +205,8 @@ pub fn diagonal(scene: &Scene) -> f32 {
 /// Reads an estimate's photon count `key`: at least 2, since the k-th nearest photon lies on
 /// the boundary of the estimate's disc and is not summed (docs/photon-mapping.md): k = 1
 /// would leave nothing to sum.
-pub fn read_k(props: &Properties<'_>, key: &str) -> Result<usize> {
-    let k = props.u32(key, 50)? as usize;
+pub fn read_k(props: &Properties<'_>, key: &str, default: u32) -> Result<usize> {
+    let k = props.u32(key, default)? as usize;
     if k < 2 {
         return Err(props.error(
             key,

@@ -6,14 +6,14 @@
 //!
 //! | parameter           | type    | meaning                                                    | default |
 //! |---------------------|---------|------------------------------------------------------------|---------|
-//! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps, >= 1 | 200000 |
+//! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps, >= 1 | 48 per pixel of the film, at most 4000000 (3145728 at 256x256) |
 //! | `caustic_photons`   | integer | photons emitted for the surface caustic map; 0: no caustic map, the global map keeps the L S+ D surface photons | 100000 |
 //! | `volume_photons`    | integer | photons emitted for the volume map (traced only when the scene has media); 0: no volume map | 200000 |
-//! | `k`                 | integer | photons per surface estimate (>= 2)                        | 50      |
+//! | `k`                 | integer | photons per surface estimate (>= 2)                        | 8       |
 //! | `max_radius`        | float   | largest surface estimate radius, > 0                       | 1/20 of the diagonal |
-//! | `k_volume`          | integer | photons per volume estimate (>= 2); with `estimate = "beam"`, the neighbour that sets each photon's radius | 50 |
+//! | `k_volume`          | integer | photons per volume estimate (>= 2); with `estimate = "beam"`, the neighbour that sets each photon's radius | 8 |
 //! | `max_radius_volume` | float   | largest volume estimate radius, > 0                        | 1/20 of the diagonal |
-//! | `step`              | float   | ray-marching step (jittered per camera sample), > 0        | 1/100 of the diagonal |
+//! | `step`              | float   | ray-marching step (jittered per camera sample), > 0        | 1/5 of the diagonal |
 //! | `kernel`            | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 2-D on surfaces and for the beam estimate, in 3-D for the marched volume estimate) | `box` |
 //! | `cone_c`            | float   | the cone kernel's c >= 1 (read only with `kernel = "cone"`) | 1      |
 //! | `direct`            | string  | `nee` (shadow rays) or `photons`                           | `nee`   |
@@ -21,6 +21,18 @@
 //! | `beam_type`         | string  | with `estimate = "beams"`: `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
 //! | `beam_radius`       | float   | with `estimate = "beams"`: the photon beams' width r (the 1-D kernel's radius), > 0 | 0.0287 x diagonal x volume_photons^(-1/5) (1/400 of the diagonal for 200000) |
 //! | `glossy_roughness`  | float   | glossy lobes smoother than this (microfacet alpha) are followed by the camera walk, not estimated (docs/photon-mapping.md, "Glossy surfaces") | 0.5 |
+//!
+//! **Why these defaults** (measured at 256x256 on the fog scenes against converged
+//! references; README, "Defaults"): the error a 16x16 block shows comes from two things, the
+//! photons that fall in it (their count, not k, sets its noise: the camera samples' jitter
+//! averages neighbouring estimates) and the bias of the estimates' disc and ball where they
+//! reach past a wall's edge or out of the fog (a band as wide as the radius). So k is small
+//! (8: a small radius, so a thin band) and the global photons grow with the pixels (48 a
+//! pixel: the radius keeps its size in pixels). The march `step` is long (a fifth of the
+//! diagonal, a few points per camera ray): the jitter makes the march unbiased at any step,
+//! and the scene's camera samples average its noise, while each point costs a k-nearest query
+//! and a shadow ray. The marched estimate is the default: at these settings it was faster
+//! than the beam radiance estimate, whose walk along the ray meets the largest photon radius.
 //!
 //! `[render] max_depth` bounds the scattering events of whole light paths (surface hits and
 //! medium scattering events alike), as in the path tracer. `[render] spp` camera samples. A
@@ -117,8 +129,8 @@ use foton_photonmap::beams::{
 };
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
 use foton_photonmap::surface::{
-    SurfaceMaps, SurfaceParams, check_k, diagonal, read_k, read_positive, render_with_maps,
-    surface_views, trace_surface_photons,
+    SurfaceDefaults, SurfaceMaps, SurfaceParams, check_k, diagonal, read_k, read_positive,
+    render_with_maps, surface_views, trace_surface_photons,
 };
 use foton_photonmap::trace::{
     PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons_and_beams,
@@ -516,12 +528,29 @@ impl Integrator for Vpm {
     }
 }
 
+/// Global photons per pixel of the film by default: with k fixed, the surface estimate's
+/// radius, and with it the band along a wall's edge that its disc darkens, then keeps its
+/// size in pixels whatever the resolution (README, "Defaults").
+pub const GLOBAL_PHOTONS_PER_PIXEL: u64 = 48;
+/// ... and at most this many (3M took 175 MB of memory in all on the foggy Cornell box).
+pub const MAX_DEFAULT_GLOBAL_PHOTONS: u64 = 4_000_000;
+/// The default k of the surface and volume estimates: small, since the camera samples'
+/// jitter averages neighbouring estimates (a 16x16 block's error is set by the photons in
+/// it, not by k) and a small k keeps the radius, and its bias at edges, small.
+pub const DEFAULT_K: u32 = 8;
+
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
     let diagonal = diagonal(scene);
-    let surface = SurfaceParams::read(props, scene)?;
+    let pixels = scene.film.width as u64 * scene.film.height as u64;
+    let defaults = SurfaceDefaults {
+        global_photons: (GLOBAL_PHOTONS_PER_PIXEL * pixels).clamp(1, MAX_DEFAULT_GLOBAL_PHOTONS),
+        caustic_photons: 100_000,
+        k: DEFAULT_K,
+    };
+    let surface = SurfaceParams::read_with(props, scene, defaults)?;
     let volume_photons = props.u64("volume_photons", 200_000)?;
-    let k_volume = read_k(props, "k_volume")?;
+    let k_volume = read_k(props, "k_volume", DEFAULT_K)?;
     check_k(
         props,
         "k_volume",
@@ -530,7 +559,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     )?;
     let positive = |key: &str, default: f32| read_positive(props, key, default);
     let max_radius_volume = positive("max_radius_volume", diagonal / 20.0)?;
-    let step = positive("step", diagonal / 100.0)?;
+    let step = positive("step", diagonal / 5.0)?;
     let kernel = props.kernel("kernel", "box")?;
     let direct = Direct::read(props)?;
     let estimate = match props.choice("estimate", &["march", "beam", "beams"], "march")? {
