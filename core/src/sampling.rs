@@ -116,12 +116,16 @@ pub struct Sampler {
     pixel_key: u64,
     /// The sample's index within its pixel.
     index: u32,
-    /// `index` with its bits reversed (`sobol` only; see [`Sampler::sobol_index`]).
+    /// `index` with its bits reversed (`sobol` only; see [`sobol_block`]).
     index_reversed: u32,
     /// Samples the pixel takes in all (strata per dimension).
     spp: u32,
     /// The next dimension to hand out.
     dimension: u32,
+    /// `sobol`: the points of dimensions `block_start..block_start + SOBOL_BLOCK`, computed
+    /// together ([`sobol_block`]); before the first block, `NO_BLOCK`, far from every dimension.
+    block_start: u32,
+    block: SobolBlock,
 }
 
 impl Sampler {
@@ -157,6 +161,8 @@ impl Sampler {
             index_reversed: index.reverse_bits(),
             spp: spp.max(1),
             dimension: 0,
+            block_start: NO_BLOCK,
+            block: SobolBlock::EMPTY,
         }
     }
 
@@ -169,7 +175,9 @@ impl Sampler {
     pub fn next_f32(&mut self) -> f32 {
         match self.kind {
             SamplerKind::Independent => self.rng.next_f32(),
-            _ => self.next_1d_structured(),
+            // Two loads while the block lasts, inlined like the independent stream's draw.
+            SamplerKind::Sobol => self.sobol_point().0,
+            SamplerKind::Stratified { .. } => self.next_1d_stratified(),
         }
     }
 
@@ -178,7 +186,11 @@ impl Sampler {
     pub fn next_2d(&mut self) -> Vec2 {
         match self.kind {
             SamplerKind::Independent => self.rng.next_2d(),
-            _ => self.next_2d_structured(),
+            SamplerKind::Sobol => {
+                let (x, y) = self.sobol_point();
+                Vec2::new(x, y)
+            }
+            SamplerKind::Stratified { .. } => self.next_2d_stratified(),
         }
     }
 
@@ -187,7 +199,7 @@ impl Sampler {
     fn dimension_key(&mut self) -> u64 {
         let d = self.dimension;
         self.dimension += 1;
-        splitmix64(self.pixel_key ^ (d as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+        dimension_key(self.pixel_key, d)
     }
 
     /// Index within the pixel's strata, and a key for the round when the index is past spp
@@ -204,70 +216,190 @@ impl Sampler {
         (p, (key >> 32) as u32)
     }
 
-    /// The low 24 bits of [`shuffled_index`] of the sample's index with `seed`, from the
-    /// reversed index kept in the sampler: the two scrambles share their outer bit reversal
-    /// (it is linear over xor), which leaves one reversal where there were four. The Sobol
-    /// sampler's cost is mostly these reversals (x86 has no instruction for them). Only the
-    /// low 24 bits of the index matter: a point keeps the top 24 bits of its 32-bit fraction
-    /// ([`unit_f32`]), which are the low 24 of what the scramble hashes (bit-reversed), and each
-    /// bit of the hash depends only on the bits below it; the Sobol matrices' reversed columns
-    /// past 23 have no bits below 24.
-    #[inline]
-    fn sobol_index(&self, seed: u32) -> u32 {
-        reverse_24(laine_karras(self.index_reversed, seed) ^ laine_karras(0, seed))
+    /// The next dimension's Sobol point (both coordinates; a 1-D request takes the first,
+    /// which is what it would compute alone), from the block of [`SOBOL_BLOCK`] dimensions
+    /// that holds it, computed when the block's first dimension is asked for.
+    #[inline(always)]
+    fn sobol_point(&mut self) -> (f32, f32) {
+        let d = self.dimension;
+        self.dimension += 1;
+        let mut k = d.wrapping_sub(self.block_start);
+        if k >= SOBOL_BLOCK as u32 {
+            self.next_sobol_block(d);
+            k = 0;
+        }
+        (self.block.x[k as usize], self.block.y[k as usize])
     }
 
-    fn next_1d_structured(&mut self) -> f32 {
-        let key = self.dimension_key();
-        match self.kind {
-            SamplerKind::Stratified { jitter } => {
-                let (stratum, _) = self.stratum_index(key);
-                let offset = if jitter { self.rng.next_f32() } else { 0.5 };
-                ((stratum as f32 + offset) / self.spp as f32).min(ONE_MINUS_EPSILON)
-            }
-            _ => {
-                // = owen_scramble(sobol_dimension(i, 0), seed): dimension 0 reverses the
-                // index's bits and the scramble reverses them back before hashing.
-                let i = self.sobol_index(key as u32);
-                reversed_unit_f32(laine_karras(i, (key >> 32) as u32))
-            }
-        }
+    #[inline(never)]
+    fn next_sobol_block(&mut self, first: u32) {
+        self.block_start = first;
+        sobol_block(self.pixel_key, self.index_reversed, first, &mut self.block);
     }
 
-    fn next_2d_structured(&mut self) -> Vec2 {
+    fn next_1d_stratified(&mut self) -> f32 {
+        let SamplerKind::Stratified { jitter } = self.kind else {
+            unreachable!("called for the stratified sampler only")
+        };
         let key = self.dimension_key();
-        match self.kind {
-            SamplerKind::Stratified { jitter } => {
-                let (stratum, _) = self.stratum_index(key);
-                let (nx, ny) = strata_2d(self.spp);
-                let (sx, sy) = (stratum % nx, stratum / nx);
-                let (jx, jy) = if jitter {
-                    (self.rng.next_f32(), self.rng.next_f32())
-                } else {
-                    (0.5, 0.5)
-                };
-                Vec2::new(
-                    ((sx as f32 + jx) / nx as f32).min(ONE_MINUS_EPSILON),
-                    ((sy as f32 + jy) / ny as f32).min(ONE_MINUS_EPSILON),
-                )
-            }
-            _ => {
-                // Padding (Burley 2020, section 4): every pair takes Sobol dimensions 0 and 1,
-                // a (0, 2)-sequence, with its own shuffle of the sample index, so pairs are
-                // independent of one another and each is as well stratified as the first.
-                // One 64-bit hash gives the three 32-bit seeds (the third by an odd multiplier:
-                // the scramble's hash needs distinct seeds, not independent bits).
-                let i = self.sobol_index(key as u32);
-                let (sx, sy) = ((key >> 32) as u32, (key >> 16) as u32 ^ 0x9E37_79B9);
-                // owen_scramble(sobol_dimension(i, d), s) with the bit reversals that cancel
-                // left out (see `sobol_dimension_reversed`).
-                Vec2::new(
-                    reversed_unit_f32(laine_karras(i, sx)),
-                    reversed_unit_f32(laine_karras(sobol_dimension_reversed(i, 1), sy)),
-                )
-            }
+        let (stratum, _) = self.stratum_index(key);
+        let offset = if jitter { self.rng.next_f32() } else { 0.5 };
+        ((stratum as f32 + offset) / self.spp as f32).min(ONE_MINUS_EPSILON)
+    }
+
+    fn next_2d_stratified(&mut self) -> Vec2 {
+        let SamplerKind::Stratified { jitter } = self.kind else {
+            unreachable!("called for the stratified sampler only")
+        };
+        let key = self.dimension_key();
+        let (stratum, _) = self.stratum_index(key);
+        let (nx, ny) = strata_2d(self.spp);
+        let (sx, sy) = (stratum % nx, stratum / nx);
+        let (jx, jy) = if jitter {
+            (self.rng.next_f32(), self.rng.next_f32())
+        } else {
+            (0.5, 0.5)
+        };
+        Vec2::new(
+            ((sx as f32 + jx) / nx as f32).min(ONE_MINUS_EPSILON),
+            ((sy as f32 + jy) / ny as f32).min(ONE_MINUS_EPSILON),
+        )
+    }
+}
+
+/// Dimensions of a `sobol` sampler computed together ([`sobol_block`]).
+pub const SOBOL_BLOCK: usize = 8;
+
+/// A sampler's `block_start` before its first block: no dimension d has
+/// `d - NO_BLOCK` (wrapping) below [`SOBOL_BLOCK`].
+const NO_BLOCK: u32 = 1 << 31;
+
+/// The points of [`SOBOL_BLOCK`] consecutive dimensions of one `sobol` sample: `x` is a 1-D
+/// request's value and a 2-D request's first coordinate, `y` the second.
+#[derive(Clone, Copy, Debug)]
+pub struct SobolBlock {
+    pub x: [f32; SOBOL_BLOCK],
+    pub y: [f32; SOBOL_BLOCK],
+}
+
+impl SobolBlock {
+    const EMPTY: SobolBlock = SobolBlock {
+        x: [0.0; SOBOL_BLOCK],
+        y: [0.0; SOBOL_BLOCK],
+    };
+}
+
+/// The Owen-scrambled Sobol points of dimensions `first..first + SOBOL_BLOCK` of the sample
+/// whose pixel key and reversed index are given (the [`Sampler`]'s fields), into `block`.
+///
+/// Padding (Burley 2020, section 4): every dimension takes Sobol dimensions 0 and 1, a
+/// (0, 2)-sequence, with its own shuffle of the sample index, so dimensions are independent
+/// of one another and each is as well stratified as the first. One 64-bit hash gives the
+/// three 32-bit seeds (the third by an odd multiplier: the scramble's hash needs distinct
+/// seeds, not independent bits). The point is `owen_scramble(sobol_dimension(i, d), s)` of
+/// the shuffled index i, with the bit reversals that cancel left out:
+///
+/// * the shuffle is [`shuffled_index`] of the index, whose two scrambles share their outer
+///   bit reversal (it is linear over xor): one reversal of the reversed index's hash, where
+///   there were four. Only the low 24 bits of the shuffled index matter: a point keeps the
+///   top 24 bits of its 32-bit fraction ([`unit_f32`]), which are the low 24 of what the
+///   scramble hashes (bit-reversed), and each bit of the hash depends only on the bits below
+///   it; the Sobol matrices' reversed columns past 23 have no bits below 24;
+/// * dimension 0 reverses the index's bits and the scramble reverses them back before
+///   hashing; dimension 1 reads its generator matrix with reversed columns
+///   (`SOBOL_MATRICES_REVERSED`), each under a mask of its bit of the index.
+///
+/// Eight dimensions are computed at once, each step for all of them, because that runs in
+/// the eight 32-bit lanes of an AVX2 register where the processor has them (the hashes are
+/// 32-bit multiplies and shifts, the bit reversals byte shuffles, dimension 1 a masked xor
+/// per column): about 34 instructions a dimension on the Cornell box, against about 105 one
+/// at a time with a data-dependent loop (docs/PERFORMANCE.md, session 26). Integer arithmetic,
+/// so the points are the same bits with or without AVX2, and as one dimension alone computes
+/// them (unit test `sobol_block_matches_each_lane`). A sample that ends inside a block has
+/// computed a few dimensions it does not use (on the Cornell box, 21 for 17).
+#[inline]
+pub fn sobol_block(pixel_key: u64, index_reversed: u32, first: u32, block: &mut SobolBlock) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor has AVX2 (checked just above).
+            return unsafe { sobol_block_avx2(pixel_key, index_reversed, first, block) };
         }
     }
+    sobol_block_lanes(pixel_key, index_reversed, first, block)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+unsafe fn sobol_block_avx2(
+    pixel_key: u64,
+    index_reversed: u32,
+    first: u32,
+    block: &mut SobolBlock,
+) {
+    sobol_block_lanes(pixel_key, index_reversed, first, block)
+}
+
+/// [`sobol_block`] written step by step over arrays of lanes, for the compiler to vectorise.
+#[inline(always)]
+fn sobol_block_lanes(pixel_key: u64, index_reversed: u32, first: u32, block: &mut SobolBlock) {
+    const N: usize = SOBOL_BLOCK;
+    let (mut seed, mut sx, mut sy) = ([0u32; N], [0u32; N], [0u32; N]);
+    for k in 0..N {
+        let key = dimension_key(pixel_key, first.wrapping_add(k as u32));
+        (seed[k], sx[k], sy[k]) = key_seeds(key);
+    }
+    let mut i = [0u32; N];
+    for k in 0..N {
+        i[k] = reverse_24(laine_karras(index_reversed, seed[k]) ^ laine_karras(0, seed[k]));
+    }
+    for k in 0..N {
+        block.x[k] = reversed_unit_f32(laine_karras(i[k], sx[k]));
+    }
+    for k in 0..N {
+        block.y[k] = reversed_unit_f32(laine_karras(sobol_24_reversed(i[k]), sy[k]));
+    }
+}
+
+/// The hash of (pixel, dimension) that seeds a dimension's shuffle and scrambles.
+#[inline(always)]
+fn dimension_key(pixel_key: u64, dimension: u32) -> u64 {
+    splitmix64(pixel_key ^ (dimension as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
+}
+
+/// One dimension's point alone, both coordinates, as [`sobol_block`] computes eight: the
+/// reference its unit test compares the blocks with.
+#[cfg(test)]
+fn sobol_lane(key: u64, index_reversed: u32) -> (f32, f32) {
+    let (seed, sx, sy) = key_seeds(key);
+    let i = reverse_24(laine_karras(index_reversed, seed) ^ laine_karras(0, seed));
+    (
+        reversed_unit_f32(laine_karras(i, sx)),
+        reversed_unit_f32(laine_karras(sobol_24_reversed(i), sy)),
+    )
+}
+
+/// The three 32-bit seeds of a dimension's key: the index shuffle's, and the scrambles of
+/// the point's two coordinates.
+#[inline(always)]
+fn key_seeds(key: u64) -> (u32, u32, u32) {
+    (
+        key as u32,
+        (key >> 32) as u32,
+        (key >> 16) as u32 ^ 0x9E37_79B9,
+    )
+}
+
+/// `sobol_dimension_reversed(i, 1)` for an index below 2^24, without the data-dependent
+/// loop: every column is taken under a mask of its bit (branch-free, so it vectorises).
+#[inline(always)]
+fn sobol_24_reversed(i: u32) -> u32 {
+    let matrix = &SOBOL_MATRICES_REVERSED[1];
+    let mut x = 0;
+    for (k, column) in matrix.iter().enumerate().take(24) {
+        x ^= column & ((i >> k) & 1).wrapping_neg();
+    }
+    x
 }
 
 /// The 2-D strata of `spp` samples: nx x ny = spp with nx the largest divisor of spp not above
@@ -400,7 +532,7 @@ static SOBOL_MATRICES_REVERSED: [[u32; 32]; SOBOL_DIMENSIONS] = {
 };
 
 /// [`sobol_dimension`] with its bits reversed (see [`SOBOL_MATRICES_REVERSED`]).
-#[inline]
+#[cfg(test)]
 fn sobol_dimension_reversed(mut index: u32, dimension: usize) -> u32 {
     let matrix = &SOBOL_MATRICES_REVERSED[dimension];
     let mut x = 0;
@@ -413,7 +545,7 @@ fn sobol_dimension_reversed(mut index: u32, dimension: usize) -> u32 {
 
 /// Laine and Karras' hash, improved by Vegdahl ("Building a better LK hash", 2021): a
 /// permutation of 32-bit numbers in which each bit depends only on the bits below it.
-#[inline]
+#[inline(always)]
 fn laine_karras(mut x: u32, seed: u32) -> u32 {
     x ^= x.wrapping_mul(0x3d20_adea);
     x = x.wrapping_add(seed);
@@ -439,29 +571,18 @@ pub fn shuffled_index(index: u32, seed: u32) -> u32 {
     owen_scramble(index, seed) ^ owen_scramble(0, seed)
 }
 
-/// Bit reversal of each byte, for [`reverse_24`].
-static REVERSED_BYTES: [u8; 256] = {
-    let mut t = [0u8; 256];
-    let mut i = 0;
-    while i < 256 {
-        t[i] = (i as u8).reverse_bits();
-        i += 1;
-    }
-    t
-};
-
-/// `x.reverse_bits() & 0xFF_FFFF`: the top 24 bits of `x` reversed, by three byte lookups
-/// (cheaper than the 32-bit reversal's shifts and masks).
-#[inline]
+/// `x.reverse_bits() & 0xFF_FFFF`: the top 24 bits of `x` reversed (the only ones a point
+/// keeps; with AVX2 the compiler reverses eight lanes by byte shuffles).
+#[inline(always)]
 fn reverse_24(x: u32) -> u32 {
-    let r = |shift: u32| REVERSED_BYTES[((x >> shift) & 0xFF) as usize] as u32;
-    r(24) | (r(16) << 8) | (r(8) << 16)
+    x.reverse_bits() & 0xFF_FFFF
 }
 
 /// `unit_f32(y.reverse_bits())`: the float of the reversal of `y`'s low 24 bits.
 #[inline]
 fn reversed_unit_f32(y: u32) -> f32 {
-    reverse_24(y << 8) as f32 * (1.0 / (1u32 << 24) as f32)
+    // Below 2^24: the signed conversion is exact and has a vector instruction.
+    reverse_24(y << 8) as i32 as f32 * (1.0 / (1u32 << 24) as f32)
 }
 
 /// A 32-bit fraction as a float in [0, 1).
@@ -794,6 +915,34 @@ mod tests {
                         let u = sampler.next_2d();
                         assert_eq!((u.x.to_bits(), u.y.to_bits()), (x.to_bits(), y.to_bits()));
                     }
+                }
+            }
+        }
+    }
+
+    /// A block of Sobol dimensions, vectorised or not, holds each dimension's point as
+    /// `sobol_lane` computes it alone; the branch-free dimension 1 is the loop's.
+    #[test]
+    fn sobol_block_matches_each_lane() {
+        let mut rng = Rng::new(&[11]);
+        for _ in 0..3000 {
+            let i = rng.next_u32() >> 8;
+            assert_eq!(sobol_24_reversed(i), sobol_dimension_reversed(i, 1));
+        }
+        for _ in 0..500 {
+            let pixel_key = (rng.next_u32() as u64) << 32 | rng.next_u32() as u64;
+            let index_reversed = rng.next_u32();
+            let first = rng.next_u32() % 100;
+            let mut fast = SobolBlock::EMPTY;
+            sobol_block(pixel_key, index_reversed, first, &mut fast);
+            let mut plain = SobolBlock::EMPTY;
+            sobol_block_lanes(pixel_key, index_reversed, first, &mut plain);
+            for k in 0..SOBOL_BLOCK {
+                let key = dimension_key(pixel_key, first + k as u32);
+                let (x, y) = sobol_lane(key, index_reversed);
+                for block in [&fast, &plain] {
+                    assert_eq!(block.x[k].to_bits(), x.to_bits());
+                    assert_eq!(block.y[k].to_bits(), y.to_bits());
                 }
             }
         }
