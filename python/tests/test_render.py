@@ -85,8 +85,9 @@ def test_sampler_is_the_programs_and_a_misspelt_one_is_refused(program, tmp_path
     sets = as_sets({k: v for k, v in TINY.items() if k.startswith("film.")})
     run_program(program, "render", SCENES / "cornell-box.toml", "--spp", 4, "--set", 'render.sampler="sobol"', *sets, "-q", "-o", out)
     assert np.array_equal(sobol, foton.read(out))
-    assert not np.array_equal(sobol, scene.render(spp=4, progress=False))
-    assert scene.sampler == "independent"
+    assert not np.array_equal(sobol, scene.render(spp=4, sampler="independent", progress=False))
+    assert np.array_equal(sobol, scene.render(spp=4, progress=False))  # the file names none: sobol
+    assert scene.sampler == "sobol"
     with pytest.raises(foton.SceneError, match='did you mean "sobol"'):
         scene.render(spp=4, sampler="sobl", progress=False)
 
