@@ -146,7 +146,7 @@ output = "out.exr"
     )
 }
 
-/// The point-light fog box of the photon-beam tests (tests/tests/beams.rs, ppb.rs): a fog box
+/// The point-light fog box of the photon-beam tests (tests/tests/suite/beams.rs, ppb.rs): a fog box
 /// [-1, 1] x [-1.6, 1.6] x [-1, 1] behind a null boundary with a point light inside, nothing
 /// else, 24 x 24 pixels: the camera (in vacuum) sees only light scattered by the fog. The light
 /// sits just above the field of view: in view it would be a singularity (in-scattered

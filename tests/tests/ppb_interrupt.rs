@@ -2,7 +2,7 @@
 //! `sppm`: Ctrl-C after some passes returns exactly the average of the passes done (the image
 //! is bit for bit the render of that many passes), `--checkpoint` writes the image of the
 //! passes so far atomically, and the interrupted command says how many passes its image holds.
-//! `--part I/N` + `foton merge` (bit for bit the whole render) is in tests/tests/ppb.rs. In a
+//! `--part I/N` + `foton merge` (bit for bit the whole render) is in tests/tests/suite/ppb.rs. In a
 //! test binary of its own, because it raises the process-wide interrupt flag that every
 //! in-process render watches.
 

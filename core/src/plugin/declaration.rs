@@ -1,7 +1,7 @@
 //! What an integrator plugin exports, and the guards compiled into it: the API versions, the
 //! `#[repr(C)]` declarations (`FOTON_INTEGRATOR_PLUGIN`, the C kernel struct), the layout
 //! fingerprint, `declare_integrator!` and the panic guards. This file and integrator.rs are the
-//! plugin interface: a change to either is a new `PLUGIN_API_VERSION` (tests/plugin_api.rs
+//! plugin interface: a change to either is a new `PLUGIN_API_VERSION` (tests/tests/suite/plugin_api.rs
 //! holds the rule).
 
 use crate::error::{Error, Result};

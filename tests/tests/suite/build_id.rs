@@ -5,10 +5,10 @@
 //! plugins are refused, with both identifiers named: bad_input.rs). The function tested here
 //! is the one build.rs runs: it reproduces this build's identifier.
 
-#[path = "../../core/build_id.rs"]
-mod build_id;
+#[path = "../../../core/build_id.rs"]
+mod core_build_id;
 
-use build_id::{Inputs, build_id, dependency_closure};
+use core_build_id::{Inputs, build_id, dependency_closure};
 use foton_tests::{repo_root, temp_dir};
 use std::path::Path;
 

@@ -64,7 +64,7 @@ fn error_falls_with_passes_on_the_fog_box() {
     );
 }
 
-/// The point-light fog box of tests/tests/beams.rs (the light just above the view, shared in
+/// The point-light fog box of tests/tests/suite/beams.rs (the light just above the view, shared in
 /// foton_tests): at max_depth 1 the image is single scattering only, all of it from beams.
 fn point_light_fog(integrator: &str, max_depth: u32) -> String {
     let ppb = "[integrators.ppb]\niterations = 16\nphotons_per_iteration = 10000\nsurface_photons = 10000";
@@ -72,7 +72,7 @@ fn point_light_fog(integrator: &str, max_depth: u32) -> String {
     foton_tests::point_light_fog(integrator, 4096, max_depth, hg, ppb)
 }
 
-/// Tolerances as in tests/tests/beams.rs (there with 200k photons in one pass; here 16
+/// Tolerances as in tests/tests/suite/beams.rs (there with 200k photons in one pass; here 16
 /// passes of 10k, with shrinking beams): image mean within 3 %, 3 x 3 blocks within 8 % or
 /// 4 se.
 #[test]

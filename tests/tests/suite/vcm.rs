@@ -12,7 +12,7 @@
 //! * a scene with participating media is refused with the integrators that render it.
 //!
 //! Block means are compared within z standard errors of the pixel-wise difference
-//! (`foton_tests::stats::compare_blocks`), as in tests/tests/bdpt.rs; where merges are used the
+//! (`foton_tests::stats::compare_blocks`), as in tests/tests/suite/bdpt.rs; where merges are used the
 //! radius bias is allowed for as a relative term derived in the test's comment.
 
 use foton_core::film::Film;
@@ -27,7 +27,7 @@ const Z: Tolerance = Tolerance {
     floor: 1e-4,
 };
 
-/// The Cornell box of tests/tests/bdpt.rs: its spheres of materials `a` and `b`, a 1 x 1 quad
+/// The Cornell box of tests/tests/suite/bdpt.rs: its spheres of materials `a` and `b`, a 1 x 1 quad
 /// light of radiance 5 below the ceiling, at SIZE x SIZE.
 fn cornell(a: &str, b: &str) -> String {
     format!(

@@ -1,0 +1,52 @@
+//! foton's integration tests, one test binary for all of them: physics checks, plugins,
+//! scenes, tools, bad input. One binary instead of one per file, because each binary links
+//! core, the loader and the program again (42 links, and the compile time of the test
+//! command was mostly that). Each file is a module; run one file's tests with
+//! `cargo test --release -p foton-tests --test suite vpm::`.
+//!
+//! Two files stay binaries of their own (tests/tests/ppb_interrupt.rs and
+//! sppm_interrupt.rs): they raise the process-wide interrupt flag that every in-process
+//! render watches, and would stop the renders of tests running beside them.
+
+mod bad_input;
+mod bdpt;
+mod beams;
+mod bitterli;
+mod build_id;
+mod capabilities;
+mod conductor;
+mod crossing_limit;
+mod deploy;
+mod directional;
+mod disc_estimate;
+mod environment;
+mod filter;
+mod glossy;
+mod kernels;
+mod media;
+mod media_sides;
+mod medium_kind;
+mod mitsuba;
+mod mitsuba05;
+mod one_sided;
+mod parts;
+mod photon;
+mod physics;
+mod plugin_api;
+mod plugins;
+mod ply;
+mod ppb;
+mod samplers;
+mod sampling;
+mod scenes;
+mod shapes;
+mod sphere_light;
+mod spot;
+mod sppm;
+mod textures;
+mod thin_dielectric;
+mod tonemap;
+mod tools;
+mod vcm;
+mod volume_photons;
+mod vpm;
