@@ -31,12 +31,13 @@ const Z: Tolerance = Tolerance {
 };
 
 /// A Cornell box (the course scene's walls), its two spheres of `sphere_a` and `sphere_b`
-/// (material names), `extra` materials and `light` (TOML tables), at SIZE x SIZE.
+/// (material names), `extra` materials and `light` (TOML tables), at SIZE x SIZE (also the
+/// box of vcm.rs).
 /// The sampler is pinned to `independent`: the tests' tolerances are standard errors of
 /// per-pixel means (`Z`), which assume independent samples; a strategy alone in fog has
 /// heavy-tailed connections whose sobol estimate is unbiased but whose error those standard
 /// errors do not describe.
-fn cornell(sphere_a: &str, sphere_b: &str, extra: &str, light: &str) -> String {
+pub(super) fn cornell(sphere_a: &str, sphere_b: &str, extra: &str, light: &str) -> String {
     format!(
         r#"
 [render]
@@ -125,7 +126,7 @@ material = "{sphere_b}"
 }
 
 /// A 1 x 1 quad light of radiance 5 just below the ceiling, facing down.
-const CEILING_LIGHT: &str = r#"
+pub(super) const CEILING_LIGHT: &str = r#"
 [[shapes]]
 type = "quad"
 origin = [-0.5, 1.98, -0.5]

@@ -27,105 +27,18 @@ const Z: Tolerance = Tolerance {
     floor: 1e-4,
 };
 
-/// The Cornell box of tests/tests/suite/bdpt.rs: its spheres of materials `a` and `b`, a 1 x 1 quad
-/// light of radiance 5 below the ceiling, at SIZE x SIZE.
+/// The Cornell box of bdpt.rs (its spheres of materials `a` and `b`, a 1 x 1 quad light of
+/// radiance 5 below the ceiling, at SIZE x SIZE, the `independent` sampler its standard errors
+/// assume) with a glass material.
 fn cornell(a: &str, b: &str) -> String {
-    format!(
-        r#"
-[render]
-integrator = "path"
-spp = 16
-seed = 3
-max_depth = 8
+    super::bdpt::cornell(a, b, GLASS, super::bdpt::CEILING_LIGHT)
+}
 
-[film]
-width = {SIZE}
-height = {SIZE}
-output = "out.exr"
-
-[camera]
-position = [0.0, 1.0, 3.9]
-look_at = [0.0, 1.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 39.3
-
-[materials.white]
-type = "diffuse"
-reflectance = [0.73, 0.73, 0.73]
-
-[materials.red]
-type = "diffuse"
-reflectance = [0.63, 0.065, 0.05]
-
-[materials.green]
-type = "diffuse"
-reflectance = [0.14, 0.45, 0.091]
-
-[materials.black]
-type = "diffuse"
-reflectance = [0.0, 0.0, 0.0]
-
+const GLASS: &str = r#"
 [materials.glass]
 type = "dielectric"
 ior = 1.5
-
-[[shapes]]
-type = "quad"
-origin = [-1.0, 0.0, 1.0]
-u = [2.0, 0.0, 0.0]
-v = [0.0, 0.0, -2.0]
-material = "white"
-
-[[shapes]]
-type = "quad"
-origin = [-1.0, 2.0, -1.0]
-u = [2.0, 0.0, 0.0]
-v = [0.0, 0.0, 2.0]
-material = "white"
-
-[[shapes]]
-type = "quad"
-origin = [-1.0, 0.0, -1.0]
-u = [2.0, 0.0, 0.0]
-v = [0.0, 2.0, 0.0]
-material = "white"
-
-[[shapes]]
-type = "quad"
-origin = [-1.0, 0.0, -1.0]
-u = [0.0, 2.0, 0.0]
-v = [0.0, 0.0, 2.0]
-material = "red"
-
-[[shapes]]
-type = "quad"
-origin = [1.0, 0.0, -1.0]
-u = [0.0, 0.0, 2.0]
-v = [0.0, 2.0, 0.0]
-material = "green"
-
-[[shapes]]
-type = "sphere"
-center = [-0.45, 0.35, -0.35]
-radius = 0.35
-material = "{a}"
-
-[[shapes]]
-type = "sphere"
-center = [0.45, 0.3, 0.25]
-radius = 0.3
-material = "{b}"
-
-[[shapes]]
-type = "quad"
-origin = [-0.5, 1.98, -0.5]
-u = [1.0, 0.0, 0.0]
-v = [0.0, 0.0, 1.0]
-material = "black"
-emission = [5.0, 5.0, 5.0]
-"#
-    )
-}
+"#;
 
 fn render(scene: &str, integrator: &str, sets: &[String]) -> Film {
     let mut all = vec![format!("render.integrator=\"{integrator}\"")];
