@@ -11,7 +11,7 @@
 //! | `photons_per_iteration` | integer | photons emitted in each pass for the photon beams, >= 1   | 2500    |
 //! | `surface_photons`       | integer | photons emitted in each pass for the surface estimate, >= `photons_per_iteration` (equal: the beams' own photons, one trace) | 100000 (or `photons_per_iteration` if larger) |
 //! | `initial_beam_radius`   | float   | the photon beams' width r_1 in the first pass (world units), > 0 | 0.0287 x diagonal x photons_per_iteration^(-1/5) |
-//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 1.25 pixel footprints at the pass's visible point, within [1/1000, 1/50] of the diagonal |
+//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 3 pixel footprints (`sppm`'s) at the pass's visible point, within [1/1000, 1/50] of the diagonal |
 //! | `alpha`                 | float   | the radius schedule's exponent, in (0, 1)                 | 0.7     |
 //! | `beam_type`             | string  | `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 1-D across beams, in 2-D on surfaces) | `box` |
@@ -72,8 +72,12 @@
 //! surfaces (5000 a pass) the ceiling's noise decided the image (worst block 12.8 % on the
 //! foggy Cornell box at 256 x 256, whatever the beams' width or kind); 100000 surface photons
 //! take its noise away for about a tenth more time, and then a smaller first radius (1.25
-//! footprints instead of `sppm`'s 3) takes the corners' bias down. The beams then afford
-//! fewer photons (2500): the same error in three quarters of the time.
+//! footprints instead of `sppm`'s 3) took the corners' bias down. The beams then afford
+//! fewer photons (2500): the same error in three quarters of the time. Since the disc is
+//! clipped at the walls (session 27: no corner bias to trade against), the first radius is
+//! `sppm`'s 3 footprints again: the surfaces' noise, which decided the per-pixel error
+//! (more surface photons or a wider disc took it down; narrower beams raised it), falls by a
+//! half to two thirds (README).
 //!
 //! **Each light path once**: in media by the beams (a light path scattering at x_c on the
 //! camera ray is the photon's path up to its beam plus that event), at surfaces L D by shadow
@@ -103,8 +107,8 @@ use foton_photonmap::beams::{
 };
 use foton_photonmap::map::{CLIP_PROBES, DISC_THICKNESS, DiscClip, Photon, PhotonMap};
 use foton_photonmap::progressive::{
-    Gathered, PassBudget, Passes, Tally, auto_radius, gather_disc, global_radius2_scale,
-    pixel_angle, run_passes,
+    Gathered, PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc,
+    global_radius2_scale, pixel_angle, run_passes,
 };
 use foton_photonmap::trace::{
     PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons, trace_photons_and_beams,
@@ -132,8 +136,8 @@ pub struct Ppb {
 /// Random stream of the camera passes.
 const STREAM_CAMERA: u64 = 0x7070_6263;
 
-/// The automatic first surface radius in pixel footprints (README: measured).
-pub const FOOTPRINTS: f64 = 1.25;
+/// The automatic first surface radius in pixel footprints: `sppm`'s (README: measured).
+pub const FOOTPRINTS: f64 = SPPM_FOOTPRINTS;
 
 /// Random stream of the surface photons when they are a trace of their own.
 const STREAM_SURFACE: u64 = 0x7070_6273;
