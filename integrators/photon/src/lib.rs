@@ -41,7 +41,10 @@
 //! Each light path is counted once (docs/photon-mapping.md). An estimate
 //! (`PhotonMap::reflected`) is L = sum_p f(x, w_p, w) Phi_p K(d_p, r) over the k nearest
 //! photons of a disc around x, r the distance to the k-th (which, on the boundary, is not
-//! summed).
+//! summed). At the camera's visible point the disc is clipped at the walls around x
+//! (`PhotonMap::reflected_clipped` with foton-photonmap's `DiscClip`: eight probe rays in the
+//! tangent plane; beside a crease the disc would reach behind the wall, where no photon of
+//! this surface lands, and darken a band as wide as r); the gather rays' estimates are not.
 //!
 //! **What changed** (with foton-photonmap and core's `walk` and `direct` modules):
 //!

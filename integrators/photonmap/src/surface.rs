@@ -11,7 +11,7 @@
 //! The **caustic** pass stores the L S+ D photons, traced to their first diffuse hit only.
 //! Each light path is thus counted once (docs/photon-mapping.md).
 
-use crate::map::{Estimate, Photon, PhotonMap};
+use crate::map::{CLIP_PROBES, DiscClip, Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
 use foton_core::bsdf::Bsdf;
 use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
@@ -322,8 +322,9 @@ impl SurfaceMaps {
 
     /// Radiance reflected towards the camera at a visible point by light of at most `depth`
     /// scattering events after it: direct (shadow rays, or the direct map), caustic, and
-    /// indirect unless `indirect` is false (a final gather computes it instead). Not weighted
-    /// by the path's throughput; emission is the camera walk's.
+    /// indirect unless `indirect` is false (a final gather computes it instead). The estimates'
+    /// discs are clipped at the walls around the point ([`DiscClip`]: eight probe rays). Not
+    /// weighted by the path's throughput; emission is the camera walk's.
     #[allow(clippy::too_many_arguments)]
     pub fn reflected_at(
         &self,
@@ -337,16 +338,29 @@ impl SurfaceMaps {
         rays: &mut u64,
     ) -> Rgb {
         let (hit, bsdf, wo, n) = (&vp.hit, &vp.bsdf, vp.wo, vp.n);
+        // The walls the estimates' discs may reach across, found once for the three maps.
+        let clip = if depth > 0 {
+            *rays += CLIP_PROBES as u64;
+            DiscClip::probe(scene, hit.p, n, estimate.max_radius)
+        } else {
+            DiscClip::NONE
+        };
         let mut l = match (direct, &self.direct) {
-            (Direct::Photons, Some(map)) => map.reflected(estimate, bsdf, hit, wo, n, depth),
+            (Direct::Photons, Some(map)) => {
+                map.reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth)
+            }
             _ => {
                 let at = Scatter::Surface { hit, bsdf };
                 estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
             }
         };
-        l += self.caustic.reflected(estimate, bsdf, hit, wo, n, depth);
+        l += self
+            .caustic
+            .reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth);
         if indirect {
-            l += self.indirect.reflected(estimate, bsdf, hit, wo, n, depth);
+            l += self
+                .indirect
+                .reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth);
         }
         l
     }

@@ -11,7 +11,7 @@
 //! | `photons_per_iteration` | integer | photons emitted in each pass for the photon beams, >= 1   | 2500    |
 //! | `surface_photons`       | integer | photons emitted in each pass for the surface estimate, >= `photons_per_iteration` (equal: the beams' own photons, one trace) | 100000 (or `photons_per_iteration` if larger) |
 //! | `initial_beam_radius`   | float   | the photon beams' width r_1 in the first pass (world units), > 0 | 0.0287 x diagonal x photons_per_iteration^(-1/5) |
-//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 1.25 pixel footprints at the pass's visible point, within [1/1000, 1/50] of the diagonal |
+//! | `initial_radius`        | float   | the surface gather radius of the first pass, > 0          | automatic: 3 pixel footprints (`sppm`'s) at the pass's visible point, within [1/1000, 1/50] of the diagonal |
 //! | `alpha`                 | float   | the radius schedule's exponent, in (0, 1)                 | 0.7     |
 //! | `beam_type`             | string  | `short` (a beam ends at the photon's next scattering event) or `long` (at the next surface, with the transmittance along it) | `short` |
 //! | `kernel`                | string  | `box`, `cone`, `gaussian` or a kernel plugin's name (normalised in 1-D across beams, in 2-D on surfaces) | `box` |
@@ -39,8 +39,9 @@
 //!
 //! (foton-photonmap's `beams` module derives it), at the visible point emission, direct light
 //! by a shadow ray (`direct = "nee"`) and the photons of the disc of radius R_i around it
-//! (`sppm`'s gather, shared in foton-photonmap's `progressive`), each weighted by the
-//! throughput before it. The pixel's value is the mean of its passes' estimates.
+//! (`sppm`'s gather, shared in foton-photonmap's `progressive`, with the disc clipped at the
+//! walls that eight probe rays in the tangent plane find: foton-photonmap's `DiscClip`), each
+//! weighted by the throughput before it. The pixel's value is the mean of its passes' estimates.
 //!
 //! **Radii** (Knaus and Zwicker 2011's probabilistic analysis, which Jarosz et al. 2011 apply
 //! to beams): pass i uses
@@ -71,8 +72,12 @@
 //! surfaces (5000 a pass) the ceiling's noise decided the image (worst block 12.8 % on the
 //! foggy Cornell box at 256 x 256, whatever the beams' width or kind); 100000 surface photons
 //! take its noise away for about a tenth more time, and then a smaller first radius (1.25
-//! footprints instead of `sppm`'s 3) takes the corners' bias down. The beams then afford
-//! fewer photons (2500): the same error in three quarters of the time.
+//! footprints instead of `sppm`'s 3) took the corners' bias down. The beams then afford
+//! fewer photons (2500): the same error in three quarters of the time. Since the disc is
+//! clipped at the walls (session 27: no corner bias to trade against), the first radius is
+//! `sppm`'s 3 footprints again: the surfaces' noise, which decided the per-pixel error
+//! (more surface photons or a wider disc took it down; narrower beams raised it), falls by a
+//! half to two thirds (README).
 //!
 //! **Each light path once**: in media by the beams (a light path scattering at x_c on the
 //! camera ray is the photon's path up to its beam plus that event), at surfaces L D by shadow
@@ -94,15 +99,16 @@ use foton_core::props::Properties;
 use foton_core::render::{usable, with_pool};
 use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
+use foton_core::walk::VisiblePoint;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
-use foton_photonmap::map::{Photon, PhotonMap};
+use foton_photonmap::map::{CLIP_PROBES, DISC_THICKNESS, DiscClip, Photon, PhotonMap};
 use foton_photonmap::progressive::{
-    PassBudget, Passes, Tally, auto_radius, gather_disc, global_radius2_scale, pixel_angle,
-    run_passes,
+    Gathered, PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc,
+    global_radius2_scale, pixel_angle, run_passes,
 };
 use foton_photonmap::trace::{
     PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons, trace_photons_and_beams,
@@ -130,8 +136,8 @@ pub struct Ppb {
 /// Random stream of the camera passes.
 const STREAM_CAMERA: u64 = 0x7070_6263;
 
-/// The automatic first surface radius in pixel footprints (README: measured).
-pub const FOOTPRINTS: f64 = 1.25;
+/// The automatic first surface radius in pixel footprints: `sppm`'s (README: measured).
+pub const FOOTPRINTS: f64 = SPPM_FOOTPRINTS;
 
 /// Random stream of the surface photons when they are a trace of their own.
 const STREAM_SURFACE: u64 = 0x7070_6273;
@@ -277,20 +283,57 @@ impl Ppb {
                 None => auto_radius(scene, angle, vp.distance, FOOTPRINTS),
             };
             let r = (r1 * pass.surface_shrink) as f32;
-            let g = gather_disc(
-                &pass.surface,
-                vp,
-                r,
-                self.max_depth - vp.bounces,
-                &self.kernel,
-            );
+            *rays += CLIP_PROBES as u64;
+            let clip = DiscClip::probe(scene, vp.hit.p, vp.n, r);
+            let depth = self.max_depth - vp.bounces;
+            let (g, coverage) = gather_clipped(&pass.surface, vp, r, depth, &self.kernel, &clip);
             *bad_photons += g.bad;
-            let disc = std::f64::consts::PI * (r as f64) * (r as f64);
+            let disc = std::f64::consts::PI * (r as f64) * (r as f64) * coverage as f64;
             lv += (g.phi / disc).as_vec3();
             l += vp.beta * lv;
         }
         l
     }
+}
+
+/// `sppm`'s disc gather with the disc clipped at the walls around the visible point
+/// (foton-photonmap's `DiscClip`: beside a crease the disc reaches behind the wall, where no
+/// photon of this surface lands), and the fraction of the kernel's mass left on the point's
+/// side, by which the caller divides. Where no wall is within r, `gather_disc` itself (and
+/// coverage 1): the image changes only beside walls.
+fn gather_clipped(
+    map: &PhotonMap,
+    vp: &VisiblePoint,
+    r: f32,
+    depth: u32,
+    kernel: &NormalizedKernel,
+    clip: &DiscClip,
+) -> (Gathered, f32) {
+    let coverage = clip.coverage(r, kernel);
+    if coverage == 1.0 {
+        return (gather_disc(map, vp, r, depth, kernel), 1.0);
+    }
+    let disc = std::f32::consts::PI * r * r;
+    let thickness = DISC_THICKNESS * r;
+    let mut g = Gathered::default();
+    map.within(vp.hit.p, r, |photon, d2| {
+        if photon.depth() > depth
+            || photon.normal().dot(vp.n) <= 0.9
+            || (photon.position - vp.hit.p).dot(vp.n).abs() > thickness
+            || !clip.keeps(photon.position)
+        {
+            return; // too long, another surface, its other side, or behind a wall
+        }
+        let w = kernel.weight_2d(d2.sqrt(), r) * disc;
+        let flux: Rgb = vp.bsdf.eval_density(vp.wo, photon.wi()) * photon.power() * w;
+        if !(usable(flux) && w.is_finite() && w >= 0.0) {
+            g.bad += 1;
+            return;
+        }
+        g.m += w as f64;
+        g.phi += flux.as_dvec3();
+    });
+    (g, coverage)
 }
 
 /// The passes of one render: each pixel's exact sum of its passes' estimates, one sample per

@@ -8,7 +8,7 @@
 //! |---------------------|---------|------------------------------------------------------------|---------|
 //! | `global_photons`    | integer | photons emitted for the surface direct and indirect maps, >= 1 | 48 per pixel of the film, at most 4000000 (3145728 at 256x256) |
 //! | `caustic_photons`   | integer | photons emitted for the surface caustic map; 0: no caustic map, the global map keeps the L S+ D surface photons | 100000 |
-//! | `volume_photons`    | integer | photons emitted for the volume map (traced only when the scene has media); 0: no volume map | 200000 |
+//! | `volume_photons`    | integer | photons emitted for the volume map (traced only when the scene has media); 0: no volume map | `march`: 24 per pixel of the film, at most 4000000 (1572864 at 256x256); `beam`, `beams`: 200000 |
 //! | `k`                 | integer | photons per surface estimate (>= 2)                        | 8       |
 //! | `max_radius`        | float   | largest surface estimate radius, > 0                       | 1/20 of the diagonal |
 //! | `k_volume`          | integer | photons per volume estimate (>= 2); with `estimate = "beam"`, the neighbour that sets each photon's radius | 8 |
@@ -28,7 +28,11 @@
 //! averages neighbouring estimates) and the bias of the estimates' disc and ball where they
 //! reach past a wall's edge or out of the fog (a band as wide as the radius). So k is small
 //! (8: a small radius, so a thin band) and the global photons grow with the pixels (48 a
-//! pixel: the radius keeps its size in pixels). The march `step` is long (a fifth of the
+//! pixel: the radius keeps its size in pixels), the volume photons too for the march (24 a
+//! pixel: the ball's layer along the walls, which a grazing camera ray crosses for a long
+//! way, was the worst block on Bitterli's volumetric caustic at 200000), and the surface
+//! estimate's disc is clipped at the walls its probes find (foton-photonmap's `DiscClip`:
+//! it no longer reaches behind a crease). The march `step` is long (a fifth of the
 //! diagonal, a few points per camera ray): the jitter makes the march unbiased at any step,
 //! and the scene's camera samples average its noise, while each point costs a k-nearest query
 //! and a shadow ray. The marched estimate is the default: at these settings it was faster
@@ -534,6 +538,17 @@ impl Integrator for Vpm {
 pub const GLOBAL_PHOTONS_PER_PIXEL: u64 = 48;
 /// ... and at most this many (3M took 175 MB of memory in all on the foggy Cornell box).
 pub const MAX_DEFAULT_GLOBAL_PHOTONS: u64 = 4_000_000;
+/// Volume photons per pixel of the film by default for the marched estimate (at most
+/// [`MAX_DEFAULT_GLOBAL_PHOTONS`]): the ball of the volume estimate beside a wall, or at the
+/// fog's boundary, reaches out of the fog where no photon is stored and darkens a layer as
+/// thick as its radius, which a camera ray grazing a wall crosses for a long way (the box's
+/// sides on Bitterli's volumetric caustic); more photons shrink the ball. The march's cost
+/// hardly grows with them (a k-nearest query per point), so they are counted per pixel like
+/// the global photons (README, "Defaults").
+pub const VOLUME_PHOTONS_PER_PIXEL: u64 = 24;
+/// The volume photons of the beam radiance estimate and of photon beams by default: their
+/// cost grows with the photons (every photon radius, or beam, a camera ray passes).
+pub const BEAM_VOLUME_PHOTONS: u64 = 200_000;
 /// The default k of the surface and volume estimates: small, since the camera samples'
 /// jitter averages neighbouring estimates (a 16x16 block's error is set by the photons in
 /// it, not by k) and a small k keeps the radius, and its bias at edges, small.
@@ -549,7 +564,20 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         k: DEFAULT_K,
     };
     let surface = SurfaceParams::read_with(props, scene, defaults)?;
-    let volume_photons = props.u64("volume_photons", 200_000)?;
+    let estimate = match props.choice("estimate", &["march", "beam", "beams"], "march")? {
+        "beam" => VolumeEstimate::Beam,
+        "beams" => VolumeEstimate::Beams,
+        _ => VolumeEstimate::March,
+    };
+    let volume_photons = props.u64(
+        "volume_photons",
+        match estimate {
+            VolumeEstimate::March => {
+                (VOLUME_PHOTONS_PER_PIXEL * pixels).clamp(1, MAX_DEFAULT_GLOBAL_PHOTONS)
+            }
+            _ => BEAM_VOLUME_PHOTONS,
+        },
+    )?;
     let k_volume = read_k(props, "k_volume", DEFAULT_K)?;
     check_k(
         props,
@@ -562,11 +590,6 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let step = positive("step", diagonal / 5.0)?;
     let kernel = props.kernel("kernel", "box")?;
     let direct = Direct::read(props)?;
-    let estimate = match props.choice("estimate", &["march", "beam", "beams"], "march")? {
-        "beam" => VolumeEstimate::Beam,
-        "beams" => VolumeEstimate::Beams,
-        _ => VolumeEstimate::March,
-    };
     let beams = estimate == VolumeEstimate::Beams;
     let beam_type = if beams {
         read_beam_type(props)?

@@ -18,6 +18,7 @@ mod conductor;
 mod crossing_limit;
 mod deploy;
 mod directional;
+mod disc_edges;
 mod disc_estimate;
 mod environment;
 mod filter;
