@@ -110,6 +110,8 @@ impl SamplerKind {
 #[derive(Clone, Debug)]
 pub struct Sampler {
     kind: SamplerKind,
+    /// `kind` without its payload, for the requests' one test (see [`Request`]).
+    request: Request,
     /// The independent stream; for `stratified`, the jitter inside strata.
     rng: Rng,
     /// Hash of (seed, pixel): what decorrelates the patterns of neighbouring pixels.
@@ -150,6 +152,11 @@ impl Sampler {
     ) -> Sampler {
         Sampler {
             kind,
+            request: match kind {
+                SamplerKind::Independent => Request::Independent,
+                SamplerKind::Sobol => Request::Sobol,
+                SamplerKind::Stratified { .. } => Request::Stratified,
+            },
             rng: Rng::new(keys),
             // Not needed by the independent stream, whose samples should cost what they did.
             pixel_key: if kind == SamplerKind::Independent {
@@ -173,24 +180,27 @@ impl Sampler {
     /// Uniform in [0, 1).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        match self.kind {
-            SamplerKind::Independent => self.rng.next_f32(),
+        // Independent first, by one byte compare (see [`Request`]).
+        if self.request == Request::Independent {
+            self.rng.next_f32()
+        } else if self.request == Request::Sobol {
             // Two loads while the block lasts, inlined like the independent stream's draw.
-            SamplerKind::Sobol => self.sobol_point().0,
-            SamplerKind::Stratified { .. } => self.next_1d_stratified(),
+            self.sobol_point().0
+        } else {
+            self.next_1d_stratified()
         }
     }
 
     /// Uniform in [0, 1)^2; the two coordinates are stratified together.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        match self.kind {
-            SamplerKind::Independent => self.rng.next_2d(),
-            SamplerKind::Sobol => {
-                let (x, y) = self.sobol_point();
-                Vec2::new(x, y)
-            }
-            SamplerKind::Stratified { .. } => self.next_2d_stratified(),
+        if self.request == Request::Independent {
+            self.rng.next_2d()
+        } else if self.request == Request::Sobol {
+            let (x, y) = self.sobol_point();
+            Vec2::new(x, y)
+        } else {
+            self.next_2d_stratified()
         }
     }
 
@@ -265,6 +275,19 @@ impl Sampler {
             ((sy as f32 + jy) / ny as f32).min(ONE_MINUS_EPSILON),
         )
     }
+}
+
+/// How a [`Sampler`]'s requests are answered: [`SamplerKind`] without `stratified`'s payload.
+/// `SamplerKind` keeps its `jitter` in the byte that tells the kinds apart, so a `match` on it
+/// in every request compiled to a chain of compares (about 7 instructions a request on the
+/// Cornell box, against 2 when only the independent arm was inline: `independent` renders
+/// lost 3 to 4 %); a plain byte tested for `Independent` first is one compare and a branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+enum Request {
+    Independent,
+    Sobol,
+    Stratified,
 }
 
 /// Dimensions of a `sobol` sampler computed together ([`sobol_block`]).
