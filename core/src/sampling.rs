@@ -72,7 +72,7 @@ pub enum SamplerKind {
     Stratified { jitter: bool },
     /// Owen-scrambled Sobol points (Burley 2020), padded: every 1-D or 2-D request takes the
     /// first two Sobol dimensions with its own index shuffle and scramble. The least error at
-    /// equal time on every scene measured, but not yet the default (docs/PERFORMANCE.md).
+    /// equal time on every scene measured, and the TOML scenes' default (docs/PERFORMANCE.md).
     Sobol,
 }
 
@@ -335,8 +335,10 @@ impl SobolBlock {
 /// Eight dimensions are computed at once, each step for all of them, because that runs in
 /// the eight 32-bit lanes of an AVX2 register where the processor has them (the hashes are
 /// 32-bit multiplies and shifts, the bit reversals byte shuffles, dimension 1 five
-/// shift-mask-xor steps): about 34 instructions a dimension on the Cornell box, against about 105 one
-/// at a time with a data-dependent loop (docs/PERFORMANCE.md, session 26). Integer arithmetic,
+/// shift-mask-xor steps): about 21 instructions a dimension (170 a block), against about 105
+/// one at a time with a data-dependent loop (docs/PERFORMANCE.md, sessions 26 and 27); the
+/// `splitmix64` of each dimension's key is now the largest part (64-bit multiplies have no
+/// AVX2 instruction). Integer arithmetic,
 /// so the points are the same bits with or without AVX2, and as one dimension alone computes
 /// them (unit test `sobol_block_matches_each_lane`). A sample that ends inside a block has
 /// computed a few dimensions it does not use (on the Cornell box, 21 for 17).
