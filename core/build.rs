@@ -18,6 +18,10 @@ fn main() {
         .and_then(|o| String::from_utf8(o.stdout).ok())
         .map(|s| s.trim().to_string())
         .unwrap_or_else(|| "unknown rustc".into());
+    // A plugin built a second time for a newer CPU (integrators/path/build.rs sets these) is
+    // identified as the baseline build it copies, from the baseline's target features, and
+    // tagged with its level: the host accepts the tag only on a processor that has it.
+    let variant = std::env::var("FOTON_PLUGIN_VARIANT").ok();
     let settings: Vec<String> = [
         "TARGET",
         "CARGO_CFG_DEBUG_ASSERTIONS",
@@ -26,7 +30,13 @@ fn main() {
     ]
     .iter()
     // Set but empty (debug assertions on) is not the same as unset: compare the OsStrings.
-    .map(|var| format!("{var}={:?}", std::env::var_os(var)))
+    .map(|&var| match (var, &variant) {
+        ("CARGO_CFG_TARGET_FEATURE", Some(_)) => format!(
+            "{var}={:?}",
+            std::env::var_os("FOTON_VARIANT_BASE_FEATURES")
+        ),
+        _ => format!("{var}={:?}", std::env::var_os(var)),
+    })
     .collect();
     // The workspace's lock file (core is a member of the workspace at its parent).
     let lock_path = manifest.join("../Cargo.lock");
@@ -42,7 +52,8 @@ fn main() {
     } else {
         "release"
     };
-    println!("cargo:rustc-env=FOTON_BUILD_ID={id:016x}-{assertions}");
+    let tag = variant.map_or(String::new(), |v| format!("+{v}"));
+    println!("cargo:rustc-env=FOTON_BUILD_ID={id:016x}-{assertions}{tag}");
     println!("cargo:rustc-env=FOTON_RUSTC_VERSION={rustc_version}");
     // For the tests, which recompute the identifier.
     println!(
@@ -52,5 +63,7 @@ fn main() {
     println!("cargo:rerun-if-changed=src");
     println!("cargo:rerun-if-changed=Cargo.toml");
     println!("cargo:rerun-if-changed=build_id.rs");
+    println!("cargo:rerun-if-env-changed=FOTON_PLUGIN_VARIANT");
+    println!("cargo:rerun-if-env-changed=FOTON_VARIANT_BASE_FEATURES");
     println!("cargo:rerun-if-changed={}", lock_path.display());
 }

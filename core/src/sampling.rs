@@ -72,7 +72,7 @@ pub enum SamplerKind {
     Stratified { jitter: bool },
     /// Owen-scrambled Sobol points (Burley 2020), padded: every 1-D or 2-D request takes the
     /// first two Sobol dimensions with its own index shuffle and scramble. The least error at
-    /// equal time on every scene measured, but not yet the default (docs/PERFORMANCE.md).
+    /// equal time on every scene measured, and the TOML scenes' default (docs/PERFORMANCE.md).
     Sobol,
 }
 
@@ -110,6 +110,8 @@ impl SamplerKind {
 #[derive(Clone, Debug)]
 pub struct Sampler {
     kind: SamplerKind,
+    /// `kind` without its payload, for the requests' one test (see [`Request`]).
+    request: Request,
     /// The independent stream; for `stratified`, the jitter inside strata.
     rng: Rng,
     /// Hash of (seed, pixel): what decorrelates the patterns of neighbouring pixels.
@@ -150,6 +152,11 @@ impl Sampler {
     ) -> Sampler {
         Sampler {
             kind,
+            request: match kind {
+                SamplerKind::Independent => Request::Independent,
+                SamplerKind::Sobol => Request::Sobol,
+                SamplerKind::Stratified { .. } => Request::Stratified,
+            },
             rng: Rng::new(keys),
             // Not needed by the independent stream, whose samples should cost what they did.
             pixel_key: if kind == SamplerKind::Independent {
@@ -173,24 +180,27 @@ impl Sampler {
     /// Uniform in [0, 1).
     #[inline]
     pub fn next_f32(&mut self) -> f32 {
-        match self.kind {
-            SamplerKind::Independent => self.rng.next_f32(),
+        // Independent first, by one byte compare (see [`Request`]).
+        if self.request == Request::Independent {
+            self.rng.next_f32()
+        } else if self.request == Request::Sobol {
             // Two loads while the block lasts, inlined like the independent stream's draw.
-            SamplerKind::Sobol => self.sobol_point().0,
-            SamplerKind::Stratified { .. } => self.next_1d_stratified(),
+            self.sobol_point().0
+        } else {
+            self.next_1d_stratified()
         }
     }
 
     /// Uniform in [0, 1)^2; the two coordinates are stratified together.
     #[inline]
     pub fn next_2d(&mut self) -> Vec2 {
-        match self.kind {
-            SamplerKind::Independent => self.rng.next_2d(),
-            SamplerKind::Sobol => {
-                let (x, y) = self.sobol_point();
-                Vec2::new(x, y)
-            }
-            SamplerKind::Stratified { .. } => self.next_2d_stratified(),
+        if self.request == Request::Independent {
+            self.rng.next_2d()
+        } else if self.request == Request::Sobol {
+            let (x, y) = self.sobol_point();
+            Vec2::new(x, y)
+        } else {
+            self.next_2d_stratified()
         }
     }
 
@@ -267,6 +277,19 @@ impl Sampler {
     }
 }
 
+/// How a [`Sampler`]'s requests are answered: [`SamplerKind`] without `stratified`'s payload.
+/// `SamplerKind` keeps its `jitter` in the byte that tells the kinds apart, so a `match` on it
+/// in every request compiled to a chain of compares (about 7 instructions a request on the
+/// Cornell box, against 2 when only the independent arm was inline: `independent` renders
+/// lost 3 to 4 %); a plain byte tested for `Independent` first is one compare and a branch.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+enum Request {
+    Independent,
+    Sobol,
+    Stratified,
+}
+
 /// Dimensions of a `sobol` sampler computed together ([`sobol_block`]).
 pub const SOBOL_BLOCK: usize = 8;
 
@@ -306,14 +329,16 @@ impl SobolBlock {
 ///   scramble hashes (bit-reversed), and each bit of the hash depends only on the bits below
 ///   it; the Sobol matrices' reversed columns past 23 have no bits below 24;
 /// * dimension 0 reverses the index's bits and the scramble reverses them back before
-///   hashing; dimension 1 reads its generator matrix with reversed columns
-///   (`SOBOL_MATRICES_REVERSED`), each under a mask of its bit of the index.
+///   hashing; dimension 1 is its reversed matrix's product with the index in five
+///   shift-mask-xor steps ([`sobol_1_reversed`]).
 ///
 /// Eight dimensions are computed at once, each step for all of them, because that runs in
 /// the eight 32-bit lanes of an AVX2 register where the processor has them (the hashes are
-/// 32-bit multiplies and shifts, the bit reversals byte shuffles, dimension 1 a masked xor
-/// per column): about 34 instructions a dimension on the Cornell box, against about 105 one
-/// at a time with a data-dependent loop (docs/PERFORMANCE.md, session 26). Integer arithmetic,
+/// 32-bit multiplies and shifts, the bit reversals byte shuffles, dimension 1 five
+/// shift-mask-xor steps): about 21 instructions a dimension (170 a block), against about 105
+/// one at a time with a data-dependent loop (docs/PERFORMANCE.md, sessions 26 and 27); the
+/// `splitmix64` of each dimension's key is now the largest part (64-bit multiplies have no
+/// AVX2 instruction). Integer arithmetic,
 /// so the points are the same bits with or without AVX2, and as one dimension alone computes
 /// them (unit test `sobol_block_matches_each_lane`). A sample that ends inside a block has
 /// computed a few dimensions it does not use (on the Cornell box, 21 for 17).
@@ -357,7 +382,7 @@ fn sobol_block_lanes(pixel_key: u64, index_reversed: u32, first: u32, block: &mu
         block.x[k] = reversed_unit_f32(laine_karras(i[k], sx[k]));
     }
     for k in 0..N {
-        block.y[k] = reversed_unit_f32(laine_karras(sobol_24_reversed(i[k]), sy[k]));
+        block.y[k] = reversed_unit_f32(laine_karras(sobol_1_reversed(i[k]), sy[k]));
     }
 }
 
@@ -375,7 +400,7 @@ fn sobol_lane(key: u64, index_reversed: u32) -> (f32, f32) {
     let i = reverse_24(laine_karras(index_reversed, seed) ^ laine_karras(0, seed));
     (
         reversed_unit_f32(laine_karras(i, sx)),
-        reversed_unit_f32(laine_karras(sobol_24_reversed(i), sy)),
+        reversed_unit_f32(laine_karras(sobol_1_reversed(i), sy)),
     )
 }
 
@@ -390,15 +415,22 @@ fn key_seeds(key: u64) -> (u32, u32, u32) {
     )
 }
 
-/// `sobol_dimension_reversed(i, 1)` for an index below 2^24, without the data-dependent
-/// loop: every column is taken under a mask of its bit (branch-free, so it vectorises).
+/// `sobol_dimension_reversed(i, 1)` without the data-dependent loop, in five steps. Sobol's
+/// dimension 1 has direction numbers (1 + x)^k (primitive polynomial x + 1), so column k of
+/// its matrix holds the binomial coefficients C(k, p) mod 2, and by Lucas' theorem C(k, p) is
+/// odd exactly when the bits of p are a subset of those of k. Bit p of the reversed point is
+/// then the xor of the index bits k whose positions are supersets of p (as 5-bit numbers): a
+/// superset-sum over the five bits of a position, one shift, mask and xor per bit, for all 32
+/// positions at once (branch-free, so it vectorises; 24 masked columns before).
 #[inline(always)]
-fn sobol_24_reversed(i: u32) -> u32 {
-    let matrix = &SOBOL_MATRICES_REVERSED[1];
-    let mut x = 0;
-    for (k, column) in matrix.iter().enumerate().take(24) {
-        x ^= column & ((i >> k) & 1).wrapping_neg();
-    }
+fn sobol_1_reversed(i: u32) -> u32 {
+    let mut x = i;
+    // Positions whose bit b is 0 take the sums of the positions with it set (p + 2^b).
+    x ^= (x >> 1) & 0x5555_5555;
+    x ^= (x >> 2) & 0x3333_3333;
+    x ^= (x >> 4) & 0x0F0F_0F0F;
+    x ^= (x >> 8) & 0x00FF_00FF;
+    x ^= (x >> 16) & 0x0000_FFFF;
     x
 }
 
@@ -516,7 +548,9 @@ pub fn sobol_dimension(mut index: u32, dimension: usize) -> u32 {
 
 /// The generator matrices with each column's bits reversed: by linearity over xor,
 /// `sobol_dimension_reversed(i, d)` is `sobol_dimension(i, d).reverse_bits()`, which is what
-/// Owen scrambling hashes, without reversing at run time.
+/// Owen scrambling hashes, without reversing at run time (the tests' reference for
+/// [`sobol_1_reversed`]).
+#[cfg(test)]
 static SOBOL_MATRICES_REVERSED: [[u32; 32]; SOBOL_DIMENSIONS] = {
     let mut m = SOBOL_MATRICES;
     let mut d = 0;
@@ -921,13 +955,13 @@ mod tests {
     }
 
     /// A block of Sobol dimensions, vectorised or not, holds each dimension's point as
-    /// `sobol_lane` computes it alone; the branch-free dimension 1 is the loop's.
+    /// `sobol_lane` computes it alone; dimension 1's five steps are the matrix's product.
     #[test]
     fn sobol_block_matches_each_lane() {
         let mut rng = Rng::new(&[11]);
         for _ in 0..3000 {
-            let i = rng.next_u32() >> 8;
-            assert_eq!(sobol_24_reversed(i), sobol_dimension_reversed(i, 1));
+            let i = rng.next_u32() >> (rng.next_u32() % 32);
+            assert_eq!(sobol_1_reversed(i), sobol_dimension_reversed(i, 1));
         }
         for _ in 0..500 {
             let pixel_key = (rng.next_u32() as u64) << 32 | rng.next_u32() as u64;

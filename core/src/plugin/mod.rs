@@ -80,7 +80,61 @@ pub fn search_path(flag_dirs: &[PathBuf]) -> Vec<PathBuf> {
         dirs.push(dir.to_path_buf());
         dirs.push(dir.join("plugins"));
     }
-    dirs
+    // A plugin built again for a newer processor sits in a subfolder named by its level, and
+    // is found first where the processor has that level (a name found later is shadowed).
+    let variants: Vec<&str> = CPU_VARIANTS.into_iter().filter(|v| cpu_has(v)).collect();
+    dirs.into_iter()
+        .flat_map(|d| {
+            let mut with = variants.iter().map(|v| d.join(v)).collect::<Vec<_>>();
+            with.push(d);
+            with
+        })
+        .collect()
+}
+
+/// The processor levels a plugin may also be built for (integrators/path/build.rs): the
+/// level's name is its folder beside the baseline plugins and the tag on its build identifier.
+pub const CPU_VARIANTS: [&str; 1] = ["x86-64-v3"];
+
+/// Whether this processor has every feature of `variant` (one of [`CPU_VARIANTS`]).
+pub fn cpu_has(variant: &str) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if variant == "x86-64-v3" {
+        use std::arch::is_x86_feature_detected as has;
+        // x86-64-v3 as rustc's target-cpu defines it (v2's features included).
+        return has!("avx2")
+            && has!("avx")
+            && has!("bmi1")
+            && has!("bmi2")
+            && has!("f16c")
+            && has!("fma")
+            && has!("lzcnt")
+            && has!("movbe")
+            && has!("xsave")
+            && has!("popcnt")
+            && has!("sse4.2")
+            && has!("ssse3")
+            && has!("cmpxchg16b");
+    }
+    let _ = variant;
+    false
+}
+
+/// Whether a plugin's core build identifier is acceptable to this host: its own, or its own
+/// tagged with a processor level this processor has. Err says why not.
+fn build_id_accepted(theirs: &str, ours: &str) -> std::result::Result<(), String> {
+    if theirs == ours {
+        return Ok(());
+    }
+    match theirs.strip_prefix(ours).and_then(|t| t.strip_prefix('+')) {
+        Some(level) if cpu_has(level) => Ok(()),
+        Some(level) => Err(format!(
+            "built for the processor level {level}, which this processor does not have"
+        )),
+        None => Err(format!(
+            "built against core build identifier `{theirs}`, but this foton has `{ours}`; rebuild the plugin with the same rustc against the same foton-core"
+        )),
+    }
 }
 
 fn read_c_str(ptr: *const c_char, what: &str, file: &Path) -> Result<String> {
@@ -132,7 +186,6 @@ fn load(file: &Path) -> Result<Loaded> {
         let checks = [
             ("foton-core version", decl.core_version, crate::CORE_VERSION),
             ("rustc version", decl.rustc_version, crate::RUSTC_VERSION),
-            ("core build identifier", decl.build_id, crate::BUILD_ID),
         ];
         for (what, ptr, ours) in checks {
             let theirs = read_c_str(ptr, what, file)?;
@@ -142,6 +195,8 @@ fn load(file: &Path) -> Result<Loaded> {
                 )));
             }
         }
+        let theirs = read_c_str(decl.build_id, "core build identifier", file)?;
+        build_id_accepted(&theirs, crate::BUILD_ID).map_err(err)?;
         if decl.layout != LAYOUT_FINGERPRINT {
             return Err(err(format!(
                 "its types have another layout (fingerprint {:016x}, this foton {LAYOUT_FINGERPRINT:016x}): it was built against other versions of foton-core's dependencies (glam, obvhs); rebuild it with this foton's Cargo.lock",
@@ -269,5 +324,45 @@ impl Registry {
     /// The kernel plugin called `name`.
     pub fn kernel(&self, name: &str) -> Option<&KernelPlugin> {
         self.kernels.iter().find(|k| k.name == name)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A plugin's build identifier is accepted when it is the host's, or the host's tagged
+    /// with a processor level this processor has; never another build's, tagged or not.
+    #[test]
+    fn build_id_tagged_with_a_processor_level() {
+        let ours = "0123456789abcdef-release";
+        assert!(build_id_accepted(ours, ours).is_ok());
+        let v3 = format!("{ours}+x86-64-v3");
+        assert_eq!(build_id_accepted(&v3, ours).is_ok(), cpu_has("x86-64-v3"));
+        let err = build_id_accepted(&format!("{ours}+x86-64-v9"), ours).unwrap_err();
+        assert!(
+            err.contains("x86-64-v9") && err.contains("does not have"),
+            "{err}"
+        );
+        for other in [
+            "fedcba9876543210-release",
+            "fedcba9876543210-release+x86-64-v3",
+            "0123456789abcdef-release-x86-64-v3",
+        ] {
+            let err = build_id_accepted(other, ours).unwrap_err();
+            assert!(err.contains("rebuild the plugin"), "{err}");
+        }
+    }
+
+    /// Each level's folder comes before the folder it is in, where the processor has it.
+    #[test]
+    fn variant_folders_are_searched_first() {
+        let dirs = search_path(&[PathBuf::from("/p")]);
+        let v3 = cpu_has("x86-64-v3");
+        assert_eq!(
+            dirs[0],
+            PathBuf::from(if v3 { "/p/x86-64-v3" } else { "/p" })
+        );
+        assert_eq!(dirs.contains(&PathBuf::from("/p/x86-64-v3")), v3);
     }
 }

@@ -41,6 +41,10 @@
 //! `Mis::WithScatterSampling`: the power heuristic against the BSDF's or phase function's
 //! pdf), the same one `photon`, `sppm` and `vpm` use (without MIS); media are queried through
 //! core's `Medium` interface.
+//!
+//! **Built twice.** Release builds for x86-64 also build this crate with `-C
+//! target-cpu=x86-64-v3` (`build.rs`), loaded instead where the processor has it: the same
+//! images, 6 to 8 % less time on the Cornell box (docs/PERFORMANCE.md, session 27).
 
 use foton_core::direct::{Mis, Scatter, estimate_direct};
 use foton_core::geometry::Ray;
