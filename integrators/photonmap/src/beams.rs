@@ -32,7 +32,8 @@
 //! gives back Phi Tr_b per unit length of beam whatever the angle, which the tests check.
 //!
 //! **The map.** Beams are cut into pieces of 16 widths (a long diagonal beam's box would be
-//! mostly empty), and the pieces' boxes, grown by r, go into core's scene BVH (`Accel`: obvhs'
+//! mostly empty), and the pieces' boxes, grown by what a disc of radius r across the beam
+//! reaches on each axis, go into core's scene BVH (`Accel`: obvhs'
 //! compressed wide BVH8, each box as a flat triangle spanning it), so that a camera segment is
 //! traversed with core's eight-wide AVX2 node test where the processor has it, as a shadow
 //! ray that nothing blocks: it is offered every piece whose box it crosses. A piece is first
@@ -205,6 +206,19 @@ impl<'a> Kernel1d<'a> {
 /// (whose boxes are loosest: length scaled by (0.64 / sum_{i<j} |d_i d_j|)^(1/2)) 3 % more.
 pub const PIECE_WIDTHS: f32 = 16.0;
 
+/// How far a piece's box reaches past its segment along each axis: the camera points a piece
+/// accepts lie within r of the segment and perpendicular to it (the closest point on the beam
+/// lies within the piece), a disc of radius r around each point of the segment, whose extent
+/// along axis i is r sqrt(1 - w_i^2). Tighter than r on every axis (no reach at all along the
+/// beam's axis for an axis-aligned beam), so a camera ray crosses fewer boxes for the same
+/// beams. A margin of 1e-3 r, and a few ulps of the piece's coordinates (`scale`: its
+/// largest), keeps rounding in the crossing test from losing a crossing at a box's face.
+#[inline]
+fn piece_grow(dir: Vec3, r: f32, scale: f32) -> Vec3 {
+    let perp = (Vec3::ONE - dir * dir).max(Vec3::ZERO);
+    perp.sqrt() * r + Vec3::splat(1e-3 * r + 8.0 * f32::EPSILON * scale)
+}
+
 /// A piece of a beam, as the BVH holds it, with what the crossing test needs of its beam
 /// (so that a piece a camera ray only passes near costs no look-up of the beam).
 #[derive(Clone, Copy, Debug)]
@@ -243,7 +257,8 @@ impl BeamMap {
                 let t0 = k as f32 * step;
                 let t1 = if k + 1 == n { b.length } else { t0 + step };
                 let (p0, p1) = (b.origin + b.dir * t0, b.origin + b.dir * t1);
-                let grow = Vec3::splat(radius);
+                let scale = p0.abs().max(p1.abs()).max_element();
+                let grow = piece_grow(b.dir, radius, scale);
                 let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
                 // Core's BVH holds shapes: a flat triangle from one corner to the opposite
                 // one has the piece's box as its bounds, and is never intersected (the
@@ -445,14 +460,19 @@ mod tests {
     }
 
     /// The BVH's traversal finds exactly the beams a loop over all of them finds (random
-    /// beams cut into many pieces, random rays and segment ends, two media).
+    /// beams cut into many pieces, a quarter of them along an axis, whose boxes reach no
+    /// farther than their ends along it; random rays and segment ends, two media).
     #[test]
     fn the_bvh_finds_what_a_loop_over_every_beam_finds() {
         let mut rng = foton_core::sampling::Rng::new(&[5]);
         let mut point = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0;
         let beams: Vec<Beam> = (0..400)
             .map(|i| {
-                let (a, b) = (point(), point());
+                let (a, mut b) = (point(), point());
+                if i % 4 == 3 {
+                    let axis = [Vec3::X, Vec3::Y, Vec3::Z][(i as usize / 4) % 3];
+                    b = a + axis * (b - a).dot(axis);
+                }
                 Beam {
                     origin: a,
                     dir: (b - a).normalize(),
@@ -495,6 +515,65 @@ mod tests {
             found_total > 100,
             "too few crossings to compare: {found_total}"
         );
+    }
+
+    /// A piece's box is only as large as the disc of radius r across the beam reaches (not r
+    /// on every axis): camera rays passing a beam at 0.999 r, offset along the direction
+    /// across the beam that reaches farthest on each axis, by either end of a piece, are all
+    /// found, for beams along the axes and in random directions.
+    #[test]
+    fn boxes_reach_as_far_as_the_width_across_the_beam() {
+        let mut rng = foton_core::sampling::Rng::new(&[11]);
+        let mut unit = || {
+            let v = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
+            v.normalize()
+        };
+        let r = 0.05;
+        let mut dirs = vec![
+            Vec3::X,
+            Vec3::Y,
+            -Vec3::Z,
+            Vec3::new(1.0, 1.0, 0.0).normalize(),
+        ];
+        dirs.extend((0..20).map(|_| unit()));
+        for (i, dir) in dirs.into_iter().enumerate() {
+            let origin = Vec3::new(0.3, -1.2, 2.1) + dir * 0.01;
+            let length = 2.5;
+            let beam = Beam {
+                origin,
+                dir,
+                length,
+                flux: Rgb::ONE,
+                hero_r: Rgb::ONE,
+                medium: 0,
+                depth: 1,
+                kind: BeamKind::Short,
+            };
+            let map = BeamMap::build(vec![beam], r);
+            let piece = length / (length / (PIECE_WIDTHS * r)).ceil();
+            for axis in [Vec3::X, Vec3::Y, Vec3::Z, -Vec3::X, -Vec3::Y, -Vec3::Z] {
+                let across = axis - dir * axis.dot(dir);
+                if across.length() < 1e-3 {
+                    continue; // the beam runs along this axis: no offset reaches along it
+                }
+                let offset = across.normalize() * (0.999 * r);
+                // The ray crosses the beam at right angles to the offset.
+                let w = offset.cross(dir).normalize();
+                for t_b in [1e-4, piece - 1e-4, piece + 1e-4, length - 1e-4] {
+                    let p = origin + dir * t_b + offset;
+                    let ray = Ray::new(p - w * 1.0, w);
+                    let mut found = 0;
+                    map.along_ray(&ray, 2.0, 0, |_, c| {
+                        found += 1;
+                        assert!((c.u - 0.999 * r).abs() < 1e-4, "{c:?}");
+                    });
+                    assert_eq!(
+                        found, 1,
+                        "beam {i} along {dir:?}, offset {offset:?}, t_b {t_b}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]
