@@ -5,7 +5,7 @@
 //! iteration's photons on a disc around a camera path's visible point. Each plugin keeps only
 //! its per-pass estimator (a [`Passes`]).
 
-use crate::map::{DISC_THICKNESS, PhotonMap};
+use crate::map::{DISC_THICKNESS, DiscClip, PhotonMap};
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::Film;
@@ -15,7 +15,7 @@ use foton_core::props::Properties;
 use foton_core::render::{usable, warn_unusable};
 use foton_core::scene::Scene;
 use foton_core::walk::VisiblePoint;
-use glam::{DVec3, Vec2};
+use glam::{DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;
 
@@ -287,6 +287,41 @@ pub fn gather_disc(
     depth: u32,
     kernel: &NormalizedKernel,
 ) -> Gathered {
+    gather(map, vp, r, depth, kernel, |_| true)
+}
+
+/// [`gather_disc`] with the disc clipped at the walls around the visible point
+/// ([`DiscClip`]: beside a crease the disc reaches behind the wall, where no photon of this
+/// surface lands), and the fraction of the kernel's mass left on the point's side, by which
+/// the caller divides the disc's area. Where no wall is within r, [`gather_disc`] itself and
+/// coverage 1: the estimate changes only beside walls.
+pub fn gather_disc_clipped(
+    map: &PhotonMap,
+    vp: &VisiblePoint,
+    r: f32,
+    depth: u32,
+    kernel: &NormalizedKernel,
+    clip: &DiscClip,
+) -> (Gathered, f32) {
+    let coverage = clip.coverage(r, kernel);
+    if coverage == 1.0 {
+        return (gather_disc(map, vp, r, depth, kernel), 1.0);
+    }
+    (
+        gather(map, vp, r, depth, kernel, |x| clip.keeps(x)),
+        coverage,
+    )
+}
+
+#[inline(always)]
+fn gather(
+    map: &PhotonMap,
+    vp: &VisiblePoint,
+    r: f32,
+    depth: u32,
+    kernel: &NormalizedKernel,
+    keeps: impl Fn(Vec3) -> bool,
+) -> Gathered {
     let disc = std::f32::consts::PI * r * r;
     let thickness = DISC_THICKNESS * r;
     let mut g = Gathered::default();
@@ -294,8 +329,9 @@ pub fn gather_disc(
         if photon.depth() > depth
             || photon.normal().dot(vp.n) <= 0.9
             || (photon.position - vp.hit.p).dot(vp.n).abs() > thickness
+            || !keeps(photon.position)
         {
-            return; // too long, another surface, or its other side
+            return; // too long, another surface, its other side, or behind a wall
         }
         let w = kernel.weight_2d(d2.sqrt(), r) * disc;
         let f = vp.bsdf.eval_density(vp.wo, photon.wi());

@@ -99,15 +99,14 @@ use foton_core::props::Properties;
 use foton_core::render::{usable, with_pool};
 use foton_core::sampling::{Sampler, splitmix64};
 use foton_core::scene::Scene;
-use foton_core::walk::VisiblePoint;
 use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
 use foton_core::{Result, Rgb, Vec3};
 use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
-use foton_photonmap::map::{CLIP_PROBES, DISC_THICKNESS, DiscClip, Photon, PhotonMap};
+use foton_photonmap::map::{CLIP_PROBES, DiscClip, Photon, PhotonMap};
 use foton_photonmap::progressive::{
-    Gathered, PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc,
+    PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc_clipped,
     global_radius2_scale, pixel_angle, run_passes,
 };
 use foton_photonmap::trace::{
@@ -286,7 +285,8 @@ impl Ppb {
             *rays += CLIP_PROBES as u64;
             let clip = DiscClip::probe(scene, vp.hit.p, vp.n, r);
             let depth = self.max_depth - vp.bounces;
-            let (g, coverage) = gather_clipped(&pass.surface, vp, r, depth, &self.kernel, &clip);
+            let (g, coverage) =
+                gather_disc_clipped(&pass.surface, vp, r, depth, &self.kernel, &clip);
             *bad_photons += g.bad;
             let disc = std::f64::consts::PI * (r as f64) * (r as f64) * coverage as f64;
             lv += (g.phi / disc).as_vec3();
@@ -294,46 +294,6 @@ impl Ppb {
         }
         l
     }
-}
-
-/// `sppm`'s disc gather with the disc clipped at the walls around the visible point
-/// (foton-photonmap's `DiscClip`: beside a crease the disc reaches behind the wall, where no
-/// photon of this surface lands), and the fraction of the kernel's mass left on the point's
-/// side, by which the caller divides. Where no wall is within r, `gather_disc` itself (and
-/// coverage 1): the image changes only beside walls.
-fn gather_clipped(
-    map: &PhotonMap,
-    vp: &VisiblePoint,
-    r: f32,
-    depth: u32,
-    kernel: &NormalizedKernel,
-    clip: &DiscClip,
-) -> (Gathered, f32) {
-    let coverage = clip.coverage(r, kernel);
-    if coverage == 1.0 {
-        return (gather_disc(map, vp, r, depth, kernel), 1.0);
-    }
-    let disc = std::f32::consts::PI * r * r;
-    let thickness = DISC_THICKNESS * r;
-    let mut g = Gathered::default();
-    map.within(vp.hit.p, r, |photon, d2| {
-        if photon.depth() > depth
-            || photon.normal().dot(vp.n) <= 0.9
-            || (photon.position - vp.hit.p).dot(vp.n).abs() > thickness
-            || !clip.keeps(photon.position)
-        {
-            return; // too long, another surface, its other side, or behind a wall
-        }
-        let w = kernel.weight_2d(d2.sqrt(), r) * disc;
-        let flux: Rgb = vp.bsdf.eval_density(vp.wo, photon.wi()) * photon.power() * w;
-        if !(usable(flux) && w.is_finite() && w >= 0.0) {
-            g.bad += 1;
-            return;
-        }
-        g.m += w as f64;
-        g.phi += flux.as_dvec3();
-    });
-    (g, coverage)
 }
 
 /// The passes of one render: each pixel's exact sum of its passes' estimates, one sample per
