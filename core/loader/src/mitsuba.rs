@@ -1751,8 +1751,9 @@ impl Reader {
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("diffuse".into()), line));
                 t.insert("twosided", at(Value::Bool(false), line));
-                // ... and an emitter without one an all-absorbing diffuse BSDF.
-                if self.v1 && emission.is_some() {
+                // ... and an emitter without one an all-absorbing diffuse BSDF: a pure
+                // emitter, in Mitsuba 3 (Shape's constructor, 3.0 to 3.9) as in 0.x.
+                if emission.is_some() {
                     t.insert("reflectance", vec3(DVec3::ZERO, line));
                 }
                 table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));

@@ -813,3 +813,38 @@ fn a_shapes_exterior_medium_is_the_medium_in_front_of_it() {
         Some("smoke")
     );
 }
+
+/// Mitsuba (3.0 to 3.9, as 0.x) gives a shape with an area emitter and no BSDF a black
+/// diffuse BSDF, not the diffuse 0.5 of other shapes: the light reflects nothing. A square
+/// light of radiance 1 filling the view under a constant environment of radiance 1 is
+/// exactly 1 (diffuse 0.5 would add 0.5, the cosine-weighted environment times the albedo).
+/// Foton had given such lights the 0.5, which made scenes/glossy-caustic.xml's box 0.5 %
+/// brighter than Mitsuba 3 (its light, below the ceiling, sent the light of the floor back).
+#[test]
+fn an_emitter_without_a_bsdf_reflects_nothing() {
+    let dir = temp_dir("mitsuba-emitter-bsdf");
+    let xml = write(
+        &dir,
+        "scene.xml",
+        r#"<scene version="3.0.0">
+    <integrator type="path"><integer name="max_depth" value="4"/></integrator>
+    <sensor type="perspective">
+        <float name="fov" value="20"/>
+        <transform name="to_world"><lookat origin="0, 0, 4" target="0, 0, 0" up="0, 1, 0"/></transform>
+        <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+        <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+    </sensor>
+    <shape type="rectangle">
+        <emitter type="area"><rgb name="radiance" value="1, 1, 1"/></emitter>
+    </shape>
+    <emitter type="constant"><rgb name="radiance" value="1, 1, 1"/></emitter>
+</scene>
+"#,
+    );
+    let out = dir.join("light.exr");
+    ok(&render(&xml, &out, &[]));
+    let m = mean(&out);
+    for c in m {
+        assert!((c - 1.0).abs() < 1e-4, "the light reflects: {m:?}");
+    }
+}
