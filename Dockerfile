@@ -17,10 +17,13 @@ WORKDIR /src
 COPY . .
 # The program and every plugin of the workspace, not the test crates. Host and plugins come
 # from this one build: a plugin built elsewhere is refused (its build identifier differs).
+# The path plugin's x86-64-v3 copy (integrators/path/build.rs) goes to the subfolder where
+# foton looks first on a processor that has that level.
 RUN --mount=type=cache,target=/usr/local/cargo/registry \
     cargo build --release --locked --workspace --exclude foton-tests --exclude foton-test-panicky \
     && mkdir /out \
-    && cp target/release/foton target/release/libfoton_*.so /out/
+    && cp target/release/foton target/release/libfoton_*.so /out/ \
+    && if [ -d target/release/x86-64-v3 ]; then cp -r target/release/x86-64-v3 /out/; fi
 
 FROM ${RUNTIME_IMAGE}
 # Not root: the jobs need only to read the scenes and write to the shared volume.

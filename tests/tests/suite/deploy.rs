@@ -829,6 +829,11 @@ fn the_image_puts_the_plugins_beside_foton_and_runs_the_entrypoint() {
             && lines.contains(&"COPY --from=build /out/ /opt/foton/"),
         "foton and its plugins must land in one folder"
     );
+    // The path plugin's x86-64-v3 copy lands in the subfolder the plugin search tries first.
+    assert!(
+        dockerfile.contains("cp -r target/release/x86-64-v3 /out/"),
+        "the x86-64-v3 plugins must land in /opt/foton/x86-64-v3"
+    );
     assert!(dockerfile.contains("ENV PATH=/opt/foton:$PATH"));
     // The entrypoint is the repository's script, copied to where ENTRYPOINT names it.
     let entry = lines
