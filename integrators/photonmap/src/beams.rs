@@ -47,7 +47,7 @@ use foton_core::error::Result;
 use foton_core::geometry::Ray;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::medium::Medium;
+use foton_core::medium::{Medium, Phase, transmittance_homogeneous};
 use foton_core::props::Properties;
 use foton_core::scene::Scene;
 use foton_core::{Rgb, Vec3};
@@ -94,7 +94,12 @@ impl Beam {
     /// comment), in medium `m`.
     #[inline]
     pub fn weight(&self, m: &dyn Medium, t: f32) -> Rgb {
-        let tr = m.transmittance(&Ray::new(self.origin, self.dir), t);
+        self.weight_of(m.transmittance(&Ray::new(self.origin, self.dir), t))
+    }
+
+    /// W_b(t) from the beam's transmittance Tr_b(t).
+    #[inline]
+    pub fn weight_of(&self, tr: Rgb) -> Rgb {
         match self.kind {
             BeamKind::Long => tr,
             BeamKind::Short => {
@@ -357,6 +362,7 @@ impl BeamMap {
         depth: u32,
     ) -> Rgb {
         let m = scene.medium(medium);
+        let coefficients = Coefficients::of(m);
         let phase = m.phase();
         let r = self.radius;
         let mut sum = Rgb::ZERO;
@@ -364,17 +370,64 @@ impl BeamMap {
             if beam.depth > depth {
                 return;
             }
-            let x = ray.at(c.t_c);
-            let k = kernel.weight(c.u, r) / c.sin;
-            let f = phase.eval(beam.dir.dot(-ray.dir));
-            sum += beam.flux
-                * beam.weight(m, c.t_b)
-                * m.sigma_s(x)
-                * m.transmittance(ray, c.t_c)
-                * (f * k);
+            sum +=
+                coefficients.crossing(beam, ray, c) * phase_kernel(phase, kernel, r, beam, ray, c);
         });
         sum
     }
+}
+
+/// What the estimate needs of the medium a camera segment crosses: its coefficients when they
+/// are constant (core's `Medium::homogeneous`: the transmittances are exp(-sigma_t d) inline,
+/// one exponential in a grey medium), else the medium itself.
+#[derive(Clone, Copy)]
+enum Coefficients<'a> {
+    Homogeneous { sigma_t: Rgb, sigma_s: Rgb },
+    General(&'a dyn Medium),
+}
+
+impl<'a> Coefficients<'a> {
+    fn of(m: &'a dyn Medium) -> Self {
+        match m.homogeneous() {
+            Some(h) => Coefficients::Homogeneous {
+                sigma_t: h.sigma_t(),
+                sigma_s: h.sigma_s,
+            },
+            None => Coefficients::General(m),
+        }
+    }
+
+    /// Phi_b W_b(t_b) sigma_s(x_c) Tr_c(t_c) of the beam crossing the query `ray` at `c`.
+    #[inline]
+    fn crossing(&self, beam: &Beam, ray: &Ray, c: &Crossing) -> Rgb {
+        match *self {
+            Coefficients::Homogeneous { sigma_t, sigma_s } => {
+                beam.flux
+                    * beam.weight_of(transmittance_homogeneous(sigma_t, c.t_b))
+                    * sigma_s
+                    * transmittance_homogeneous(sigma_t, c.t_c)
+            }
+            Coefficients::General(m) => {
+                beam.flux
+                    * beam.weight(m, c.t_b)
+                    * m.sigma_s(ray.at(c.t_c))
+                    * m.transmittance(ray, c.t_c)
+            }
+        }
+    }
+}
+
+/// p(w_b . -w) K1(u, r) / sin(theta): the crossing's phase function and kernel.
+#[inline]
+fn phase_kernel(
+    phase: Phase,
+    kernel: &Kernel1d<'_>,
+    r: f32,
+    beam: &Beam,
+    ray: &Ray,
+    c: &Crossing,
+) -> f32 {
+    phase.eval(beam.dir.dot(-ray.dir)) * (kernel.weight(c.u, r) / c.sin)
 }
 
 /// The parameter `beam_type` (`short` or `long`, default short: see the integrators' docs).
