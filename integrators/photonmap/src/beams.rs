@@ -42,6 +42,7 @@
 //! beam lies within the piece, so a beam is counted once.
 
 use crate::map::Photon;
+use crate::screen::ScreenBeams;
 use foton_core::accel::Accel;
 use foton_core::error::Result;
 use foton_core::geometry::Ray;
@@ -50,7 +51,7 @@ use foton_core::kernel::NormalizedKernel;
 use foton_core::medium::{Medium, Phase, transmittance_homogeneous};
 use foton_core::props::Properties;
 use foton_core::scene::Scene;
-use foton_core::{Rgb, Vec3};
+use foton_core::{Rgb, Vec2, Vec3};
 
 /// Which flight segments a photon records (module comment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -227,20 +228,49 @@ fn piece_grow(dir: Vec3, r: f32, scale: f32) -> Vec3 {
 /// A piece of a beam, as the BVH holds it, with what the crossing test needs of its beam
 /// (so that a piece a camera ray only passes near costs no look-up of the beam).
 #[derive(Clone, Copy, Debug)]
-struct Piece {
-    origin: Vec3,
-    dir: Vec3,
-    t0: f32,
-    t1: f32,
-    beam: u32,
-    medium: u32,
+pub(crate) struct Piece {
+    pub(crate) origin: Vec3,
+    pub(crate) dir: Vec3,
+    pub(crate) t0: f32,
+    pub(crate) t1: f32,
+    pub(crate) beam: u32,
+    pub(crate) medium: u32,
+}
+
+impl Piece {
+    pub(crate) fn start(&self) -> Vec3 {
+        self.origin + self.dir * self.t0
+    }
+
+    pub(crate) fn end(&self) -> Vec3 {
+        self.origin + self.dir * self.t1
+    }
+
+    /// The piece's box in the BVH (`piece_grow`), as core's BVH holds it: a flat triangle
+    /// from one corner to the opposite one has the box as its bounds, and is never
+    /// intersected (the traversal's callback tests the beam itself). `object` names the piece.
+    pub(crate) fn primitive(&self, r: f32, id: u32) -> Primitive {
+        let (p0, p1) = (self.start(), self.end());
+        let scale = p0.abs().max(p1.abs()).max_element();
+        let grow = piece_grow(self.dir, r, scale);
+        let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
+        Primitive {
+            shape: Shape::Triangle {
+                p0: lo,
+                e1: hi - lo,
+                e2: Vec3::ZERO,
+            },
+            object: id,
+            attrs: NO_ATTRS,
+        }
+    }
 }
 
 /// The photon beams of one pass, with a common width r, in a BVH.
 pub struct BeamMap {
     beams: Vec<Beam>,
-    /// In BVH leaf order, so a traversal's id indexes them.
-    pieces: Vec<Piece>,
+    /// Indexed by the BVH primitives' `object`.
+    pub(crate) pieces: Vec<Piece>,
     bvh: Accel,
     radius: f32,
 }
@@ -251,7 +281,6 @@ impl BeamMap {
     pub fn build(beams: Vec<Beam>, radius: f32) -> BeamMap {
         let piece = PIECE_WIDTHS * radius;
         let mut pieces = Vec::with_capacity(beams.len());
-        let mut boxes = Vec::with_capacity(beams.len());
         for (i, b) in beams.iter().enumerate() {
             if !(b.length > 0.0 && b.length.is_finite()) {
                 continue;
@@ -261,22 +290,6 @@ impl BeamMap {
             for k in 0..n {
                 let t0 = k as f32 * step;
                 let t1 = if k + 1 == n { b.length } else { t0 + step };
-                let (p0, p1) = (b.origin + b.dir * t0, b.origin + b.dir * t1);
-                let scale = p0.abs().max(p1.abs()).max_element();
-                let grow = piece_grow(b.dir, radius, scale);
-                let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
-                // Core's BVH holds shapes: a flat triangle from one corner to the opposite
-                // one has the piece's box as its bounds, and is never intersected (the
-                // traversal's callback tests the beam itself). `object` names the piece.
-                boxes.push(Primitive {
-                    shape: Shape::Triangle {
-                        p0: lo,
-                        e1: hi - lo,
-                        e2: Vec3::ZERO,
-                    },
-                    object: pieces.len() as u32,
-                    attrs: NO_ATTRS,
-                });
                 pieces.push(Piece {
                     origin: b.origin,
                     dir: b.dir,
@@ -287,6 +300,11 @@ impl BeamMap {
                 });
             }
         }
+        let boxes = pieces
+            .iter()
+            .enumerate()
+            .map(|(id, p)| p.primitive(radius, id as u32))
+            .collect();
         let bvh = Accel::build(boxes);
         BeamMap {
             beams,
@@ -312,6 +330,61 @@ impl BeamMap {
         self.radius
     }
 
+    /// The pieces the beams were cut into.
+    pub fn pieces(&self) -> usize {
+        self.pieces.len()
+    }
+
+    /// Whether piece `id` of medium `medium` passes within the width of the query segment
+    /// `ray` from 0 to `t_end` with its closest point within the piece and the segment: the
+    /// crossing, if so. The one test of a candidate piece, wherever the candidates come from
+    /// (the BVH, or the screen's bins for camera rays: `screen`), so that both accept the same.
+    #[inline]
+    pub(crate) fn cross(&self, id: u32, ray: &Ray, t_end: f32, medium: u32) -> Option<Crossing> {
+        let r = self.radius;
+        let piece = &self.pieces[id as usize];
+        if piece.medium != medium {
+            return None;
+        }
+        // Most pieces whose box the ray crosses pass farther than r from it: reject those by
+        // the distance between the lines, |d . n| / |n| < r, before solving for the closest
+        // points.
+        let n = ray.dir.cross(piece.dir);
+        let sin2 = n.length_squared();
+        let dn = (piece.origin - ray.origin).dot(n);
+        if dn * dn >= r * r * sin2 {
+            return None;
+        }
+        let c = closest_approach(ray.origin, ray.dir, piece.origin, piece.dir)?;
+        (c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end)
+            .then_some(c)
+    }
+
+    /// The beam a piece belongs to.
+    #[inline]
+    pub(crate) fn beam_of(&self, id: u32) -> &Beam {
+        &self.beams[self.pieces[id as usize].beam as usize]
+    }
+
+    /// Calls `visit(piece id, crossing)` for every piece of `bvh` (a BVH of this map's
+    /// pieces' boxes) that [`BeamMap::cross`] accepts.
+    pub(crate) fn traverse(
+        &self,
+        bvh: &Accel,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        visit: &mut dyn FnMut(u32, &Crossing),
+    ) {
+        let visit = std::cell::RefCell::new(visit);
+        bvh.occluded(ray, t_end, |prim| {
+            if let Some(c) = self.cross(prim.object, ray, t_end, medium) {
+                (visit.borrow_mut())(prim.object, &c);
+            }
+            false
+        });
+    }
+
     /// Calls `visit(beam, crossing)` for every beam of medium `medium` that passes within the
     /// width of the query segment `ray` (unit direction) from 0 to `t_end`, its closest
     /// point within the beam and the segment.
@@ -320,32 +393,10 @@ impl BeamMap {
         ray: &Ray,
         t_end: f32,
         medium: u32,
-        visit: impl FnMut(&Beam, &Crossing),
+        mut visit: impl FnMut(&Beam, &Crossing),
     ) {
-        let r = self.radius;
-        let visit = std::cell::RefCell::new(visit);
-        self.bvh.occluded(ray, t_end, |prim| {
-            let id = prim.object as usize;
-            let piece = &self.pieces[id];
-            if piece.medium != medium {
-                return false;
-            }
-            // Most pieces whose box the ray crosses pass farther than r from it: reject
-            // those by the distance between the lines, |d . n| / |n| < r, before solving
-            // for the closest points.
-            let n = ray.dir.cross(piece.dir);
-            let sin2 = n.length_squared();
-            let dn = (piece.origin - ray.origin).dot(n);
-            if dn * dn >= r * r * sin2 {
-                return false;
-            }
-            let Some(c) = closest_approach(ray.origin, ray.dir, piece.origin, piece.dir) else {
-                return false;
-            };
-            if c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end {
-                (visit.borrow_mut())(&self.beams[piece.beam as usize], &c);
-            }
-            false
+        self.traverse(&self.bvh, ray, t_end, medium, &mut |id, c| {
+            visit(self.beam_of(id), c)
         });
     }
 
@@ -361,12 +412,52 @@ impl BeamMap {
         medium: u32,
         depth: u32,
     ) -> Rgb {
+        self.estimate(scene, kernel, ray, medium, depth, |visit| {
+            self.traverse(&self.bvh, ray, t_end, medium, visit)
+        })
+    }
+
+    /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
+    /// point `film` (a segment of the camera path before any scattering: from the pinhole, or
+    /// past null boundaries on the same line), with the candidate pieces from the pass's
+    /// screen bins `screen` where they apply ([`ScreenBeams::along_primary`]); the same
+    /// estimate, summed in piece order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn in_scattered_primary(
+        &self,
+        scene: &Scene,
+        kernel: &Kernel1d<'_>,
+        screen: &ScreenBeams,
+        film: Vec2,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        depth: u32,
+    ) -> Rgb {
+        self.estimate(scene, kernel, ray, medium, depth, |visit| {
+            if !screen.along_primary(self, film, ray, t_end, medium, visit) {
+                self.traverse(&self.bvh, ray, t_end, medium, visit)
+            }
+        })
+    }
+
+    /// The estimate's sum over the crossings `along` offers.
+    fn estimate(
+        &self,
+        scene: &Scene,
+        kernel: &Kernel1d<'_>,
+        ray: &Ray,
+        medium: u32,
+        depth: u32,
+        along: impl FnOnce(&mut dyn FnMut(u32, &Crossing)),
+    ) -> Rgb {
         let m = scene.medium(medium);
         let coefficients = Coefficients::of(m);
         let phase = m.phase();
         let r = self.radius;
         let mut sum = Rgb::ZERO;
-        self.along_ray(ray, t_end, medium, |beam, c| {
+        along(&mut |id, c| {
+            let beam = self.beam_of(id);
             if beam.depth > depth {
                 return;
             }
@@ -378,21 +469,39 @@ impl BeamMap {
 }
 
 /// What the estimate needs of the medium a camera segment crosses: its coefficients when they
-/// are constant (core's `Medium::homogeneous`: the transmittances are exp(-sigma_t d) inline,
-/// one exponential in a grey medium), else the medium itself.
+/// are constant (core's `Medium::homogeneous`: the transmittances are exp(-sigma_t d) inline),
+/// else the medium itself.
 #[derive(Clone, Copy)]
 enum Coefficients<'a> {
-    Homogeneous { sigma_t: Rgb, sigma_s: Rgb },
+    /// The same sigma_t in every channel: one exponential a crossing (below).
+    Grey {
+        sigma_t: f32,
+        sigma_s: Rgb,
+    },
+    Homogeneous {
+        sigma_t: Rgb,
+        sigma_s: Rgb,
+    },
     General(&'a dyn Medium),
 }
 
 impl<'a> Coefficients<'a> {
     fn of(m: &'a dyn Medium) -> Self {
         match m.homogeneous() {
-            Some(h) => Coefficients::Homogeneous {
-                sigma_t: h.sigma_t(),
-                sigma_s: h.sigma_s,
-            },
+            Some(h) => {
+                let sigma_t = h.sigma_t();
+                if sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z {
+                    Coefficients::Grey {
+                        sigma_t: sigma_t.x,
+                        sigma_s: h.sigma_s,
+                    }
+                } else {
+                    Coefficients::Homogeneous {
+                        sigma_t,
+                        sigma_s: h.sigma_s,
+                    }
+                }
+            }
             None => Coefficients::General(m),
         }
     }
@@ -401,6 +510,22 @@ impl<'a> Coefficients<'a> {
     #[inline]
     fn crossing(&self, beam: &Beam, ray: &Ray, c: &Crossing) -> Rgb {
         match *self {
+            // With one sigma_t, a short beam's W_b = Tr_b / mean(r Tr_b) is 1 / mean(r) (its
+            // transmittance cancels), and a long beam's Tr_b Tr_c is exp(-sigma_t (t_b + t_c)).
+            Coefficients::Grey { sigma_t, sigma_s } => {
+                let w = match beam.kind {
+                    BeamKind::Short => {
+                        let p = foton_core::average(beam.hero_r);
+                        if p > 0.0 {
+                            (-sigma_t * c.t_c).exp() / p
+                        } else {
+                            0.0
+                        }
+                    }
+                    BeamKind::Long => (-sigma_t * (c.t_b + c.t_c)).exp(),
+                };
+                beam.flux * sigma_s * w
+            }
             Coefficients::Homogeneous { sigma_t, sigma_s } => {
                 beam.flux
                     * beam.weight_of(transmittance_homogeneous(sigma_t, c.t_b))

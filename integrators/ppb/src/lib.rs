@@ -109,6 +109,7 @@ use foton_photonmap::progressive::{
     PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc_clipped,
     global_radius2_scale, pixel_angle, run_passes,
 };
+use foton_photonmap::screen::ScreenBeams;
 use foton_photonmap::trace::{
     PathClass, STREAM_GLOBAL, Site, TraceOptions, trace_photons, trace_photons_and_beams,
 };
@@ -145,6 +146,8 @@ const STREAM_SURFACE: u64 = 0x7070_6273;
 struct Pass {
     surface: PhotonMap,
     beams: BeamMap,
+    /// The beams' pieces binned by the pixels whose primary rays may accept them.
+    screen: ScreenBeams,
     /// R_i / R_1 for the surface gather.
     surface_shrink: f64,
 }
@@ -200,9 +203,12 @@ impl Ppb {
         let (photons, beams) = self.trace(scene, iteration, ctx)?;
         let scale = global_radius2_scale(iteration + 1, self.alpha);
         let r = (self.initial_beam_radius as f64 * scale) as f32;
+        let beams = BeamMap::build(beams, r);
+        let margin = scene.film.filter.margin();
         Ok(Pass {
             surface: PhotonMap::build(photons),
-            beams: BeamMap::build(beams, r),
+            screen: ScreenBeams::build(&beams, &scene.camera, margin),
+            beams,
             surface_shrink: scale.sqrt(),
         })
     }
@@ -255,8 +261,23 @@ impl Ppb {
                     return Rgb::ZERO;
                 }
                 let depth = self.max_depth - bounces;
-                pass.beams
-                    .in_scattered(scene, &kernel, &start, t_end, medium, depth)
+                if bounces == 0 {
+                    // Still on the primary ray through `film` (null boundaries keep the
+                    // direction): the screen's bins give the candidates.
+                    pass.beams.in_scattered_primary(
+                        scene,
+                        &kernel,
+                        &pass.screen,
+                        film,
+                        &start,
+                        t_end,
+                        medium,
+                        depth,
+                    )
+                } else {
+                    pass.beams
+                        .in_scattered(scene, &kernel, &start, t_end, medium, depth)
+                }
             },
         );
         let mut l = path.emitted;
