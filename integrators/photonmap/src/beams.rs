@@ -136,11 +136,15 @@ pub const MIN_SIN: f32 = 1e-4;
 #[inline]
 pub fn closest_approach(o_c: Vec3, w_c: Vec3, o_b: Vec3, w_b: Vec3) -> Option<Crossing> {
     let n = w_c.cross(w_b);
-    let sin2 = n.length_squared();
+    closest_approach_from(o_b - o_c, n, n.length_squared(), w_c, w_b)
+}
+
+/// [`closest_approach`] from d = o_b - o_c, n = w_c x w_b and |n|^2 (computed before).
+#[inline]
+fn closest_approach_from(d: Vec3, n: Vec3, sin2: f32, w_c: Vec3, w_b: Vec3) -> Option<Crossing> {
     if sin2 < MIN_SIN * MIN_SIN {
         return None;
     }
-    let d = o_b - o_c;
     // Solve o_c + t_c w_c + s n = o_b + t_b w_b by Cramer's rule with n = w_c x w_b.
     let t_c = d.cross(w_b).dot(n) / sin2;
     let t_b = d.cross(w_c).dot(n) / sin2;
@@ -159,20 +163,26 @@ pub struct Kernel1d<'a> {
     kernel: &'a NormalizedKernel,
     /// 1 / integral_{-1}^{1} of the 2-D weight at radius 1.
     inv_norm: f32,
+    /// The box kernel's constant 2-D weight at radius 1 (the same value `weight` would
+    /// compute, without the kernel's call per crossing).
+    constant: Option<f32>,
 }
 
 impl<'a> Kernel1d<'a> {
     /// The kernel with its 1-D normalisation ([`Kernel1d::norm`]: compute it once).
     pub fn new(kernel: &'a NormalizedKernel) -> Self {
-        Kernel1d {
-            kernel,
-            inv_norm: Self::norm(kernel),
-        }
+        Self::with_norm(kernel, Self::norm(kernel))
     }
 
     /// The kernel with a normalisation [`Kernel1d::norm`] computed before.
     pub fn with_norm(kernel: &'a NormalizedKernel, inv_norm: f32) -> Self {
-        Kernel1d { kernel, inv_norm }
+        // Core's built-in "box" (kernel plugins cannot take a built-in's name).
+        let constant = (kernel.name() == "box").then(|| kernel.weight_2d(0.0, 1.0));
+        Kernel1d {
+            kernel,
+            inv_norm,
+            constant,
+        }
     }
 
     /// 1 / integral_{-1}^{1} of the kernel's 2-D weight at radius 1.
@@ -199,7 +209,11 @@ impl<'a> Kernel1d<'a> {
         if u > r {
             return 0.0;
         }
-        self.kernel.weight_2d(u / r, 1.0) * self.inv_norm / r
+        let w = match self.constant {
+            Some(w) => w,
+            None => self.kernel.weight_2d(u / r, 1.0),
+        };
+        w * self.inv_norm / r
     }
 }
 
@@ -351,11 +365,12 @@ impl BeamMap {
         // points.
         let n = ray.dir.cross(piece.dir);
         let sin2 = n.length_squared();
-        let dn = (piece.origin - ray.origin).dot(n);
+        let d = piece.origin - ray.origin;
+        let dn = d.dot(n);
         if dn * dn >= r * r * sin2 {
             return None;
         }
-        let c = closest_approach(ray.origin, ray.dir, piece.origin, piece.dir)?;
+        let c = closest_approach_from(d, n, sin2, ray.dir, piece.dir)?;
         (c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end)
             .then_some(c)
     }
@@ -374,7 +389,7 @@ impl BeamMap {
         ray: &Ray,
         t_end: f32,
         medium: u32,
-        visit: &mut dyn FnMut(u32, &Crossing),
+        visit: &mut impl FnMut(u32, &Crossing),
     ) {
         let visit = std::cell::RefCell::new(visit);
         bvh.occluded(ray, t_end, |prim| {
@@ -412,9 +427,12 @@ impl BeamMap {
         medium: u32,
         depth: u32,
     ) -> Rgb {
-        self.estimate(scene, kernel, ray, medium, depth, |visit| {
-            self.traverse(&self.bvh, ray, t_end, medium, visit)
-        })
+        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
+        let mut sum = Rgb::ZERO;
+        self.traverse(&self.bvh, ray, t_end, medium, &mut |id, c| {
+            gather.add(&mut sum, id, c)
+        });
+        sum
     }
 
     /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
@@ -434,37 +452,55 @@ impl BeamMap {
         medium: u32,
         depth: u32,
     ) -> Rgb {
-        self.estimate(scene, kernel, ray, medium, depth, |visit| {
-            if !screen.along_primary(self, film, ray, t_end, medium, visit) {
-                self.traverse(&self.bvh, ray, t_end, medium, visit)
-            }
-        })
+        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
+        let mut sum = Rgb::ZERO;
+        let mut add = |id, c: &Crossing| gather.add(&mut sum, id, c);
+        if !screen.along_primary(self, film, ray, t_end, medium, &mut add) {
+            self.traverse(&self.bvh, ray, t_end, medium, &mut add)
+        }
+        sum
     }
+}
 
-    /// The estimate's sum over the crossings `along` offers.
-    fn estimate(
-        &self,
-        scene: &Scene,
-        kernel: &Kernel1d<'_>,
-        ray: &Ray,
+/// One segment's beam x beam estimate: what each accepted crossing adds (module comment).
+struct Gather<'a> {
+    map: &'a BeamMap,
+    coefficients: Coefficients<'a>,
+    phase: Phase,
+    kernel: &'a Kernel1d<'a>,
+    ray: &'a Ray,
+    depth: u32,
+}
+
+impl<'a> Gather<'a> {
+    fn new(
+        map: &'a BeamMap,
+        scene: &'a Scene,
+        kernel: &'a Kernel1d<'a>,
+        ray: &'a Ray,
         medium: u32,
         depth: u32,
-        along: impl FnOnce(&mut dyn FnMut(u32, &Crossing)),
-    ) -> Rgb {
+    ) -> Self {
         let m = scene.medium(medium);
-        let coefficients = Coefficients::of(m);
-        let phase = m.phase();
-        let r = self.radius;
-        let mut sum = Rgb::ZERO;
-        along(&mut |id, c| {
-            let beam = self.beam_of(id);
-            if beam.depth > depth {
-                return;
-            }
-            sum +=
-                coefficients.crossing(beam, ray, c) * phase_kernel(phase, kernel, r, beam, ray, c);
-        });
-        sum
+        Gather {
+            map,
+            coefficients: Coefficients::of(m),
+            phase: m.phase(),
+            kernel,
+            ray,
+            depth,
+        }
+    }
+
+    #[inline]
+    fn add(&self, sum: &mut Rgb, id: u32, c: &Crossing) {
+        let beam = self.map.beam_of(id);
+        if beam.depth > self.depth {
+            return;
+        }
+        let r = self.map.radius;
+        *sum += self.coefficients.crossing(beam, self.ray, c)
+            * phase_kernel(self.phase, self.kernel, r, beam, self.ray, c);
     }
 }
 

@@ -92,14 +92,7 @@ impl ScreenBeams {
             reach,
             margin,
         };
-        // The camera's frame: the image's x and y axes and the optical axis (the cubes'
-        // faces parallel to the image plane, so their projections are tight rectangles).
-        let forward = camera.forward();
-        let c = Vec2::new(width as f32 * 0.5, height as f32 * 0.5);
-        let towards_x = camera.generate_ray(c + Vec2::new(1.0, 0.0)).dir;
-        let right = (towards_x - forward * towards_x.dot(forward)).normalize();
-        let up = forward.cross(right).normalize();
-        let axes = [right, up, forward];
+        let pinhole = Pinhole::of(camera);
         let mut near = Vec::new();
         for (id, piece) in map.pieces.iter().enumerate() {
             let (p0, p1) = (piece.start(), piece.end());
@@ -107,33 +100,15 @@ impl ScreenBeams {
             // The cubes' half-size: the width, what the segments' lines may be offset, and
             // margins against rounding (as the BVH's boxes have).
             let rho = r * 1.001 + reach + 16.0 * f32::EPSILON * scale;
-            let depth = |p: Vec3| (p - camera.position).dot(forward);
-            let (z0, z1) = (depth(p0), depth(p1));
-            let reach_z = rho * 1.8; // a cube's corner lies within sqrt(3) rho
-            if z0.max(z1) + reach_z < 0.0 {
+            let (c0, c1) = (pinhole.to_camera(p0), pinhole.to_camera(p1));
+            if c0.z.max(c1.z) + rho < 0.0 {
                 continue; // behind the camera: no camera ray comes near it
             }
-            if z0.min(z1) - reach_z <= 1e-3 * r.max(1e-6 * scale) {
+            if c0.z.min(c1.z) - rho <= 1e-3 * r.max(1e-6 * scale) {
                 near.push(piece.primitive(r, id as u32));
                 continue;
             }
-            let (Some(a), Some(b)) = (
-                project_cube(camera, p0, rho, axes),
-                project_cube(camera, p1, rho, axes),
-            ) else {
-                near.push(piece.primitive(r, id as u32));
-                continue;
-            };
-            screen.insert(id as u32, a, b);
-        }
-        if std::env::var_os("FOTON_SCREEN_STATS").is_some() {
-            eprintln!(
-                "pieces {} entries {} near {} r {}",
-                map.pieces.len(),
-                screen.entries(),
-                near.len(),
-                r
-            );
+            screen.insert(id as u32, pinhole.cube(c0, rho), pinhole.cube(c1, rho));
         }
         if !near.is_empty() {
             screen.near = Some(Accel::build(near));
@@ -214,7 +189,7 @@ impl ScreenBeams {
         ray: &Ray,
         t_end: f32,
         medium: u32,
-        visit: &mut dyn FnMut(u32, &Crossing),
+        visit: &mut impl FnMut(u32, &Crossing),
     ) -> bool {
         let off = (ray.origin - self.position).cross(ray.dir);
         let (w, h, m) = (self.width as f32, self.height as f32, self.margin);
@@ -254,31 +229,67 @@ fn at_most(u: f32, v: f32, bound: f32) -> (f32, f32) {
     if d > 0.0 { (0.0, s) } else { (s, 1.0) }
 }
 
-/// The film-space rectangle (x_lo, y_lo, x_hi, y_hi) around the projection of the cube of
-/// half-size `rho` centred at `p` with faces along `axes`; None if a corner is not in front
-/// of the camera.
-fn project_cube(camera: &Camera, p: Vec3, rho: f32, [x, y, z]: [Vec3; 3]) -> Option<[f32; 4]> {
-    let mut rect = [
-        f32::INFINITY,
-        f32::INFINITY,
-        f32::NEG_INFINITY,
-        f32::NEG_INFINITY,
-    ];
-    for k in 0..8 {
-        let sign = |bit: u32| if k & bit == 0 { -rho } else { rho };
-        let corner = p + x * sign(1) + y * sign(2) + z * sign(4);
-        let f = camera.project_within(corner, f32::INFINITY)?;
-        if !(f.x.is_finite() && f.y.is_finite()) {
-            return None;
+/// The camera's projection, as the bins use it: film = centre + f (X / Z, -Y / Z) in the
+/// camera's frame (X along the image's x axis, Y up, Z the optical axis), read off the
+/// camera's own rays (to about 1e-7 relative: the bins' margins cover it).
+struct Pinhole {
+    position: Vec3,
+    right: Vec3,
+    up: Vec3,
+    forward: Vec3,
+    centre: Vec2,
+    /// The focal length in pixels.
+    focal: f32,
+}
+
+impl Pinhole {
+    fn of(camera: &Camera) -> Pinhole {
+        let (width, height) = camera.resolution();
+        let forward = camera.forward();
+        let centre = Vec2::new(width as f32 * 0.5, height as f32 * 0.5);
+        let towards_x = camera.generate_ray(centre + Vec2::new(1.0, 0.0)).dir;
+        let right = (towards_x - forward * towards_x.dot(forward)).normalize();
+        let up = right.cross(forward).normalize();
+        // The ray through the top edge's middle leaves at tan(fov / 2) above the axis.
+        let top = camera.generate_ray(Vec2::new(centre.x, 0.0)).dir;
+        let tan_half = top.dot(up) / top.dot(forward);
+        Pinhole {
+            position: camera.position,
+            right,
+            up,
+            forward,
+            centre,
+            focal: height as f32 * 0.5 / tan_half,
         }
-        rect = [
-            rect[0].min(f.x),
-            rect[1].min(f.y),
-            rect[2].max(f.x),
-            rect[3].max(f.y),
-        ];
     }
-    Some(rect)
+
+    #[inline]
+    fn to_camera(&self, p: Vec3) -> Vec3 {
+        let d = p - self.position;
+        Vec3::new(d.dot(self.right), d.dot(self.up), d.dot(self.forward))
+    }
+
+    /// The film-space rectangle (x_lo, y_lo, x_hi, y_hi) around the projection of the cube
+    /// of half-size `rho` centred at `c` (camera frame, c.z - rho > 0) with faces along the
+    /// camera's axes: each extreme at a corner, the nearer or the farther face's as the sign
+    /// of the coordinate says. Widened by the margin against rounding (FILM_EPS, and 1e-5 of
+    /// the coordinates' size for the far-off ones).
+    #[inline]
+    fn cube(&self, c: Vec3, rho: f32) -> [f32; 4] {
+        let (near, far) = (c.z - rho, c.z + rho);
+        let lo = |v: f32| v / if v < 0.0 { near } else { far };
+        let hi = |v: f32| v / if v > 0.0 { near } else { far };
+        let f = self.focal;
+        let rect = [
+            self.centre.x + f * lo(c.x - rho),
+            self.centre.y - f * hi(c.y + rho),
+            self.centre.x + f * hi(c.x + rho),
+            self.centre.y - f * lo(c.y - rho),
+        ];
+        let size = rect.iter().fold(0.0f32, |m, v| m.max(v.abs()));
+        let eps = FILM_EPS + 1e-5 * size;
+        [rect[0] - eps, rect[1] - eps, rect[2] + eps, rect[3] + eps]
+    }
 }
 
 #[cfg(test)]

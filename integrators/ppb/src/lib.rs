@@ -37,7 +37,9 @@
 //! sum_b Phi_b W_b(t_b) sigma_s(x_c) p(w_b . -w) Tr(x, x_c) K1(u_b, r_i) / sin(theta_b)
 //! ```
 //!
-//! (foton-photonmap's `beams` module derives it), at the visible point emission, direct light
+//! (foton-photonmap's `beams` module derives it; the candidate beams of a segment still on
+//! the camera's primary ray come from the pass's screen bins, foton-photonmap's `screen`, those
+//! of later segments from the beams' BVH: the same crossings), at the visible point emission, direct light
 //! by a shadow ray (`direct = "nee"`) and the photons of the disc of radius R_i around it
 //! (`sppm`'s gather, shared in foton-photonmap's `progressive`, with the disc clipped at the
 //! walls that eight probe rays in the tangent plane find: foton-photonmap's `DiscClip`), each
@@ -86,7 +88,8 @@
 //! the box around the scene (beams end there too).
 //!
 //! **Determinism**: photons and camera samples draw from streams keyed by the pass, the
-//! photon and the pixel; the beam BVH and the kd-tree are built in a fixed order; images are
+//! photon and the pixel; the beam BVH, the screen bins (in piece order) and the kd-tree are
+//! built in a fixed order; images are
 //! identical for any number of threads and any split into parts. Memory holds one pass's
 //! photons and beams at a time.
 
