@@ -438,7 +438,7 @@ impl BeamMap {
     /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
     /// point `film` (a segment of the camera path before any scattering: from the pinhole, or
     /// past null boundaries on the same line), with the candidate pieces from the pass's
-    /// screen bins `screen` where they apply ([`ScreenBeams::along_primary`]); the same
+    /// screen bins `screen` where they apply (`ScreenBeams::along_primary`); the same
     /// estimate, summed in piece order.
     #[allow(clippy::too_many_arguments)]
     pub fn in_scattered_primary(
