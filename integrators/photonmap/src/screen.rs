@@ -14,10 +14,11 @@
 //! faces parallel to the image plane). Projection maps that hull (in front of the camera) to
 //! the hull of the cubes' projected corners, within the hull of the two rectangles R_0, R_1
 //! bounding the projected corners of each cube: the union over s in [0, 1] of the
-//! rectangles interpolated between them. For each image row the rectangles of the s whose
-//! y-range meets the row's band form an interval of s, and the row's x-range is read at its
-//! ends (the rectangles' sides are linear in s). Each piece goes into the bins (a row and a
-//! chunk of [`CHUNK`] pixels) its x-ranges touch, with its range, in piece order.
+//! rectangles interpolated between them. For each band of image rows (one row; several in
+//! tall images, [`ROWS`]) the rectangles of the s whose y-range meets the band form an
+//! interval of s, and the band's x-range is read at its ends (the rectangles' sides are
+//! linear in s). Each piece goes into the bins (a band and a chunk of [`CHUNK`] bands' width)
+//! its x-ranges touch, with its range, in piece order.
 //!
 //! **The query.** A camera segment through the film point (x, y) takes the bin of (x, y) and
 //! runs the map's own test (`BeamMap::cross`) on the pieces whose range holds x: the same
@@ -40,10 +41,17 @@ use foton_core::camera::Camera;
 use foton_core::geometry::Ray;
 use foton_core::{Vec2, Vec3};
 
-/// Bins are this many pixels wide. Narrower bins mean fewer pieces scanned and more
-/// entries built: 4, 8 and 16 pixels took 3.196, 3.178 and 3.190 G instructions for one
-/// pass of the volumetric caustic at 256 x 256, the same CPU time within the noise.
+/// Bins are this many rows' bands wide (a band is one row up to 511 rows, [`ROWS`] more
+/// rows a band above). Narrower bins mean fewer pieces scanned and more entries built: 4, 8
+/// and 16 pixels took 3.196, 3.178 and 3.190 G instructions for one pass of the volumetric
+/// caustic at 256 x 256, the same CPU time within the noise.
 pub const CHUNK: u32 = 8;
+
+/// Images this many rows or more tall bin a band of several rows together (and chunks as
+/// many times wider): the bins then hold about as many entries as at this height, whatever
+/// the image's size (a piece is in every band its footprint crosses: at 1024 rows, one row a
+/// band held 130 MB of entries a pass), and a bin as many pieces.
+pub const ROWS: u32 = 256;
 
 /// Film-space margin (pixels) added to each range against the rounding of the projection
 /// and of the camera's rays (whose film positions round-trip to about 1e-4 pixel).
@@ -62,8 +70,12 @@ pub struct ScreenBeams {
     position: Vec3,
     width: u32,
     height: u32,
+    /// Rows a band, and the bins' width in pixels.
+    band: u32,
+    chunk: f32,
+    bands: u32,
     chunks: u32,
-    /// Row-major: row y, chunk c at y * chunks + c.
+    /// Band-major: band k, chunk c at k * chunks + c.
     bins: Vec<Vec<Span>>,
     /// Pieces too near the pinhole's plane to project, in a BVH of their own.
     near: Option<Accel>,
@@ -78,7 +90,9 @@ impl ScreenBeams {
     /// within `margin` pixels of the image (the filter's reach: `FilterSampler::margin`).
     pub fn build(map: &BeamMap, camera: &Camera, margin: f32) -> ScreenBeams {
         let (width, height) = camera.resolution();
-        let chunks = width.div_ceil(CHUNK).max(1);
+        let band = (height / ROWS).max(1);
+        let bands = height.div_ceil(band).max(1);
+        let chunks = width.div_ceil(CHUNK * band).max(1);
         let r = map.radius();
         // Segments offset from the pinhole's line by up to this much use the bins (a fiftieth
         // of the width: a null boundary's offset, seen along a camera ray, is far less).
@@ -88,8 +102,11 @@ impl ScreenBeams {
             position: camera.position,
             width,
             height,
+            band,
+            chunk: (CHUNK * band) as f32,
+            bands,
             chunks,
-            bins: vec![Vec::new(); (height * chunks) as usize],
+            bins: vec![Vec::new(); (bands * chunks) as usize],
             near: None,
             reach,
             margin,
@@ -126,19 +143,18 @@ impl ScreenBeams {
         if y_hi < -m || y_lo > h + m || a[2].max(b[2]) < -m || a[0].min(b[0]) > w + m {
             return;
         }
-        let last_row = self.height as i64 - 1;
-        let row_of = |y: f32| (y.floor() as i64).clamp(0, last_row);
-        for row in row_of(y_lo)..=row_of(y_hi) {
-            // The row's band; the edge rows take what lies beyond the image.
-            let band_lo = if row == 0 {
+        let last = self.bands as i64 - 1;
+        for k in self.band_of(y_lo)..=self.band_of(y_hi) {
+            // The band's rows; the edge bands take what lies beyond the image.
+            let band_lo = if k == 0 {
                 f32::NEG_INFINITY
             } else {
-                row as f32
+                (k as u32 * self.band) as f32
             } - FILM_EPS;
-            let band_hi = if row == last_row {
+            let band_hi = if k as i64 == last {
                 f32::INFINITY
             } else {
-                row as f32 + 1.0
+                ((k as u32 + 1) * self.band) as f32
             } + FILM_EPS;
             // The s for which the interpolated rectangle's y-range meets the band: y_lo(s) <=
             // band_hi and y_hi(s) >= band_lo, each an interval of s.
@@ -157,7 +173,7 @@ impl ScreenBeams {
                 continue;
             }
             let (c0, c1) = (self.chunk_of(x0), self.chunk_of(x1));
-            let bins = row as usize * self.chunks as usize;
+            let bins = k * self.chunks as usize;
             for chunk in c0..=c1 {
                 self.bins[bins + chunk].push(Span { piece: id, x0, x1 });
             }
@@ -166,7 +182,12 @@ impl ScreenBeams {
 
     #[inline]
     fn chunk_of(&self, x: f32) -> usize {
-        ((x / CHUNK as f32).floor() as i64).clamp(0, self.chunks as i64 - 1) as usize
+        ((x / self.chunk).floor() as i64).clamp(0, self.chunks as i64 - 1) as usize
+    }
+
+    #[inline]
+    fn band_of(&self, y: f32) -> usize {
+        ((y / self.band as f32).floor() as i64).clamp(0, self.bands as i64 - 1) as usize
     }
 
     /// The farthest a camera segment's line may pass from the pinhole and still use the bins.
@@ -203,8 +224,7 @@ impl ScreenBeams {
         {
             return false;
         }
-        let row = (film.y.floor() as i64).clamp(0, self.height as i64 - 1) as usize;
-        let bin = &self.bins[row * self.chunks as usize + self.chunk_of(film.x)];
+        let bin = &self.bins[self.band_of(film.y) * self.chunks as usize + self.chunk_of(film.x)];
         for span in bin {
             if span.x0 <= film.x
                 && film.x <= span.x1
@@ -347,25 +367,33 @@ mod tests {
     /// margin) without visiting anything.
     #[test]
     fn the_bins_accept_what_the_bvh_accepts() {
-        let camera = Camera::new(
-            Vec3::new(0.4, 0.3, 6.0),
-            Vec3::new(0.0, -0.2, 0.0),
-            Vec3::Y,
-            45.0,
-            640,
-            480,
-        );
         let mut rng = Rng::new(&[17]);
         let (mut accepted, mut declined, mut near) = (0, 0, 0);
-        for r in [0.05f32, 0.012] {
+        // One row a band, and four (a tall image: ROWS).
+        for (r, (w, h)) in [
+            (0.05f32, (640, 480)),
+            (0.012, (640, 480)),
+            (0.03, (320, 1100)),
+        ] {
+            let camera = Camera::new(
+                Vec3::new(0.4, 0.3, 6.0),
+                Vec3::new(0.0, -0.2, 0.0),
+                Vec3::Y,
+                45.0,
+                w,
+                h,
+            );
+            let (w, h) = (w as f32, h as f32);
             let beams = random_beams(&mut rng, &camera, 700);
             let map = BeamMap::build(beams, r);
             let screen = ScreenBeams::build(&map, &camera, 0.5);
             let bvh = map_bvh(&map);
             near += screen.near.is_some() as u32;
             for i in 0..3000 {
-                let mut film =
-                    Vec2::new(rng.next_f32() * 644.0 - 2.0, rng.next_f32() * 484.0 - 2.0);
+                let mut film = Vec2::new(
+                    rng.next_f32() * (w + 4.0) - 2.0,
+                    rng.next_f32() * (h + 4.0) - 2.0,
+                );
                 if i % 2 == 1 {
                     // Through a point 0.999 r from a random piece, across the piece as the
                     // image sees it (the edge of its footprint), near its ends too.
@@ -408,7 +436,8 @@ mod tests {
                     screen.along_primary(&map, film, &ray, t_end, medium, &mut |id, c| {
                         got.push((id, c.t_c.to_bits()))
                     });
-                let inside = film.x >= -1.5 && film.y >= -1.5 && film.x <= 641.5 && film.y <= 481.5;
+                let inside =
+                    film.x >= -1.5 && film.y >= -1.5 && film.x <= w + 1.5 && film.y <= h + 1.5;
                 if off <= 1.0 && inside {
                     assert!(answered, "film {film}, offset {off}");
                 }
