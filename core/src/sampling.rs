@@ -317,9 +317,8 @@ impl SobolBlock {
 ///
 /// Padding (Burley 2020, section 4): every dimension takes Sobol dimensions 0 and 1, a
 /// (0, 2)-sequence, with its own shuffle of the sample index, so dimensions are independent
-/// of one another and each is as well stratified as the first. One 64-bit hash gives the
-/// three 32-bit seeds (the third by an odd multiplier: the scramble's hash needs distinct
-/// seeds, not independent bits). The point is `owen_scramble(sobol_dimension(i, d), s)` of
+/// of one another and each is as well stratified as the first. Two 32-bit hashes give the
+/// three 32-bit seeds ([`sobol_seeds`]). The point is `owen_scramble(sobol_dimension(i, d), s)` of
 /// the shuffled index i, with the bit reversals that cancel left out:
 ///
 /// * the shuffle is [`shuffled_index`] of the index, whose two scrambles share their outer
@@ -335,10 +334,9 @@ impl SobolBlock {
 /// Eight dimensions are computed at once, each step for all of them, because that runs in
 /// the eight 32-bit lanes of an AVX2 register where the processor has them (the hashes are
 /// 32-bit multiplies and shifts, the bit reversals byte shuffles, dimension 1 five
-/// shift-mask-xor steps): about 21 instructions a dimension (170 a block), against about 105
-/// one at a time with a data-dependent loop (docs/PERFORMANCE.md, sessions 26 and 27); the
-/// `splitmix64` of each dimension's key is now the largest part (64-bit multiplies have no
-/// AVX2 instruction). Integer arithmetic,
+/// shift-mask-xor steps): about 21 instructions a dimension (170 a block) with a 64-bit key
+/// hash, against about 105 one at a time with a data-dependent loop (docs/PERFORMANCE.md,
+/// sessions 26 to 28). Integer arithmetic,
 /// so the points are the same bits with or without AVX2, and as one dimension alone computes
 /// them (unit test `sobol_block_matches_each_lane`). A sample that ends inside a block has
 /// computed a few dimensions it does not use (on the Cornell box, 21 for 17).
@@ -371,8 +369,7 @@ fn sobol_block_lanes(pixel_key: u64, index_reversed: u32, first: u32, block: &mu
     const N: usize = SOBOL_BLOCK;
     let (mut seed, mut sx, mut sy) = ([0u32; N], [0u32; N], [0u32; N]);
     for k in 0..N {
-        let key = dimension_key(pixel_key, first.wrapping_add(k as u32));
-        (seed[k], sx[k], sy[k]) = key_seeds(key);
+        (seed[k], sx[k], sy[k]) = sobol_seeds(pixel_key, first.wrapping_add(k as u32));
     }
     let mut i = [0u32; N];
     for k in 0..N {
@@ -386,32 +383,48 @@ fn sobol_block_lanes(pixel_key: u64, index_reversed: u32, first: u32, block: &mu
     }
 }
 
-/// The hash of (pixel, dimension) that seeds a dimension's shuffle and scrambles.
+/// The hash of (pixel, dimension) that seeds a `stratified` dimension's permutation.
 #[inline(always)]
 fn dimension_key(pixel_key: u64, dimension: u32) -> u64 {
     splitmix64(pixel_key ^ (dimension as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
 }
 
+/// The three 32-bit seeds of a `sobol` dimension (the index shuffle's, and the scrambles of
+/// the point's two coordinates), from the pixel's key and the dimension: two 32-bit hashes,
+/// the first of the key's low half and the dimension, the second of the first and the key's
+/// high half; the third seed mixes the halves of both. 32-bit arithmetic because it runs in
+/// AVX2's eight 32-bit lanes (a 64-bit `splitmix64` per dimension, as before session 28, has
+/// no AVX2 multiply and was a third of a block's instructions). The seeds need to differ
+/// from dimension to dimension and pixel to pixel and look random, not be independent bits:
+/// for one pixel each hash is a bijection of the dimension, so no two dimensions share a
+/// shuffle or a scramble.
+#[inline(always)]
+fn sobol_seeds(pixel_key: u64, dimension: u32) -> (u32, u32, u32) {
+    let h1 = hash32(pixel_key as u32 ^ dimension.wrapping_mul(0x9E37_79B9));
+    let h2 = hash32(h1 ^ (pixel_key >> 32) as u32);
+    (h1, h2, ((h1 >> 16) | (h2 << 16)) ^ 0x9E37_79B9)
+}
+
+/// Wellons' `lowbias32` (github.com/skeeto/hash-prospector): a 32-bit integer hash, a
+/// bijection with low avalanche bias, two multiplies.
+#[inline(always)]
+pub fn hash32(mut x: u32) -> u32 {
+    x ^= x >> 16;
+    x = x.wrapping_mul(0x7feb_352d);
+    x ^= x >> 15;
+    x = x.wrapping_mul(0x846c_a68b);
+    x ^ (x >> 16)
+}
+
 /// One dimension's point alone, both coordinates, as [`sobol_block`] computes eight: the
 /// reference its unit test compares the blocks with.
 #[cfg(test)]
-fn sobol_lane(key: u64, index_reversed: u32) -> (f32, f32) {
-    let (seed, sx, sy) = key_seeds(key);
+fn sobol_lane(pixel_key: u64, dimension: u32, index_reversed: u32) -> (f32, f32) {
+    let (seed, sx, sy) = sobol_seeds(pixel_key, dimension);
     let i = reverse_24(laine_karras(index_reversed, seed) ^ laine_karras(0, seed));
     (
         reversed_unit_f32(laine_karras(i, sx)),
         reversed_unit_f32(laine_karras(sobol_1_reversed(i), sy)),
-    )
-}
-
-/// The three 32-bit seeds of a dimension's key: the index shuffle's, and the scrambles of
-/// the point's two coordinates.
-#[inline(always)]
-fn key_seeds(key: u64) -> (u32, u32, u32) {
-    (
-        key as u32,
-        (key >> 32) as u32,
-        (key >> 16) as u32 ^ 0x9E37_79B9,
     )
 }
 
@@ -935,11 +948,10 @@ mod tests {
         for spp in [1, 5, 64, 1000] {
             for index in (0..3 * spp).step_by(7) {
                 let mut sampler = Sampler::new(SamplerKind::Sobol, 3, 12345, index, spp);
-                let mut plain = sampler.clone();
+                let pixel_key = sampler.pixel_key;
                 for dim in 0..20 {
-                    let key = plain.dimension_key();
-                    let i = shuffled_index(index, key as u32);
-                    let (sx, sy) = ((key >> 32) as u32, (key >> 16) as u32 ^ 0x9E37_79B9);
+                    let (seed, sx, sy) = sobol_seeds(pixel_key, dim);
+                    let i = shuffled_index(index, seed);
                     if dim % 3 == 0 {
                         let x = unit_f32(owen_scramble(sobol_dimension(i, 0), sx));
                         assert_eq!(sampler.next_f32().to_bits(), x.to_bits());
@@ -950,6 +962,46 @@ mod tests {
                         assert_eq!((u.x.to_bits(), u.y.to_bits()), (x.to_bits(), y.to_bits()));
                     }
                 }
+            }
+        }
+    }
+
+    /// A `sobol` dimension's shuffle and first scramble are seeded differently from every
+    /// other dimension's of the same pixel (each hash is a bijection of the dimension), and
+    /// every bit of the three seeds is set about half the time over pixels and dimensions.
+    #[test]
+    fn sobol_seeds_differ_between_dimensions_and_are_balanced() {
+        let mut ones = [[0u32; 32]; 3];
+        let (pixels, dimensions) = (16u64, 4096u32);
+        for pixel in 0..pixels {
+            let key = splitmix64(splitmix64(7 ^ 0x5A3F_C0DE) ^ pixel);
+            let mut seen = [
+                std::collections::HashSet::new(),
+                std::collections::HashSet::new(),
+            ];
+            for d in 0..dimensions {
+                let (a, b, c) = sobol_seeds(key, d);
+                assert!(
+                    seen[0].insert(a),
+                    "pixel {pixel}: shuffle seed of {d} repeats"
+                );
+                assert!(
+                    seen[1].insert(b),
+                    "pixel {pixel}: scramble seed of {d} repeats"
+                );
+                for (s, seed) in [a, b, c].into_iter().enumerate() {
+                    for (bit, n) in ones[s].iter_mut().enumerate() {
+                        *n += seed >> bit & 1;
+                    }
+                }
+            }
+        }
+        // 65536 values a bit: a fair bit is within 1 % of one half with odds of 1 in 10^6.
+        let n = (pixels * dimensions as u64) as f64;
+        for (s, bits) in ones.iter().enumerate() {
+            for (bit, &k) in bits.iter().enumerate() {
+                let f = k as f64 / n;
+                assert!((f - 0.5).abs() < 0.01, "seed {s} bit {bit} set in {f}");
             }
         }
     }
@@ -972,8 +1024,7 @@ mod tests {
             let mut plain = SobolBlock::EMPTY;
             sobol_block_lanes(pixel_key, index_reversed, first, &mut plain);
             for k in 0..SOBOL_BLOCK {
-                let key = dimension_key(pixel_key, first + k as u32);
-                let (x, y) = sobol_lane(key, index_reversed);
+                let (x, y) = sobol_lane(pixel_key, first + k as u32, index_reversed);
                 for block in [&fast, &plain] {
                     assert_eq!(block.x[k].to_bits(), x.to_bits());
                     assert_eq!(block.y[k].to_bits(), y.to_bits());
