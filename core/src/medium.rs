@@ -129,6 +129,10 @@ impl HeroChannel {
 #[inline]
 pub fn transmittance_homogeneous(sigma_t: Rgb, d: f32) -> Rgb {
     let tr = |s: f32| if s == 0.0 { 1.0 } else { (-s * d).exp() };
+    // A grey medium (the common case) needs one exponential, not three: the same values.
+    if sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z {
+        return Rgb::splat(tr(sigma_t.x));
+    }
     Rgb::new(tr(sigma_t.x), tr(sigma_t.y), tr(sigma_t.z))
 }
 
@@ -169,6 +173,13 @@ pub trait Medium: Send + Sync + std::fmt::Debug {
     /// Samples a free-flight distance along `ray` within (0, `tmax`) with channel `channel`'s
     /// density (see the module comment for the weights); `u` is uniform in [0, 1).
     fn sample_free_flight(&self, ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight;
+    /// The medium's coefficients if they are the same everywhere, else None (the default).
+    /// For estimates that evaluate many transmittances in one medium (the beam x beam
+    /// gather: two per beam a camera ray crosses), so that they compute exp(-sigma_t d)
+    /// inline rather than through this trait's virtual calls; what they compute is the same.
+    fn homogeneous(&self) -> Option<Homogeneous> {
+        None
+    }
 }
 
 /// A medium with the same coefficients everywhere.
@@ -235,6 +246,9 @@ impl Medium for Homogeneous {
                 pdf: tr,
             }
         }
+    }
+    fn homogeneous(&self) -> Option<Homogeneous> {
+        Some(*self)
     }
 }
 

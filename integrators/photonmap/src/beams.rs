@@ -42,15 +42,16 @@
 //! beam lies within the piece, so a beam is counted once.
 
 use crate::map::Photon;
+use crate::screen::ScreenBeams;
 use foton_core::accel::Accel;
 use foton_core::error::Result;
 use foton_core::geometry::Ray;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
 use foton_core::kernel::NormalizedKernel;
-use foton_core::medium::Medium;
+use foton_core::medium::{Medium, Phase, transmittance_homogeneous};
 use foton_core::props::Properties;
 use foton_core::scene::Scene;
-use foton_core::{Rgb, Vec3};
+use foton_core::{Rgb, Vec2, Vec3};
 
 /// Which flight segments a photon records (module comment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -94,7 +95,12 @@ impl Beam {
     /// comment), in medium `m`.
     #[inline]
     pub fn weight(&self, m: &dyn Medium, t: f32) -> Rgb {
-        let tr = m.transmittance(&Ray::new(self.origin, self.dir), t);
+        self.weight_of(m.transmittance(&Ray::new(self.origin, self.dir), t))
+    }
+
+    /// W_b(t) from the beam's transmittance Tr_b(t).
+    #[inline]
+    pub fn weight_of(&self, tr: Rgb) -> Rgb {
         match self.kind {
             BeamKind::Long => tr,
             BeamKind::Short => {
@@ -130,11 +136,15 @@ pub const MIN_SIN: f32 = 1e-4;
 #[inline]
 pub fn closest_approach(o_c: Vec3, w_c: Vec3, o_b: Vec3, w_b: Vec3) -> Option<Crossing> {
     let n = w_c.cross(w_b);
-    let sin2 = n.length_squared();
+    closest_approach_from(o_b - o_c, n, n.length_squared(), w_c, w_b)
+}
+
+/// [`closest_approach`] from d = o_b - o_c, n = w_c x w_b and |n|^2 (computed before).
+#[inline]
+fn closest_approach_from(d: Vec3, n: Vec3, sin2: f32, w_c: Vec3, w_b: Vec3) -> Option<Crossing> {
     if sin2 < MIN_SIN * MIN_SIN {
         return None;
     }
-    let d = o_b - o_c;
     // Solve o_c + t_c w_c + s n = o_b + t_b w_b by Cramer's rule with n = w_c x w_b.
     let t_c = d.cross(w_b).dot(n) / sin2;
     let t_b = d.cross(w_c).dot(n) / sin2;
@@ -153,20 +163,26 @@ pub struct Kernel1d<'a> {
     kernel: &'a NormalizedKernel,
     /// 1 / integral_{-1}^{1} of the 2-D weight at radius 1.
     inv_norm: f32,
+    /// The box kernel's constant 2-D weight at radius 1 (the same value `weight` would
+    /// compute, without the kernel's call per crossing).
+    constant: Option<f32>,
 }
 
 impl<'a> Kernel1d<'a> {
     /// The kernel with its 1-D normalisation ([`Kernel1d::norm`]: compute it once).
     pub fn new(kernel: &'a NormalizedKernel) -> Self {
-        Kernel1d {
-            kernel,
-            inv_norm: Self::norm(kernel),
-        }
+        Self::with_norm(kernel, Self::norm(kernel))
     }
 
     /// The kernel with a normalisation [`Kernel1d::norm`] computed before.
     pub fn with_norm(kernel: &'a NormalizedKernel, inv_norm: f32) -> Self {
-        Kernel1d { kernel, inv_norm }
+        // Core's built-in "box" (kernel plugins cannot take a built-in's name).
+        let constant = (kernel.name() == "box").then(|| kernel.weight_2d(0.0, 1.0));
+        Kernel1d {
+            kernel,
+            inv_norm,
+            constant,
+        }
     }
 
     /// 1 / integral_{-1}^{1} of the kernel's 2-D weight at radius 1.
@@ -193,7 +209,11 @@ impl<'a> Kernel1d<'a> {
         if u > r {
             return 0.0;
         }
-        self.kernel.weight_2d(u / r, 1.0) * self.inv_norm / r
+        let w = match self.constant {
+            Some(w) => w,
+            None => self.kernel.weight_2d(u / r, 1.0),
+        };
+        w * self.inv_norm / r
     }
 }
 
@@ -222,20 +242,49 @@ fn piece_grow(dir: Vec3, r: f32, scale: f32) -> Vec3 {
 /// A piece of a beam, as the BVH holds it, with what the crossing test needs of its beam
 /// (so that a piece a camera ray only passes near costs no look-up of the beam).
 #[derive(Clone, Copy, Debug)]
-struct Piece {
-    origin: Vec3,
-    dir: Vec3,
-    t0: f32,
-    t1: f32,
-    beam: u32,
-    medium: u32,
+pub(crate) struct Piece {
+    pub(crate) origin: Vec3,
+    pub(crate) dir: Vec3,
+    pub(crate) t0: f32,
+    pub(crate) t1: f32,
+    pub(crate) beam: u32,
+    pub(crate) medium: u32,
+}
+
+impl Piece {
+    pub(crate) fn start(&self) -> Vec3 {
+        self.origin + self.dir * self.t0
+    }
+
+    pub(crate) fn end(&self) -> Vec3 {
+        self.origin + self.dir * self.t1
+    }
+
+    /// The piece's box in the BVH (`piece_grow`), as core's BVH holds it: a flat triangle
+    /// from one corner to the opposite one has the box as its bounds, and is never
+    /// intersected (the traversal's callback tests the beam itself). `object` names the piece.
+    pub(crate) fn primitive(&self, r: f32, id: u32) -> Primitive {
+        let (p0, p1) = (self.start(), self.end());
+        let scale = p0.abs().max(p1.abs()).max_element();
+        let grow = piece_grow(self.dir, r, scale);
+        let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
+        Primitive {
+            shape: Shape::Triangle {
+                p0: lo,
+                e1: hi - lo,
+                e2: Vec3::ZERO,
+            },
+            object: id,
+            attrs: NO_ATTRS,
+        }
+    }
 }
 
 /// The photon beams of one pass, with a common width r, in a BVH.
 pub struct BeamMap {
     beams: Vec<Beam>,
-    /// In BVH leaf order, so a traversal's id indexes them.
-    pieces: Vec<Piece>,
+    /// Indexed by the BVH primitives' `object`.
+    pub(crate) pieces: Vec<Piece>,
     bvh: Accel,
     radius: f32,
 }
@@ -246,7 +295,6 @@ impl BeamMap {
     pub fn build(beams: Vec<Beam>, radius: f32) -> BeamMap {
         let piece = PIECE_WIDTHS * radius;
         let mut pieces = Vec::with_capacity(beams.len());
-        let mut boxes = Vec::with_capacity(beams.len());
         for (i, b) in beams.iter().enumerate() {
             if !(b.length > 0.0 && b.length.is_finite()) {
                 continue;
@@ -256,22 +304,6 @@ impl BeamMap {
             for k in 0..n {
                 let t0 = k as f32 * step;
                 let t1 = if k + 1 == n { b.length } else { t0 + step };
-                let (p0, p1) = (b.origin + b.dir * t0, b.origin + b.dir * t1);
-                let scale = p0.abs().max(p1.abs()).max_element();
-                let grow = piece_grow(b.dir, radius, scale);
-                let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
-                // Core's BVH holds shapes: a flat triangle from one corner to the opposite
-                // one has the piece's box as its bounds, and is never intersected (the
-                // traversal's callback tests the beam itself). `object` names the piece.
-                boxes.push(Primitive {
-                    shape: Shape::Triangle {
-                        p0: lo,
-                        e1: hi - lo,
-                        e2: Vec3::ZERO,
-                    },
-                    object: pieces.len() as u32,
-                    attrs: NO_ATTRS,
-                });
                 pieces.push(Piece {
                     origin: b.origin,
                     dir: b.dir,
@@ -282,6 +314,11 @@ impl BeamMap {
                 });
             }
         }
+        let boxes = pieces
+            .iter()
+            .enumerate()
+            .map(|(id, p)| p.primitive(radius, id as u32))
+            .collect();
         let bvh = Accel::build(boxes);
         BeamMap {
             beams,
@@ -307,6 +344,62 @@ impl BeamMap {
         self.radius
     }
 
+    /// The pieces the beams were cut into.
+    pub fn pieces(&self) -> usize {
+        self.pieces.len()
+    }
+
+    /// Whether piece `id` of medium `medium` passes within the width of the query segment
+    /// `ray` from 0 to `t_end` with its closest point within the piece and the segment: the
+    /// crossing, if so. The one test of a candidate piece, wherever the candidates come from
+    /// (the BVH, or the screen's bins for camera rays: `screen`), so that both accept the same.
+    #[inline]
+    pub(crate) fn cross(&self, id: u32, ray: &Ray, t_end: f32, medium: u32) -> Option<Crossing> {
+        let r = self.radius;
+        let piece = &self.pieces[id as usize];
+        if piece.medium != medium {
+            return None;
+        }
+        // Most pieces whose box the ray crosses pass farther than r from it: reject those by
+        // the distance between the lines, |d . n| / |n| < r, before solving for the closest
+        // points.
+        let n = ray.dir.cross(piece.dir);
+        let sin2 = n.length_squared();
+        let d = piece.origin - ray.origin;
+        let dn = d.dot(n);
+        if dn * dn >= r * r * sin2 {
+            return None;
+        }
+        let c = closest_approach_from(d, n, sin2, ray.dir, piece.dir)?;
+        (c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end)
+            .then_some(c)
+    }
+
+    /// The beam a piece belongs to.
+    #[inline]
+    pub(crate) fn beam_of(&self, id: u32) -> &Beam {
+        &self.beams[self.pieces[id as usize].beam as usize]
+    }
+
+    /// Calls `visit(piece id, crossing)` for every piece of `bvh` (a BVH of this map's
+    /// pieces' boxes) that [`BeamMap::cross`] accepts.
+    pub(crate) fn traverse(
+        &self,
+        bvh: &Accel,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        visit: &mut impl FnMut(u32, &Crossing),
+    ) {
+        let visit = std::cell::RefCell::new(visit);
+        bvh.occluded(ray, t_end, |prim| {
+            if let Some(c) = self.cross(prim.object, ray, t_end, medium) {
+                (visit.borrow_mut())(prim.object, &c);
+            }
+            false
+        });
+    }
+
     /// Calls `visit(beam, crossing)` for every beam of medium `medium` that passes within the
     /// width of the query segment `ray` (unit direction) from 0 to `t_end`, its closest
     /// point within the beam and the segment.
@@ -315,32 +408,10 @@ impl BeamMap {
         ray: &Ray,
         t_end: f32,
         medium: u32,
-        visit: impl FnMut(&Beam, &Crossing),
+        mut visit: impl FnMut(&Beam, &Crossing),
     ) {
-        let r = self.radius;
-        let visit = std::cell::RefCell::new(visit);
-        self.bvh.occluded(ray, t_end, |prim| {
-            let id = prim.object as usize;
-            let piece = &self.pieces[id];
-            if piece.medium != medium {
-                return false;
-            }
-            // Most pieces whose box the ray crosses pass farther than r from it: reject
-            // those by the distance between the lines, |d . n| / |n| < r, before solving
-            // for the closest points.
-            let n = ray.dir.cross(piece.dir);
-            let sin2 = n.length_squared();
-            let dn = (piece.origin - ray.origin).dot(n);
-            if dn * dn >= r * r * sin2 {
-                return false;
-            }
-            let Some(c) = closest_approach(ray.origin, ray.dir, piece.origin, piece.dir) else {
-                return false;
-            };
-            if c.u < r && c.t_b >= piece.t0 && c.t_b < piece.t1 && c.t_c >= 0.0 && c.t_c < t_end {
-                (visit.borrow_mut())(&self.beams[piece.beam as usize], &c);
-            }
-            false
+        self.traverse(&self.bvh, ray, t_end, medium, &mut |id, c| {
+            visit(self.beam_of(id), c)
         });
     }
 
@@ -356,25 +427,168 @@ impl BeamMap {
         medium: u32,
         depth: u32,
     ) -> Rgb {
-        let m = scene.medium(medium);
-        let phase = m.phase();
-        let r = self.radius;
+        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
         let mut sum = Rgb::ZERO;
-        self.along_ray(ray, t_end, medium, |beam, c| {
-            if beam.depth > depth {
-                return;
-            }
-            let x = ray.at(c.t_c);
-            let k = kernel.weight(c.u, r) / c.sin;
-            let f = phase.eval(beam.dir.dot(-ray.dir));
-            sum += beam.flux
-                * beam.weight(m, c.t_b)
-                * m.sigma_s(x)
-                * m.transmittance(ray, c.t_c)
-                * (f * k);
+        self.traverse(&self.bvh, ray, t_end, medium, &mut |id, c| {
+            gather.add(&mut sum, id, c)
         });
         sum
     }
+
+    /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
+    /// point `film` (a segment of the camera path before any scattering: from the pinhole, or
+    /// past null boundaries on the same line), with the candidate pieces from the pass's
+    /// screen bins `screen` where they apply (`ScreenBeams::along_primary`); the same
+    /// estimate, summed in piece order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn in_scattered_primary(
+        &self,
+        scene: &Scene,
+        kernel: &Kernel1d<'_>,
+        screen: &ScreenBeams,
+        film: Vec2,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        depth: u32,
+    ) -> Rgb {
+        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
+        let mut sum = Rgb::ZERO;
+        let mut add = |id, c: &Crossing| gather.add(&mut sum, id, c);
+        if !screen.along_primary(self, film, ray, t_end, medium, &mut add) {
+            self.traverse(&self.bvh, ray, t_end, medium, &mut add)
+        }
+        sum
+    }
+}
+
+/// One segment's beam x beam estimate: what each accepted crossing adds (module comment).
+struct Gather<'a> {
+    map: &'a BeamMap,
+    coefficients: Coefficients<'a>,
+    phase: Phase,
+    kernel: &'a Kernel1d<'a>,
+    ray: &'a Ray,
+    depth: u32,
+}
+
+impl<'a> Gather<'a> {
+    fn new(
+        map: &'a BeamMap,
+        scene: &'a Scene,
+        kernel: &'a Kernel1d<'a>,
+        ray: &'a Ray,
+        medium: u32,
+        depth: u32,
+    ) -> Self {
+        let m = scene.medium(medium);
+        Gather {
+            map,
+            coefficients: Coefficients::of(m),
+            phase: m.phase(),
+            kernel,
+            ray,
+            depth,
+        }
+    }
+
+    #[inline]
+    fn add(&self, sum: &mut Rgb, id: u32, c: &Crossing) {
+        let beam = self.map.beam_of(id);
+        if beam.depth > self.depth {
+            return;
+        }
+        let r = self.map.radius;
+        *sum += self.coefficients.crossing(beam, self.ray, c)
+            * phase_kernel(self.phase, self.kernel, r, beam, self.ray, c);
+    }
+}
+
+/// What the estimate needs of the medium a camera segment crosses: its coefficients when they
+/// are constant (core's `Medium::homogeneous`: the transmittances are exp(-sigma_t d) inline),
+/// else the medium itself.
+#[derive(Clone, Copy)]
+enum Coefficients<'a> {
+    /// The same sigma_t in every channel: one exponential a crossing (below).
+    Grey {
+        sigma_t: f32,
+        sigma_s: Rgb,
+    },
+    Homogeneous {
+        sigma_t: Rgb,
+        sigma_s: Rgb,
+    },
+    General(&'a dyn Medium),
+}
+
+impl<'a> Coefficients<'a> {
+    fn of(m: &'a dyn Medium) -> Self {
+        match m.homogeneous() {
+            Some(h) => {
+                let sigma_t = h.sigma_t();
+                if sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z {
+                    Coefficients::Grey {
+                        sigma_t: sigma_t.x,
+                        sigma_s: h.sigma_s,
+                    }
+                } else {
+                    Coefficients::Homogeneous {
+                        sigma_t,
+                        sigma_s: h.sigma_s,
+                    }
+                }
+            }
+            None => Coefficients::General(m),
+        }
+    }
+
+    /// Phi_b W_b(t_b) sigma_s(x_c) Tr_c(t_c) of the beam crossing the query `ray` at `c`.
+    #[inline]
+    fn crossing(&self, beam: &Beam, ray: &Ray, c: &Crossing) -> Rgb {
+        match *self {
+            // With one sigma_t, a short beam's W_b = Tr_b / mean(r Tr_b) is 1 / mean(r) (its
+            // transmittance cancels), and a long beam's Tr_b Tr_c is exp(-sigma_t (t_b + t_c)).
+            Coefficients::Grey { sigma_t, sigma_s } => {
+                let w = match beam.kind {
+                    BeamKind::Short => {
+                        let p = foton_core::average(beam.hero_r);
+                        if p > 0.0 {
+                            (-sigma_t * c.t_c).exp() / p
+                        } else {
+                            0.0
+                        }
+                    }
+                    BeamKind::Long => (-sigma_t * (c.t_b + c.t_c)).exp(),
+                };
+                beam.flux * sigma_s * w
+            }
+            Coefficients::Homogeneous { sigma_t, sigma_s } => {
+                beam.flux
+                    * beam.weight_of(transmittance_homogeneous(sigma_t, c.t_b))
+                    * sigma_s
+                    * transmittance_homogeneous(sigma_t, c.t_c)
+            }
+            Coefficients::General(m) => {
+                beam.flux
+                    * beam.weight(m, c.t_b)
+                    * m.sigma_s(ray.at(c.t_c))
+                    * m.transmittance(ray, c.t_c)
+            }
+        }
+    }
+}
+
+/// p(w_b . -w) K1(u, r) / sin(theta): the crossing's phase function and kernel.
+#[inline]
+fn phase_kernel(
+    phase: Phase,
+    kernel: &Kernel1d<'_>,
+    r: f32,
+    beam: &Beam,
+    ray: &Ray,
+    c: &Crossing,
+) -> f32 {
+    phase.eval(beam.dir.dot(-ray.dir)) * (kernel.weight(c.u, r) / c.sin)
 }
 
 /// The parameter `beam_type` (`short` or `long`, default short: see the integrators' docs).

@@ -15,6 +15,8 @@
 //!   [`map::DISC_THICKNESS`] (1/4) of the radius are not counted.
 //! - [`beams`]: photon beams (each photon flight through a medium, short or long), their BVH
 //!   and the beam x beam estimate with a 1-D kernel (Jarosz et al. 2011), for `vpm` and `ppb`;
+//! - [`screen`]: a pass's beams binned in screen space, the candidates of the camera's primary
+//!   rays (`ppb`), in place of the BVH's;
 //! - [`progressive`]: what `sppm` and `ppb` share: the pass loop (`run_passes`: iterations or
 //!   a time budget, parts, Ctrl-C, checkpoints; each plugin gives only its per-pass estimator,
 //!   a `Passes`) and its parameters (`PassBudget`), Knaus and Zwicker's radius schedule, the
@@ -32,6 +34,7 @@
 pub mod beams;
 pub mod map;
 pub mod progressive;
+pub mod screen;
 pub mod surface;
 pub mod trace;
 

@@ -7,9 +7,10 @@ use foton_core::geometry::Ray;
 use foton_core::kernel::{BoxKernel, ConeKernel, NormalizedKernel};
 use foton_core::scene::Scene;
 use foton_photonmap::beams::{Beam, BeamKind, BeamMap, Kernel1d, closest_approach};
+use foton_photonmap::screen::ScreenBeams;
 use foton_tests::stats::{Tolerance, assert_blocks_agree, rel_err};
 use foton_tests::{header, render_toml, temp_dir, write};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
 
 /// Integrates the beam x beam estimate of a unit-flux beam of length 1 (no medium: sigma_s =
@@ -105,11 +106,19 @@ intensity = [1.0, 1.0, 1.0]
 /// pencil's width, a beam of flux Phi (a line of fluence Phi Tr_b(t)) gives
 /// Phi sigma_s p(cos) Tr_b(t_b) Tr_c(t_c) / sin(theta) exactly: the kernel's shape and width
 /// must not matter. Long beams carry Tr_b; short ones Tr_b / mean(Tr_b) (spectral MIS, the
-/// photon path's channel pdfs all one).
+/// photon path's channel pdfs all one). A chromatic medium and a grey one (where the estimate
+/// computes one exponential a crossing, a short beam's transmittance cancelling).
 #[test]
 fn one_beam_against_its_analytic_in_scattered_radiance() {
-    let sigma_a = [0.1, 0.3, 0.05];
-    let sigma_s = [0.5, 0.2, 0.8];
+    for (sigma_a, sigma_s) in [
+        ([0.1, 0.3, 0.05], [0.5, 0.2, 0.8]),
+        ([0.2, 0.2, 0.2], [0.6, 0.6, 0.6]),
+    ] {
+        one_beam_in(sigma_a, sigma_s);
+    }
+}
+
+fn one_beam_in(sigma_a: [f32; 3], sigma_s: [f32; 3]) {
     let sigma_t: Vec<f32> = (0..3).map(|c| sigma_a[c] + sigma_s[c]).collect();
     let cone = NormalizedKernel::new(Box::new(ConeKernel { c: 1.0 })).unwrap();
     for (phase, p) in [
@@ -263,6 +272,88 @@ fn single_scattering_from_a_point_light_agrees_with_path() {
 fn multiple_scattering_agrees_with_path() {
     // Shadow rays for L M, beams for the rest.
     assert_beams_agree("multiple scattering", 8, "\"isotropic\"", &[], 0.08);
+}
+
+/// The camera's primary rays take their candidate beams from the pass's screen bins
+/// (foton-photonmap's `screen`) rather than the BVH: the same estimate, summed in another
+/// order, on random beams (some around and behind the camera) and segments from the pinhole
+/// or past a null boundary on the same line, in a grey and a chromatic medium, short and
+/// long beams.
+#[test]
+fn screen_bins_give_the_bvh_estimate_on_primary_rays() {
+    let camera = foton_core::camera::Camera::new(
+        Vec3::new(0.3, 0.2, 5.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        40.0,
+        96,
+        64,
+    );
+    let box_kernel = NormalizedKernel::new(Box::new(BoxKernel)).unwrap();
+    let kernel = Kernel1d::new(&box_kernel);
+    let mut rng = foton_core::sampling::Rng::new(&[23]);
+    let mut point = |c: Vec3, s: f32| {
+        c + (Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0) * s
+    };
+    let (mut compared, mut nonzero) = (0, 0);
+    for (sigma_a, sigma_s) in [
+        ([0.1, 0.1, 0.1], [0.4, 0.4, 0.4]),
+        ([0.1, 0.3, 0.05], [0.5, 0.2, 0.8]),
+    ] {
+        let scene = medium_scene(sigma_a, sigma_s, "{ type = \"hg\", g = 0.4 }");
+        for kind in [BeamKind::Short, BeamKind::Long] {
+            let beams: Vec<Beam> = (0..600)
+                .map(|i| {
+                    let c = if i % 10 == 0 {
+                        camera.position
+                    } else {
+                        Vec3::ZERO
+                    };
+                    let (a, b) = (point(c, 1.5), point(c, 1.5));
+                    Beam {
+                        origin: a,
+                        dir: (b - a).normalize(),
+                        length: (b - a).length(),
+                        flux: Rgb::new(1.0, 0.5, 2.0),
+                        hero_r: Rgb::new(0.8, 1.1, 1.1),
+                        medium: 0,
+                        depth: 1 + i % 3,
+                        kind,
+                    }
+                })
+                .collect();
+            let map = BeamMap::build(beams, 0.04);
+            let screen = ScreenBeams::build(&map, &camera, 0.5);
+            for i in 0..2000 {
+                let film = Vec2::new(
+                    point(Vec3::ZERO, 1.0).x * 50.0 + 48.0,
+                    point(Vec3::ZERO, 1.0).y * 34.0 + 32.0,
+                );
+                let primary = camera.generate_ray(film);
+                let start = if i % 2 == 0 {
+                    0.0
+                } else {
+                    4.0 * point(Vec3::ONE, 1.0).x
+                };
+                let ray = Ray::new(primary.at(start), primary.dir);
+                let t_end = 8.0 * point(Vec3::ONE, 1.0).y;
+                let depth = (i % 3) as u32 + 1;
+                let bvh = map.in_scattered(&scene, &kernel, &ray, t_end, 0, depth);
+                let bins =
+                    map.in_scattered_primary(&scene, &kernel, &screen, film, &ray, t_end, 0, depth);
+                assert!(
+                    rel_err(bins, bvh) < 1e-5 || (bins - bvh).abs().max_element() < 1e-6,
+                    "film {film}, start {start}: {bins} against {bvh}"
+                );
+                compared += 1;
+                nonzero += (bvh.max_element() > 0.0) as u32;
+            }
+        }
+    }
+    assert!(
+        nonzero > compared / 4,
+        "{nonzero} of {compared} estimates nonzero"
+    );
 }
 
 #[test]
