@@ -633,6 +633,18 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     Ok(0)
 }
 
+/// A rate with a unit prefix that keeps its digits: "1.27 M", "4.8 k" (a progressive render of
+/// a few thousand photons a pass read "0.00 M photons/s").
+fn rate(per_second: f64) -> String {
+    if per_second >= 1e6 {
+        format!("{:.2} M", per_second / 1e6)
+    } else if per_second >= 1e3 {
+        format!("{:.1} k", per_second / 1e3)
+    } else {
+        format!("{per_second:.0}")
+    }
+}
+
 /// What a render did, for its summary line: the iterations and photons of a progressive
 /// integrator (its camera samples are one per pixel per iteration, a meaningless rate), or the
 /// samples of the others.
@@ -641,17 +653,17 @@ fn work_done(film: &Film, elapsed: Duration, threads: usize) -> String {
     let per_second = |n: u64| n as f64 / secs.max(1e-9);
     if film.iterations > 0 {
         format!(
-            "{} iterations, {} photons in {secs:.2} s ({:.2} M photons/s, {:.2} iterations/s, {threads} threads)",
+            "{} iterations, {} photons in {secs:.2} s ({} photons/s, {:.2} iterations/s, {threads} threads)",
             film.iterations,
             film.photons,
-            per_second(film.photons) / 1e6,
+            rate(per_second(film.photons)),
             per_second(film.iterations),
         )
     } else {
         let samples = film.total_samples();
         format!(
-            "{samples} samples in {secs:.2} s ({:.2} M samples/s, {threads} threads)",
-            per_second(samples) / 1e6
+            "{samples} samples in {secs:.2} s ({} samples/s, {threads} threads)",
+            rate(per_second(samples))
         )
     }
 }
@@ -929,4 +941,16 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
         }
     );
     Ok(0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate;
+
+    #[test]
+    fn rates_keep_their_digits() {
+        assert_eq!(rate(1_270_000.0), "1.27 M");
+        assert_eq!(rate(4_796.0), "4.8 k");
+        assert_eq!(rate(12.4), "12");
+    }
 }
