@@ -1,27 +1,45 @@
-//! One BVH over every primitive in the scene (obvhs' compressed wide BVH8).
+//! One BVH over every primitive in the scene: obvhs builds it (a compressed wide BVH8), foton
+//! traverses it.
 //!
-//! **Wide node tests.** obvhs tests a node's eight children four at a time with SSE2 (the
-//! baseline of x86-64), converting its quantised bounds to floats one byte at a time. Where
-//! the processor has AVX2 (checked once, at run time: the program still runs on any x86-64),
-//! closest-hit and shadow rays are traversed by the same loop (obvhs' `traverse!`) with a node
-//! test that converts and tests all eight children at once ([`simd`]); the traversal, and the
-//! primitive tests inlined into it, are then compiled for x86-64-v3. Its arithmetic is
-//! obvhs' own (the same products and sums, no fused multiply-add), so it culls exactly the
-//! same children and renders the same images.
+//! **Float nodes.** obvhs stores each node's eight child boxes quantised to bytes and, in its
+//! traversal (`traverse!`, made for GPUs), converts them back to floats, keeps its state in
+//! bit-packed groups and zeroes a 32-entry stack for every ray: for the few nodes a ray of a
+//! small scene visits, that machinery was most of the traversal's cost. The scene's BVH
+//! ([`Accel::build`]) is therefore decoded once into [`Node`]s of the same tree with each
+//! child's box in floats (the exact union of the primitive boxes below it, tighter than the
+//! quantised one), and closest-hit and shadow rays walk them with a plain stack: one slab test
+//! of all eight children (AVX2 in the x86-64-v3 build, two SSE passes in the baseline's),
+//! children visited nearest entry first, subtrees past the closest hit skipped. Entry
+//! distances start at 0, where obvhs' start at 1e-4: a ray spawned within 1e-4 of another
+//! surface (the crease of two walls, a sphere resting on the floor) now hits it instead of
+//! passing through.
+//!
+//! **A BVH of boxes** ([`Accel::build_boxes`], photon beams' pieces) keeps obvhs' traversal
+//! and its culling. Where the processor has AVX2 (checked once, at run time: the program still
+//! runs on any x86-64), its node test converts and tests all eight children at once
+//! ([`simd`]), with obvhs' own arithmetic (the same products and sums, no fused multiply-add),
+//! so it culls exactly the same children as obvhs' SSE2 test, four at a time.
 
 use crate::geometry::{Hit, Primitive, Ray};
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use obvhs::BvhBuildParams;
 use obvhs::aabb::Aabb;
 use obvhs::cwbvh::CwBvh;
 use obvhs::cwbvh::builder::build_cwbvh;
 use obvhs::ray::{Ray as BvhRay, RayHit};
+use std::mem::MaybeUninit;
 
 pub struct Accel {
+    /// obvhs' compressed BVH8: traversed as it is by a BVH of boxes, by the narrow traversal
+    /// and by [`Accel::for_each_hit`] and [`Accel::visit`].
     bvh: Option<CwBvh>,
+    /// The same tree with its child boxes in floats (module comment); empty for a BVH of
+    /// boxes ([`Accel::build_boxes`]).
+    nodes: Vec<Node>,
     /// Primitives in BVH leaf order, so a traversal id indexes them directly.
     prims: Vec<Primitive>,
-    /// Traverse with the eight-wide node test (the processor has AVX2; see the module comment).
+    /// Traverse closest-hit and shadow rays with the float nodes (or, for a BVH of boxes,
+    /// with the eight-wide node test where the processor has AVX2), not obvhs' own traversal.
     wide: bool,
 }
 
@@ -34,41 +52,61 @@ fn bvh_ray(ray: &Ray, tmax: f32) -> BvhRay {
     BvhRay::new(ray.origin.into(), (ray.dir + Vec3::ZERO).into(), 0.0, tmax)
 }
 
+fn cwbvh(prims: &[Primitive]) -> (CwBvh, Vec<Primitive>) {
+    let aabbs: Vec<Aabb> = prims.iter().map(|p| p.shape.aabb()).collect();
+    let bvh = build_cwbvh(
+        &aabbs,
+        BvhBuildParams::medium_build(),
+        &mut std::time::Duration::default(),
+    );
+    let ordered = bvh
+        .primitive_indices
+        .iter()
+        .map(|&i| prims[i as usize])
+        .collect();
+    (bvh, ordered)
+}
+
 impl Accel {
+    /// The scene's BVH: obvhs' tree, traversed through its float nodes.
     pub fn build(prims: Vec<Primitive>) -> Accel {
+        let mut accel = Accel::build_boxes(prims);
+        if let Some(bvh) = &accel.bvh {
+            accel.nodes = Node::decode(bvh, &accel.prims);
+        }
+        accel.wide = true;
+        accel
+    }
+
+    /// A BVH for primitives that stand for boxes, traversed through obvhs' compressed nodes
+    /// (photon beams' pieces: their callbacks rely on obvhs' culling, whose entry distance
+    /// starts at 1e-4).
+    pub fn build_boxes(prims: Vec<Primitive>) -> Accel {
         let wide = simd::available();
         if prims.is_empty() {
             return Accel {
                 bvh: None,
+                nodes: Vec::new(),
                 prims,
                 wide,
             };
         }
-        let aabbs: Vec<Aabb> = prims.iter().map(|p| p.shape.aabb()).collect();
-        let bvh = build_cwbvh(
-            &aabbs,
-            BvhBuildParams::medium_build(),
-            &mut std::time::Duration::default(),
-        );
-        let ordered = bvh
-            .primitive_indices
-            .iter()
-            .map(|&i| prims[i as usize])
-            .collect();
+        let (bvh, prims) = cwbvh(&prims);
         Accel {
             bvh: Some(bvh),
-            prims: ordered,
+            nodes: Vec::new(),
+            prims,
             wide,
         }
     }
 
-    /// The same BVH traversed with obvhs' own node test only (`wide` false), or with the
-    /// wide one where the processor has it (true): for tests and benchmarks.
+    /// The same BVH traversed with obvhs' own traversal (`wide` false), or with the faster
+    /// one (true, where there is one): for tests and benchmarks.
     pub fn set_wide(&mut self, wide: bool) {
-        self.wide = wide && simd::available();
+        self.wide = wide && (!self.nodes.is_empty() || simd::available());
     }
 
-    /// Whether traversals use the eight-wide node test.
+    /// Whether traversals use the float nodes or the eight-wide node test.
     pub fn wide(&self) -> bool {
         self.wide
     }
@@ -80,37 +118,45 @@ impl Accel {
     /// Closest intersection with t in (0, tmax).
     #[inline]
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
-        let bvh = self.bvh.as_ref()?;
-        let bray = bvh_ray(ray, tmax);
-        let mut hit = RayHit::none();
-        let test = |r: &BvhRay, id: usize| {
-            self.prims[id]
-                .shape
-                .intersect(ray, r.tmax)
-                .unwrap_or(f32::INFINITY)
-        };
-        let found = if self.wide {
-            simd::closest(bvh, bray, &mut hit, test)
+        let (t, prim) = if self.wide && !self.nodes.is_empty() {
+            self.closest(ray, tmax)?
         } else {
-            bvh.ray_traverse(bray, &mut hit, test)
+            let bvh = self.bvh.as_ref()?;
+            let bray = bvh_ray(ray, tmax);
+            let mut hit = RayHit::none();
+            let test = |r: &BvhRay, id: usize| {
+                self.prims[id]
+                    .shape
+                    .intersect(ray, r.tmax)
+                    .unwrap_or(f32::INFINITY)
+            };
+            let found = if self.wide {
+                simd::closest(bvh, bray, &mut hit, test)
+            } else {
+                bvh.ray_traverse(bray, &mut hit, test)
+            };
+            if !found {
+                return None;
+            }
+            (hit.t, hit.primitive_id)
         };
-        if !found {
-            return None;
-        }
-        let prim = &self.prims[hit.primitive_id as usize];
-        let p = ray.at(hit.t);
+        let p = ray.at(t);
         Some(Hit {
-            t: hit.t,
+            t,
             p,
-            ng: prim.shape.normal(p),
-            prim: hit.primitive_id,
+            ng: self.prims[prim as usize].shape.normal(p),
+            prim,
         })
     }
 
     /// Whether any primitive accepted by `blocks` lies on the ray within (0, tmax). Stops at the
-    /// first such hit (shadow rays need no closest hit).
+    /// first such hit (shadow rays need no closest hit). `blocks` is asked about every
+    /// primitive of each leaf whose box the ray enters, before the primitive is tested.
     #[inline]
     pub fn occluded(&self, ray: &Ray, tmax: f32, blocks: impl Fn(&Primitive) -> bool) -> bool {
+        if self.wide && !self.nodes.is_empty() {
+            return self.any_hit(ray, tmax, &blocks);
+        }
         let Some(bvh) = self.bvh.as_ref() else {
             return false;
         };
@@ -120,6 +166,107 @@ impl Accel {
             !simd::miss(bvh, bray, test)
         } else {
             !bvh.ray_traverse_miss(bray, test)
+        }
+    }
+
+    /// Closest hit through the float nodes: (t, primitive index). Children are visited
+    /// nearest entry first, and a subtree whose entry lies past the closest hit so far is
+    /// skipped.
+    #[inline]
+    fn closest(&self, ray: &Ray, tmax: f32) -> Option<(f32, u32)> {
+        let slab = Slab::new(ray);
+        let mut tmax = tmax;
+        let mut best = None;
+        let mut stack = [MaybeUninit::<Entry>::uninit(); STACK];
+        let mut sp = 0usize;
+        let mut cur = Entry {
+            item: 0,
+            count: 0,
+            t: 0.0,
+        };
+        loop {
+            if cur.count == 0 {
+                let node = &self.nodes[cur.item as usize];
+                let (mut mask, tn) = node.enter(&slab, tmax);
+                if mask != 0 && mask & (mask - 1) == 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    cur = node.entry(i, tn[i]);
+                    continue;
+                }
+                // Pushed in slot order, then sorted so that the nearest is on top.
+                let base = sp;
+                while mask != 0 {
+                    let i = mask.trailing_zeros() as usize;
+                    mask &= mask - 1;
+                    let e = node.entry(i, tn[i]);
+                    // Insertion into the entries pushed from this node, farthest at `base`.
+                    let mut j = sp;
+                    // SAFETY: stack[base..sp] were written above.
+                    while j > base && unsafe { stack[j - 1].assume_init().t } < e.t {
+                        stack[j] = stack[j - 1];
+                        j -= 1;
+                    }
+                    stack[j] = MaybeUninit::new(e);
+                    sp += 1;
+                }
+            } else {
+                let first = cur.item as usize;
+                for (k, prim) in self.prims[first..first + cur.count as usize]
+                    .iter()
+                    .enumerate()
+                {
+                    if let Some(t) = prim.shape.intersect(ray, tmax) {
+                        tmax = t;
+                        best = Some((t, (first + k) as u32));
+                    }
+                }
+            }
+            loop {
+                if sp == 0 {
+                    return best;
+                }
+                sp -= 1;
+                // SAFETY: every entry below `sp` was written.
+                cur = unsafe { stack[sp].assume_init() };
+                if cur.t < tmax {
+                    break;
+                }
+            }
+        }
+    }
+
+    /// [`Accel::occluded`] through the float nodes.
+    #[inline]
+    fn any_hit(&self, ray: &Ray, tmax: f32, blocks: &impl Fn(&Primitive) -> bool) -> bool {
+        let slab = Slab::new(ray);
+        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            let node = &self.nodes[cur as usize];
+            let (mut mask, _) = node.enter(&slab, tmax);
+            while mask != 0 {
+                let i = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                let count = node.count[i] as usize;
+                if count == 0 {
+                    stack[sp] = MaybeUninit::new(node.child[i]);
+                    sp += 1;
+                    continue;
+                }
+                let first = node.child[i] as usize;
+                for prim in &self.prims[first..first + count] {
+                    if blocks(prim) && prim.shape.intersect(ray, tmax).is_some() {
+                        return true;
+                    }
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            // SAFETY: every entry below `sp` was written.
+            cur = unsafe { stack[sp].assume_init() };
         }
     }
 
@@ -157,6 +304,198 @@ impl Accel {
                 f32::INFINITY
             }
         })
+    }
+}
+
+/// Entries of the traversal stacks: a node's visit pops one entry and pushes at most eight,
+/// so a tree of depth d needs at most 7 d + 1. Room for depth 64 (obvhs' own stack holds 32
+/// groups); uninitialised, it costs nothing until used.
+const STACK: usize = 7 * 64 + 1;
+
+/// A subtree to visit: a node (`count` 0) or a leaf of `count` primitives from `item`, entered
+/// at distance `t`.
+#[derive(Clone, Copy, Debug)]
+struct Entry {
+    item: u32,
+    count: u32,
+    t: f32,
+}
+
+/// A ray as the slab test takes it: origin, inverse direction (obvhs' `safe_inverse`: finite,
+/// so that a zero distance never makes a NaN), and the rows of each axis' near and far planes
+/// (near x, y, z, far x, y, z).
+struct Slab {
+    origin: [f32; 3],
+    inv: [f32; 3],
+    rows: [u8; 6],
+}
+
+/// [`Slab::rows`] by the ray's octant (bit i: the ray runs towards -axis i, whose near plane
+/// is then the max row, 3 + i).
+const ROWS: [[u8; 6]; 8] = {
+    let mut rows = [[0u8; 6]; 8];
+    let mut octant = 0;
+    while octant < 8 {
+        let mut axis = 0;
+        while axis < 3 {
+            let negative = (octant >> axis) & 1 == 1;
+            rows[octant][axis] = if negative { 3 + axis as u8 } else { axis as u8 };
+            rows[octant][3 + axis] = if negative { axis as u8 } else { 3 + axis as u8 };
+            axis += 1;
+        }
+        octant += 1;
+    }
+    rows
+};
+
+impl Slab {
+    // Branch-free, in SSE lanes: a scalar branch and division per axis cost 57 instructions
+    // a ray, about as much as the node test.
+    #[inline(always)]
+    fn new(ray: &Ray) -> Slab {
+        let d = Vec3A::from(ray.dir + Vec3::ZERO);
+        // safe_inverse: 1 / x, or sign(x) / EPSILON where |x| <= EPSILON, which is
+        // 1 / copysign(EPSILON, x) exactly (EPSILON is a power of two).
+        let inv = Vec3A::ONE / d.abs().max(Vec3A::splat(f32::EPSILON)).copysign(d);
+        Slab {
+            origin: ray.origin.to_array(),
+            inv: inv.to_array(),
+            rows: ROWS[d.is_negative_bitmask() as usize],
+        }
+    }
+}
+
+/// An eight-wide node whose children's boxes are floats: the exact union of the primitive
+/// boxes below each child (tighter than obvhs' quantised ones, which are rounded outwards to
+/// 8 bits), in rows of eight for one slab test of all children.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(32))]
+struct Node {
+    /// Min x, y, z, then max x, y, z; an empty slot is the empty box (min +inf, max -inf):
+    /// its near plane is at +inf and its far one at -inf whichever way a ray runs.
+    bounds: [[f32; 8]; 6],
+    /// A node's index, or a leaf's first primitive.
+    child: [u32; 8],
+    /// A leaf's primitives; 0 for a node.
+    count: [u8; 8],
+}
+
+impl Node {
+    /// obvhs' nodes with their children's boxes computed from `prims` (in leaf order); the
+    /// same indices.
+    fn decode(bvh: &CwBvh, prims: &[Primitive]) -> Vec<Node> {
+        let empty = Node {
+            bounds: [
+                [f32::INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+                [f32::NEG_INFINITY; 8],
+            ],
+            child: [0; 8],
+            count: [0; 8],
+        };
+        let mut nodes = vec![empty; bvh.nodes.len()];
+        fn fill(i: usize, bvh: &CwBvh, prims: &[Primitive], nodes: &mut [Node]) -> Aabb {
+            let node = &bvh.nodes[i];
+            let mut all = Aabb::empty();
+            for ch in 0..8 {
+                if node.is_child_empty(ch) {
+                    continue;
+                }
+                let b = if node.is_leaf(ch) {
+                    let (first, count) = node.child_primitives(ch);
+                    nodes[i].child[ch] = first;
+                    nodes[i].count[ch] = count as u8;
+                    prims[first as usize..(first + count) as usize]
+                        .iter()
+                        .fold(Aabb::empty(), |b, p| b.union(&p.shape.aabb()))
+                } else {
+                    let j = node.child_node_index(ch);
+                    nodes[i].child[ch] = j;
+                    fill(j as usize, bvh, prims, nodes)
+                };
+                for axis in 0..3 {
+                    nodes[i].bounds[axis][ch] = b.min[axis];
+                    nodes[i].bounds[3 + axis][ch] = b.max[axis];
+                }
+                all = all.union(&b);
+            }
+            all
+        }
+        if !nodes.is_empty() {
+            fill(0, bvh, prims, &mut nodes);
+        }
+        nodes
+    }
+
+    /// The children the ray enters within [0, tmax], as a bit mask, and their entry
+    /// distances: the slab test of all eight at once. Written out in AVX2 where the code is
+    /// compiled for it (the x86-64-v3 build of the path plugin), where LLVM vectorised the
+    /// loop below only in part; elsewhere that loop (two SSE passes). Both compute the same
+    /// values: maxps and minps are the `if` below.
+    #[cfg(all(target_arch = "x86_64", target_feature = "avx2"))]
+    #[inline(always)]
+    fn enter(&self, r: &Slab, tmax: f32) -> (u32, [f32; 8]) {
+        use std::arch::x86_64::*;
+        // SAFETY: the build has AVX2 (the cfg above); the rows are 32-byte aligned
+        // (`repr(align(32))`, rows of 32 bytes).
+        unsafe {
+            // SAFETY (the index): a slab's rows are below 6.
+            let row = |i: u8| _mm256_load_ps(self.bounds.get_unchecked(i as usize).as_ptr());
+            let mut tn = _mm256_setzero_ps();
+            let mut tf = _mm256_set1_ps(tmax);
+            for axis in 0..3 {
+                let (o, inv) = (_mm256_set1_ps(r.origin[axis]), _mm256_set1_ps(r.inv[axis]));
+                let a = _mm256_mul_ps(_mm256_sub_ps(row(r.rows[axis]), o), inv);
+                let b = _mm256_mul_ps(_mm256_sub_ps(row(r.rows[3 + axis]), o), inv);
+                tn = _mm256_max_ps(a, tn);
+                tf = _mm256_min_ps(b, tf);
+            }
+            let mask = _mm256_movemask_ps(_mm256_cmp_ps::<_CMP_LE_OQ>(tn, tf)) as u32;
+            let mut t = [0.0f32; 8];
+            _mm256_storeu_ps(t.as_mut_ptr(), tn);
+            (mask, t)
+        }
+    }
+
+    /// See the AVX2 version above.
+    #[cfg(not(all(target_arch = "x86_64", target_feature = "avx2")))]
+    #[inline(always)]
+    fn enter(&self, r: &Slab, tmax: f32) -> (u32, [f32; 8]) {
+        let mut tn = [0.0f32; 8];
+        let mut tf = [tmax; 8];
+        for axis in 0..3 {
+            // SAFETY: a slab's rows are below 6.
+            let (near, far) = unsafe {
+                (
+                    self.bounds.get_unchecked(r.rows[axis] as usize),
+                    self.bounds.get_unchecked(r.rows[3 + axis] as usize),
+                )
+            };
+            let (o, inv) = (r.origin[axis], r.inv[axis]);
+            for i in 0..8 {
+                let a = (near[i] - o) * inv;
+                let b = (far[i] - o) * inv;
+                tn[i] = if a > tn[i] { a } else { tn[i] };
+                tf[i] = if b < tf[i] { b } else { tf[i] };
+            }
+        }
+        let mut mask = 0;
+        for i in 0..8 {
+            mask |= ((tn[i] <= tf[i]) as u32) << i;
+        }
+        (mask, tn)
+    }
+
+    #[inline(always)]
+    fn entry(&self, i: usize, t: f32) -> Entry {
+        Entry {
+            item: self.child[i],
+            count: self.count[i] as u32,
+            t,
+        }
     }
 }
 
@@ -388,9 +727,9 @@ mod tests {
             .collect()
     }
 
-    /// The wide node test culls exactly what obvhs' own does (every node, random rays,
-    /// random tmax), and the traversals built on it find the same closest hits and the same
-    /// blocked shadow rays.
+    /// The wide node test of a BVH of boxes culls exactly what obvhs' own does (every node,
+    /// random rays, random tmax), and the traversals built on it find the same closest hits
+    /// and the same blocked shadow rays.
     #[test]
     fn wide_traversal_matches_obvhs() {
         if !simd::available() {
@@ -399,7 +738,7 @@ mod tests {
         }
         let mut rng = Rng::new(&[3]);
         let prims = scene(&mut rng, 300);
-        let mut accel = Accel::build(prims);
+        let mut accel = Accel::build_boxes(prims);
         let bvh = accel.bvh.as_ref().unwrap();
         let mut masks = 0;
         for _ in 0..2000 {
@@ -452,6 +791,122 @@ mod tests {
             hits > 500 && blocked > 200 && blocked < 4900,
             "{hits} {blocked}"
         );
+    }
+
+    /// The nearest hit of `ray` among all of `prims`, by testing every one.
+    fn brute_force(prims: &[Primitive], ray: &Ray, tmax: f32) -> Option<f32> {
+        prims
+            .iter()
+            .filter_map(|p| p.shape.intersect(ray, tmax))
+            .min_by(|a, b| a.total_cmp(b))
+    }
+
+    /// Random rays, half of them starting just off a random primitive's surface (what
+    /// bounces and shadow rays do), a tenth of them along an axis.
+    fn rays_through(rng: &mut Rng, prims: &[Primitive], n: usize) -> Vec<(Ray, f32)> {
+        (0..n)
+            .map(|k| {
+                let mut d = uniform_sphere(rng.next_2d());
+                if k % 10 == 0 {
+                    d = [Vec3::X, -Vec3::Y, Vec3::Z][k % 3];
+                }
+                let o = if k % 2 == 0 {
+                    Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0
+                } else {
+                    let prim = &prims[(rng.next_f32() * prims.len() as f32) as usize % prims.len()];
+                    let (p, n) = prim.shape.sample_area(rng.next_2d());
+                    p + n * if rng.next_f32() < 0.5 { 2e-5 } else { -2e-5 }
+                };
+                let tmax = if rng.next_f32() < 0.5 {
+                    f32::INFINITY
+                } else {
+                    rng.next_f32() * 8.0
+                };
+                (Ray::new(o, d), tmax)
+            })
+            .collect()
+    }
+
+    /// The float nodes' traversals find what testing every primitive finds: the same
+    /// nearest distance, bit for bit, and the same blocked shadow rays, on trees of one node
+    /// and of several levels.
+    #[test]
+    fn float_traversal_matches_testing_every_primitive() {
+        let mut rng = Rng::new(&[5]);
+        for n in [1, 7, 40, 3000] {
+            let prims = scene(&mut rng, n);
+            let accel = Accel::build(prims.clone());
+            assert!(accel.wide() && !accel.nodes.is_empty());
+            let (mut hits, mut blocked) = (0, 0);
+            for (ray, tmax) in rays_through(&mut rng, &prims, 4000) {
+                let want = brute_force(&prims, &ray, tmax);
+                let got = accel.intersect(&ray, tmax);
+                assert_eq!(
+                    got.map(|h| h.t.to_bits()),
+                    want.map(f32::to_bits),
+                    "{n} primitives, {ray:?} up to {tmax}"
+                );
+                if let Some(h) = got {
+                    let shape = &accel.primitives()[h.prim as usize].shape;
+                    assert_eq!(
+                        shape.intersect(&ray, tmax),
+                        Some(h.t),
+                        "the hit's primitive"
+                    );
+                    hits += 1;
+                }
+                let occluded = accel.occluded(&ray, tmax, |_| true);
+                assert_eq!(
+                    occluded,
+                    want.is_some(),
+                    "{n} primitives, shadow ray {ray:?}"
+                );
+                blocked += occluded as u32;
+                // A shadow ray that only the even primitives block.
+                let even = |p: &Primitive| p.object.is_multiple_of(2);
+                let want_even = prims
+                    .iter()
+                    .any(|p| even(p) && p.shape.intersect(&ray, tmax).is_some());
+                assert_eq!(accel.occluded(&ray, tmax, even), want_even);
+            }
+            assert!(
+                hits > 100 && blocked > 100,
+                "{n}: {hits} hits, {blocked} blocked"
+            );
+        }
+    }
+
+    /// A ray leaving a surface 2e-5 from another one (the crease of a floor and a wall, a
+    /// sphere resting on the floor) hits it: obvhs' traversal starts its entry distances at
+    /// 1e-4 and let such rays through, light leaking along every crease.
+    #[test]
+    fn rays_spawned_beside_a_surface_hit_it() {
+        let floor = Shape::quad(Vec3::new(-1.0, 0.0, 1.0), Vec3::X * 2.0, -Vec3::Z * 2.0);
+        let wall = Shape::quad(Vec3::new(-1.0, 0.0, -1.0), Vec3::Y * 2.0, Vec3::Z * 2.0);
+        let ball = Shape::sphere(Vec3::new(0.3, 0.3, 0.0), 0.3);
+        let prims: Vec<Primitive> = [floor, wall, ball]
+            .into_iter()
+            .enumerate()
+            .map(|(i, shape)| Primitive {
+                shape,
+                object: i as u32,
+                attrs: crate::geometry::NO_ATTRS,
+            })
+            .collect();
+        let accel = Accel::build(prims);
+        for (o, d) in [
+            (Vec3::new(-0.9998, 2e-5, 0.1), Vec3::new(0.4, -0.9, -0.1)),
+            (Vec3::new(0.3, 2e-5, 0.01), Vec3::new(-0.3, -0.9, 0.2)),
+            (Vec3::new(-1.0 + 2e-5, 0.5, 0.2), Vec3::new(-0.8, 0.5, 0.3)),
+        ] {
+            let ray = Ray::new(o, d.normalize());
+            let hit = accel.intersect(&ray, f32::INFINITY);
+            assert!(
+                hit.is_some_and(|h| h.t < 1e-4),
+                "{ray:?} passes through the surface beside it: {hit:?}"
+            );
+            assert!(accel.occluded(&ray, 1.0, |_| true));
+        }
     }
 
     /// A direction with a -0.0 component (the axis directions written as `-Vec3::Y`, what

@@ -319,7 +319,7 @@ impl BeamMap {
             .enumerate()
             .map(|(id, p)| p.primitive(radius, id as u32))
             .collect();
-        let bvh = Accel::build(boxes);
+        let bvh = Accel::build_boxes(boxes);
         BeamMap {
             beams,
             pieces,

@@ -130,7 +130,7 @@ impl ScreenBeams {
             screen.insert(id as u32, pinhole.cube(c0, rho), pinhole.cube(c1, rho));
         }
         if !near.is_empty() {
-            screen.near = Some(Accel::build(near));
+            screen.near = Some(Accel::build_boxes(near));
         }
         screen
     }
@@ -460,7 +460,7 @@ mod tests {
 
     /// The map's own BVH (private to the map: rebuilt here from its pieces).
     fn map_bvh(map: &BeamMap) -> Accel {
-        Accel::build(
+        Accel::build_boxes(
             map.pieces
                 .iter()
                 .enumerate()
