@@ -353,7 +353,16 @@ impl Scene {
         if material.is_null() {
             return None;
         }
-        material.bsdf(&self.surface_point(hit, material.needs_coordinates()))
+        let prim = self.primitive(hit);
+        let attrs = self.triangle_attrs.get(prim.attrs as usize);
+        let coordinates = material.needs_coordinates();
+        // Most hits: no vertex normals, constant colours, an isotropic lobe. The surface point
+        // would be the hit's normal and a zero tangent (`Shape::surface_at`), which
+        // `flat_bsdf` takes as known.
+        if !coordinates && attrs.is_none_or(|a| a.normals.is_none()) {
+            return material.flat_bsdf(hit.ng);
+        }
+        material.bsdf(&prim.shape.surface_at(hit.p, hit.ng, attrs, coordinates))
     }
 
     /// The area light a hit lies on, if its object emits.
