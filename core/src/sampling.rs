@@ -21,13 +21,33 @@ pub struct Rng {
     inc: u64,
 }
 
+/// The hash [`Rng::new`] starts its keys from.
+const RNG_KEYS_START: u64 = 0x2545_F491_4F6C_DD1D;
+
+/// The hash of `keys` after `h` (what [`Rng::new`] hashes its keys with, from
+/// [`RNG_KEYS_START`]): keys hashed in two parts give the hash of them all.
+#[inline]
+fn hash_keys(mut h: u64, keys: &[u64]) -> u64 {
+    for &k in keys {
+        h = splitmix64(h ^ k);
+    }
+    h
+}
+
 impl Rng {
     /// A stream determined by a tuple of keys, e.g. (seed, pixel, sample).
+    #[inline]
     pub fn new(keys: &[u64]) -> Self {
-        let mut h = 0x2545_F491_4F6C_DD1Du64;
-        for &k in keys {
-            h = splitmix64(h ^ k);
-        }
+        Rng::from_hash(hash_keys(RNG_KEYS_START, keys))
+    }
+
+    /// A stream that is never drawn from (a `sobol` sampler's: its points are hashes of the
+    /// pixel key and the sample index alone).
+    const UNUSED: Rng = Rng { state: 0, inc: 1 };
+
+    /// The stream of the keys whose hash is `h` ([`hash_keys`]).
+    #[inline]
+    fn from_hash(h: u64) -> Self {
         let mut rng = Rng {
             state: 0,
             inc: (splitmix64(h ^ 0xDA3E_39CB_94B9_5BDB) << 1) | 1,
@@ -133,9 +153,11 @@ pub struct Sampler {
 impl Sampler {
     /// Sample `index` of `spp` of `pixel` (any number that names the pixel, e.g. y width + x).
     /// With `Independent` the numbers are those of `Rng::new(&[seed, pixel, index])`.
+    /// (A loop over the samples of one pixel makes them with [`PixelSamplers`], which hashes
+    /// the seed and the pixel once.)
     #[inline]
     pub fn new(kind: SamplerKind, seed: u64, pixel: u64, index: u32, spp: u32) -> Sampler {
-        Sampler::with_keys(kind, &[seed, pixel, index as u64], seed, pixel, index, spp)
+        PixelSamplers::new(kind, seed, pixel, spp).sample(index)
     }
 
     /// As [`Sampler::new`], with the independent stream keyed by `keys` (integrators that
@@ -150,6 +172,17 @@ impl Sampler {
         index: u32,
         spp: u32,
     ) -> Sampler {
+        let rng = if kind == SamplerKind::Sobol {
+            Rng::UNUSED
+        } else {
+            Rng::new(keys)
+        };
+        Sampler::from_parts(kind, rng, pixel_key(kind, seed, pixel), index, spp)
+    }
+
+    /// The sampler of sample `index` with its stream and pixel key made.
+    #[inline]
+    fn from_parts(kind: SamplerKind, rng: Rng, pixel_key: u64, index: u32, spp: u32) -> Sampler {
         Sampler {
             kind,
             request: match kind {
@@ -157,13 +190,8 @@ impl Sampler {
                 SamplerKind::Sobol => Request::Sobol,
                 SamplerKind::Stratified { .. } => Request::Stratified,
             },
-            rng: Rng::new(keys),
-            // Not needed by the independent stream, whose samples should cost what they did.
-            pixel_key: if kind == SamplerKind::Independent {
-                0
-            } else {
-                splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
-            },
+            rng,
+            pixel_key,
             index,
             index_reversed: index.reverse_bits(),
             spp: spp.max(1),
@@ -274,6 +302,58 @@ impl Sampler {
             ((sx as f32 + jx) / nx as f32).min(ONE_MINUS_EPSILON),
             ((sy as f32 + jy) / ny as f32).min(ONE_MINUS_EPSILON),
         )
+    }
+}
+
+/// A sampler's pixel key: the hash of (seed, pixel) that decorrelates the patterns of
+/// neighbouring pixels. Not needed by the independent stream, whose samples should cost what
+/// they did.
+#[inline]
+fn pixel_key(kind: SamplerKind, seed: u64, pixel: u64) -> u64 {
+    if kind == SamplerKind::Independent {
+        0
+    } else {
+        splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
+    }
+}
+
+/// What the samplers of one pixel share: the hashes of the seed and the pixel (the pixel key,
+/// and the independent stream's keys before the sample index), made once for all the pixel's
+/// samples. [`PixelSamplers::sample`] gives the sampler [`Sampler::new`] gives.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelSamplers {
+    kind: SamplerKind,
+    /// `Rng::new`'s hash of (seed, pixel), before the sample index (not for `sobol`).
+    keys_hash: u64,
+    pixel_key: u64,
+    spp: u32,
+}
+
+impl PixelSamplers {
+    /// The samplers of `pixel` (as in [`Sampler::new`]).
+    #[inline]
+    pub fn new(kind: SamplerKind, seed: u64, pixel: u64, spp: u32) -> PixelSamplers {
+        PixelSamplers {
+            kind,
+            keys_hash: if kind == SamplerKind::Sobol {
+                0
+            } else {
+                hash_keys(RNG_KEYS_START, &[seed, pixel])
+            },
+            pixel_key: pixel_key(kind, seed, pixel),
+            spp,
+        }
+    }
+
+    /// The sampler of the pixel's sample `index`: `Sampler::new(kind, seed, pixel, index, spp)`.
+    #[inline]
+    pub fn sample(&self, index: u32) -> Sampler {
+        let rng = if self.kind == SamplerKind::Sobol {
+            Rng::UNUSED
+        } else {
+            Rng::from_hash(hash_keys(self.keys_hash, &[index as u64]))
+        };
+        Sampler::from_parts(self.kind, rng, self.pixel_key, index, self.spp)
     }
 }
 
@@ -1072,6 +1152,34 @@ mod tests {
                 .sample(Vec2::splat(0.5))
                 .is_none()
         );
+    }
+
+    /// A pixel's samplers made once per pixel draw what each sample's sampler keyed by
+    /// (seed, pixel, index) draws, for every kind.
+    #[test]
+    fn pixel_samplers_draw_what_keyed_samplers_draw() {
+        for kind in [
+            SamplerKind::Independent,
+            SamplerKind::Stratified { jitter: true },
+            SamplerKind::Stratified { jitter: false },
+            SamplerKind::Sobol,
+        ] {
+            for (seed, pixel) in [(0u64, 0u64), (7, 12345), (u64::MAX, 65535)] {
+                let pixel_samplers = PixelSamplers::new(kind, seed, pixel, 16);
+                for index in [0u32, 1, 5, 15, 16, 40] {
+                    let keys = [seed, pixel, index as u64];
+                    let mut a = pixel_samplers.sample(index);
+                    let mut b = Sampler::with_keys(kind, &keys, seed, pixel, index, 16);
+                    for d in 0..40 {
+                        if d % 3 == 0 {
+                            assert_eq!(a.next_2d(), b.next_2d(), "{kind:?} {index} {d}");
+                        } else {
+                            assert_eq!(a.next_f32(), b.next_f32(), "{kind:?} {index} {d}");
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]
