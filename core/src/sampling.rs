@@ -142,11 +142,16 @@ pub struct Sampler {
     index_reversed: u32,
     /// Samples the pixel takes in all (strata per dimension).
     spp: u32,
-    /// The next dimension to hand out.
+    /// The next dimension to hand out (`stratified`; `sobol` counts in blocks).
     dimension: u32,
     /// `sobol`: the points of dimensions `block_start..block_start + SOBOL_BLOCK`, computed
-    /// together ([`sobol_block`]); before the first block, `NO_BLOCK`, far from every dimension.
+    /// together ([`sobol_block`]); before the first block, `0 - SOBOL_BLOCK` (the first block
+    /// starts `SOBOL_BLOCK` past it).
     block_start: u32,
+    /// `sobol`: the place in `block` of the next dimension to hand out (`SOBOL_BLOCK`: the
+    /// next block is to be computed). Requests come in order, so the next dimension is
+    /// `block_start + block_pos`: one counter moved on per request.
+    block_pos: u32,
     block: SobolBlock,
 }
 
@@ -196,7 +201,8 @@ impl Sampler {
             index_reversed: index.reverse_bits(),
             spp: spp.max(1),
             dimension: 0,
-            block_start: NO_BLOCK,
+            block_start: 0u32.wrapping_sub(SOBOL_BLOCK as u32),
+            block_pos: SOBOL_BLOCK as u32,
             block: SobolBlock::EMPTY,
         }
     }
@@ -259,20 +265,25 @@ impl Sampler {
     /// that holds it, computed when the block's first dimension is asked for.
     #[inline(always)]
     fn sobol_point(&mut self) -> (f32, f32) {
-        let d = self.dimension;
-        self.dimension += 1;
-        let mut k = d.wrapping_sub(self.block_start);
+        let mut k = self.block_pos;
         if k >= SOBOL_BLOCK as u32 {
-            self.next_sobol_block(d);
+            self.next_sobol_block();
             k = 0;
         }
+        self.block_pos = k + 1;
         (self.block.x[k as usize], self.block.y[k as usize])
     }
 
+    /// Computes the block after the current one (the first block, before any).
     #[inline(never)]
-    fn next_sobol_block(&mut self, first: u32) {
-        self.block_start = first;
-        sobol_block(self.pixel_key, self.index_reversed, first, &mut self.block);
+    fn next_sobol_block(&mut self) {
+        self.block_start = self.block_start.wrapping_add(SOBOL_BLOCK as u32);
+        sobol_block(
+            self.pixel_key,
+            self.index_reversed,
+            self.block_start,
+            &mut self.block,
+        );
     }
 
     fn next_1d_stratified(&mut self) -> f32 {
@@ -372,10 +383,6 @@ enum Request {
 
 /// Dimensions of a `sobol` sampler computed together ([`sobol_block`]).
 pub const SOBOL_BLOCK: usize = 8;
-
-/// A sampler's `block_start` before its first block: no dimension d has
-/// `d - NO_BLOCK` (wrapping) below [`SOBOL_BLOCK`].
-const NO_BLOCK: u32 = 1 << 31;
 
 /// The points of [`SOBOL_BLOCK`] consecutive dimensions of one `sobol` sample: `x` is a 1-D
 /// request's value and a 2-D request's first coordinate, `y` the second.
