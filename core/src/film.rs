@@ -31,6 +31,13 @@ const FRACTION_BITS: i32 = 64;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RadianceSum(pub [i128; 3]);
 
+/// `a.saturating_add(b)` where the sum overflows (out of line: sums of radiance never get there).
+#[cold]
+#[inline(never)]
+fn saturated(a: i128, b: i128) -> i128 {
+    a.saturating_add(b)
+}
+
 impl RadianceSum {
     pub const ZERO: RadianceSum = RadianceSum([0; 3]);
 
@@ -79,7 +86,13 @@ impl RadianceSum {
     #[inline]
     pub fn add(&mut self, radiance: Rgb) {
         for (s, x) in self.0.iter_mut().zip([radiance.x, radiance.y, radiance.z]) {
-            *s = s.saturating_add(Self::fixed_f32(x));
+            let v = Self::fixed_f32(x);
+            // `saturating_add`, its saturation out of line: an add with carry and a branch on
+            // overflow per channel, where the saturating form selects on every add.
+            *s = match s.checked_add(v) {
+                Some(sum) => sum,
+                None => saturated(*s, v),
+            };
         }
     }
 
@@ -475,6 +488,18 @@ pub fn check_output(path: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Sums saturate at the ends of the range, as `saturating_add` made them.
+    #[test]
+    fn radiance_sums_saturate() {
+        let mut sum = RadianceSum([i128::MAX - 5, i128::MIN + 5, 7]);
+        sum.add(Rgb::new(1.0, -1.0, 2.0));
+        assert_eq!(sum.0[0], i128::MAX);
+        assert_eq!(sum.0[1], i128::MIN);
+        assert_eq!(sum.0[2], 7 + (2i128 << 64));
+        sum.add(Rgb::new(f32::MAX, 0.0, 0.0));
+        assert_eq!(sum.0[0], i128::MAX);
+    }
 
     /// The f32 conversion from the bits gives the f64 conversion's value for every kind of
     /// f32: zeros, subnormals, the whole exponent range around both ends of the fast path,
