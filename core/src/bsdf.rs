@@ -400,20 +400,44 @@ impl Bsdf {
     /// shading-normal correction (module comment).
     #[inline]
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<BsdfSample> {
-        // The diffuse lobe reads only wo's cosine (see `Bsdf::cosines`).
-        let mut local_wo = if let Lobe::Diffuse { .. } = self.lobe {
-            Vec3::new(0.0, 0.0, wo.dot(self.frame.n))
+        let s = if let Lobe::Diffuse {
+            reflectance,
+            twosided,
+        } = self.lobe
+        {
+            // The diffuse lobe reads only wo's cosine (see `Bsdf::cosines`): `Lobe::sample`'s
+            // diffuse case with the two-sided mirroring folded in. Black from below a
+            // one-sided lobe; the cosine-weighted direction is taken to wo's side.
+            let cos_o = wo.dot(self.frame.n);
+            if cos_o == 0.0 || (cos_o < 0.0 && !(twosided || self.twosided)) {
+                return None;
+            }
+            let mut wi = cosine_hemisphere(u);
+            if wi.z <= 0.0 {
+                return None;
+            }
+            let pdf = wi.z * FRAC_1_PI;
+            if cos_o < 0.0 {
+                wi.z = -wi.z;
+            }
+            LocalSample {
+                wi,
+                weight: reflectance,
+                pdf,
+                delta: false,
+            }
         } else {
-            self.frame.to_local(wo)
+            let mut local_wo = self.frame.to_local(wo);
+            let below = self.twosided && local_wo.z < 0.0;
+            if below {
+                local_wo.z = -local_wo.z;
+            }
+            let mut s = self.lobe.sample(local_wo, u, uc, mode)?;
+            if below {
+                s.wi.z = -s.wi.z;
+            }
+            s
         };
-        let below = self.twosided && local_wo.z < 0.0;
-        if below {
-            local_wo.z = -local_wo.z;
-        }
-        let mut s = self.lobe.sample(local_wo, u, uc, mode)?;
-        if below {
-            s.wi.z = -s.wi.z;
-        }
         let wi = self.frame.to_world(s.wi);
         let mut weight = s.weight;
         if mode == TransportMode::Importance && self.frame.n != self.ng {

@@ -31,6 +31,13 @@ const FRACTION_BITS: i32 = 64;
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RadianceSum(pub [i128; 3]);
 
+/// `a.saturating_add(b)` where the sum overflows (out of line: sums of radiance never get there).
+#[cold]
+#[inline(never)]
+fn saturated(a: i128, b: i128) -> i128 {
+    a.saturating_add(b)
+}
+
 impl RadianceSum {
     pub const ZERO: RadianceSum = RadianceSum([0; 3]);
 
@@ -51,9 +58,42 @@ impl RadianceSum {
         }
     }
 
+    /// [`RadianceSum::fixed`] of an f32, from its bits: below 2^63 (non-negative) the value is
+    /// m 2^(e - 150) with m its 24-bit significand and e its biased exponent (1 for a
+    /// subnormal), so its fixed-point value, floor(x 2^64), is m shifted by e - 86 places
+    /// (left up to 103 places, or right, where the bits shifted out are the truncation). The
+    /// same value as the conversion through f64 (unit test `fixed_f32_matches_fixed`) in about
+    /// a third of its instructions (its saturating conversions and the unsigned 64-bit one,
+    /// which x86 lacks): three per camera sample. Negative values and from 2^63 on: `fixed`.
+    #[inline]
+    fn fixed_f32(x: f32) -> i128 {
+        let bits = x.to_bits();
+        // Sign bit clear, biased exponent below 127 + 63.
+        if bits >= 190 << 23 {
+            return Self::fixed(x as f64);
+        }
+        let exponent = bits >> 23;
+        let significand = (bits & 0x7F_FFFF) | ((exponent > 0) as u32) << 23;
+        let shift = exponent.max(1) as i32 - 86;
+        if shift >= 0 {
+            (significand as i128) << shift
+        } else {
+            // Right by 24 places or more leaves nothing.
+            (significand as u64 >> (-shift).min(63)) as i128
+        }
+    }
+
     #[inline]
     pub fn add(&mut self, radiance: Rgb) {
-        self.add_f64([radiance.x as f64, radiance.y as f64, radiance.z as f64]);
+        for (s, x) in self.0.iter_mut().zip([radiance.x, radiance.y, radiance.z]) {
+            let v = Self::fixed_f32(x);
+            // `saturating_add`, its saturation out of line: an add with carry and a branch on
+            // overflow per channel, where the saturating form selects on every add.
+            *s = match s.checked_add(v) {
+                Some(sum) => sum,
+                None => saturated(*s, v),
+            };
+        }
     }
 
     #[inline]
@@ -448,6 +488,61 @@ pub fn check_output(path: &Path) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Sums saturate at the ends of the range, as `saturating_add` made them.
+    #[test]
+    fn radiance_sums_saturate() {
+        let mut sum = RadianceSum([i128::MAX - 5, i128::MIN + 5, 7]);
+        sum.add(Rgb::new(1.0, -1.0, 2.0));
+        assert_eq!(sum.0[0], i128::MAX);
+        assert_eq!(sum.0[1], i128::MIN);
+        assert_eq!(sum.0[2], 7 + (2i128 << 64));
+        sum.add(Rgb::new(f32::MAX, 0.0, 0.0));
+        assert_eq!(sum.0[0], i128::MAX);
+    }
+
+    /// The f32 conversion from the bits gives the f64 conversion's value for every kind of
+    /// f32: zeros, subnormals, the whole exponent range around both ends of the fast path,
+    /// negative values, infinities and NaN (what `add` took before).
+    #[test]
+    fn fixed_f32_matches_fixed() {
+        let mut rng = crate::sampling::Rng::new(&[11]);
+        let mut values = vec![
+            0.0f32,
+            -0.0,
+            f32::MIN_POSITIVE,
+            f32::from_bits(1),
+            f32::from_bits(0x7F_FFFF),
+            1.0,
+            0.5,
+            9.0e18,
+            9.3e18,
+            2f32.powi(63),
+            f32::from_bits(2f32.powi(63).to_bits() - 1),
+            f32::MAX,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+            -1.0,
+            -1e-30,
+            2f32.powi(-64),
+            2f32.powi(-65),
+            1.5 * 2f32.powi(-64),
+        ];
+        for _ in 0..200_000 {
+            values.push(f32::from_bits(rng.next_u32()));
+            // Mostly the range radiance lives in.
+            values.push(rng.next_f32() * 2f32.powi((rng.next_u32() % 80) as i32 - 40));
+        }
+        for x in values {
+            assert_eq!(
+                RadianceSum::fixed_f32(x),
+                RadianceSum::fixed(x as f64),
+                "{x:e} ({:#x})",
+                x.to_bits()
+            );
+        }
+    }
 
     #[test]
     fn filmic_is_its_formula_monotonic_and_bounded() {

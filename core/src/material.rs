@@ -7,7 +7,7 @@ use crate::bsdf::{Bsdf, Frame, Lobe};
 use crate::geometry::SurfacePoint;
 use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
 use crate::texture::Texture;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 pub use crate::scattering::{
     TransportMode, fresnel_conductor, fresnel_dielectric, reflect, refract,
@@ -331,12 +331,37 @@ impl Material {
     /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
     #[inline]
     pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
+        // Without a tangent (not needed, or none), any frame: isotropic lobes do not care.
+        let frame = || {
+            if sp.dpdu == Vec3::ZERO {
+                Frame::from_normal(sp.ns)
+            } else {
+                Frame::from_normal_tangent(sp.ns, sp.dpdu)
+            }
+        };
+        self.bsdf_in(sp.uv, sp.ng, frame)
+    }
+
+    /// The BSDF at a point of a flat surface whose material needs no texture coordinates and
+    /// no tangent ([`Material::needs_coordinates`] false): the shading normal is the
+    /// geometric one `ng`, and the frame any frame around it, as [`Material::bsdf`] makes it
+    /// for such a point. (The scene's hit queries call this where they can: the frame is then
+    /// built without testing a tangent that is known to be zero.)
+    #[inline]
+    pub fn flat_bsdf(&self, ng: Vec3) -> Option<Bsdf> {
+        self.bsdf_in(Vec2::ZERO, ng, || Frame::from_normal(ng))
+    }
+
+    /// The BSDF with its textures looked up at `uv`, the geometric normal `ng`, and the
+    /// shading frame `frame` makes (not made for the null material).
+    #[inline(always)]
+    fn bsdf_in(&self, uv: Vec2, ng: Vec3, frame: impl FnOnce() -> Frame) -> Option<Bsdf> {
         // Constant colours without the call: `Texture::eval` is too large to be inlined, and
         // most colours of most scenes are constants (a call per colour per hit cost about 1%
         // of the path tracer's instructions on the Cornell box).
         let at = |t: &Texture| match t {
             Texture::Constant(c) => *c,
-            _ => t.eval(sp.uv),
+            _ => t.eval(uv),
         };
         let lobe = match self {
             Material::Diffuse {
@@ -408,13 +433,8 @@ impl Material {
         };
         Some(Bsdf {
             lobe,
-            // Without a tangent (not needed, or none), any frame: isotropic lobes do not care.
-            frame: if sp.dpdu == Vec3::ZERO {
-                Frame::from_normal(sp.ns)
-            } else {
-                Frame::from_normal_tangent(sp.ns, sp.dpdu)
-            },
-            ng: sp.ng,
+            frame: frame(),
+            ng,
             twosided,
         })
     }

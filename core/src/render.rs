@@ -24,7 +24,7 @@ use crate::error::{Error, Result};
 use crate::film::{Film, RadianceSum};
 use crate::geometry::Ray;
 use crate::integrator::RenderContext;
-use crate::sampling::Sampler;
+use crate::sampling::{PixelSamplers, Sampler};
 use crate::scene::{RenderSettings, Scene};
 use glam::Vec2;
 use rayon::prelude::*;
@@ -53,8 +53,15 @@ pub fn pixel_sampler(
     y: u32,
     sample: u32,
 ) -> Sampler {
+    pixel_samplers(settings, width, x, y).sample(sample)
+}
+
+/// The samplers of pixel (x, y)'s camera samples ([`pixel_sampler`] of each), the hashes of
+/// the seed and the pixel made once.
+#[inline]
+pub fn pixel_samplers(settings: &RenderSettings, width: u32, x: u32, y: u32) -> PixelSamplers {
     let pixel = (y as u64) * width as u64 + x as u64;
-    Sampler::new(settings.sampler, settings.seed, pixel, sample, settings.spp)
+    PixelSamplers::new(settings.sampler, settings.seed, pixel, settings.spp)
 }
 
 /// One camera sample as the pixel loop draws it.
@@ -200,8 +207,9 @@ where
                         }
                         for x in x0..(x0 + TILE).min(width) {
                             let mut sum = RadianceSum::ZERO;
+                            let samplers = pixel_samplers(&scene.render, width, x, y);
                             for s in s0..s1 {
-                                let mut sampler = pixel_sampler(&scene.render, width, x, y, s);
+                                let mut sampler = samplers.sample(s);
                                 let at = filter.film_position(x, y, sampler.next_2d());
                                 let sample = PixelSample {
                                     ray: scene.camera.generate_ray(at),

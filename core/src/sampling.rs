@@ -21,13 +21,33 @@ pub struct Rng {
     inc: u64,
 }
 
+/// The hash [`Rng::new`] starts its keys from.
+const RNG_KEYS_START: u64 = 0x2545_F491_4F6C_DD1D;
+
+/// The hash of `keys` after `h` (what [`Rng::new`] hashes its keys with, from
+/// [`RNG_KEYS_START`]): keys hashed in two parts give the hash of them all.
+#[inline]
+fn hash_keys(mut h: u64, keys: &[u64]) -> u64 {
+    for &k in keys {
+        h = splitmix64(h ^ k);
+    }
+    h
+}
+
 impl Rng {
     /// A stream determined by a tuple of keys, e.g. (seed, pixel, sample).
+    #[inline]
     pub fn new(keys: &[u64]) -> Self {
-        let mut h = 0x2545_F491_4F6C_DD1Du64;
-        for &k in keys {
-            h = splitmix64(h ^ k);
-        }
+        Rng::from_hash(hash_keys(RNG_KEYS_START, keys))
+    }
+
+    /// A stream that is never drawn from (a `sobol` sampler's: its points are hashes of the
+    /// pixel key and the sample index alone).
+    const UNUSED: Rng = Rng { state: 0, inc: 1 };
+
+    /// The stream of the keys whose hash is `h` ([`hash_keys`]).
+    #[inline]
+    fn from_hash(h: u64) -> Self {
         let mut rng = Rng {
             state: 0,
             inc: (splitmix64(h ^ 0xDA3E_39CB_94B9_5BDB) << 1) | 1,
@@ -122,20 +142,27 @@ pub struct Sampler {
     index_reversed: u32,
     /// Samples the pixel takes in all (strata per dimension).
     spp: u32,
-    /// The next dimension to hand out.
+    /// The next dimension to hand out (`stratified`; `sobol` counts in blocks).
     dimension: u32,
     /// `sobol`: the points of dimensions `block_start..block_start + SOBOL_BLOCK`, computed
-    /// together ([`sobol_block`]); before the first block, `NO_BLOCK`, far from every dimension.
+    /// together ([`sobol_block`]); before the first block, `0 - SOBOL_BLOCK` (the first block
+    /// starts `SOBOL_BLOCK` past it).
     block_start: u32,
+    /// `sobol`: the place in `block` of the next dimension to hand out (`SOBOL_BLOCK`: the
+    /// next block is to be computed). Requests come in order, so the next dimension is
+    /// `block_start + block_pos`: one counter moved on per request.
+    block_pos: u32,
     block: SobolBlock,
 }
 
 impl Sampler {
     /// Sample `index` of `spp` of `pixel` (any number that names the pixel, e.g. y width + x).
     /// With `Independent` the numbers are those of `Rng::new(&[seed, pixel, index])`.
+    /// (A loop over the samples of one pixel makes them with [`PixelSamplers`], which hashes
+    /// the seed and the pixel once.)
     #[inline]
     pub fn new(kind: SamplerKind, seed: u64, pixel: u64, index: u32, spp: u32) -> Sampler {
-        Sampler::with_keys(kind, &[seed, pixel, index as u64], seed, pixel, index, spp)
+        PixelSamplers::new(kind, seed, pixel, spp).sample(index)
     }
 
     /// As [`Sampler::new`], with the independent stream keyed by `keys` (integrators that
@@ -150,6 +177,17 @@ impl Sampler {
         index: u32,
         spp: u32,
     ) -> Sampler {
+        let rng = if kind == SamplerKind::Sobol {
+            Rng::UNUSED
+        } else {
+            Rng::new(keys)
+        };
+        Sampler::from_parts(kind, rng, pixel_key(kind, seed, pixel), index, spp)
+    }
+
+    /// The sampler of sample `index` with its stream and pixel key made.
+    #[inline]
+    fn from_parts(kind: SamplerKind, rng: Rng, pixel_key: u64, index: u32, spp: u32) -> Sampler {
         Sampler {
             kind,
             request: match kind {
@@ -157,18 +195,14 @@ impl Sampler {
                 SamplerKind::Sobol => Request::Sobol,
                 SamplerKind::Stratified { .. } => Request::Stratified,
             },
-            rng: Rng::new(keys),
-            // Not needed by the independent stream, whose samples should cost what they did.
-            pixel_key: if kind == SamplerKind::Independent {
-                0
-            } else {
-                splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
-            },
+            rng,
+            pixel_key,
             index,
             index_reversed: index.reverse_bits(),
             spp: spp.max(1),
             dimension: 0,
-            block_start: NO_BLOCK,
+            block_start: 0u32.wrapping_sub(SOBOL_BLOCK as u32),
+            block_pos: SOBOL_BLOCK as u32,
             block: SobolBlock::EMPTY,
         }
     }
@@ -231,20 +265,25 @@ impl Sampler {
     /// that holds it, computed when the block's first dimension is asked for.
     #[inline(always)]
     fn sobol_point(&mut self) -> (f32, f32) {
-        let d = self.dimension;
-        self.dimension += 1;
-        let mut k = d.wrapping_sub(self.block_start);
+        let mut k = self.block_pos;
         if k >= SOBOL_BLOCK as u32 {
-            self.next_sobol_block(d);
+            self.next_sobol_block();
             k = 0;
         }
+        self.block_pos = k + 1;
         (self.block.x[k as usize], self.block.y[k as usize])
     }
 
+    /// Computes the block after the current one (the first block, before any).
     #[inline(never)]
-    fn next_sobol_block(&mut self, first: u32) {
-        self.block_start = first;
-        sobol_block(self.pixel_key, self.index_reversed, first, &mut self.block);
+    fn next_sobol_block(&mut self) {
+        self.block_start = self.block_start.wrapping_add(SOBOL_BLOCK as u32);
+        sobol_block(
+            self.pixel_key,
+            self.index_reversed,
+            self.block_start,
+            &mut self.block,
+        );
     }
 
     fn next_1d_stratified(&mut self) -> f32 {
@@ -277,6 +316,58 @@ impl Sampler {
     }
 }
 
+/// A sampler's pixel key: the hash of (seed, pixel) that decorrelates the patterns of
+/// neighbouring pixels. Not needed by the independent stream, whose samples should cost what
+/// they did.
+#[inline]
+fn pixel_key(kind: SamplerKind, seed: u64, pixel: u64) -> u64 {
+    if kind == SamplerKind::Independent {
+        0
+    } else {
+        splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
+    }
+}
+
+/// What the samplers of one pixel share: the hashes of the seed and the pixel (the pixel key,
+/// and the independent stream's keys before the sample index), made once for all the pixel's
+/// samples. [`PixelSamplers::sample`] gives the sampler [`Sampler::new`] gives.
+#[derive(Clone, Copy, Debug)]
+pub struct PixelSamplers {
+    kind: SamplerKind,
+    /// `Rng::new`'s hash of (seed, pixel), before the sample index (not for `sobol`).
+    keys_hash: u64,
+    pixel_key: u64,
+    spp: u32,
+}
+
+impl PixelSamplers {
+    /// The samplers of `pixel` (as in [`Sampler::new`]).
+    #[inline]
+    pub fn new(kind: SamplerKind, seed: u64, pixel: u64, spp: u32) -> PixelSamplers {
+        PixelSamplers {
+            kind,
+            keys_hash: if kind == SamplerKind::Sobol {
+                0
+            } else {
+                hash_keys(RNG_KEYS_START, &[seed, pixel])
+            },
+            pixel_key: pixel_key(kind, seed, pixel),
+            spp,
+        }
+    }
+
+    /// The sampler of the pixel's sample `index`: `Sampler::new(kind, seed, pixel, index, spp)`.
+    #[inline]
+    pub fn sample(&self, index: u32) -> Sampler {
+        let rng = if self.kind == SamplerKind::Sobol {
+            Rng::UNUSED
+        } else {
+            Rng::from_hash(hash_keys(self.keys_hash, &[index as u64]))
+        };
+        Sampler::from_parts(self.kind, rng, self.pixel_key, index, self.spp)
+    }
+}
+
 /// How a [`Sampler`]'s requests are answered: [`SamplerKind`] without `stratified`'s payload.
 /// `SamplerKind` keeps its `jitter` in the byte that tells the kinds apart, so a `match` on it
 /// in every request compiled to a chain of compares (about 7 instructions a request on the
@@ -292,10 +383,6 @@ enum Request {
 
 /// Dimensions of a `sobol` sampler computed together ([`sobol_block`]).
 pub const SOBOL_BLOCK: usize = 8;
-
-/// A sampler's `block_start` before its first block: no dimension d has
-/// `d - NO_BLOCK` (wrapping) below [`SOBOL_BLOCK`].
-const NO_BLOCK: u32 = 1 << 31;
 
 /// The points of [`SOBOL_BLOCK`] consecutive dimensions of one `sobol` sample: `x` is a 1-D
 /// request's value and a 2-D request's first coordinate, `y` the second.
@@ -1072,6 +1159,34 @@ mod tests {
                 .sample(Vec2::splat(0.5))
                 .is_none()
         );
+    }
+
+    /// A pixel's samplers made once per pixel draw what each sample's sampler keyed by
+    /// (seed, pixel, index) draws, for every kind.
+    #[test]
+    fn pixel_samplers_draw_what_keyed_samplers_draw() {
+        for kind in [
+            SamplerKind::Independent,
+            SamplerKind::Stratified { jitter: true },
+            SamplerKind::Stratified { jitter: false },
+            SamplerKind::Sobol,
+        ] {
+            for (seed, pixel) in [(0u64, 0u64), (7, 12345), (u64::MAX, 65535)] {
+                let pixel_samplers = PixelSamplers::new(kind, seed, pixel, 16);
+                for index in [0u32, 1, 5, 15, 16, 40] {
+                    let keys = [seed, pixel, index as u64];
+                    let mut a = pixel_samplers.sample(index);
+                    let mut b = Sampler::with_keys(kind, &keys, seed, pixel, index, 16);
+                    for d in 0..40 {
+                        if d % 3 == 0 {
+                            assert_eq!(a.next_2d(), b.next_2d(), "{kind:?} {index} {d}");
+                        } else {
+                            assert_eq!(a.next_f32(), b.next_f32(), "{kind:?} {index} {d}");
+                        }
+                    }
+                }
+            }
+        }
     }
 
     #[test]

@@ -12,7 +12,7 @@ use volumes::Volume;
 
 use crate::Rgb;
 use crate::accel::Accel;
-use crate::bsdf::Bsdf;
+use crate::bsdf::{Bsdf, Frame, Lobe};
 use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::film::{DisplayTransform, ToneMap};
@@ -23,6 +23,7 @@ use crate::medium::Medium;
 use crate::props::Properties;
 use crate::props::Unused;
 use crate::sampling::Distribution1D;
+use crate::texture::Texture;
 use crate::value::{Document, Value};
 use glam::Vec3;
 use std::path::PathBuf;
@@ -353,7 +354,36 @@ impl Scene {
         if material.is_null() {
             return None;
         }
-        material.bsdf(&self.surface_point(hit, material.needs_coordinates()))
+        let prim = self.primitive(hit);
+        let attrs = self.triangle_attrs.get(prim.attrs as usize);
+        let flat = attrs.is_none_or(|a| a.normals.is_none());
+        // The most common surface of all, a constant diffuse colour, tested for first: the
+        // general case below tests the material's kind twice (for its coordinates and for
+        // its lobe), each a jump table.
+        if flat
+            && let Material::Diffuse {
+                reflectance: Texture::Constant(reflectance),
+                twosided,
+            } = *material
+        {
+            return Some(Bsdf {
+                lobe: Lobe::Diffuse {
+                    reflectance,
+                    twosided,
+                },
+                frame: Frame::from_normal(hit.ng),
+                ng: hit.ng,
+                twosided: false,
+            });
+        }
+        let coordinates = material.needs_coordinates();
+        // Most hits: no vertex normals, constant colours, an isotropic lobe. The surface point
+        // would be the hit's normal and a zero tangent (`Shape::surface_at`), which
+        // `flat_bsdf` takes as known.
+        if !coordinates && flat {
+            return material.flat_bsdf(hit.ng);
+        }
+        material.bsdf(&prim.shape.surface_at(hit.p, hit.ng, attrs, coordinates))
     }
 
     /// The area light a hit lies on, if its object emits.
