@@ -202,20 +202,7 @@ impl Lobe {
                 if !twosided && cos_o < 0.0 {
                     return None;
                 }
-                let mut wi = cosine_hemisphere(u);
-                if wi.z <= 0.0 {
-                    return None;
-                }
-                let pdf = wi.z * FRAC_1_PI;
-                if cos_o < 0.0 {
-                    wi.z = -wi.z;
-                }
-                Some(LocalSample {
-                    wi,
-                    weight: reflectance,
-                    pdf,
-                    delta: false,
-                })
+                diffuse_sample(reflectance, cos_o, u)
             }
             Lobe::Mirror { reflectance } => delta(reflect_local(wo), reflectance, 1.0),
             Lobe::Conductor {
@@ -412,20 +399,7 @@ impl Bsdf {
             if cos_o == 0.0 || (cos_o < 0.0 && !(twosided || self.twosided)) {
                 return None;
             }
-            let mut wi = cosine_hemisphere(u);
-            if wi.z <= 0.0 {
-                return None;
-            }
-            let pdf = wi.z * FRAC_1_PI;
-            if cos_o < 0.0 {
-                wi.z = -wi.z;
-            }
-            LocalSample {
-                wi,
-                weight: reflectance,
-                pdf,
-                delta: false,
-            }
+            diffuse_sample(reflectance, cos_o, u)?
         } else {
             let mut local_wo = self.frame.to_local(wo);
             let below = self.twosided && local_wo.z < 0.0;
@@ -467,6 +441,26 @@ impl Bsdf {
         let (wo, _) = self.local(wo, wo);
         self.lobe.delta_probability(wo)
     }
+}
+
+/// A cosine-weighted direction of the diffuse lobe in local coordinates, on the side of wo
+/// (`cos_o`, not zero).
+#[inline(always)]
+fn diffuse_sample(reflectance: Rgb, cos_o: f32, u: Vec2) -> Option<LocalSample> {
+    let mut wi = cosine_hemisphere(u);
+    if wi.z <= 0.0 {
+        return None;
+    }
+    let pdf = wi.z * FRAC_1_PI;
+    if cos_o < 0.0 {
+        wi.z = -wi.z;
+    }
+    Some(LocalSample {
+        wi,
+        weight: reflectance,
+        pdf,
+        delta: false,
+    })
 }
 
 #[cfg(test)]
