@@ -1,6 +1,8 @@
 //! Computes the build identifier that plugins are checked against (see build_id.rs for what
 //! it covers and why), and the rustc version.
 
+#[path = "api_surface.rs"]
+mod api_surface;
 #[path = "build_id.rs"]
 mod build_id;
 
@@ -55,6 +57,11 @@ fn main() {
     let tag = variant.map_or(String::new(), |v| format!("+{v}"));
     println!("cargo:rustc-env=FOTON_BUILD_ID={id:016x}-{assertions}{tag}");
     println!("cargo:rustc-env=FOTON_RUSTC_VERSION={rustc_version}");
+    let surface = api_surface::surface(&manifest.join("src")).unwrap_or_else(|e| panic!("{e}"));
+    println!(
+        "cargo:rustc-env=FOTON_PLUGIN_API_VERSION={}",
+        api_surface::version(&surface)
+    );
     // For the tests, which recompute the identifier.
     println!(
         "cargo:rustc-env=FOTON_BUILD_SETTINGS={}",
@@ -63,6 +70,7 @@ fn main() {
     println!("cargo:rerun-if-changed=src");
     println!("cargo:rerun-if-changed=Cargo.toml");
     println!("cargo:rerun-if-changed=build_id.rs");
+    println!("cargo:rerun-if-changed=api_surface.rs");
     println!("cargo:rerun-if-env-changed=FOTON_PLUGIN_VARIANT");
     println!("cargo:rerun-if-env-changed=FOTON_VARIANT_BASE_FEATURES");
     println!("cargo:rerun-if-changed={}", lock_path.display());

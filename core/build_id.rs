@@ -107,7 +107,7 @@ pub fn dependency_closure(lock: &str, root: &str) -> BTreeSet<String> {
 pub fn build_id(inputs: &Inputs<'_>) -> u64 {
     let mut hasher = DefaultHasher::new();
     hash_dir(&inputs.core_dir.join("src"), &mut hasher);
-    for file in ["Cargo.toml", "build.rs", "build_id.rs"] {
+    for file in ["Cargo.toml", "build.rs", "build_id.rs", "api_surface.rs"] {
         std::fs::read(inputs.core_dir.join(file))
             .unwrap_or_default()
             .hash(&mut hasher);

@@ -11,6 +11,7 @@
 //! `integrators/photonmap`.
 
 pub mod accel;
+pub mod api;
 pub mod bsdf;
 pub mod camera;
 pub mod direct;

@@ -13,9 +13,20 @@ use crate::props::Properties;
 use crate::scene::Scene;
 use std::ffi::{CStr, c_char};
 
-/// Version of the integrator plugin interface (bumped on any change of the declaration or of
-/// the traits that cross the boundary).
-pub const PLUGIN_API_VERSION: u32 = 5;
+/// Version of the plugin interface: a hash of the surface of [`crate::api`], computed by
+/// build.rs (core/api_surface.rs), so that it changes exactly when what a plugin may use does.
+pub const PLUGIN_API_VERSION: u32 = parse_u32(env!("FOTON_PLUGIN_API_VERSION"));
+
+const fn parse_u32(decimal: &str) -> u32 {
+    let bytes = decimal.as_bytes();
+    let mut value = 0u32;
+    let mut i = 0;
+    while i < bytes.len() {
+        value = value * 10 + (bytes[i] - b'0') as u32;
+        i += 1;
+    }
+    value
+}
 /// Version of the C kernel interface.
 pub const KERNEL_API_VERSION: u32 = 1;
 

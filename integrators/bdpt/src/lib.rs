@@ -23,7 +23,7 @@
 //! * s = 0: the camera subpath reaches an emitter (an area light, or the environment);
 //! * s = 1: next-event estimation from a camera vertex (a fresh light sample, as `path`'s);
 //! * t = 1: a light vertex is connected to the pinhole, and what it sends there is added to
-//!   the pixel it lands on (a splat: `foton_core::render::render_pixels_splatting`), light
+//!   the pixel it lands on (a splat: `foton_core::api::render_pixels_splatting`), light
 //!   tracing; s = 1, t = 1 is an area light's point seen directly;
 //! * s, t >= 2: a light vertex and a camera vertex connected.
 //!
@@ -67,13 +67,10 @@
 pub use foton_bidir::{Strategy, mis};
 
 use foton_bidir::Bidir;
-use foton_core::Result;
-use foton_core::error::Error;
-use foton_core::film::Film;
-use foton_core::integrator::{Integrator, Parameter, RenderContext};
-use foton_core::props::Properties;
-use foton_core::render::render_pixels_splatting;
-use foton_core::scene::Scene;
+use foton_core::api::{
+    Error, Film, Integrator, Parameter, Properties, RenderContext, Result, Scene,
+    render_pixels_splatting,
+};
 
 /// The plugin: foton-bidir's estimator with merging off, one light subpath per camera sample.
 pub struct Bdpt(pub Bidir);
@@ -122,4 +119,4 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     ))))
 }
 
-foton_core::declare_integrator!("bdpt", "bidirectional path tracer (Veach, MIS)", create);
+foton_core::api::declare_integrator!("bdpt", "bidirectional path tracer (Veach, MIS)", create);

@@ -25,16 +25,10 @@
 
 pub mod mis;
 
-use foton_core::bsdf::Bsdf;
-use foton_core::geometry::{Hit, Ray, offset_origin};
-use foton_core::light::Light;
-use foton_core::material::TransportMode;
-use foton_core::medium::{self, Phase};
-use foton_core::render::{PixelSample, Splats};
-use foton_core::sampling::{Sampler, russian_roulette};
-use foton_core::scene::Scene;
-use foton_core::walk::{RayWalk, Reached};
-use foton_core::{Rgb, Vec3};
+use foton_core::api::{
+    Bsdf, Hit, Light, Phase, PixelSample, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Splats,
+    TransportMode, Vec3, channel, offset_origin, russian_roulette,
+};
 use mis::{
     Factors, Running, mis, weight_connect, weight_direct, weight_emitter_hit, weight_to_camera,
 };
@@ -459,7 +453,7 @@ impl Bidir {
             // ---- Medium: free flight to a scattering event or to the surface ----
             if let Some(m) = seg.interacting_medium(scene) {
                 // One-sample MIS over the channels of this event (FreeFlight::weight).
-                let channel = medium::channel(sampler.next_f32());
+                let channel = channel(sampler.next_f32());
                 let flight =
                     m.sample_free_flight(&seg.start(), seg.length(), channel, sampler.next_f32());
                 beta *= flight.weight();

@@ -225,9 +225,9 @@ pub fn weight_merge(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use foton_core::camera::Camera;
-    use foton_core::sampling::Rng;
-    use foton_core::{Vec2, Vec3};
+    use foton_core::api::Camera;
+    use foton_core::api::Rng;
+    use foton_core::api::{Vec2, Vec3};
     use std::f32::consts::FRAC_1_PI;
 
     /// A diffuse vertex's solid-angle density of sampling `w` (two-sided, cosine-weighted).
@@ -291,7 +291,7 @@ mod tests {
                     xs.push(p);
                 }
                 for _ in 1..=k {
-                    ns.push(foton_core::sampling::uniform_sphere(rng.next_2d()));
+                    ns.push(foton_core::api::uniform_sphere(rng.next_2d()));
                 }
                 // The light's normal faces the vertex before it (it emits on that side).
                 let to_prev = (xs[k - 1] - xs[k]).normalize();

@@ -4,7 +4,7 @@
 //! geometry and orientation. Each camera ray is followed to the first surface whose material
 //! is not `null` (null boundaries are crossed); the pixel is the unit shading normal `n` there
 //! (the geometric one, but on smooth meshes, where it is interpolated) mapped to a colour, `n * 0.5 + 0.5` (x to red, y to green, z to blue), and black when the
-//! ray hits nothing. The walk is core's `foton_core::walk::first_surface` (the crossing loop
+//! ray hits nothing. The walk is core's `foton_core::api::first_surface` (the crossing loop
 //! every integrator shares): past `MAX_NULL_CROSSINGS` null boundaries in a row the ray is
 //! given up, and the pixel is black.
 //!
@@ -19,14 +19,10 @@
 //! `max_depth`, materials, lights and media play no part. The values are written as they are:
 //! exactly to an EXR, sRGB-encoded to a PNG like any other linear value.
 
-use foton_core::film::Film;
-use foton_core::geometry::Ray;
-use foton_core::integrator::{Integrator, Parameter, RenderContext};
-use foton_core::props::Properties;
-use foton_core::render::render_pixels;
-use foton_core::scene::Scene;
-use foton_core::walk::first_surface;
-use foton_core::{Result, Rgb};
+use foton_core::api::{
+    Film, Integrator, Parameter, Properties, Ray, RenderContext, Result, Rgb, Scene, first_surface,
+    render_pixels,
+};
 
 pub struct Normals {
     flip_to_camera: bool,
@@ -74,4 +70,4 @@ pub fn create(props: &Properties<'_>, _scene: &Scene) -> Result<Box<dyn Integrat
     Ok(Box::new(Normals::new(flip_to_camera)))
 }
 
-foton_core::declare_integrator!("normals", "surface normals as colours (example)", create);
+foton_core::api::declare_integrator!("normals", "surface normals as colours (example)", create);

@@ -33,11 +33,11 @@
 //! area lights are found, slowly. That is what photon mapping is for.
 //!
 //! **Shared code.** The ray's walk through null boundaries and media is core's
-//! (`foton_core::walk::RayWalk`, the one crossing loop every integrator and the photon pass
+//! (`foton_core::api::RayWalk`, the one crossing loop every integrator and the photon pass
 //! use): a segment is measured from the boundary the ray last crossed, so the gap between the
 //! boundary and the ray's offset origin is sampled too, and past `MAX_NULL_CROSSINGS` (256)
 //! crossings in a row the path is ended and carries nothing further. Light sampling is core's
-//! direct-light estimator (`foton_core::direct::estimate_direct` with
+//! direct-light estimator (`foton_core::api::estimate_direct` with
 //! `Mis::WithScatterSampling`: the power heuristic against the BSDF's or phase function's
 //! pdf), the same one `photon`, `sppm` and `vpm` use (without MIS); media are queried through
 //! core's `Medium` interface.
@@ -46,17 +46,11 @@
 //! target-cpu=x86-64-v3` (`build.rs`), loaded instead where the processor has it: the same
 //! images, 6 to 8 % less time on the Cornell box (docs/PERFORMANCE.md, session 27).
 
-use foton_core::direct::{Mis, Scatter, estimate_direct};
-use foton_core::geometry::Ray;
-use foton_core::integrator::{Integrator, Parameter, RenderContext};
-use foton_core::material::TransportMode;
-use foton_core::medium::HeroChannel;
-use foton_core::props::Properties;
-use foton_core::render::render_pixels;
-use foton_core::sampling::{Sampler, power_heuristic, russian_roulette};
-use foton_core::scene::Scene;
-use foton_core::walk::{RayWalk, Reached};
-use foton_core::{Result, Rgb, Vec3, film::Film};
+use foton_core::api::{
+    Film, HeroChannel, Integrator, Mis, Parameter, Properties, Ray, RayWalk, Reached,
+    RenderContext, Result, Rgb, Sampler, Scatter, Scene, TransportMode, Vec3, estimate_direct,
+    power_heuristic, render_pixels, russian_roulette,
+};
 
 pub struct PathTracer {
     max_depth: u32,
@@ -220,4 +214,4 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     Ok(Box::new(PathTracer::new(scene.render.max_depth, rr_depth)))
 }
 
-foton_core::declare_integrator!("path", "unidirectional path tracer (NEE + MIS)", create);
+foton_core::api::declare_integrator!("path", "unidirectional path tracer (NEE + MIS)", create);

@@ -31,7 +31,7 @@
 //! and glass to the first diffuse point x (core's camera walk, `foton_core::walk`), where
 //! radiance = emission + direct + caustic + indirect:
 //!
-//! * direct: core's direct-light estimator (`foton_core::direct::estimate_direct`: one shadow
+//! * direct: core's direct-light estimator (`foton_core::api::estimate_direct`: one shadow
 //!   ray to a light chosen by power), or the direct map's estimate;
 //! * caustic: the caustic map's estimate;
 //! * indirect: the indirect map's estimate, or with `final_gather` the mean over cosine-
@@ -69,18 +69,11 @@
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
 
-use foton_core::bsdf::Bsdf;
-use foton_core::direct::Direct;
-use foton_core::film::Film;
-use foton_core::geometry::{Hit, Ray, offset_origin};
-use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::material::TransportMode;
-use foton_core::props::Properties;
-use foton_core::sampling::Sampler;
-use foton_core::scene::Scene;
-use foton_core::walk::{CameraWalk, first_surface, trace_to_diffuse};
-use foton_core::{Error, Result, Rgb, Vec3};
+use foton_core::api::{
+    Bsdf, Budget, CameraWalk, Direct, Error, Film, Hit, Integrator, NormalizedKernel, Parameter,
+    PhotonMapView, Properties, Ray, RenderContext, Result, Rgb, Sampler, Scene, TransportMode,
+    Vec3, Work, first_surface, offset_origin, trace_to_diffuse,
+};
 use foton_photonmap::surface::{
     SurfaceMaps, SurfaceParams, render_with_maps, surface_views, trace_surface_photons,
 };
@@ -328,4 +321,4 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!("photon", "photon mapping (Jensen)", create);
+foton_core::api::declare_integrator!("photon", "photon mapping (Jensen)", create);

@@ -43,15 +43,10 @@
 
 use crate::map::Photon;
 use crate::screen::ScreenBeams;
-use foton_core::accel::Accel;
-use foton_core::error::Result;
-use foton_core::geometry::Ray;
-use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::medium::{Medium, Phase, transmittance_homogeneous};
-use foton_core::props::Properties;
-use foton_core::scene::Scene;
-use foton_core::{Rgb, Vec2, Vec3};
+use foton_core::api::{
+    Accel, Medium, NO_ATTRS, NormalizedKernel, Phase, Primitive, Properties, Ray, Result, Rgb,
+    Scene, Shape, Vec2, Vec3, transmittance_homogeneous,
+};
 
 /// Which flight segments a photon records (module comment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,7 +76,7 @@ pub struct Beam {
     /// Flux at the start (W).
     pub flux: Rgb,
     /// Short beams: the photon path's per-channel pdf ratios before this flight (spectral MIS;
-    /// [`foton_core::medium::HeroChannel::r`]).
+    /// [`foton_core::api::HeroChannel::r`]).
     pub hero_r: Rgb,
     pub medium: u32,
     /// Scattering events of a light path that scatters once on this beam (the photon's events
@@ -104,7 +99,7 @@ impl Beam {
         match self.kind {
             BeamKind::Long => tr,
             BeamKind::Short => {
-                let p = foton_core::average(self.hero_r * tr);
+                let p = foton_core::api::average(self.hero_r * tr);
                 if p > 0.0 { tr / p } else { Rgb::ZERO }
             }
         }
@@ -551,7 +546,7 @@ impl<'a> Coefficients<'a> {
             Coefficients::Grey { sigma_t, sigma_s } => {
                 let w = match beam.kind {
                     BeamKind::Short => {
-                        let p = foton_core::average(beam.hero_r);
+                        let p = foton_core::api::average(beam.hero_r);
                         if p > 0.0 {
                             (-sigma_t * c.t_c).exp() / p
                         } else {
@@ -623,7 +618,7 @@ pub fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use foton_core::kernel::{BoxKernel, ConeKernel};
+    use foton_core::api::{BoxKernel, ConeKernel};
 
     #[test]
     fn closest_approach_of_crossing_lines() {
@@ -678,7 +673,7 @@ mod tests {
     /// farther than their ends along it; random rays and segment ends, two media).
     #[test]
     fn the_bvh_finds_what_a_loop_over_every_beam_finds() {
-        let mut rng = foton_core::sampling::Rng::new(&[5]);
+        let mut rng = foton_core::api::Rng::new(&[5]);
         let mut point = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 4.0;
         let beams: Vec<Beam> = (0..400)
             .map(|i| {
@@ -737,7 +732,7 @@ mod tests {
     /// found, for beams along the axes and in random directions.
     #[test]
     fn boxes_reach_as_far_as_the_width_across_the_beam() {
-        let mut rng = foton_core::sampling::Rng::new(&[11]);
+        let mut rng = foton_core::api::Rng::new(&[11]);
         let mut unit = || {
             let v = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 2.0 - 1.0;
             v.normalize()

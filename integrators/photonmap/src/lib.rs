@@ -40,7 +40,7 @@ pub mod trace;
 
 pub use map::{Estimate, Neighbour, Photon, PhotonMap};
 
-use foton_core::integrator::{MapPhoton, PhotonMapView};
+use foton_core::api::{MapPhoton, PhotonMapView};
 
 /// A map as the tools see it (`Integrator::photon_maps`).
 pub fn view(name: &str, description: &str, emitted: u64, photons: &[Photon]) -> PhotonMapView {

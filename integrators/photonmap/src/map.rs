@@ -9,12 +9,7 @@
 //! incrementally (Arya and Mount), which prunes more than the distance to the last plane.
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
-use foton_core::Rgb;
-use foton_core::bsdf::{Bsdf, Lobe};
-use foton_core::geometry::{Hit, Ray, offset_origin};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::medium::Phase;
-use foton_core::scene::Scene;
+use foton_core::api::{Bsdf, Hit, Lobe, NormalizedKernel, Phase, Ray, Rgb, Scene, offset_origin};
 use glam::{Vec2, Vec3};
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
@@ -808,7 +803,7 @@ impl PhotonMap {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use foton_core::sampling::Rng;
+    use foton_core::api::Rng;
 
     fn random_map(n: usize, seed: u64) -> (Vec<Photon>, PhotonMap) {
         let mut rng = Rng::new(&[seed]);
@@ -827,7 +822,7 @@ mod tests {
         let mut rng = Rng::new(&[4]);
         for _ in 0..100 {
             let origin = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 1.4 - 0.2;
-            let dir = foton_core::sampling::uniform_sphere(rng.next_2d());
+            let dir = foton_core::api::uniform_sphere(rng.next_2d());
             let (t_max, radius) = (0.2 + rng.next_f32(), 0.01 + 0.05 * rng.next_f32());
             let mut got = Vec::new();
             map.along_ray(origin, dir, t_max, radius, |_, p, t, d2| {
@@ -898,7 +893,7 @@ mod tests {
     fn directions_survive_encoding() {
         let mut rng = Rng::new(&[4]);
         for _ in 0..1000 {
-            let d = foton_core::sampling::uniform_sphere(rng.next_2d());
+            let d = foton_core::api::uniform_sphere(rng.next_2d());
             let p = Photon::new(Vec3::ZERO, Rgb::ONE, d, -d);
             assert!(p.wi().dot(d) > 0.99999);
             assert!(p.normal().dot(-d) > 0.99 && p.normal().length() < 1.01);

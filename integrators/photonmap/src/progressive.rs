@@ -6,15 +6,10 @@
 //! its per-pass estimator (a [`Passes`]).
 
 use crate::map::{DISC_THICKNESS, DiscClip, PhotonMap};
-use foton_core::Rgb;
-use foton_core::error::{Error, Result};
-use foton_core::film::Film;
-use foton_core::integrator::{Budget, NoProgress, Parameter, RenderContext, Work};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::props::Properties;
-use foton_core::render::{usable, warn_unusable};
-use foton_core::scene::Scene;
-use foton_core::walk::VisiblePoint;
+use foton_core::api::{
+    Budget, Error, Film, NoProgress, NormalizedKernel, Parameter, Properties, RenderContext,
+    Result, Rgb, Scene, VisiblePoint, Work, usable, warn_unusable,
+};
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::Instant;

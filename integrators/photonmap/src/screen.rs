@@ -36,10 +36,7 @@
 //! out (no point of a camera ray is near them).
 
 use crate::beams::{BeamMap, Crossing};
-use foton_core::accel::Accel;
-use foton_core::camera::Camera;
-use foton_core::geometry::Ray;
-use foton_core::{Vec2, Vec3};
+use foton_core::api::{Accel, Camera, Ray, Vec2, Vec3};
 
 /// Bins are this many rows' bands wide (a band is one row up to 511 rows, [`ROWS`] more
 /// rows a band above). Narrower bins mean fewer pieces scanned and more entries built: 4, 8
@@ -318,8 +315,8 @@ impl Pinhole {
 mod tests {
     use super::*;
     use crate::beams::{Beam, BeamKind};
-    use foton_core::Rgb;
-    use foton_core::sampling::Rng;
+    use foton_core::api::Rgb;
+    use foton_core::api::Rng;
 
     /// Random beams in front of a camera, some through the pinhole's plane and behind it, two
     /// media.

@@ -13,19 +13,11 @@
 
 use crate::map::{CLIP_PROBES, DiscClip, Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
-use foton_core::bsdf::Bsdf;
-use foton_core::direct::{Direct, Mis, Scatter, estimate_direct};
-use foton_core::error::Result;
-use foton_core::film::Film;
-use foton_core::geometry::{Hit, Ray};
-use foton_core::integrator::{Parameter, PhotonMapView, RenderContext};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::props::Properties;
-use foton_core::render::render_pixels;
-use foton_core::sampling::Sampler;
-use foton_core::scene::Scene;
-use foton_core::walk::VisiblePoint;
-use foton_core::{Rgb, Vec3};
+use foton_core::api::{
+    Bsdf, Direct, Film, Hit, Mis, NormalizedKernel, Parameter, PhotonMapView, Properties, Ray,
+    RenderContext, Result, Rgb, Sampler, Scatter, Scene, Vec3, VisiblePoint, estimate_direct,
+    render_pixels,
+};
 
 /// The photon budgets of the surface maps.
 #[derive(Clone, Copy, Debug)]

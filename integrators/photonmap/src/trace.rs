@@ -10,16 +10,10 @@
 
 use crate::beams::{Beam, BeamKind, exit_distance};
 use crate::map::Photon;
-use foton_core::Rgb;
-use foton_core::error::Result;
-use foton_core::geometry::{Ray, offset_origin};
-use foton_core::integrator::RenderContext;
-use foton_core::material::TransportMode;
-use foton_core::medium::HeroChannel;
-use foton_core::render::with_pool;
-use foton_core::sampling::{Rng, SOBOL_DIMENSIONS, SamplerKind, SobolPoint, splitmix64};
-use foton_core::scene::Scene;
-use foton_core::walk::{RayWalk, Reached};
+use foton_core::api::{
+    HeroChannel, Ray, RayWalk, Reached, RenderContext, Result, Rgb, Rng, SOBOL_DIMENSIONS,
+    SamplerKind, Scene, SobolPoint, TransportMode, offset_origin, splitmix64, with_pool,
+};
 use glam::Vec2;
 use rayon::prelude::*;
 

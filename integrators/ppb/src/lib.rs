@@ -96,17 +96,11 @@
 //! identical for any number of threads and any split into parts. Memory holds one pass's
 //! photons and beams at a time.
 
-use foton_core::direct::Direct;
-use foton_core::direct::{Mis, Scatter, estimate_direct};
-use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::props::Properties;
-use foton_core::render::{usable, with_pool};
-use foton_core::sampling::{Sampler, splitmix64};
-use foton_core::scene::Scene;
-use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
-use foton_core::{Result, Rgb, Vec3};
+use foton_core::api::{
+    Budget, CameraWalk, Direct, Film, Integrator, Mis, NormalizedKernel, Parameter, PhotonMapView,
+    Properties, RadianceSum, RenderContext, Result, Rgb, Sampler, Scatter, Scene, Segment, Vec3,
+    estimate_direct, splitmix64, usable, walk_to_diffuse, with_pool,
+};
 use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
@@ -519,4 +513,4 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!("ppb", "progressive photon beams (Jarosz et al.)", create);
+foton_core::api::declare_integrator!("ppb", "progressive photon beams (Jarosz et al.)", create);

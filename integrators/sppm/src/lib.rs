@@ -36,7 +36,7 @@
 //! Each iteration traces a new camera path per pixel through mirrors and glass to its first
 //! diffuse point, the *visible point* (core's camera walk, `foton_core::walk`, so
 //! anti-aliasing comes for free), adds the emission met and, with `direct = "nee"`, direct
-//! light by core's estimator (`foton_core::direct::estimate_direct`, one shadow ray); then
+//! light by core's estimator (`foton_core::api::estimate_direct`, one shadow ray); then
 //! traces a batch of photons (foton-photonmap's photon pass: stored at diffuse surfaces only,
 //! never on mirrors or glass), gathers at each visible point the photons within the pixel's
 //! radius R that lie on a disc of the same surface (below), and updates the pixel's
@@ -79,17 +79,11 @@
 //! crossed by core's one crossing loop, a ray ended past `MAX_NULL_CROSSINGS` crossings in a
 //! row) and the direct light are core's, the same code as `path`, `photon` and `vpm` use.
 
-use foton_core::direct::Direct;
-use foton_core::direct::{Mis, Scatter, estimate_direct};
-use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::props::Properties;
-use foton_core::render::{usable, with_pool};
-use foton_core::sampling::{Sampler, splitmix64};
-use foton_core::scene::Scene;
-use foton_core::walk::{CameraWalk, VisiblePoint, trace_to_diffuse};
-use foton_core::{Error, Result, Rgb};
+use foton_core::api::{
+    Budget, CameraWalk, Direct, Error, Film, Integrator, Mis, NormalizedKernel, Parameter,
+    PhotonMapView, Properties, RadianceSum, RenderContext, Result, Rgb, Sampler, Scatter, Scene,
+    VisiblePoint, estimate_direct, splitmix64, trace_to_diffuse, usable, with_pool,
+};
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::progressive::{
     PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc, pixel_angle, run_passes,
@@ -536,7 +530,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!(
+foton_core::api::declare_integrator!(
     "sppm",
     "stochastic progressive photon mapping (Hachisuka and Jensen)",
     create

@@ -6,7 +6,7 @@
 //! (two cells of the block may share a bucket: visited once) and each bucket's vertices in
 //! order, so the sum a pixel makes of its merges is the same whatever the thread count.
 
-use foton_core::Vec3;
+use foton_core::api::Vec3;
 
 pub struct HashGrid {
     min: Vec3,
@@ -113,7 +113,7 @@ impl HashGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use foton_core::sampling::Rng;
+    use foton_core::api::Rng;
 
     /// The grid finds exactly the points a brute-force search finds, each once.
     #[test]

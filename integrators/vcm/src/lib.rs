@@ -67,14 +67,10 @@ pub mod grid;
 
 use foton_bidir::mis::{Factors, weight_merge};
 use foton_bidir::{At, Bidir, Origin, SplatSink, Strategy, Vertex};
-use foton_core::error::Error;
-use foton_core::film::{Film, RadianceSum};
-use foton_core::integrator::{Budget, Integrator, Parameter, RenderContext};
-use foton_core::props::Properties;
-use foton_core::render::{PixelSample, usable, with_pool};
-use foton_core::sampling::Sampler;
-use foton_core::scene::Scene;
-use foton_core::{Result, Rgb};
+use foton_core::api::{
+    Budget, Error, Film, Integrator, Parameter, PixelSample, Properties, RadianceSum,
+    RenderContext, Result, Rgb, Sampler, Scene, usable, with_pool,
+};
 use foton_photonmap::progressive::{PassBudget, Passes, Tally, read_passes, run_passes};
 use grid::HashGrid;
 use rayon::prelude::*;
@@ -571,7 +567,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!(
+foton_core::api::declare_integrator!(
     "vcm",
     "vertex connection and merging (Georgiev et al., MIS of bdpt and photon mapping)",
     create

@@ -50,7 +50,7 @@
 //! map (with `direct = "nee"` the first scattering events, L M, are not stored: shadow rays
 //! count them). `foton photons` draws the maps `global`, `caustic` and `volume`.
 //!
-//! **Camera rays** are followed by core's camera walk (`foton_core::walk::walk_to_diffuse`)
+//! **Camera rays** are followed by core's camera walk (`foton_core::api::walk_to_diffuse`)
 //! through null boundaries and delta surfaces (murky glass included), tracking the medium.
 //! Along each segment through a medium of length s (measured from the boundary the ray last
 //! crossed, so the gap between a boundary and the ray's offset origin is not skipped):
@@ -115,19 +115,11 @@
 //!   the direct light and every medium query (`dyn Medium`) are core's, shared with `path`,
 //!   `photon` and `sppm`; the gap after a crossing is now sampled, as `path` samples it.
 
-use foton_core::direct::Direct;
-use foton_core::direct::{Mis, Scatter, estimate_direct};
-use foton_core::film::Film;
-use foton_core::geometry::Ray;
-use foton_core::integrator::{Budget, Integrator, Parameter, PhotonMapView, RenderContext, Work};
-use foton_core::kernel::NormalizedKernel;
-use foton_core::medium::Medium;
-use foton_core::props::Properties;
-use foton_core::render::with_pool;
-use foton_core::sampling::Sampler;
-use foton_core::scene::Scene;
-use foton_core::walk::{CameraWalk, Segment, walk_to_diffuse};
-use foton_core::{Result, Rgb, Vec3};
+use foton_core::api::{
+    Budget, CameraWalk, Direct, Film, Integrator, Medium, Mis, NormalizedKernel, Parameter,
+    PhotonMapView, Properties, Ray, RenderContext, Result, Rgb, Sampler, Scatter, Scene, Segment,
+    Vec3, Work, estimate_direct, walk_to_diffuse, with_pool,
+};
 use foton_photonmap::beams::{
     Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
@@ -622,7 +614,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     }))
 }
 
-foton_core::declare_integrator!(
+foton_core::api::declare_integrator!(
     "vpm",
     "volumetric photon mapping (Jensen and Christensen)",
     create

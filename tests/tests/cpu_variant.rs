@@ -1,4 +1,4 @@
-//! The x86-64-v3 build of this plugin (build.rs) is accepted by the `foton` built beside it and
+//! The x86-64-v3 build of the path plugin (build.rs) is accepted by the `foton` built beside it and
 //! renders the same images bit for bit as the baseline build. Runs where a release build has
 //! made the variant and the `foton` program and the processor has x86-64-v3 (as
 //! `cargo test --release --workspace` on such a machine); says so and passes otherwise.
@@ -16,7 +16,7 @@ fn render(foton: &Path, plugin: &Path, dir: &Path, sampler: &str) -> Vec<u8> {
     let plugins = dir.join("plugins");
     std::fs::create_dir_all(&plugins).unwrap();
     std::fs::copy(plugin, plugins.join("libfoton_path.so")).unwrap();
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../scenes/cornell_point.toml");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/cornell_point.toml");
     let out = dir.join("image.exr");
     let run = Command::new(foton)
         .arg("render")
