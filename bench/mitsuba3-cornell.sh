@@ -41,9 +41,13 @@ for seed in 1 2; do
         "$FOTON" render $SCENE "${ARGS[@]}" --spp 64 --seed $seed --set render.sampler="\"$sampler\"" \
             -o "$OUT/foton-$sampler-$seed.exr" >/dev/null
     done
-    "$MI" "$HERE/mitsuba3_cornell.py" time 64 independent $seed "$OUT/mi-independent-64-$seed.exr" >/dev/null
-    "$MI" "$HERE/mitsuba3_cornell.py" time "$at_foton" independent $seed "$OUT/mi-independent-$at_foton-$seed.exr" >/dev/null
-    "$MI" "$HERE/mitsuba3_cornell.py" time 64 multijitter $seed "$OUT/mi-multijitter-64-$seed.exr" >/dev/null
+    for sampler in independent stratified multijitter ldsampler; do
+        "$MI" "$HERE/mitsuba3_cornell.py" time 64 $sampler $seed "$OUT/mi-$sampler-64-$seed.exr" >/dev/null
+    done
+    # At foton's time; Mitsuba rounds orthogonal's count up (to 121 for 68).
+    for sampler in independent orthogonal; do
+        "$MI" "$HERE/mitsuba3_cornell.py" time "$at_foton" $sampler $seed "$OUT/mi-$sampler-$at_foton-$seed.exr" >/dev/null
+    done
 done
 echo "Mitsuba at foton's sobol time: $at_foton spp"
 "$MI" "$HERE/mitsuba3_cornell.py" rmse "$OUT/ref-4096.exr" "$OUT"/foton-*.exr "$OUT"/mi-*.exr
