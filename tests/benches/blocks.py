@@ -1,7 +1,7 @@
 """Block errors of renders against a reference, as docs/PERFORMANCE.md and the vpm and ppb
 READMEs give them for the fog scenes.
 
-    python bench/blocks.py REF.exr IMAGE.exr... [--block 16] [--lamp 20]
+    python tests/benches/blocks.py REF.exr IMAGE.exr... [--block 16] [--lamp 20]
 
 For each image: the worst and the median block (16x16 pixels by default) of the channel mean,
 |block - reference block| / max(reference block, 2 % of the reference's image mean); the image

@@ -1,4 +1,4 @@
-"""Mitsuba 3's side of bench/mitsuba3-cornell.sh: its CPU time on docs/cornell_point-mitsuba3.xml,
+"""Mitsuba 3's side of tests/benches/mitsuba3-cornell.sh: its CPU time on docs/cornell_point-mitsuba3.xml,
 and the RMSE of EXR images against a reference.
 
     python mitsuba3_cornell.py time SPP SAMPLER SEED [OUT.exr]   # prints CPU seconds

@@ -3,8 +3,8 @@
 # (loading the scene and writing the image), as docs/PERFORMANCE.md compares renderers on a
 # shared machine: CPU time moves far less with the load than wall time.
 #
-#   bench/cpu-seconds.sh SCENE SPP [foton render options...]
-#   bench/cpu-seconds.sh scenes/cornell_point.toml 64 --threads 2 --set render.max_depth=16
+#   tests/benches/cpu-seconds.sh SCENE SPP [foton render options...]
+#   tests/benches/cpu-seconds.sh scenes/cornell_point.toml 64 --threads 2 --set render.max_depth=16
 set -euo pipefail
 FOTON=${FOTON:-target/release/foton}
 SCENE=$1 SPP=$2

@@ -3,8 +3,8 @@
 # `foton bench` with one thread at 4 spp and at 1 spp, (I(4) - I(1)) / 3. Instruction counts do
 # not depend on the machine's load, which is why docs/PERFORMANCE.md compares builds by them.
 #
-#   bench/instructions.sh [SCENE] [foton bench options...]
-#   bench/instructions.sh scenes/cornell_point.toml --set render.sampler='"independent"'
+#   tests/benches/instructions.sh [SCENE] [foton bench options...]
+#   tests/benches/instructions.sh scenes/cornell_point.toml --set render.sampler='"independent"'
 #
 # SCENE defaults to scenes/cornell_point.toml; FOTON to target/release/foton (build it with
 # `cargo build --release`). Needs valgrind.

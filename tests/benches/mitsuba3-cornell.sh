@@ -7,7 +7,7 @@
 #
 #   python -m venv /tmp/mi && /tmp/mi/bin/pip install mitsuba==3.9.1 numpy
 #   export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so   # where libLLVM is
-#   cargo build --release && MI_PYTHON=/tmp/mi/bin/python bench/mitsuba3-cornell.sh
+#   cargo build --release && MI_PYTHON=/tmp/mi/bin/python tests/benches/mitsuba3-cornell.sh
 #
 # ROUNDS (default 7); OUT (default /tmp/foton-mitsuba3) keeps the images and the reference.
 set -euo pipefail
