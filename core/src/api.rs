@@ -25,7 +25,7 @@ pub use crate::declare_integrator;
 pub use crate::error::{Error, Result};
 pub use crate::integrator::{
     Budget, Integrator, MapPhoton, NoProgress, ParamValue, Parameter, Part, PhotonMapView,
-    Progress, RenderContext, Work,
+    Progress, RenderContext, Work, describe,
 };
 pub use crate::plugin::PLUGIN_API_VERSION;
 #[doc(hidden)]
