@@ -9,7 +9,8 @@
 //! a macro's whole text; an external item's path. For each exposed type, the signatures of
 //! its public inherent methods and constants and the headers of the traits it implements;
 //! and, since a plugin reaches them through those signatures and fields, the same again for
-//! every type of the crate that they name, to the end of that chain. Doc comments, other
+//! every type of the crate that they name, to the end of that chain. Members marked
+//! `#[doc(hidden)]` are the host's and not part of it. Doc comments, other
 //! comments, formatting, function bodies and everything the chain does not reach are not
 //! part of it.
 
@@ -119,6 +120,17 @@ fn canonical(tokens: &impl quote::ToTokens) -> String {
 
 fn is_pub(vis: &Visibility) -> bool {
     matches!(vis, Visibility::Public(_))
+}
+
+/// `#[doc(hidden)]`: public for the host's crates, not promised to plugins (the rule
+/// cargo-semver-checks follows too).
+fn is_hidden(attrs: &[Attribute]) -> bool {
+    attrs.iter().any(|a| {
+        a.path().is_ident("doc")
+            && a.meta
+                .require_list()
+                .is_ok_and(|l| l.tokens.to_string().trim() == "hidden")
+    })
 }
 
 /// The identifiers of the paths a piece of syntax names (types, traits), for the chain.
@@ -294,13 +306,9 @@ fn definition(item: &Item) -> (String, Names) {
     let text = match item {
         Item::Struct(s) => {
             let mut s = s.clone();
-            let private = s.fields.iter().any(|f| !is_pub(&f.vis));
-            let kept: Vec<syn::Field> = s
-                .fields
-                .iter()
-                .filter(|f| is_pub(&f.vis))
-                .cloned()
-                .collect();
+            let promised = |f: &&syn::Field| is_pub(&f.vis) && !is_hidden(&f.attrs);
+            let private = s.fields.iter().any(|f| !promised(&f));
+            let kept: Vec<syn::Field> = s.fields.iter().filter(promised).cloned().collect();
             match &mut s.fields {
                 syn::Fields::Named(f) => f.named = kept.into_iter().collect(),
                 syn::Fields::Unnamed(f) => f.unnamed = kept.into_iter().collect(),
@@ -414,7 +422,7 @@ pub fn surface(src: &Path) -> Result<String, String> {
                     }
                     for member in &imp.items {
                         let text = match member {
-                            syn::ImplItem::Fn(f) if is_pub(&f.vis) => {
+                            syn::ImplItem::Fn(f) if is_pub(&f.vis) && !is_hidden(&f.attrs) => {
                                 names.visit_signature(&f.sig);
                                 let mut f = f.clone();
                                 Strip.visit_impl_item_fn_mut(&mut f);
@@ -424,7 +432,7 @@ pub fn surface(src: &Path) -> Result<String, String> {
                                 };
                                 canonical(&f)
                             }
-                            syn::ImplItem::Const(c) if is_pub(&c.vis) => {
+                            syn::ImplItem::Const(c) if is_pub(&c.vis) && !is_hidden(&c.attrs) => {
                                 names.visit_type(&c.ty);
                                 let mut c = c.clone();
                                 Strip.visit_impl_item_const_mut(&mut c);

@@ -282,35 +282,35 @@ fn param_value(py: Python<'_>, v: &ParamValue) -> PyResult<Py<PyAny>> {
 impl NativeScene {
     #[getter]
     fn file(&self) -> PathBuf {
-        self.base.scene.file.clone()
+        self.base.scene.file().to_path_buf()
     }
     #[getter]
     fn width(&self) -> u32 {
-        self.base.scene.film.width
+        self.base.scene.film().width
     }
     #[getter]
     fn height(&self) -> u32 {
-        self.base.scene.film.height
+        self.base.scene.film().height
     }
     #[getter]
     fn spp(&self) -> u32 {
-        self.base.scene.render.spp
+        self.base.scene.render().spp
     }
     #[getter]
     fn seed(&self) -> u64 {
-        self.base.scene.render.seed
+        self.base.scene.render().seed
     }
     #[getter]
     fn sampler(&self) -> &'static str {
-        self.base.scene.render.sampler.name()
+        self.base.scene.render().sampler.name()
     }
     #[getter]
     fn max_depth(&self) -> u32 {
-        self.base.scene.render.max_depth
+        self.base.scene.render().max_depth
     }
     #[getter]
     fn integrator(&self) -> String {
-        self.base.scene.render.integrator.clone()
+        self.base.scene.render().integrator.clone()
     }
     /// The integrator with its parameters in force, as `foton render` prints it.
     #[getter]
@@ -320,12 +320,12 @@ impl NativeScene {
     /// The film output the scene names (resolved against its folder).
     #[getter]
     fn output(&self) -> PathBuf {
-        self.base.scene.film.output.clone()
+        self.base.scene.film().output.clone()
     }
     /// (exposure, tone map name): the scene's display transform for PNG outputs.
     #[getter]
     fn display(&self) -> (f32, &'static str) {
-        let d = self.base.scene.film.display();
+        let d = self.base.scene.film().display();
         (d.exposure, d.tonemap.name())
     }
     #[getter]
@@ -431,8 +431,8 @@ impl NativeScene {
         let info = PyDict::new(py);
         info.set_item("integrator", p.integrator.describe())?;
         info.set_item("seconds", elapsed.as_secs_f64())?;
-        info.set_item("spp", p.scene.render.spp)?;
-        info.set_item("sampler", p.scene.render.sampler.name())?;
+        info.set_item("spp", p.scene.render().spp)?;
+        info.set_item("sampler", p.scene.render().sampler.name())?;
         info.set_item("samples", film.total_samples())?;
         info.set_item("iterations", film.iterations)?;
         info.set_item("iterations_planned", film.iterations_planned)?;

@@ -88,7 +88,7 @@ fn main() {
         "caustics.toml, 1M global + 1M caustic photons, k = 50, {}x{} x {} spp: {:.2} s ({threads} threads)",
         film.width,
         film.height,
-        prepared.scene.render.spp,
+        prepared.scene.render().spp,
         secs.as_secs_f64()
     );
 }

@@ -104,7 +104,7 @@ fn load(scene: &Path) -> (Scene, f64) {
     let start = Instant::now();
     let loaded = foton_loader::load(scene, &[]).unwrap();
     let seconds = start.elapsed().as_secs_f64();
-    assert_eq!(loaded.accel.primitives().len(), 2 * (N - 1) * (N - 1));
+    assert_eq!(loaded.accel().primitives().len(), 2 * (N - 1) * (N - 1));
     (loaded, seconds)
 }
 
@@ -140,7 +140,7 @@ fn main() {
     assert!(!is_closed(&corners), "the sphere is open at its poles");
     let closed = start.elapsed().as_secs_f64();
     println!("  of which is_closed: {closed:.3} s");
-    let prims: Vec<Primitive> = loaded.accel.primitives().to_vec();
+    let prims: Vec<Primitive> = loaded.accel().primitives().to_vec();
     drop(loaded);
     let start = Instant::now();
     let accel = Accel::build(prims);

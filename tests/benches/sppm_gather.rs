@@ -42,7 +42,7 @@ fn atomic_add(a: &AtomicU32, v: f32) {
 fn main() {
     let threads = std::thread::available_parallelism().map_or(1, |n| n.get());
     let scene = foton_loader::load(&repo_root().join("scenes/cornell-box.toml"), &[]).unwrap();
-    let (w, h) = (scene.film.width, scene.film.height);
+    let (w, h) = (scene.film().width, scene.film().height);
     let mut rays = 0;
     let vps: Vec<Vp> = (0..w * h)
         .filter_map(|i| {
@@ -51,7 +51,7 @@ fn main() {
             let film = Vec2::new((i % w) as f32, (i / w) as f32) + s.next_2d();
             let path = trace_to_diffuse(
                 &scene,
-                scene.camera.generate_ray(film),
+                scene.camera().generate_ray(film),
                 CameraWalk {
                     max_depth: 16,
                     glossy_roughness: GLOSSY_ROUGHNESS,

@@ -251,7 +251,7 @@ impl Plan {
 /// as its parameters say), or "own budget".
 fn budget_text(p: &Prepared, settings: &[String]) -> String {
     match p.integrator.budget().work {
-        Work::Samples => format!("{} spp", p.scene.render.spp),
+        Work::Samples => format!("{} spp", p.scene.render().spp),
         Work::Iterations { key } => {
             let set = settings
                 .iter()
@@ -436,7 +436,7 @@ fn calibrate(
         }
         Work::Samples => {
             let cost = calibrate_cost(min_seconds, |n| {
-                p.scene.render.spp = n;
+                p.scene.render_mut().spp = n;
                 Ok(render_timed(p, threads, true, err)?.1.as_secs_f64())
             })?;
             let plan = if scaled.is_empty() {
@@ -581,7 +581,10 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         }
         prepared.push(p);
     }
-    let (width, height) = (prepared[0].scene.film.width, prepared[0].scene.film.height);
+    let (width, height) = (
+        prepared[0].scene.film().width,
+        prepared[0].scene.film().height,
+    );
     if let (Some((w, h, _)), Some(path)) = (&reference, &a.reference)
         && (*w, *h) != (width, height)
     {
@@ -680,10 +683,10 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         if interrupted(err) {
             return Ok(130);
         }
-        let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render.spp);
+        let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
         let budget = budget_text(&p, &settings);
         let image = exr_of(name);
-        film.write(&image, &p.scene.film.display())?;
+        film.write(&image, &p.scene.film().display())?;
         let errors = reference
             .as_ref()
             .map(|(_, _, r)| errors(&film.pixels(), r));
@@ -695,7 +698,7 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             seconds: elapsed.as_secs_f64(),
             settings,
             film,
-            display: p.scene.film.display(),
+            display: p.scene.film().display(),
             image,
             errors,
             curve,

@@ -361,7 +361,7 @@ pub fn prepare_xml(
 /// package does with its own plugin folder); as [`prepare`] does after loading.
 pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<Prepared> {
     let registry = Registry::discover(search);
-    let plugin = match registry.integrator(&scene.render.integrator) {
+    let plugin = match registry.integrator(&scene.render().integrator) {
         Ok(p) => p.clone(),
         Err(e) => {
             // Written in the file: say where; given on the command line: say so.
@@ -377,18 +377,18 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
         }
     };
     let props = scene
-        .integrator_properties(&scene.render.integrator)?
+        .integrator_properties(&scene.render().integrator)?
         .with_kernels(&registry.kernels);
     let integrator = plugin
         .create(&props, &scene)
         .map_err(|e| blame_plugin(&plugin, e))?;
-    let mut unused = scene.unused.clone();
+    let mut unused = scene.unused().to_vec();
     unused.extend(props.unused());
     drop(props);
     // A value the command line set (--set, --spp, Python's overrides: no line in the file)
     // that nothing reads was asked for explicitly: rendering without it would answer another
     // question than the one asked, so it is an error even without --strict.
-    unread_set(&unused, &scene.render.integrator)?;
+    unread_set(&unused, &scene.render().integrator)?;
     // Values set for other integrators (settings for several, as a file holds, switched with
     // --integrator) are checked by those integrators' plugins, so that a typo there is caught
     // too. One that cannot be created for this scene (`photon` refuses media) is not checked.
@@ -403,7 +403,7 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
             unread_set(&props.unused(), &name)?;
         }
     }
-    if strict && let Some(w) = scene.ignored.first() {
+    if strict && let Some(w) = scene.ignored().first() {
         return Err(Error::Usage(format!(
             "{w} (--strict: a parameter foton ignores is an error)"
         )));
@@ -418,8 +418,8 @@ pub fn prepare_scene(scene: Scene, search: &[PathBuf], strict: bool) -> Result<P
             ),
         });
     }
-    let mut warnings = scene.warnings.clone();
-    warnings.extend(scene.ignored.iter().cloned());
+    let mut warnings = scene.warnings().to_vec();
+    warnings.extend(scene.ignored().iter().cloned());
     warnings.extend(
         unused
             .iter()
@@ -443,7 +443,8 @@ fn other_integrators_set(scene: &Scene) -> Vec<(String, String)> {
             _ => None,
         })
     }
-    let Some(Value::Table(integrators)) = scene.document.root.get("integrators").map(|n| &n.value)
+    let Some(Value::Table(integrators)) =
+        scene.document().root.get("integrators").map(|n| &n.value)
     else {
         return Vec::new();
     };
@@ -451,7 +452,7 @@ fn other_integrators_set(scene: &Scene) -> Vec<(String, String)> {
         .0
         .iter()
         .filter_map(|(name, node)| match &node.value {
-            Value::Table(t) if *name != scene.render.integrator => {
+            Value::Table(t) if *name != scene.render().integrator => {
                 first_set(t, &format!("integrators.{name}")).map(|key| (name.clone(), key))
             }
             _ => None,
@@ -563,7 +564,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
             &a.scene.scene,
             &format!("part-{}-of-{}.exr", part.index, part.count),
         ),
-        (None, None) => p.scene.film.output.clone(),
+        (None, None) => p.scene.film().output.clone(),
     };
     check_output(&output)?;
     if a.part.is_some() {
@@ -584,7 +585,7 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
     }
     let mut progress = TermProgress::new(a.quiet);
     if let Some(every) = a.checkpoint {
-        progress = progress.with_checkpoint(every, output.clone(), p.scene.film.display());
+        progress = progress.with_checkpoint(every, output.clone(), p.scene.film().display());
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = threads(a.threads);
@@ -609,14 +610,14 @@ fn cmd_render(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result
             format!(", part {part}")
         }
         None => {
-            film.write(&output, &p.scene.film.display())?;
+            film.write(&output, &p.scene.film().display())?;
             String::new()
         }
     };
     let _ = writeln!(
         out,
         "{}: {}x{}{of_part}, {} with {} -> {}",
-        p.scene.file.display(),
+        p.scene.file().display(),
         film.width,
         film.height,
         work_done(&film, elapsed, threads),
@@ -682,7 +683,7 @@ fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
             film.iterations
         )
     } else {
-        let share = film.part.share(scene.render.spp as u64);
+        let share = film.part.share(scene.render().spp as u64);
         let full = film.width as u64 * film.height as u64 * (share.end - share.start);
         format!(
             "wrote the image of the {} of {full} samples done so far",
@@ -731,7 +732,7 @@ fn cmd_convert(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> Resu
     let mut scene = foton_loader::from_document(written)?;
     if let Some((integrator, factor, line)) = &report.relative_radius {
         foton_loader::set_relative_radius(&mut scene, integrator, *factor, *line);
-        doc.root = scene.document.root;
+        doc.root = scene.document().root.clone();
     }
     let header = format!(
         "# Converted by `foton convert` from {}\n",
@@ -755,18 +756,18 @@ fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     let overrides = scene_overrides(&a.scene);
     let p = prepare_args(&a.scene, &overrides)?;
     let s = &p.scene;
-    let _ = writeln!(out, "scene      {}", s.file.display());
+    let _ = writeln!(out, "scene      {}", s.file().display());
     let _ = writeln!(out, "integrator {}", p.integrator.describe());
     let _ = writeln!(
         out,
         "render     {}x{}, {} spp ({}), seed {}, max_depth {} -> {}",
-        s.film.width,
-        s.film.height,
-        s.render.spp,
-        s.render.sampler.name(),
-        s.render.seed,
-        s.render.max_depth,
-        s.film.output.display()
+        s.film().width,
+        s.film().height,
+        s.render().spp,
+        s.render().sampler.name(),
+        s.render().seed,
+        s.render().max_depth,
+        s.film().output.display()
     );
     let names = |v: Vec<&str>| {
         if v.is_empty() {
@@ -778,21 +779,21 @@ fn cmd_check(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     let _ = writeln!(
         out,
         "materials  {}",
-        names(s.materials.iter().map(|m| m.name.as_str()).collect())
+        names(s.materials().iter().map(|m| m.name.as_str()).collect())
     );
     let _ = writeln!(
         out,
         "media      {}",
-        names(s.media.iter().map(|m| m.name.as_str()).collect())
+        names(s.media().iter().map(|m| m.name.as_str()).collect())
     );
     let _ = writeln!(
         out,
         "shapes     {} ({} primitives)",
-        s.objects.len(),
-        s.accel.primitives().len()
+        s.objects().len(),
+        s.accel().primitives().len()
     );
     use foton_core::light::Light;
-    let count = |f: fn(&Light) -> bool| s.lights.iter().filter(|l| f(l)).count();
+    let count = |f: fn(&Light) -> bool| s.lights().iter().filter(|l| f(l)).count();
     let kinds = [
         ("point", count(|l| matches!(l, Light::Point { .. }))),
         ("spot", count(|l| matches!(l, Light::Spot { .. }))),
@@ -897,7 +898,7 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
         let _ = writeln!(err, "warning: {w}");
     }
     if a.narrow_bvh {
-        p.scene.accel.set_wide(false);
+        p.scene.accel_mut().set_wide(false);
     }
     let threads = threads(a.threads);
     let progress = TermProgress::new(true);
@@ -923,19 +924,19 @@ fn cmd_bench(a: BenchArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u
     } else {
         format!(
             "{} spp, {threads} threads: best {best:.3} s, {:.3} M samples/s",
-            p.scene.render.spp,
+            p.scene.render().spp,
             rate(film.total_samples())
         )
     };
     let _ = writeln!(
         out,
         "{} with {}: {}x{} x {work}, {:.3} M rays/s, {} BVH node test",
-        p.scene.file.display(),
+        p.scene.file().display(),
         p.integrator.describe(),
-        p.scene.film.width,
-        p.scene.film.height,
+        p.scene.film().width,
+        p.scene.film().height,
         rate(film.rays),
-        if p.scene.accel.wide() {
+        if p.scene.accel().wide() {
             "8-wide (AVX2)"
         } else {
             "4-wide (SSE2)"

@@ -73,17 +73,17 @@ impl PartInfo {
         let (work, planned, done) = if film.iterations > 0 || film.iterations_planned > 0 {
             ("iterations", film.iterations_planned, film.iterations)
         } else {
-            let share = film.part.share(scene.render.spp as u64);
+            let share = film.part.share(scene.render().spp as u64);
             let done = film.counts().iter().copied().min().unwrap_or(0) as u64;
             ("samples", share.end - share.start, done)
         };
-        let display = scene.film.display();
+        let display = scene.film().display();
         Ok(PartInfo {
             part: film.part,
-            scene: scene.file.display().to_string(),
+            scene: scene.file().display().to_string(),
             scene_hash: scene_hash(scene, overrides)?,
             integrator: integrator.to_string(),
-            seed: scene.render.seed,
+            seed: scene.render().seed,
             build: foton_core::BUILD_ID.to_string(),
             width: film.width,
             height: film.height,
@@ -219,12 +219,12 @@ pub fn fnv_hex(fields: &[Vec<u8>]) -> String {
 pub fn scene_hash(scene: &Scene, overrides: &[String]) -> FotonResult<String> {
     let mut h = Fnv::new();
     let read = |path: &Path| std::fs::read(path).map_err(|e| Error::io(path, e));
-    h.field(&read(&scene.file)?);
+    h.field(&read(scene.file())?);
     h.write(&(overrides.len() as u64).to_le_bytes());
     for o in overrides {
         h.field(o.as_bytes());
     }
-    for source in &scene.sources {
+    for source in scene.sources() {
         h.field(&read(source)?);
     }
     Ok(format!("{:016x}", h.0))

@@ -54,7 +54,7 @@ pub(crate) struct PhotonsArgs {
 /// the image, on the side of its surface that faces the camera (a volume photon has no
 /// surface: its normal is zero), and not hidden.
 fn visible_at(scene: &Scene, photon: &MapPhoton) -> Option<Vec2> {
-    let camera = &scene.camera;
+    let camera = &scene.camera();
     let film = camera.project(photon.position)?;
     let n = photon.normal;
     if n != Vec3::ZERO && n.dot(camera.position - photon.position) <= 0.0 {
@@ -135,7 +135,7 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
 
     // Each pixel shows the mean colour of the dots covering it: density shows as coverage,
     // flux as colour.
-    let (width, height) = (scene.film.width, scene.film.height);
+    let (width, height) = (scene.film().width, scene.film().height);
     let mut sum = vec![Rgb::ZERO; width as usize * height as usize];
     let mut count = vec![0u32; sum.len()];
     let half = (a.dot as i64 - 1) / 2;
@@ -156,12 +156,12 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         .zip(&count)
         .map(|(s, &n)| if n == 0 { Rgb::ZERO } else { *s / n as f32 })
         .collect();
-    foton_loader::image::write_image(&output, width, height, &pixels, &scene.film.display())?;
+    foton_loader::image::write_image(&output, width, height, &pixels, &scene.film().display())?;
 
     let _ = writeln!(
         out,
         "{}: {name} {} map ({}): {} stored of {} photons emitted, {} drawn (visible from the camera), exposure x{:.4e} -> {}",
-        scene.file.display(),
+        scene.file().display(),
         map.name,
         map.description,
         photons.len(),

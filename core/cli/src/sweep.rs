@@ -334,7 +334,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
         label.push(format!("{:.2} s", secs));
         // Each cell through its own scene's display transform: a sweep may vary the exposure.
         tiles.push(Tile {
-            image: render_image(&film, &p.scene.film.display(), &output),
+            image: render_image(&film, &p.scene.film().display(), &output),
             label,
         });
     }
@@ -366,7 +366,7 @@ fn cell_work(film: &foton_core::film::Film, p: &crate::Prepared) -> String {
     if film.iterations > 0 {
         format!("{} iterations", film.iterations)
     } else {
-        format!("{} spp", p.scene.render.spp)
+        format!("{} spp", p.scene.render().spp)
     }
 }
 

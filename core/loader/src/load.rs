@@ -119,10 +119,12 @@ pub fn load_with(
         if let Some((integrator, factor, line)) = &report.relative_radius {
             set_relative_radius(&mut scene, integrator, *factor, *line);
         }
-        scene.ignored.extend(report.warnings);
-        scene.sources.extend(report.included);
         let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
-        scene.warnings.extend(left_out.chain(report.notes));
+        scene.add_report(
+            report.included,
+            left_out.chain(report.notes).collect::<Vec<_>>(),
+            report.warnings,
+        );
     }
     Ok(scene)
 }
@@ -244,7 +246,7 @@ pub fn from_document(doc: Document) -> Result<Scene> {
 /// plugin's `max_radius` in world units, unless the document already gives one (`--set`).
 pub fn set_relative_radius(scene: &mut Scene, integrator: &str, factor: f64, line: u32) {
     use foton_core::value::{Node, Value};
-    let (lo, hi) = scene.bounds;
+    let (lo, hi) = scene.bounds();
     let radius = 0.5 * f64::from((hi - lo).length());
     if !radius.is_finite() || radius <= 0.0 {
         return;
@@ -254,7 +256,7 @@ pub fn set_relative_radius(scene: &mut Scene, integrator: &str, factor: f64, lin
         line,
         column: u32::from(line > 0),
     };
-    let root = &mut scene.document.root;
+    let root = &mut scene.document_mut().root;
     if root.get("integrators").is_none() {
         root.insert("integrators", node(Value::Table(Default::default())));
     }

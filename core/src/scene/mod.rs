@@ -26,7 +26,7 @@ use crate::sampling::Distribution1D;
 use crate::texture::Texture;
 use crate::value::{Document, Value};
 use glam::Vec3;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use volumes::{locate_medium, medium_interfaces};
 
 #[derive(Clone, Debug)]
@@ -97,30 +97,30 @@ pub struct Named<T> {
 }
 
 pub struct Scene {
-    pub file: PathBuf,
-    pub render: RenderSettings,
-    pub film: FilmSettings,
-    pub camera: Camera,
-    pub materials: Vec<Named<Material>>,
+    pub(crate) file: PathBuf,
+    pub(crate) render: RenderSettings,
+    pub(crate) film: FilmSettings,
+    pub(crate) camera: Camera,
+    pub(crate) materials: Vec<Named<Material>>,
     /// The media, each behind the `Medium` interface (a new kind is one implementation).
-    pub media: Vec<Named<BoxedMedium>>,
-    pub objects: Vec<Object>,
-    pub lights: Vec<Light>,
+    pub(crate) media: Vec<Named<BoxedMedium>>,
+    pub(crate) objects: Vec<Object>,
+    pub(crate) lights: Vec<Light>,
     /// Chooses a light proportionally to its power.
-    pub light_distribution: Distribution1D,
+    pub(crate) light_distribution: Distribution1D,
     /// The environment light (`constant`), seen by rays that leave the scene.
-    pub environment: Option<u32>,
-    pub accel: Accel,
+    pub(crate) environment: Option<u32>,
+    pub(crate) accel: Accel,
     /// Vertex normals and texture coordinates of mesh triangles (`Primitive::attrs`).
-    pub triangle_attrs: Vec<TriangleAttrs>,
+    pub(crate) triangle_attrs: Vec<TriangleAttrs>,
     /// The medium filling free space, if any.
-    pub medium: Option<u32>,
+    pub(crate) medium: Option<u32>,
     /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
     /// None in a scene without media.
-    pub interfaces: Vec<Option<MediumInterface>>,
+    pub(crate) interfaces: Vec<Option<MediumInterface>>,
     /// The medium around the camera (None: vacuum): the camera's `medium`, or the one found
     /// where it stands.
-    pub camera_medium: Option<u32>,
+    pub(crate) camera_medium: Option<u32>,
     /// Whether any medium is used (see [`Scene::has_media`]).
     has_media: bool,
     /// Per light: the medium the file puts it in (a point or spot light's `medium`, an area
@@ -132,18 +132,18 @@ pub struct Scene {
     /// boundary can coincide with it and crossing it needs no search for coincident ones.
     alone: Vec<bool>,
     /// Axis-aligned bounds of all geometry and point lights.
-    pub bounds: (Vec3, Vec3),
+    pub(crate) bounds: (Vec3, Vec3),
     /// The parsed document (integrators read their `[integrators.NAME]` table from it).
-    pub document: Document,
+    pub(crate) document: Document,
     /// The files the scene read besides its own (meshes), in the order it read them.
-    pub sources: Vec<PathBuf>,
+    pub(crate) sources: Vec<PathBuf>,
     /// Keys that were present but never read by the loader (not counting `[integrators]`).
-    pub unused: Vec<crate::props::Unused>,
+    pub(crate) unused: Vec<crate::props::Unused>,
     /// Non-fatal problems (reflectance above one, no lights...).
-    pub warnings: Vec<String>,
+    pub(crate) warnings: Vec<String>,
     /// Parameters of a Mitsuba file foton understands but ignores, each with its file:line:
     /// warnings, or errors with `--strict`.
-    pub ignored: Vec<String>,
+    pub(crate) ignored: Vec<String>,
 }
 
 /// What a scene file describes, as the loader read it: the parts [`Scene::new`] builds a scene
@@ -176,6 +176,7 @@ impl Scene {
     /// The scene of `parts`: its bounds, lights fitted to them and their distribution, the
     /// BVH, the medium interfaces and the camera's medium. Err: why the medium around the
     /// camera is undefined (the loader names the camera's line with it).
+    #[doc(hidden)]
     pub fn new(parts: SceneParts) -> std::result::Result<Scene, String> {
         let SceneParts {
             file,
@@ -283,7 +284,47 @@ impl Scene {
         })
     }
 
+    /// The scene file.
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// How to render: the integrator, samples per pixel, seed, path depth, sampler.
+    pub fn render(&self) -> &RenderSettings {
+        &self.render
+    }
+
+    /// The image: size, output, exposure, tone map, pixel filter.
+    pub fn film(&self) -> &FilmSettings {
+        &self.film
+    }
+
+    pub fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    /// The lights, indexed as [`Scene::sample_light`] and [`Scene::area_light`] number them.
+    pub fn lights(&self) -> &[Light] {
+        &self.lights
+    }
+
+    /// Axis-aligned bounds (min, max) of all geometry and point lights.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
+    }
+
+    /// The medium around the camera (None: vacuum).
+    pub fn camera_medium(&self) -> Option<u32> {
+        self.camera_medium
+    }
+
+    /// The number of media; [`Scene::medium`] gives each.
+    pub fn media_count(&self) -> usize {
+        self.media.len()
+    }
+
     /// Where a key path was written in the scene file (line 0: it came from `--set`).
+    #[doc(hidden)]
     pub fn location_of(&self, path: &[&str]) -> Option<Location> {
         let mut node = self.document.root.get(path.first()?)?;
         for key in &path[1..] {
@@ -300,6 +341,7 @@ impl Scene {
     }
 
     /// The parameters of integrator `name` (its `[integrators.NAME]` table, or an empty bag).
+    #[doc(hidden)]
     pub fn integrator_properties(&self, name: &str) -> Result<Properties<'_>> {
         let path = format!("integrators.{name}");
         let Some(node) = self.document.root.get("integrators") else {
@@ -437,5 +479,112 @@ impl Scene {
     #[inline]
     pub fn has_media(&self) -> bool {
         self.has_media
+    }
+}
+
+/// What the host (the loader, the tools, the tests) reads and changes of a scene besides what
+/// integrators use: not part of the plugin API (`#[doc(hidden)]`, as cargo-semver-checks
+/// counts it).
+impl Scene {
+    #[doc(hidden)]
+    pub fn render_mut(&mut self) -> &mut RenderSettings {
+        &mut self.render
+    }
+
+    #[doc(hidden)]
+    pub fn film_mut(&mut self) -> &mut FilmSettings {
+        &mut self.film
+    }
+
+    #[doc(hidden)]
+    pub fn materials(&self) -> &[Named<Material>] {
+        &self.materials
+    }
+
+    #[doc(hidden)]
+    pub fn media(&self) -> &[Named<BoxedMedium>] {
+        &self.media
+    }
+
+    /// The media, to put another kind of medium in one's place (the tests' media).
+    #[doc(hidden)]
+    pub fn media_mut(&mut self) -> &mut [Named<BoxedMedium>] {
+        &mut self.media
+    }
+
+    #[doc(hidden)]
+    pub fn objects(&self) -> &[Object] {
+        &self.objects
+    }
+
+    #[doc(hidden)]
+    pub fn accel(&self) -> &Accel {
+        &self.accel
+    }
+
+    #[doc(hidden)]
+    pub fn accel_mut(&mut self) -> &mut Accel {
+        &mut self.accel
+    }
+
+    /// The medium filling free space, if any.
+    #[doc(hidden)]
+    pub fn ambient_medium(&self) -> Option<u32> {
+        self.medium
+    }
+
+    /// Per object: its medium interface if it bounds a volume.
+    #[doc(hidden)]
+    pub fn interfaces(&self) -> &[Option<MediumInterface>] {
+        &self.interfaces
+    }
+
+    /// The parsed document (integrators read their `[integrators.NAME]` table from it).
+    #[doc(hidden)]
+    pub fn document(&self) -> &Document {
+        &self.document
+    }
+
+    #[doc(hidden)]
+    pub fn document_mut(&mut self) -> &mut Document {
+        &mut self.document
+    }
+
+    /// The files the scene read besides its own (meshes, includes), in the order it read them.
+    #[doc(hidden)]
+    pub fn sources(&self) -> &[PathBuf] {
+        &self.sources
+    }
+
+    /// Keys that were present but never read by the loader (not counting `[integrators]`).
+    #[doc(hidden)]
+    pub fn unused(&self) -> &[Unused] {
+        &self.unused
+    }
+
+    /// Non-fatal problems (reflectance above one, no lights...).
+    #[doc(hidden)]
+    pub fn warnings(&self) -> &[String] {
+        &self.warnings
+    }
+
+    /// Parameters of a Mitsuba file foton understands but ignores, each with its file:line.
+    #[doc(hidden)]
+    pub fn ignored(&self) -> &[String] {
+        &self.ignored
+    }
+
+    /// Adds what a reader found besides the document: files it read, warnings, parameters it
+    /// ignored.
+    #[doc(hidden)]
+    pub fn add_report(
+        &mut self,
+        sources: impl IntoIterator<Item = PathBuf>,
+        warnings: impl IntoIterator<Item = String>,
+        ignored: impl IntoIterator<Item = String>,
+    ) {
+        self.sources.extend(sources);
+        self.warnings.extend(warnings);
+        self.ignored.extend(ignored);
     }
 }

@@ -103,16 +103,16 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     let light_image = props.bool("light_image", true)?;
     let strategy = Strategy::parse(props.string("strategy", "all")?)
         .map_err(|e| props.error("strategy", e))?;
-    if scene.render.hide_emitters && scene.has_media() {
+    if scene.render().hide_emitters && scene.has_media() {
         return Err(Error::Usage(format!(
             "{}: `bdpt` does not render hide_emitters in a scene with participating media \
              (a light path connected to the camera would have to pass emitters and media as a \
              camera ray does): use `path`",
-            scene.file.display()
+            scene.file().display()
         )));
     }
     Ok(Box::new(Bdpt(Bidir::new(
-        scene.render.max_depth,
+        scene.render().max_depth,
         rr_depth,
         strategy,
         light_image,

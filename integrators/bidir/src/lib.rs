@@ -318,8 +318,8 @@ impl Bidir {
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
     ) -> Rgb {
-        let margin = scene.film.filter.margin();
-        let (_, pdf_we) = scene.camera.pdf_we(ps.ray.dir, margin);
+        let margin = scene.film().filter.margin();
+        let (_, pdf_we) = scene.camera().pdf_we(ps.ray.dir, margin);
         let pdf_camera = ps.filter_pdf * pdf_we;
         if pdf_camera <= 0.0 {
             return Rgb::ZERO;
@@ -356,7 +356,7 @@ impl Bidir {
         let u_light = sampler.next_f32();
         let (u_pos, u_dir, u_shape) = (sampler.next_2d(), sampler.next_2d(), sampler.next_f32());
         let (id, pick) = scene.sample_light(u_light)?;
-        let light = &scene.lights[id];
+        let light = &scene.lights()[id];
         let e = light.sample_emission(u_pos, u_dir, u_shape);
         let medium = light_media.get(id).copied().flatten();
         let origin = matches!(light, Light::Area { .. }).then_some(Origin {
@@ -506,7 +506,7 @@ impl Bidir {
                             // No other strategy sees a light at infinity directly.
                             return 1.0;
                         }
-                        let light = &scene.lights[id as usize];
+                        let light = &scene.lights()[id as usize];
                         let pick = scene.light_pmf(id as usize);
                         let direct = pick * light.pdf_li(prev, prev + dir, Vec3::ZERO);
                         let (pos, pdf_dir) = light.pdf_le(Vec3::ZERO, -dir);
@@ -609,8 +609,8 @@ impl Bidir {
         if self.weight(s, 1, || 1.0) == 0.0 {
             return;
         }
-        let camera = &scene.camera;
-        let margin = scene.film.filter.margin();
+        let camera = &scene.camera();
+        let margin = scene.film().filter.margin();
         let Some(cs) = camera.sample_wi(v.p, margin) else {
             return;
         };
@@ -618,7 +618,7 @@ impl Bidir {
         if f == Rgb::ZERO {
             return;
         }
-        let tr = if scene.render.hide_emitters {
+        let tr = if scene.render().hide_emitters {
             // Camera rays pass through emitters until they first scatter: so does this
             // connection, the camera subpath's first segment seen from its other end.
             Rgb::splat(seen_past_emitters(scene, v, rays) as u8 as f32)
@@ -634,9 +634,9 @@ impl Bidir {
         // The camera's density of having sampled v, per unit area there (filter aside).
         let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
         let pdf_rev = v.pdf(cs.wi, v.wo);
-        let (width, height) = (scene.film.width, scene.film.height);
+        let (width, height) = (scene.film().width, scene.film().height);
         scene
-            .film
+            .film()
             .filter
             .footprint(cs.film, width, height, |x, y, h| {
                 let w = self.weight(s, 1, || {
@@ -657,15 +657,15 @@ impl Bidir {
     ) {
         // With hide_emitters the camera does not see emitters directly (their s = 0, t = 2
         // twin never happens either: camera rays pass through them).
-        if self.weight(1, 1, || 1.0) == 0.0 || scene.render.hide_emitters {
+        if self.weight(1, 1, || 1.0) == 0.0 || scene.render().hide_emitters {
             return;
         }
-        let camera = &scene.camera;
-        let margin = scene.film.filter.margin();
+        let camera = &scene.camera();
+        let margin = scene.film().filter.margin();
         let Some(cs) = camera.sample_wi(o.p, margin) else {
             return;
         };
-        let le = scene.lights[o.light].emitted(o.n, cs.wi);
+        let le = scene.lights()[o.light].emitted(o.n, cs.wi);
         if le == Rgb::ZERO {
             return;
         }
@@ -684,9 +684,9 @@ impl Bidir {
             d_vc: 0.0,
             d_vm: 0.0,
         };
-        let (width, height) = (scene.film.width, scene.film.height);
+        let (width, height) = (scene.film().width, scene.film().height);
         scene
-            .film
+            .film()
             .filter
             .footprint(cs.film, width, height, |x, y, h| {
                 let w = self.weight(1, 1, || {
@@ -707,7 +707,7 @@ impl Bidir {
         let Some((id, pick)) = scene.sample_light(u_light) else {
             return Rgb::ZERO;
         };
-        let light = &scene.lights[id];
+        let light = &scene.lights()[id];
         let Some(ls) = light.sample_li(c.p, u, uc) else {
             return Rgb::ZERO;
         };
@@ -804,7 +804,7 @@ fn seen_past_emitters(scene: &Scene, v: &Vertex, rays: &mut u64) -> bool {
     if scene.object(vh).light.is_some() {
         return false;
     }
-    let origin = scene.camera.position;
+    let origin = scene.camera().position;
     let to = v.p - origin;
     let dist = to.length();
     let mut walk = RayWalk::camera(scene, Ray::new(origin, to / dist));

@@ -36,7 +36,7 @@ impl Normals {
     /// The colour seen along a camera ray; adds the rays traced to `rays` (statistics).
     pub fn shade(&self, scene: &Scene, ray: Ray, rays: &mut u64) -> Rgb {
         // Core's walk crosses null boundaries (and gives up, black, past its crossing limit).
-        let Some((hit, _)) = first_surface(scene, ray, scene.camera_medium, rays) else {
+        let Some((hit, _)) = first_surface(scene, ray, scene.camera_medium(), rays) else {
             return Rgb::ZERO;
         };
         // The shading normal (interpolated on smooth meshes), as a renderer's normal pass.

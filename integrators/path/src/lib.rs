@@ -126,12 +126,12 @@ impl PathTracer {
             let Some(hit) = seg.hit else {
                 // ---- The environment, weighted against light sampling as an emitter ----
                 if let Some((light_id, le)) = scene.escaped(seg.ray.dir)
-                    && !(depth == 0 && scene.render.hide_emitters)
+                    && !(depth == 0 && scene.render().hide_emitters)
                 {
                     if specular {
                         radiance += beta * le;
                     } else {
-                        let light = &scene.lights[light_id as usize];
+                        let light = &scene.lights()[light_id as usize];
                         let pdf_light = scene.light_pmf(light_id as usize)
                             * light.pdf_li(prev_p, prev_p + seg.ray.dir, Vec3::ZERO);
                         radiance += beta * le * power_heuristic(prev_pdf, pdf_light);
@@ -211,7 +211,10 @@ impl Integrator for PathTracer {
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
     let rr_depth = props.u32("rr_depth", 5)?;
-    Ok(Box::new(PathTracer::new(scene.render.max_depth, rr_depth)))
+    Ok(Box::new(PathTracer::new(
+        scene.render().max_depth,
+        rr_depth,
+    )))
 }
 
 foton_core::api::declare_integrator!("path", "unidirectional path tracer (NEE + MIS)", create);

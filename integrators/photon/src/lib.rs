@@ -115,7 +115,7 @@ impl PhotonMapper {
             need_direct,
             self.final_gather,
         )?;
-        if lists[2].is_empty() && !scene.lights.is_empty() {
+        if lists[2].is_empty() && !scene.lights().is_empty() {
             ctx.progress
                 .warn("no photon reached a second diffuse surface: the indirect map is empty");
         }
@@ -307,7 +307,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     if scene.has_media() {
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `photon` does not render (use `vpm`)",
-            scene.file.display()
+            scene.file().display()
         )));
     }
     Ok(Box::new(PhotonMapper {
@@ -316,7 +316,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         direct,
         final_gather,
         gather_rays,
-        max_depth: scene.render.max_depth,
+        max_depth: scene.render().max_depth,
         camera: CameraWalk::read(props, scene)?,
     }))
 }

@@ -236,10 +236,10 @@ pub fn global_radius2_scale(iteration: u64, alpha: f64) -> f64 {
 
 /// The angle one pixel subtends at the centre of the image.
 pub fn pixel_angle(scene: &Scene) -> f32 {
-    let (w, h) = (scene.film.width as f32, scene.film.height as f32);
-    let a = scene.camera.generate_ray(Vec2::new(w / 2.0, h / 2.0)).dir;
+    let (w, h) = (scene.film().width as f32, scene.film().height as f32);
+    let a = scene.camera().generate_ray(Vec2::new(w / 2.0, h / 2.0)).dir;
     let b = scene
-        .camera
+        .camera()
         .generate_ray(Vec2::new(w / 2.0, h / 2.0 + 1.0))
         .dir;
     a.dot(b).clamp(-1.0, 1.0).acos()
@@ -252,7 +252,7 @@ pub fn pixel_angle(scene: &Scene) -> f32 {
 /// 3 footprints ([`SPPM_FOOTPRINTS`]); `ppb`, whose passes gather from many more surface
 /// photons, fewer (its README).
 pub fn auto_radius(scene: &Scene, pixel_angle: f32, distance: f32, footprints: f64) -> f64 {
-    let diagonal = (scene.bounds.1 - scene.bounds.0).length().max(1e-6) as f64;
+    let diagonal = (scene.bounds().1 - scene.bounds().0).length().max(1e-6) as f64;
     (footprints * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
 }
 

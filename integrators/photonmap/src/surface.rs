@@ -45,10 +45,10 @@ pub fn trace_surface_photons(
     let pass = |photons, stream, stop_at_diffuse| TraceOptions {
         photons,
         max_depth: budgets.max_depth,
-        seed: scene.render.seed,
+        seed: scene.render().seed,
         stream,
         stop_at_diffuse,
-        sobol_emission: TraceOptions::emission_for(scene.render.sampler),
+        sobol_emission: TraceOptions::emission_for(scene.render().sampler),
     };
     let caustic_map = budgets.caustic > 0;
     let global = pass(budgets.global, STREAM_GLOBAL, false);
@@ -190,7 +190,7 @@ impl SurfaceParams {
 /// The scene's bounding-box diagonal, the unit of the default radii and steps (1 for an
 /// empty scene).
 pub fn diagonal(scene: &Scene) -> f32 {
-    let d = (scene.bounds.1 - scene.bounds.0).length();
+    let d = (scene.bounds().1 - scene.bounds().0).length();
     if d > 0.0 { d } else { 1.0 }
 }
 
@@ -259,7 +259,7 @@ pub fn render_with_maps<M: Sync>(
 ) -> Result<Film> {
     let maps = build()?;
     if ctx.cancelled() {
-        return Ok(Film::new(scene.film.width, scene.film.height));
+        return Ok(Film::new(scene.film().width, scene.film().height));
     }
     let film = render_pixels(scene, ctx, |ray, sampler, rays| {
         li(&maps, *ray, sampler, rays)

@@ -119,7 +119,7 @@ pub fn trace_one_with_beams(
     let Some((light_id, pmf)) = scene.sample_light(u[0]) else {
         return;
     };
-    let light = &scene.lights[light_id];
+    let light = &scene.lights()[light_id];
     let (u_pos, u_dir, uc) = (Vec2::new(u[1], u[2]), Vec2::new(u[3], u[4]), u[5]);
     let emitted = light.sample_emission(u_pos, u_dir, uc);
     let mut flux: Rgb = emitted.flux / (pmf * opts.photons as f32);
@@ -157,7 +157,7 @@ pub fn trace_one_with_beams(
                 let length = if end.is_finite() {
                     end
                 } else {
-                    exit_distance(&start, scene.bounds)
+                    exit_distance(&start, scene.bounds())
                 };
                 if length > 0.0 {
                     beam(

@@ -165,10 +165,10 @@ impl Ppb {
         let options = |photons, stream| TraceOptions {
             photons,
             max_depth: self.max_depth,
-            seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
+            seed: splitmix64(scene.render().seed ^ splitmix64(iteration)),
             stream,
             stop_at_diffuse: false,
-            sobol_emission: TraceOptions::emission_for(scene.render.sampler),
+            sobol_emission: TraceOptions::emission_for(scene.render().sampler),
         };
         let keep_direct = self.direct == Direct::Photons;
         let shared = self.surface_photons == self.passes.photons_per_iteration;
@@ -204,10 +204,10 @@ impl Ppb {
         let scale = global_radius2_scale(iteration + 1, self.alpha);
         let r = (self.initial_beam_radius as f64 * scale) as f32;
         let beams = BeamMap::build(beams, r);
-        let margin = scene.film.filter.margin();
+        let margin = scene.film().filter.margin();
         Ok(Pass {
             surface: PhotonMap::build(photons),
-            screen: ScreenBeams::build(&beams, &scene.camera, margin),
+            screen: ScreenBeams::build(&beams, scene.camera(), margin),
             beams,
             surface_shrink: scale.sqrt(),
         })
@@ -225,21 +225,21 @@ impl Ppb {
         rays: &mut u64,
         bad_photons: &mut u64,
     ) -> Rgb {
-        let seed = scene.render.seed;
-        let pixel = y as u64 * scene.film.width as u64 + x as u64;
+        let seed = scene.render().seed;
+        let pixel = y as u64 * scene.film().width as u64 + x as u64;
         let mut sampler = Sampler::with_keys(
-            scene.render.sampler,
+            scene.render().sampler,
             &[seed, STREAM_CAMERA, pixel, iteration],
             seed,
             pixel,
             iteration as u32,
             self.passes.iterations.unwrap_or(1) as u32,
         );
-        let film = scene.film.filter.film_position(x, y, sampler.next_2d());
-        let ray = scene.camera.generate_ray(film);
+        let film = scene.film().filter.film_position(x, y, sampler.next_2d());
+        let ray = scene.camera().generate_ray(film);
         let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
         let grow = Vec3::splat(pass.beams.radius());
-        let bounds = (scene.bounds.0 - grow, scene.bounds.1 + grow);
+        let bounds = (scene.bounds().0 - grow, scene.bounds().1 + grow);
         let path = walk_to_diffuse(
             scene,
             ray,
@@ -334,7 +334,7 @@ impl Passes for PpbPasses<'_> {
         if quiet.cancelled() {
             return Ok(None);
         }
-        let (width, angle) = (scene.film.width as usize, self.angle);
+        let (width, angle) = (scene.film().width as usize, self.angle);
         with_pool(quiet.threads, || {
             self.sums
                 .par_chunks_mut(width)
@@ -376,7 +376,7 @@ impl Passes for PpbPasses<'_> {
     }
 
     fn film(&self, passes: u64) -> Film {
-        let (width, height) = (self.scene.film.width, self.scene.film.height);
+        let (width, height) = (self.scene.film().width, self.scene.film().height);
         let mut film = Film::new(width, height);
         let count = passes.min(u32::MAX as u64) as u32;
         for (i, sum) in self.sums.iter().enumerate() {
@@ -394,7 +394,7 @@ impl Integrator for Ppb {
             scene,
             sums: vec![
                 RadianceSum::default();
-                scene.film.width as usize * scene.film.height as usize
+                scene.film().width as usize * scene.film().height as usize
             ],
             angle: pixel_angle(scene),
             tally: &tally,
@@ -508,7 +508,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         kernel,
         kernel_1d,
         direct,
-        max_depth: scene.render.max_depth,
+        max_depth: scene.render().max_depth,
         camera: CameraWalk::read(props, scene)?,
     }))
 }

@@ -186,8 +186,8 @@ impl CameraSample {
 
 impl Sppm {
     fn camera_pass(&self, scene: &Scene, iteration: u64, rays: &mut u64) -> Vec<CameraSample> {
-        let (width, height) = (scene.film.width, scene.film.height);
-        let seed = scene.render.seed;
+        let (width, height) = (scene.film().width, scene.film().height);
+        let seed = scene.render().seed;
         let rows: Vec<(Vec<CameraSample>, u64)> = (0..height)
             .into_par_iter()
             .map(|y| {
@@ -196,15 +196,15 @@ impl Sppm {
                     .map(|x| {
                         let pixel = y as u64 * width as u64 + x as u64;
                         let mut sampler = Sampler::with_keys(
-                            scene.render.sampler,
+                            scene.render().sampler,
                             &[seed, STREAM_CAMERA, pixel, iteration],
                             seed,
                             pixel,
                             iteration as u32,
                             self.passes.iterations.unwrap_or(1) as u32,
                         );
-                        let film = scene.film.filter.film_position(x, y, sampler.next_2d());
-                        let ray = scene.camera.generate_ray(film);
+                        let film = scene.film().filter.film_position(x, y, sampler.next_2d());
+                        let ray = scene.camera().generate_ray(film);
                         let path =
                             trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
                         let mut ld = path.emitted;
@@ -252,10 +252,10 @@ impl Sppm {
         let options = TraceOptions {
             photons: self.passes.photons_per_iteration,
             max_depth: self.max_depth,
-            seed: splitmix64(scene.render.seed ^ splitmix64(iteration)),
+            seed: splitmix64(scene.render().seed ^ splitmix64(iteration)),
             stream: STREAM_GLOBAL,
             stop_at_diffuse: false,
-            sobol_emission: TraceOptions::emission_for(scene.render.sampler),
+            sobol_emission: TraceOptions::emission_for(scene.render().sampler),
         };
         let keep_direct = self.direct == Direct::Photons;
         Ok(trace_photons(scene, &options, ctx, 1, |_, class| {
@@ -390,7 +390,7 @@ impl Passes for SppmPasses<'_> {
     }
 
     fn film(&self, iterations: u64) -> Film {
-        let (width, height) = (self.scene.film.width, self.scene.film.height);
+        let (width, height) = (self.scene.film().width, self.scene.film().height);
         let mut film = Film::new(width, height);
         for y in 0..height {
             for x in 0..width {
@@ -419,7 +419,7 @@ impl Integrator for Sppm {
             scene,
             stats: vec![
                 PixelStats::default();
-                scene.film.width as usize * scene.film.height as usize
+                scene.film().width as usize * scene.film().height as usize
             ],
             angle: pixel_angle(scene),
             tally: &tally,
@@ -515,7 +515,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
     if scene.has_media() {
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `sppm` does not render (use `vpm` or `path`)",
-            scene.file.display()
+            scene.file().display()
         )));
     }
     Ok(Box::new(Sppm {
@@ -524,7 +524,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         alpha: alpha as f64,
         kernel,
         direct,
-        max_depth: scene.render.max_depth,
+        max_depth: scene.render().max_depth,
         camera: CameraWalk::read(props, scene)?,
         schedule,
     }))

@@ -194,7 +194,7 @@ impl Vcm {
     /// The estimator of iteration `iteration` (1-based): its radius and weights.
     fn estimator(&self, scene: &Scene, iteration: u64) -> (Bidir, f32) {
         let radius = radius_of(self.radius, self.alpha, iteration);
-        let light_paths = (scene.film.width as f32) * (scene.film.height as f32);
+        let light_paths = (scene.film().width as f32) * (scene.film().height as f32);
         let mut bidir = Bidir::new(self.max_depth, self.rr_depth, Strategy::All, true);
         bidir.factors = Factors::vcm(
             radius,
@@ -214,10 +214,10 @@ impl Vcm {
     }
 
     fn sampler(&self, scene: &Scene, stream: u64, pixel: u64, iteration: u64) -> Sampler {
-        let seed = scene.render.seed;
+        let seed = scene.render().seed;
         // The structured samplers' patterns are keyed by the seed: the two passes get their own.
         Sampler::with_keys(
-            scene.render.sampler,
+            scene.render().sampler,
             &[seed, stream, pixel, iteration],
             seed ^ stream,
             pixel,
@@ -234,7 +234,7 @@ impl Vcm {
         media: &[Option<u32>],
         iteration: u64,
     ) -> (LightPaths, u64) {
-        let (width, height) = (scene.film.width, scene.film.height);
+        let (width, height) = (scene.film().width, scene.film().height);
         // Each row's paths (its ends counted from the row's first vertex), then joined in row
         // order: the same vertices in the same order whatever the thread count.
         let rows: Vec<(LightPaths, u64)> = (0..height)
@@ -290,8 +290,8 @@ impl Vcm {
         radius: f32,
         iteration: u64,
     ) -> Vec<Row> {
-        let (width, height) = (scene.film.width, scene.film.height);
-        let filter = &scene.film.filter;
+        let (width, height) = (scene.film().width, scene.film().height);
+        let filter = &scene.film().filter;
         let light_paths = width as f32 * height as f32;
         (0..height)
             .into_par_iter()
@@ -320,7 +320,7 @@ impl Vcm {
                     if self.mode != Mode::Lt {
                         let at = filter.film_position(x, y, sampler.next_2d());
                         let ps = PixelSample {
-                            ray: scene.camera.generate_ray(at),
+                            ray: scene.camera().generate_ray(at),
                             x,
                             y,
                             film: at,
@@ -437,7 +437,7 @@ impl Passes for VcmPasses<'_> {
             // An iteration cut short would leave pixels without their sample: drop it.
             return Ok(None);
         }
-        let width = scene.film.width as usize;
+        let width = scene.film().width as usize;
         for (y, row) in rows.into_iter().enumerate() {
             let y0 = y * width;
             for (x, sum) in row.sums.iter().enumerate() {
@@ -475,7 +475,7 @@ impl Integrator for Vcm {
             vcm: self,
             scene,
             media: scene.emission_media()?,
-            film: Film::new(scene.film.width, scene.film.height),
+            film: Film::new(scene.film().width, scene.film().height),
             tally: Tally::default(),
         };
         // Iteration i's radius and random streams depend on i alone: any share of them can
@@ -520,7 +520,7 @@ impl Integrator for Vcm {
 
 /// SmallVCM's default first radius: 0.003 x the radius of the scene's bounding sphere.
 pub fn auto_radius(scene: &Scene) -> f32 {
-    let diagonal = (scene.bounds.1 - scene.bounds.0).length();
+    let diagonal = (scene.bounds().1 - scene.bounds().0).length();
     (0.003 * 0.5 * diagonal).max(1e-6)
 }
 
@@ -548,10 +548,10 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         return Err(Error::Usage(format!(
             "{}: the scene has participating media, which `vcm` does not render (merging is on \
              surfaces only): use `bdpt` or `vpm`",
-            scene.file.display()
+            scene.file().display()
         )));
     }
-    let light_paths = scene.film.width as u64 * scene.film.height as u64;
+    let light_paths = scene.film().width as u64 * scene.film().height as u64;
     Ok(Box::new(Vcm {
         passes: PassBudget {
             iterations,
@@ -562,7 +562,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         radius_given: radius.is_some(),
         alpha,
         mode,
-        max_depth: scene.render.max_depth,
+        max_depth: scene.render().max_depth,
         rr_depth,
     }))
 }

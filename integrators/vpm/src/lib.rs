@@ -210,10 +210,10 @@ impl Vpm {
             let opts = TraceOptions {
                 photons: self.volume_photons,
                 max_depth: self.max_depth,
-                seed: scene.render.seed,
+                seed: scene.render().seed,
                 stream: STREAM_VOLUME,
                 stop_at_diffuse: false,
-                sobol_emission: TraceOptions::emission_for(scene.render.sampler),
+                sobol_emission: TraceOptions::emission_for(scene.render().sampler),
             };
             // Each light path once: L M by shadow rays unless direct = "photons".
             let keep = |class| class != PathClass::Direct || photons_direct;
@@ -266,7 +266,7 @@ impl Vpm {
             Vec::new()
         };
         let volume_radius_max = volume_radius.iter().copied().fold(0.0, f32::max);
-        let (mut lo, mut hi) = scene.bounds;
+        let (mut lo, mut hi) = scene.bounds();
         if !volume.is_empty() {
             let (vlo, vhi) = volume.bounds();
             lo = lo.min(vlo);
@@ -549,7 +549,7 @@ pub const DEFAULT_K: u32 = 8;
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
     let diagonal = diagonal(scene);
-    let pixels = scene.film.width as u64 * scene.film.height as u64;
+    let pixels = scene.film().width as u64 * scene.film().height as u64;
     let defaults = SurfaceDefaults {
         global_photons: (GLOBAL_PHOTONS_PER_PIXEL * pixels).clamp(1, MAX_DEFAULT_GLOBAL_PHOTONS),
         caustic_photons: 100_000,
@@ -609,7 +609,7 @@ pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrato
         beam_type,
         beam_radius,
         kernel_1d,
-        max_depth: scene.render.max_depth,
+        max_depth: scene.render().max_depth,
         camera: CameraWalk::read(props, scene)?,
     }))
 }

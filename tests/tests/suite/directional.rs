@@ -65,7 +65,7 @@ fn load(text: &str) -> Scene {
 #[test]
 fn irradiance_on_a_plane_is_e_cos_theta() {
     let scene = load(&scene("path", 1, "[0.6, -0.8, 0.0]"));
-    let light = &scene.lights[0];
+    let light = &scene.lights()[0];
     let p = Vec3::new(0.5, 0.0, 0.5);
     let ls = light.sample_li(p, Vec2::splat(0.5), 0.5).unwrap();
     assert!(ls.delta);
@@ -78,7 +78,7 @@ fn irradiance_on_a_plane_is_e_cos_theta() {
             < 1e-6,
         "{e}"
     );
-    let (lo, hi) = scene.bounds;
+    let (lo, hi) = scene.bounds();
     assert!(
         ls.p.distance(p) > (hi - lo).length(),
         "the shadow ray must leave the scene"
@@ -90,7 +90,7 @@ fn irradiance_on_a_plane_is_e_cos_theta() {
 #[test]
 fn photons_deliver_irradiance_times_area() {
     let scene = load(&scene("photon", 1, "[0.0, -1.0, 0.0]"));
-    let power = scene.lights[0].power().as_dvec3();
+    let power = scene.lights()[0].power().as_dvec3();
     let opts = TraceOptions {
         photons: 200_000,
         max_depth: 1,

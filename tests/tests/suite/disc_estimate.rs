@@ -157,7 +157,7 @@ intensity = [60.0, 60.0, 60.0]
     // The pixels of the floor strip x in [0.02, 0.08], |z| < 0.1: within the radius of the
     // box's edge and inside its shadow (about 0.37 long).
     let corners = [(0.02, -0.1), (0.08, -0.1), (0.02, 0.1), (0.08, 0.1)]
-        .map(|(x, z)| scene.camera.project(Vec3::new(x, 0.0, z)).unwrap());
+        .map(|(x, z)| scene.camera().project(Vec3::new(x, 0.0, z)).unwrap());
     let x0 = corners
         .iter()
         .map(|c| c.x)
@@ -174,7 +174,7 @@ intensity = [60.0, 60.0, 60.0]
     let (a, sa) = region_mean(&photon, x0, y0, x1, y1);
     let (b, sb) = region_mean(&reference, x0, y0, x1, y1);
     // The box top, for scale: the strip is much darker.
-    let top = scene.camera.project(Vec3::new(-0.1, h, 0.0)).unwrap();
+    let top = scene.camera().project(Vec3::new(-0.1, h, 0.0)).unwrap();
     let (t, _) = region_mean(
         &reference,
         top.x as u32 - 1,

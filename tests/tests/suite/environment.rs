@@ -140,7 +140,7 @@ fn environment_photons(light: &str) {
     let path = write(&dir, "scene.toml", &scene("photon", 1, light));
     let scene = foton_loader::load(&path, &[]).unwrap();
     let _ = std::fs::remove_dir_all(dir);
-    let power = scene.lights[0].power().as_dvec3();
+    let power = scene.lights()[0].power().as_dvec3();
     let opts = TraceOptions {
         photons: 200_000,
         max_depth: 1,
@@ -244,7 +244,7 @@ to_world = { rotate = { axis = [0, 1, 0], degrees = 90 } }
     );
     let from_xml = foton_loader::load(&xml, &[]).unwrap();
     let from_toml = foton_loader::load(&toml, &[]).unwrap();
-    let (a, b) = (&from_xml.lights[0], &from_toml.lights[0]);
+    let (a, b) = (&from_xml.lights()[0], &from_toml.lights()[0]);
     for d in [
         Vec3::X,
         Vec3::Y,

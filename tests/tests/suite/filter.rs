@@ -91,7 +91,7 @@ emission = [1.0, 1.0, 1.0]
         let path = write(&dir, "scene.toml", &s);
         let scene = foton_loader::load(&path, &[]).unwrap();
         let e = scene
-            .camera
+            .camera()
             .project(glam::Vec3::new(0.0123, 0.0, 0.0))
             .unwrap()
             .x as f64;
@@ -147,7 +147,10 @@ fn the_field_of_view_spans_the_axis_asked_for() {
         let scene = foton_loader::load(&path, &[]).unwrap();
         let _ = std::fs::remove_dir_all(dir);
         let (a, b) = ends(axis);
-        let (ra, rb) = (scene.camera.generate_ray(a), scene.camera.generate_ray(b));
+        let (ra, rb) = (
+            scene.camera().generate_ray(a),
+            scene.camera().generate_ray(b),
+        );
         let angle = ra.dir.dot(rb.dir).clamp(-1.0, 1.0).acos().to_degrees();
         assert!((angle - 50.0).abs() < 0.01, "{axis}: {angle}");
     }

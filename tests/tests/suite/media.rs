@@ -62,7 +62,7 @@ fn load(path: &Path) -> Scene {
 }
 
 fn medium_index(scene: &Scene, name: &str) -> Option<u32> {
-    Some(scene.media.iter().position(|m| m.name == name).unwrap() as u32)
+    Some(scene.media().iter().position(|m| m.name == name).unwrap() as u32)
 }
 
 fn exp_rgb(v: Vec3) -> Rgb {
@@ -222,7 +222,7 @@ fn medium_at_finds_the_innermost_volume_and_the_interfaces_their_outsides() {
     let (dir, path) = scene_dir("media-at", &nested_scene(sphere_c), &nested_boxes());
     let scene = load(&path);
     let m = |n: &str| medium_index(&scene, n);
-    assert_eq!(scene.camera_medium, m("S"));
+    assert_eq!(scene.camera_medium(), m("S"));
     assert_eq!(scene.medium_at(Vec3::new(0.0, 0.0, 0.0)), Ok(m("A")));
     assert_eq!(scene.medium_at(Vec3::new(0.0, 0.5, 0.1)), Ok(m("C")));
     assert_eq!(scene.medium_at(Vec3::new(0.0, 0.0, 1.0)), Ok(m("B")));
@@ -232,14 +232,14 @@ fn medium_at_finds_the_innermost_volume_and_the_interfaces_their_outsides() {
     let err = scene.medium_at(Vec3::new(0.0, 0.0, 0.5)).unwrap_err();
     assert!(err.contains("boundary"), "{err}");
     // The sphere's outside is A, A's and B's outside is S, the glass's outside is S.
-    let sphere = scene.interfaces[3].unwrap();
+    let sphere = scene.interfaces()[3].unwrap();
     assert_eq!(
         (sphere.inside, sphere.outside, sphere.depth),
         (m("C"), m("A"), 1)
     );
-    let a = scene.interfaces[0].unwrap();
+    let a = scene.interfaces()[0].unwrap();
     assert_eq!((a.inside, a.outside, a.depth), (m("A"), m("S"), 0));
-    let glass = scene.interfaces[2].unwrap();
+    let glass = scene.interfaces()[2].unwrap();
     assert_eq!((glass.inside, glass.outside), (None, m("S")));
     let _ = std::fs::remove_dir_all(dir);
 }
@@ -248,9 +248,9 @@ fn medium_at_finds_the_innermost_volume_and_the_interfaces_their_outsides() {
 fn camera_inside_a_nested_medium_starts_there() {
     let (dir, path) = scene_dir("media-camera", &nested_scene(""), &nested_boxes());
     let scene = foton_loader::load(&path, &["camera.position=[0.2, 0.1, 1.0]".into()]).unwrap();
-    assert_eq!(scene.camera_medium, medium_index(&scene, "B"));
+    assert_eq!(scene.camera_medium(), medium_index(&scene, "B"));
     let scene = foton_loader::load(&path, &["camera.position=[4.0, 0.1, 0.0]".into()]).unwrap();
-    assert_eq!(scene.camera_medium, None, "inside the clear glass");
+    assert_eq!(scene.camera_medium(), None, "inside the clear glass");
     let _ = std::fs::remove_dir_all(dir);
 }
 

@@ -78,7 +78,7 @@ fn load_toml(name: &str, toml: &str) -> Scene {
 fn fog_between_two_open_quads_transmits_exp_minus_sigma_t_d() {
     let scene = load_toml("sides-slab-load", &slab_scene(4));
     assert!(scene.has_media());
-    assert_eq!(scene.camera_medium, None, "the camera stands in vacuum");
+    assert_eq!(scene.camera_medium(), None, "the camera stands in vacuum");
     let sigma = Vec3::new(0.4, 0.8, 1.6);
     let want = |d: f32| {
         Rgb::new(
@@ -303,7 +303,8 @@ fn bitterli_volumetric_caustic_v3_renders_its_caustic_with_vpm() {
     let file = repo_root().join("scenes/bitterli/volumetric-caustic/scene_v3.xml");
     let scene = foton_loader::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
     assert_eq!(
-        scene.camera_medium, None,
+        scene.camera_medium(),
+        None,
         "the camera stands outside the fog"
     );
     let size = ["film.width=16", "film.height=16", "render.max_depth=8"];

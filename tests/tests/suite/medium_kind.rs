@@ -145,10 +145,10 @@ fn render_with(
     let dir = temp_dir(name);
     let path = write(&dir, "scene.toml", &scene(integrator, spp));
     let mut p = prepare(&path, &[], &[plugin_dir()], true).unwrap_or_else(|e| panic!("{e}"));
-    p.scene.media[0].value = Box::new(ramp);
+    p.scene.media_mut()[0].value = Box::new(ramp);
     let (film, _) = render_prepared(&p, 2, &TermProgress::new(true)).unwrap();
     let _ = std::fs::remove_dir_all(dir);
-    (film, p.scene.camera.clone())
+    (film, p.scene.camera().clone())
 }
 
 /// exp(-optical depth) through the sphere along the camera ray through film position `at`.

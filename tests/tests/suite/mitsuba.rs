@@ -629,14 +629,14 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
 "#;
     let xml = write(&dir, "glossy.xml", text);
     let scene = foton_loader::load_with(&xml, &[], &[], false).unwrap();
-    assert!(scene.render.hide_emitters);
+    assert!(scene.render().hide_emitters);
     // 50 mm on 35 mm film: a diagonal field of view of 2 atan(43.27 / 100) = 46.8 degrees.
     let toml = dir.join("glossy.toml");
     ok(&foton(&["convert", s(&xml), "-o", s(&toml)]));
     let converted = std::fs::read_to_string(&toml).unwrap();
     assert!(converted.contains("fov_axis = \"diagonal\""), "{converted}");
     assert!(converted.contains("fov = 46.79"), "{converted}");
-    let material = |i: usize| &scene.materials[scene.objects[i].material as usize].value;
+    let material = |i: usize| &scene.materials()[scene.objects()[i].material as usize].value;
     let Material::RoughConductor { lobe, twosided, .. } = material(0) else {
         panic!("{:?}", material(0))
     };
@@ -678,7 +678,7 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
     assert!((lobe.eta - 1.49 / 1.000277).abs() < 1e-6);
     // The disk: an ellipse of semi-axes 2 and 0.5 at y = -3, turned to face -z.
     let disk = scene
-        .accel
+        .accel()
         .primitives()
         .iter()
         .find(|p| p.object == 3)
@@ -795,21 +795,26 @@ fn a_shapes_exterior_medium_is_the_medium_in_front_of_it() {
         let xml = write(&dir, "scene.xml", text);
         foton_loader::load_with(&xml, &[], &[], false)
     };
-    let name =
-        |s: &foton_core::scene::Scene, m: Option<u32>| m.map(|m| s.media[m as usize].name.clone());
+    let name = |s: &foton_core::scene::Scene, m: Option<u32>| {
+        m.map(|m| s.media()[m as usize].name.clone())
+    };
     let s = load(&scene("", "fog")).unwrap();
-    assert_eq!(s.medium, None);
-    assert_eq!(s.camera_medium, None, "no sensor medium: vacuum");
-    let sphere = s.interfaces[0].unwrap();
+    assert_eq!(s.ambient_medium(), None);
+    assert_eq!(s.camera_medium(), None, "no sensor medium: vacuum");
+    let sphere = s.interfaces()[0].unwrap();
     assert_eq!(name(&s, sphere.outside).as_deref(), Some("fog"));
     assert_eq!(sphere.inside, None);
     let s = load(&scene("<ref name=\"medium\" id=\"fog\"/>", "fog")).unwrap();
-    assert_eq!(name(&s, s.camera_medium).as_deref(), Some("fog"));
-    assert_eq!(s.medium, None, "the shapes say where the media are");
+    assert_eq!(name(&s, s.camera_medium()).as_deref(), Some("fog"));
+    assert_eq!(
+        s.ambient_medium(),
+        None,
+        "the shapes say where the media are"
+    );
     // Mitsuba renders a camera in fog that sees a sphere in smoke: accepted as written.
     let s = load(&scene("<ref name=\"medium\" id=\"fog\"/>", "smoke")).unwrap();
     assert_eq!(
-        name(&s, s.interfaces[0].unwrap().outside).as_deref(),
+        name(&s, s.interfaces()[0].unwrap().outside).as_deref(),
         Some("smoke")
     );
 }

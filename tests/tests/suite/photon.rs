@@ -48,7 +48,7 @@ fn emitted_photons_carry_the_lights_power_chosen_by_power() {
     let mut from_bright = 0u64;
     for _ in 0..n {
         let (i, pmf) = scene.sample_light(rng.next_f32()).unwrap();
-        let e = scene.lights[i].sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+        let e = scene.lights()[i].sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
         total += (e.flux / (pmf * n as f32)).as_dvec3();
         from_bright += (i == 1) as u64;
     }

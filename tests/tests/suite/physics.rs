@@ -25,7 +25,7 @@ fov = {fov}
 /// For each pixel, the mean over a sub-pixel grid of an analytic radiance function of the
 /// point where the camera ray meets the plane y = 0.
 fn analytic_image(scene: &Scene, radiance: impl Fn(Vec3) -> f32) -> Vec<f32> {
-    let (w, h) = scene.camera.resolution();
+    let (w, h) = scene.camera().resolution();
     let n = 8;
     let mut out = Vec::new();
     for y in 0..h {
@@ -37,7 +37,7 @@ fn analytic_image(scene: &Scene, radiance: impl Fn(Vec3) -> f32) -> Vec<f32> {
                         x as f32 + (i as f32 + 0.5) / n as f32,
                         y as f32 + (j as f32 + 0.5) / n as f32,
                     );
-                    let ray: Ray = scene.camera.generate_ray(film);
+                    let ray: Ray = scene.camera().generate_ray(film);
                     let t = -ray.origin.y / ray.dir.y;
                     sum += radiance(ray.at(t));
                 }

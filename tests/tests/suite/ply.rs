@@ -308,7 +308,7 @@ fn load(dir: &Path, file: &Path, extra: &str) -> Scene {
 /// The mesh's triangles, as bits, in BVH order (the same for the same input).
 fn mesh_triangles(scene: &Scene) -> Vec<[u32; 9]> {
     scene
-        .accel
+        .accel()
         .primitives()
         .iter()
         .filter(|p| p.object == 1)
@@ -333,7 +333,7 @@ fn ply_cube_loads_like_the_obj_cube() {
     let reference = load(&dir, &obj, "");
     let want = mesh_triangles(&reference);
     assert_eq!(want.len(), 12, "the OBJ cube has 12 triangles");
-    assert!(reference.objects[1].closed);
+    assert!(reference.objects()[1].closed);
     for enc in ENCODINGS {
         let ply = dir.join(format!("cube-{}.ply", enc.name()));
         std::fs::write(&ply, cube_ply(enc, &QUADS)).unwrap();
@@ -344,7 +344,7 @@ fn ply_cube_loads_like_the_obj_cube() {
             "{}: not the OBJ's triangles",
             enc.name()
         );
-        assert!(scene.objects[1].closed, "{}: not closed", enc.name());
+        assert!(scene.objects()[1].closed, "{}: not closed", enc.name());
     }
 }
 
@@ -385,14 +385,14 @@ fn polygons_are_fan_triangulated() {
         let scene = write(&dir, "scene.toml", &scene_text(&ply, ""));
         let scene = foton_loader::load(&scene, &[]).unwrap();
         let mut corners: Vec<[[f32; 3]; 3]> = Vec::new();
-        for p in scene.accel.primitives().iter().filter(|p| p.object == 1) {
+        for p in scene.accel().primitives().iter().filter(|p| p.object == 1) {
             let Shape::Triangle { p0, e1, e2 } = p.shape else {
                 panic!("not a triangle")
             };
             corners.push([p0, p0 + e1, p0 + e2].map(|v| v.to_array()));
         }
         assert_eq!(corners.len(), 3, "{}", enc.name());
-        assert!(!scene.objects[1].closed);
+        assert!(!scene.objects()[1].closed);
         // Through the transform the corners are not exact: compare the fans' first corners
         // and the areas, which identify the triangles.
         let transform = |p: [f32; 3]| {
@@ -432,7 +432,7 @@ fn interior_medium_needs_a_closed_ply_mesh() {
     let cube = dir.join("cube.ply");
     std::fs::write(&cube, cube_ply(Enc::Little, &QUADS)).unwrap();
     let scene = load(&dir, &cube, "\ninterior = \"fog\"");
-    assert_eq!(scene.objects[1].interior, Some(0));
+    assert_eq!(scene.objects()[1].interior, Some(0));
 
     // Without its top the box is open: refused.
     let open = dir.join("open.ply");

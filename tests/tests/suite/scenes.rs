@@ -21,12 +21,12 @@ fn every_scene_loads_with_no_unknown_field() {
     for file in files {
         let scene = foton_loader::load(&file, &[]).unwrap_or_else(|e| panic!("{e}"));
         assert!(
-            scene.unused.is_empty(),
+            scene.unused().is_empty(),
             "{}: unused {:?}",
             file.display(),
-            scene.unused
+            scene.unused()
         );
-        assert!(!scene.lights.is_empty(), "{}", file.display());
+        assert!(!scene.lights().is_empty(), "{}", file.display());
     }
 }
 
@@ -64,12 +64,12 @@ fn cornell_point_from_other_tooling_matches_our_cornell_box() {
 fn fog_box_from_other_tooling_parses_its_media() {
     let scene = foton_loader::load(&repo_root().join("scenes/fog_box.toml"), &[]).unwrap();
     assert!(scene.has_media());
-    let fog = scene.media.iter().find(|m| m.name == "fog").unwrap();
+    let fog = scene.media().iter().find(|m| m.name == "fog").unwrap();
     assert_eq!(fog.value.sigma_t(glam::Vec3::ZERO), glam::Vec3::splat(1.05));
     // The closed cube mesh carries the fog as its interior.
     assert_eq!(
         scene
-            .objects
+            .objects()
             .iter()
             .filter(|o| o.interior.is_some())
             .count(),
