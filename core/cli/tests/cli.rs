@@ -1,5 +1,6 @@
 //! End-to-end tests of the `foton` executable as a user runs it: plugin discovery beside the
-//! executable and through FOTON_PLUGIN_PATH, deleting a plugin, help texts, Ctrl-C.
+//! executable and through FOTON_PLUGIN_PATH, deleting a plugin, help texts, `bench`'s BVH
+//! traversal flag, Ctrl-C.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
@@ -146,7 +147,7 @@ fn a_scene_cannot_name_a_plugin_file() {
 fn every_subcommand_has_help() {
     let exe = Path::new(env!("CARGO_BIN_EXE_foton"));
     for sub in [
-        "render", "check", "plugins", "bench", "photons", "compare", "sweep",
+        "render", "check", "merge", "convert", "plugins", "bench", "photons", "compare", "sweep",
     ] {
         let (code, out, _) = foton(exe, &[sub, "--help"]);
         assert_eq!(code, 0, "{sub} --help");
@@ -155,6 +156,31 @@ fn every_subcommand_has_help() {
     let (code, _, err) = foton(exe, &["render"]);
     assert_eq!(code, 2, "a missing argument is a usage error");
     assert!(err.contains("SCENE"), "{err}");
+}
+
+/// `bench --obvhs-traversal` switches the scene's BVH to obvhs' own traversal, and says so;
+/// its former name `--narrow-bvh` still works for the scripts that use it, unlisted.
+#[test]
+fn bench_names_the_bvh_traversal_and_keeps_the_old_flag() {
+    let (dir, exe) = install("bench-traversal", true);
+    let scene = scene(&dir, 1, 8);
+    let scene = scene.to_str().unwrap();
+    let bench = |flag: Option<&str>| {
+        let mut args = vec!["bench", scene, "--repeat", "1"];
+        args.extend(flag);
+        let (code, out, err) = foton(&exe, &args);
+        assert_eq!(code, 0, "{args:?}: {err}");
+        out
+    };
+    assert!(bench(None).contains("BVH traversed through float nodes"));
+    for flag in ["--obvhs-traversal", "--narrow-bvh"] {
+        let out = bench(Some(flag));
+        assert!(out.contains("BVH traversed by obvhs"), "{flag}: {out}");
+    }
+    let (_, help, _) = foton(&exe, &["bench", "--help"]);
+    assert!(help.contains("--obvhs-traversal"), "{help}");
+    assert!(!help.contains("narrow"), "{help}");
+    let _ = std::fs::remove_dir_all(dir);
 }
 
 #[test]
