@@ -1,38 +1,41 @@
 //! `foton compare`: one scene rendered by several integrators, side by side in one labelled
 //! image; against a reference, with a false-colour difference image and error numbers per
-//! render. Each render is also written as EXR, and the numbers as JSON.
+//! render (`metrics`). Each render is also written as EXR, and the numbers as JSON (`json`).
+//! With `--time S` each integrator gets about S seconds (`budget`).
 
-use crate::montage::{Image, Series, Tile, diverging, grid, log_log_plot, render_image};
-use crate::{INTERRUPTED, PluginArgs, Prepared, TermProgress, beside_scene, prepare_xml, threads};
-use crate::{render_prepared, write_atomic};
+mod budget;
+mod json;
+mod metrics;
+
+pub use budget::{CALIBRATION_SECONDS, CostModel, Plan, curve_budgets, spp_for_budget};
+pub use metrics::{Errors, REL_EPSILON, difference_image, errors};
+
+use crate::TermProgress;
+use crate::common::{
+    INTERRUPTED, PluginArgs, Prepared, RunArgs, SceneFile, WarnOnce, parse_spp, render_prepared,
+    write_atomic,
+};
+use crate::montage::{Series, Tile, grid, log_log_plot, render_image};
+use budget::{budget_text, calibrate};
 use clap::Args;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::{DisplayTransform, Film, check_output};
-use foton_core::integrator::{Budget, Work};
+use foton_core::integrator::Work;
 use foton_core::props::unknown_value;
 use foton_core::sampling::SamplerKind;
 use foton_loader::FilmFile;
 use foton_loader::image::read_image;
+use metrics::errors_text;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
-/// Added to the squared reference value in the relative error, so that black pixels of the
-/// reference do not dominate it.
-pub const REL_EPSILON: f64 = 1e-2;
-
 #[derive(Args)]
-pub(super) struct CompareArgs {
-    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
-    scene: PathBuf,
-    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (repeatable).
-    #[arg(short = 'D', value_name = "NAME=VALUE")]
-    defines: Vec<String>,
-    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed) instead of refusing.
-    #[arg(long)]
-    lenient: bool,
+pub(crate) struct CompareArgs {
+    #[command(flatten)]
+    file: SceneFile,
     /// The integrator plugins to compare, comma-separated (e.g. path,photon), left to right;
     /// NAME:SAMPLER renders with that sampler (path:sobol,path:independent).
     #[arg(
@@ -43,7 +46,7 @@ pub(super) struct CompareArgs {
     )]
     integrators: Vec<String>,
     /// Samples per pixel for every integrator (overrides render.spp).
-    #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = crate::parse_spp)]
+    #[arg(long, conflicts_with = "time", allow_negative_numbers = true, value_parser = parse_spp)]
     spp: Option<u32>,
     /// About S seconds of rendering per integrator: samples per pixel (a progressive
     /// integrator's iterations; a photon mapper's photon budgets and spp, half the time each)
@@ -74,203 +77,10 @@ pub(super) struct CompareArgs {
     /// Treat unknown (unused) scene fields and integrator parameters as errors.
     #[arg(long)]
     strict: bool,
-    /// Worker threads (default: all cores). The images do not depend on it.
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
     #[command(flatten)]
     plugins: PluginArgs,
-}
-
-/// Errors of a render against the reference, over all pixels and channels.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Errors {
-    /// mean of (x - ref)^2 / (ref^2 + REL_EPSILON).
-    pub rel_mse: f64,
-    /// (mean(x) - mean(ref)) / mean(ref); NaN when the reference is black.
-    pub bias: f64,
-}
-
-pub fn errors(x: &[Rgb], reference: &[Rgb]) -> Errors {
-    let (mut se, mut sx, mut sr) = (0.0f64, 0.0f64, 0.0f64);
-    for (p, r) in x.iter().zip(reference) {
-        for c in 0..3 {
-            let (p, r) = (p[c] as f64, r[c] as f64);
-            se += (p - r) * (p - r) / (r * r + REL_EPSILON);
-            sx += p;
-            sr += r;
-        }
-    }
-    let n = (3 * x.len().max(1)) as f64;
-    Errors {
-        rel_mse: se / n,
-        bias: if sr > 0.0 { (sx - sr) / sr } else { f64::NAN },
-    }
-}
-
-/// The signed relative difference of each pixel's channel mean, (x - ref) / sqrt(ref^2 +
-/// REL_EPSILON) (the square root of a pixel's term of the relative MSE, with its sign), in
-/// false colour.
-pub fn difference_image(width: u32, height: u32, x: &[Rgb], reference: &[Rgb]) -> Image {
-    let pixels = x
-        .iter()
-        .zip(reference)
-        .map(|(p, r)| {
-            let (p, r) = (
-                foton_core::average(*p) as f64,
-                foton_core::average(*r) as f64,
-            );
-            diverging(((p - r) / (r * r + REL_EPSILON).sqrt()) as f32)
-        })
-        .collect();
-    Image {
-        width,
-        height,
-        pixels,
-    }
-}
-
-/// The cost of a render as a function of its budget n (samples per pixel, or iterations of a
-/// progressive integrator), t(n) = fixed + n x per_unit, from the times t1 and t2 of renders
-/// at n and 2n.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct CostModel {
-    /// Seconds that do not grow with n (a photon mapper's photon pass).
-    pub fixed: f64,
-    pub per_unit: f64,
-    /// The time of the longer calibration render (t2).
-    pub longest: f64,
-}
-
-impl CostModel {
-    /// per_unit = (t2 - t1) / n, bounded to [t2/20, t2/2] / n so that timer noise on a fast
-    /// render cannot ask for an enormous budget; fixed = t2 - 2n per_unit.
-    pub fn from_times(n: u32, t1: f64, t2: f64) -> CostModel {
-        let n = n.max(1) as f64;
-        let t2 = t2.max(1e-6);
-        let per_unit = ((t2 - t1) / n).clamp(t2 / 20.0 / n, t2 / 2.0 / n);
-        CostModel {
-            fixed: (t2 - 2.0 * n * per_unit).max(0.0),
-            per_unit,
-            longest: t2,
-        }
-    }
-
-    /// The budget n that fills `seconds`, at least 1.
-    pub fn units_for(&self, seconds: f64) -> u32 {
-        ((seconds - self.fixed) / self.per_unit)
-            .floor()
-            .clamp(1.0, u32::MAX as f64) as u32
-    }
-}
-
-/// Calibration renders take at least this long (or a tenth of the budget, if that is less),
-/// so that their times are not timer and scheduler noise.
-pub const CALIBRATION_SECONDS: f64 = 0.05;
-
-/// The cost model from renders at n and 2n units, n = 1 and then larger until the render at
-/// 2n takes `min_seconds` (n at most 2^16). `seconds_of(n)` renders at n and returns its time.
-fn calibrate_cost(
-    min_seconds: f64,
-    mut seconds_of: impl FnMut(u32) -> Result<f64>,
-) -> Result<CostModel> {
-    const MAX_UNITS: u32 = 1 << 16;
-    let mut n = 1u32;
-    loop {
-        let t1 = seconds_of(n)?;
-        let t2 = seconds_of(2 * n)?;
-        if t2 >= min_seconds || n >= MAX_UNITS || INTERRUPTED.load(Ordering::SeqCst) {
-            return Ok(CostModel::from_times(n, t1, t2));
-        }
-        let factor = (min_seconds / t2.max(1e-6)).ceil().clamp(2.0, 1024.0) as u32;
-        n = n.saturating_mul(factor).min(MAX_UNITS);
-    }
-}
-
-/// Samples per pixel that fill `budget` seconds, from the times of renders at 1 and 2 spp
-/// (see `CostModel`).
-pub fn spp_for_budget(budget: f64, t1: f64, t2: f64) -> u32 {
-    CostModel::from_times(1, t1, t2).units_for(budget)
-}
-
-/// How `--time` gives an integrator a budget of S seconds, from its calibration renders.
-#[derive(Clone, Debug, PartialEq)]
-pub enum Plan {
-    /// Samples per pixel (render.spp) fill the time.
-    Samples(CostModel),
-    /// A progressive integrator (its `Integrator::budget` counts iterations, sppm): the scene
-    /// value at `key` fills the time; render.spp is not used.
-    Iterations { cost: CostModel, key: String },
-    /// An integrator with budgets that scale beside its samples (`Integrator::budget`'s
-    /// `scaled`: a photon mapper's photon budgets): about half of the time goes to their fixed
-    /// cost, half to camera samples. The scene's budgets are taken to belong to the time 2 x
-    /// `photon_pass` (the measured fixed cost) and are scaled in proportion to the budget;
-    /// spp = (S / 2) / `per_sample`.
-    PhotonsAndSamples {
-        per_sample: f64,
-        photon_pass: f64,
-        photons: Vec<(String, u64)>,
-    },
-    /// A budget that --time cannot set: the calibration render is the render.
-    Fixed,
-}
-
-impl Plan {
-    /// The scene values (`--set` overrides) that make the integrator take about `seconds`.
-    pub fn settings(&self, seconds: f64) -> Vec<String> {
-        match self {
-            Plan::Samples(cost) => vec![format!("render.spp={}", cost.units_for(seconds))],
-            Plan::Iterations { cost, key } => vec![format!("{key}={}", cost.units_for(seconds))],
-            Plan::PhotonsAndSamples {
-                per_sample,
-                photon_pass,
-                photons,
-            } => {
-                let half = seconds / 2.0;
-                let spp = (half / per_sample).floor().clamp(1.0, u32::MAX as f64) as u32;
-                let scale = half / photon_pass;
-                let mut sets = vec![format!("render.spp={spp}")];
-                for (key, n) in photons {
-                    let scaled = if *n == 0 {
-                        0
-                    } else {
-                        (*n as f64 * scale).round().clamp(1.0, 1e15) as u64
-                    };
-                    sets.push(format!("{key}={scaled}"));
-                }
-                sets
-            }
-            Plan::Fixed => Vec::new(),
-        }
-    }
-}
-
-/// "16 spp", "23 iterations" (a progressive integrator's iterations, as --time set them or
-/// as its parameters say), or "own budget".
-fn budget_text(p: &Prepared, settings: &[String]) -> String {
-    match p.integrator.budget().work {
-        Work::Samples => format!("{} spp", p.scene.render().spp),
-        Work::Iterations { key } => {
-            let set = settings
-                .iter()
-                .find_map(|s| s.strip_prefix(&format!("{key}=")).map(str::to_string));
-            let name = key.rsplit('.').next().unwrap_or(&key);
-            let given = || {
-                p.integrator
-                    .parameters()
-                    .into_iter()
-                    .find(|q| q.name == name)
-                    .map(|q| q.value.to_string())
-            };
-            match set.or_else(given) {
-                Some(n) => format!("{n} iterations"),
-                None => "own budget".into(),
-            }
-        }
-        Work::Own => "own budget".into(),
-    }
 }
 
 /// One integrator's render and its numbers.
@@ -293,6 +103,27 @@ struct Entry {
     curve: Vec<Point>,
 }
 
+impl Entry {
+    /// The render's summary line.
+    fn print(&self, out: &mut dyn Write) {
+        let _ = write!(
+            out,
+            "{}: {} in {:.2} s -> {}",
+            self.description,
+            self.budget,
+            self.seconds,
+            self.image.display()
+        );
+        if !self.settings.is_empty() {
+            let _ = write!(out, " (--time chose {})", self.settings.join(" "));
+        }
+        if let Some(e) = self.errors {
+            let _ = write!(out, "; {}", errors_text(e));
+        }
+        let _ = writeln!(out);
+    }
+}
+
 /// One point of the error curve: a render at a budget of `budget` seconds.
 struct Point {
     budget: f64,
@@ -301,173 +132,195 @@ struct Point {
     settings: Vec<String>,
 }
 
-fn json_string(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
+/// The files a comparison writes.
+struct Outputs {
+    /// The labelled image.
+    image: PathBuf,
+    stem: String,
+    json: PathBuf,
+    /// The error curve's plot (--curve).
+    curve: PathBuf,
+}
+
+impl Outputs {
+    fn of(image: PathBuf) -> Outputs {
+        let stem = image
+            .file_stem()
+            .map_or_else(|| "compare".into(), |s| s.to_string_lossy().into_owned());
+        Outputs {
+            json: image.with_file_name(format!("{stem}.json")),
+            curve: image.with_file_name(format!("{stem}-curve.png")),
+            image,
+            stem,
         }
     }
-    out.push('"');
-    out
-}
 
-fn json_number(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        "null".into()
+    /// The render of integrator `name` (NAME or NAME:SAMPLER).
+    fn exr_of(&self, name: &str) -> PathBuf {
+        let stem = &self.stem;
+        self.image
+            .with_file_name(format!("{stem}-{}.exr", name.replace(':', "-")))
     }
 }
 
-fn json_settings(settings: &[String]) -> String {
-    let items: Vec<String> = settings.iter().map(|x| json_string(x)).collect();
-    format!("[{}]", items.join(", "))
+/// What the renders of one comparison share: its arguments, outputs, worker threads and the
+/// reference's pixels.
+struct Session<'a> {
+    a: &'a CompareArgs,
+    outputs: Outputs,
+    threads: usize,
+    reference: Option<Vec<Rgb>>,
 }
 
-fn json(scene: &Path, reference: Option<&Path>, time: Option<f64>, entries: &[Entry]) -> String {
-    let file_name = |p: &Path| {
-        p.file_name()
-            .map_or_else(String::new, |n| n.to_string_lossy().into_owned())
-    };
-    let mut s = String::from("{\n");
-    s += &format!(
-        "  \"scene\": {},\n",
-        json_string(&scene.display().to_string())
-    );
-    s += &format!(
-        "  \"reference\": {},\n",
-        reference.map_or("null".into(), |r| json_string(&r.display().to_string()))
-    );
-    s += &format!("  \"time\": {},\n", time.map_or("null".into(), json_number));
-    s += "  \"integrators\": [\n";
-    for (i, e) in entries.iter().enumerate() {
-        let (rel_mse, bias) = e
-            .errors
-            .map_or((f64::NAN, f64::NAN), |er| (er.rel_mse, er.bias));
-        s += "    {\n";
-        s += &format!("      \"name\": {},\n", json_string(&e.name));
-        s += &format!("      \"description\": {},\n", json_string(&e.description));
-        s += &format!(
-            "      \"spp\": {},\n",
-            e.spp.map_or("null".into(), |n| n.to_string())
-        );
-        s += &format!("      \"seconds\": {},\n", json_number(e.seconds));
-        s += &format!("      \"rel_mse\": {},\n", json_number(rel_mse));
-        s += &format!("      \"bias\": {},\n", json_number(bias));
-        s += &format!("      \"set\": {},\n", json_settings(&e.settings));
-        if !e.curve.is_empty() {
-            s += "      \"curve\": [\n";
-            for (j, p) in e.curve.iter().enumerate() {
-                s += &format!(
-                    "        {{\"budget\": {}, \"seconds\": {}, \"rel_mse\": {}, \"bias\": {}, \"set\": {}}}{}\n",
-                    json_number(p.budget),
-                    json_number(p.seconds),
-                    json_number(p.errors.rel_mse),
-                    json_number(p.errors.bias),
-                    json_settings(&p.settings),
-                    if j + 1 < e.curve.len() { "," } else { "" }
-                );
+impl Session<'_> {
+    /// The scene as the command line sets it for integrator `name` (NAME or NAME:SAMPLER), plus
+    /// `extra` overrides.
+    fn overrides(&self, name: &str, extra: &[String]) -> Vec<String> {
+        let a = self.a;
+        let mut overrides = a.sets.clone();
+        let (integrator, sampler) = name
+            .split_once(':')
+            .map_or((name, None), |(i, s)| (i, Some(s)));
+        overrides.push(format!("render.integrator={integrator:?}"));
+        if let Some(sampler) = sampler {
+            overrides.push(format!("render.sampler={sampler:?}"));
+        }
+        if let Some(spp) = a.spp {
+            overrides.push(format!("render.spp={spp}"));
+        }
+        if let Some(seed) = a.seed {
+            overrides.push(format!("render.seed={seed}"));
+        }
+        overrides.extend_from_slice(extra);
+        overrides
+    }
+
+    /// The scene and integrator `name` with `extra` overrides (--time's choices).
+    fn prepare(&self, name: &str, extra: &[String]) -> Result<Prepared> {
+        let a = self.a;
+        a.file
+            .prepare(&self.overrides(name, extra), &a.plugins, a.strict)
+    }
+
+    /// Renders `p` and returns the film and the time it took; the progress's warnings are
+    /// printed with the integrator's name.
+    fn render(&self, p: &Prepared, quiet: bool, err: &mut dyn Write) -> Result<(Film, Duration)> {
+        let progress = TermProgress::new(quiet);
+        let result = render_prepared(p, self.threads, &progress);
+        for w in progress.take_warnings() {
+            let _ = writeln!(err, "warning: {}: {w}", p.plugin.name);
+        }
+        result
+    }
+
+    /// Renders integrator `name` (created as `p`): once, or with --time after calibrating its
+    /// budget, and with --curve at every budget of the curve. None when interrupted.
+    fn render_entry(
+        &self,
+        name: &str,
+        mut p: Prepared,
+        out: &mut dyn Write,
+        err: &mut dyn Write,
+    ) -> Result<Option<Entry>> {
+        let a = self.a;
+        let mut curve = Vec::new();
+        let (p, film, elapsed, settings) = match a.time {
+            None => {
+                let (film, elapsed) = self.render(&p, a.run.quiet, err)?;
+                (p, film, elapsed, Vec::new())
             }
-            s += "      ],\n";
-        }
-        s += &format!("      \"image\": {}\n", json_string(&file_name(&e.image)));
-        s += if i + 1 < entries.len() {
-            "    },\n"
-        } else {
-            "    }\n"
-        };
-    }
-    s += "  ]\n}\n";
-    s
-}
-
-fn render_timed(
-    p: &Prepared,
-    threads: usize,
-    quiet: bool,
-    err: &mut dyn Write,
-) -> Result<(Film, Duration)> {
-    let progress = TermProgress::new(quiet);
-    let result = render_prepared(p, threads, &progress);
-    for w in progress.take_warnings() {
-        let _ = writeln!(err, "warning: {}: {w}", p.plugin.name);
-    }
-    result
-}
-
-/// Calibrates how `--time` sets integrator `name`'s budget (see `Plan`), from what the
-/// integrator says of its work (`Integrator::budget`): renders at n and 2n samples per pixel,
-/// or iterations of a progressive integrator (`calibrate_cost`). With `Plan::Fixed` (a budget
-/// of its own), also returns the one render made, which is then the render shown.
-fn calibrate(
-    name: &str,
-    p: &mut Prepared,
-    prep: &dyn Fn(&[String]) -> Result<Prepared>,
-    budget: f64,
-    threads: usize,
-    err: &mut dyn Write,
-) -> Result<(Plan, Option<(Film, Duration)>)> {
-    let min_seconds = CALIBRATION_SECONDS.min(budget / 10.0);
-    let Budget { work, scaled } = p.integrator.budget();
-    match work {
-        Work::Iterations { key } => {
-            let cost = calibrate_cost(min_seconds, |n| {
-                let q = prep(&[format!("{key}={n}")])?;
-                Ok(render_timed(&q, threads, true, err)?.1.as_secs_f64())
-            })?;
-            let _ = writeln!(
-                err,
-                "note: `{name}` does not take its samples from render.spp: --time sets its iterations instead ({key})"
-            );
-            Ok((Plan::Iterations { cost, key }, None))
-        }
-        Work::Own => {
-            let _ = writeln!(
-                err,
-                "warning: `{name}` sets its own budget, so --time cannot set it; it renders as the scene says"
-            );
-            let shown = render_timed(p, threads, true, err)?;
-            Ok((Plan::Fixed, Some(shown)))
-        }
-        Work::Samples => {
-            let cost = calibrate_cost(min_seconds, |n| {
-                p.scene.render_mut().spp = n;
-                Ok(render_timed(p, threads, true, err)?.1.as_secs_f64())
-            })?;
-            let plan = if scaled.is_empty() {
-                Plan::Samples(cost)
-            } else {
-                Plan::PhotonsAndSamples {
-                    per_sample: cost.per_unit,
-                    // Not below the bound of the per-sample cost: noise on a fast photon pass
-                    // would otherwise ask for an enormous number of photons.
-                    photon_pass: cost.fixed.max(cost.longest / 20.0),
-                    photons: scaled,
+            Some(budget) => {
+                let (plan, shown) = calibrate(self, name, &mut p, budget, err)?;
+                if interrupted(err) {
+                    return Ok(None);
                 }
-            };
-            Ok((plan, None))
+                let budgets = match (a.curve, &shown) {
+                    (Some(points), None) => curve_budgets(budget, points),
+                    (Some(_), Some(_)) => {
+                        let _ = writeln!(
+                            err,
+                            "warning: `{name}`: no error curve, --time cannot set its budget"
+                        );
+                        vec![budget]
+                    }
+                    (None, _) => vec![budget],
+                };
+                let mut last = None;
+                for (j, &b) in budgets.iter().enumerate() {
+                    let settings = plan.settings(b);
+                    let is_last = j + 1 == budgets.len();
+                    let (q, film, elapsed) = match shown {
+                        Some((ref film, t)) if is_last => {
+                            (self.prepare(name, &[])?, film.clone(), t)
+                        }
+                        _ => {
+                            let q = self.prepare(name, &settings)?;
+                            let (film, t) = self.render(&q, a.run.quiet || !is_last, err)?;
+                            (q, film, t)
+                        }
+                    };
+                    if interrupted(err) {
+                        return Ok(None);
+                    }
+                    if let (Some(r), Some(_)) = (&self.reference, a.curve)
+                        && shown.is_none()
+                    {
+                        let point = Point {
+                            budget: b,
+                            seconds: elapsed.as_secs_f64(),
+                            errors: errors(&film.pixels(), r),
+                            settings: settings.clone(),
+                        };
+                        let _ = writeln!(
+                            out,
+                            "{name}, curve point {} of {} ({b:.3} s budget; {}): {:.2} s, {}",
+                            j + 1,
+                            budgets.len(),
+                            settings.join(" "),
+                            point.seconds,
+                            errors_text(point.errors)
+                        );
+                        curve.push(point);
+                    }
+                    if is_last {
+                        last = Some((q, film, elapsed, settings));
+                    }
+                }
+                last.expect("at least one budget")
+            }
+        };
+        if interrupted(err) {
+            return Ok(None);
         }
+        let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
+        let errors = self.reference.as_ref().map(|r| errors(&film.pixels(), r));
+        Ok(Some(Entry {
+            name: name.to_string(),
+            description: p.integrator.describe(),
+            spp,
+            budget: budget_text(&p, &settings),
+            seconds: elapsed.as_secs_f64(),
+            settings,
+            film,
+            display: p.scene.film().display(),
+            image: self.outputs.exr_of(name),
+            errors,
+            curve,
+        }))
     }
 }
 
-/// The budgets of the error curve: `points` times from `budget` / 2^(points - 1) to `budget`,
-/// each twice the one before.
-pub fn curve_budgets(budget: f64, points: u32) -> Vec<f64> {
-    (0..points)
-        .map(|j| budget / 2f64.powi((points - 1 - j) as i32))
-        .collect()
+/// Whether Ctrl-C stopped the comparison (then nothing is written, and it says so).
+fn interrupted(err: &mut dyn Write) -> bool {
+    let stop = INTERRUPTED.load(Ordering::SeqCst);
+    if stop {
+        let _ = writeln!(err, "interrupted: nothing written");
+    }
+    stop
 }
 
-fn errors_text(e: Errors) -> String {
-    format!("rel. MSE {:.4e}, bias {:+.3}%", e.rel_mse, e.bias * 100.0)
-}
-
-pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+/// The integrator names of `--integrators`, checked: none empty or twice, samplers known.
+fn integrator_names(a: &CompareArgs) -> Result<Vec<String>> {
     let mut names: Vec<String> = Vec::new();
     for name in a.integrators.iter().map(|n| n.trim()) {
         if name.is_empty() {
@@ -511,74 +364,49 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             )));
         }
     }
-    let output = a
-        .output
-        .clone()
-        .unwrap_or_else(|| beside_scene(&a.scene, "compare.png"));
-    check_output(&output)?;
-    let stem = output
-        .file_stem()
-        .map_or_else(|| "compare".into(), |s| s.to_string_lossy().into_owned());
-    let exr_of =
-        |name: &str| output.with_file_name(format!("{stem}-{}.exr", name.replace(':', "-")));
-    let json_path = output.with_file_name(format!("{stem}.json"));
-    let curve_path = output.with_file_name(format!("{stem}-curve.png"));
+    Ok(names)
+}
+
+/// The reference image: its width, height and pixels.
+fn read_reference(path: &Path) -> Result<(u32, u32, Vec<Rgb>)> {
+    read_image(path).map_err(|e| match e {
+        Error::Io { path, message } => Error::Io {
+            path,
+            message: format!("cannot read the reference image: {message}"),
+        },
+        other => other,
+    })
+}
+
+pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let names = integrator_names(&a)?;
+    let outputs = Outputs::of(
+        a.output
+            .clone()
+            .unwrap_or_else(|| a.file.beside("compare.png")),
+    );
+    check_output(&outputs.image)?;
     for name in &names {
-        check_output(&exr_of(name))?;
+        check_output(&outputs.exr_of(name))?;
     }
     if a.curve.is_some() {
-        check_output(&curve_path)?;
+        check_output(&outputs.curve)?;
     }
-    let reference = match &a.reference {
-        Some(path) => Some(read_image(path).map_err(|e| match e {
-            Error::Io { path, message } => Error::Io {
-                path,
-                message: format!("cannot read the reference image: {message}"),
-            },
-            other => other,
-        })?),
-        None => None,
-    };
-
-    // The scene as the command line sets it for integrator `name`, plus `extra` overrides.
-    let overrides = |name: &str, extra: &[String]| {
-        let mut overrides = a.sets.clone();
-        let (integrator, sampler) = name
-            .split_once(':')
-            .map_or((name, None), |(i, s)| (i, Some(s)));
-        overrides.push(format!("render.integrator={integrator:?}"));
-        if let Some(sampler) = sampler {
-            overrides.push(format!("render.sampler={sampler:?}"));
-        }
-        if let Some(spp) = a.spp {
-            overrides.push(format!("render.spp={spp}"));
-        }
-        if let Some(seed) = a.seed {
-            overrides.push(format!("render.seed={seed}"));
-        }
-        overrides.extend_from_slice(extra);
-        overrides
+    let reference = a.reference.as_deref().map(read_reference).transpose()?;
+    let mut session = Session {
+        a: &a,
+        outputs,
+        threads: a.run.threads(),
+        reference: None,
     };
 
     // Every integrator is created before anything renders: a misspelt name or a bad
     // parameter is reported at once, not after the first render.
     let mut prepared = Vec::new();
-    let mut warned: Vec<String> = Vec::new();
+    let mut warned = WarnOnce::default();
     for name in &names {
-        let p = prepare_xml(
-            &a.scene,
-            &overrides(name, &[]),
-            &a.defines,
-            a.lenient,
-            &a.plugins.plugin_dirs,
-            a.strict,
-        )?;
-        for w in &p.warnings {
-            if !warned.contains(w) {
-                let _ = writeln!(err, "warning: {w}");
-                warned.push(w.clone());
-            }
-        }
+        let p = session.prepare(name, &[])?;
+        warned.warn(err, &p.warnings);
         prepared.push(p);
     }
     let (width, height) = (
@@ -593,167 +421,25 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             format!("the reference is {w}x{h} but the scene renders {width}x{height}"),
         ));
     }
+    session.reference = reference.map(|(_, _, pixels)| pixels);
 
-    let threads = threads(a.threads);
     INTERRUPTED.store(false, Ordering::SeqCst);
-    let interrupted = |err: &mut dyn Write| {
-        let stop = INTERRUPTED.load(Ordering::SeqCst);
-        if stop {
-            let _ = writeln!(err, "interrupted: nothing written");
-        }
-        stop
-    };
     let mut entries = Vec::new();
-    for (name, mut p) in names.iter().zip(prepared) {
-        // The scene with --time's choices for this integrator (warnings were printed above).
-        let prep = |extra: &[String]| {
-            prepare_xml(
-                &a.scene,
-                &overrides(name, extra),
-                &a.defines,
-                a.lenient,
-                &a.plugins.plugin_dirs,
-                a.strict,
-            )
-        };
-        let mut curve = Vec::new();
-        let (p, film, elapsed, settings) = match a.time {
-            None => {
-                let (film, elapsed) = render_timed(&p, threads, a.quiet, err)?;
-                (p, film, elapsed, Vec::new())
-            }
-            Some(budget) => {
-                let (plan, shown) = calibrate(name, &mut p, &prep, budget, threads, err)?;
-                if interrupted(err) {
-                    return Ok(130);
-                }
-                let budgets = match (a.curve, &shown) {
-                    (Some(points), None) => curve_budgets(budget, points),
-                    (Some(_), Some(_)) => {
-                        let _ = writeln!(
-                            err,
-                            "warning: `{name}`: no error curve, --time cannot set its budget"
-                        );
-                        vec![budget]
-                    }
-                    (None, _) => vec![budget],
-                };
-                let mut last = None;
-                for (j, &b) in budgets.iter().enumerate() {
-                    let settings = plan.settings(b);
-                    let is_last = j + 1 == budgets.len();
-                    let (q, film, elapsed) = match shown {
-                        Some((ref film, t)) if is_last => (prep(&[])?, film.clone(), t),
-                        _ => {
-                            let q = prep(&settings)?;
-                            let (film, t) = render_timed(&q, threads, a.quiet || !is_last, err)?;
-                            (q, film, t)
-                        }
-                    };
-                    if interrupted(err) {
-                        return Ok(130);
-                    }
-                    if let (Some((_, _, r)), Some(_)) = (&reference, a.curve)
-                        && shown.is_none()
-                    {
-                        let point = Point {
-                            budget: b,
-                            seconds: elapsed.as_secs_f64(),
-                            errors: errors(&film.pixels(), r),
-                            settings: settings.clone(),
-                        };
-                        let _ = writeln!(
-                            out,
-                            "{name}, curve point {} of {} ({b:.3} s budget; {}): {:.2} s, {}",
-                            j + 1,
-                            budgets.len(),
-                            settings.join(" "),
-                            point.seconds,
-                            errors_text(point.errors)
-                        );
-                        curve.push(point);
-                    }
-                    if is_last {
-                        last = Some((q, film, elapsed, settings));
-                    }
-                }
-                last.expect("at least one budget")
-            }
-        };
-        if interrupted(err) {
+    for (name, p) in names.iter().zip(prepared) {
+        let Some(entry) = session.render_entry(name, p, out, err)? else {
             return Ok(130);
-        }
-        let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
-        let budget = budget_text(&p, &settings);
-        let image = exr_of(name);
-        film.write(&image, &p.scene.film().display())?;
-        let errors = reference
-            .as_ref()
-            .map(|(_, _, r)| errors(&film.pixels(), r));
-        let entry = Entry {
-            name: name.clone(),
-            description: p.integrator.describe(),
-            spp,
-            budget,
-            seconds: elapsed.as_secs_f64(),
-            settings,
-            film,
-            display: p.scene.film().display(),
-            image,
-            errors,
-            curve,
         };
-        let _ = write!(
-            out,
-            "{}: {} in {:.2} s -> {}",
-            entry.description,
-            entry.budget,
-            entry.seconds,
-            entry.image.display()
-        );
-        if !entry.settings.is_empty() {
-            let _ = write!(out, " (--time chose {})", entry.settings.join(" "));
-        }
-        if let Some(e) = entry.errors {
-            let _ = write!(out, "; {}", errors_text(e));
-        }
-        let _ = writeln!(out);
+        entry.film.write(&entry.image, &entry.display)?;
+        entry.print(out);
         entries.push(entry);
     }
 
-    let mut tiles: Vec<Tile> = entries
-        .iter()
-        .map(|e| Tile {
-            image: render_image(&e.film, &e.display, &output),
-            label: vec![
-                format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
-                // Narrow tiles: `k=50` wraps better than `k = 50`.
-                e.description.replace(" = ", "="),
-            ],
-        })
-        .collect();
-    if let Some((_, _, r)) = &reference {
-        for e in &entries {
-            let er = e.errors.expect("errors are computed with a reference");
-            let bias = if er.bias.is_finite() {
-                format!("{:+.2}%", er.bias * 100.0)
-            } else {
-                "n/a (black reference)".into()
-            };
-            tiles.push(Tile {
-                image: difference_image(width, height, &e.film.pixels(), r),
-                label: vec![
-                    format!("{} vs reference", e.name),
-                    format!("rel. MSE {:.3e}", er.rel_mse),
-                    format!("bias {bias}"),
-                ],
-            });
-        }
-    }
-    grid(&tiles, entries.len()).write(&output)?;
+    let outputs = &session.outputs;
+    let tiles = tiles(&entries, session.reference.as_deref(), &outputs.image);
+    grid(&tiles, entries.len()).write(&outputs.image)?;
     write_atomic(
-        &json_path,
-        json(&a.scene, a.reference.as_deref(), a.time, &entries).as_bytes(),
+        &outputs.json,
+        json::json(&a.file.scene, a.reference.as_deref(), a.time, &entries).as_bytes(),
     )?;
     if a.curve.is_some() {
         let series: Vec<Series> = entries
@@ -768,105 +454,62 @@ pub(super) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             })
             .collect();
         let scene_name = a
+            .file
             .scene
             .file_name()
             .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
         let title = format!("{scene_name} {width}x{height}: error against render time");
         log_log_plot(&title, "render time (seconds)", "relative MSE", &series)
-            .write(&curve_path)?;
+            .write(&outputs.curve)?;
         let _ = writeln!(
             out,
             "-> {}, {} and {}",
-            output.display(),
-            curve_path.display(),
-            json_path.display()
+            outputs.image.display(),
+            outputs.curve.display(),
+            outputs.json.display()
         );
     } else {
-        let _ = writeln!(out, "-> {} and {}", output.display(), json_path.display());
+        let _ = writeln!(
+            out,
+            "-> {} and {}",
+            outputs.image.display(),
+            outputs.json.display()
+        );
     }
     Ok(0)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn errors_of_an_identical_image_are_zero() {
-        let x = [Rgb::new(0.1, 0.5, 2.0), Rgb::ZERO];
-        assert_eq!(
-            errors(&x, &x),
-            Errors {
-                rel_mse: 0.0,
-                bias: 0.0
-            }
-        );
-        let brighter: Vec<Rgb> = x.iter().map(|p| *p * 1.1).collect();
-        let e = errors(&brighter, &x);
-        assert!(e.rel_mse > 0.0);
-        assert!((e.bias - 0.1).abs() < 1e-6, "{e:?}");
-        assert!(errors(&x, &[Rgb::ZERO, Rgb::ZERO]).bias.is_nan());
-    }
-
-    #[test]
-    fn budget_is_filled_and_fixed_costs_are_not_counted_per_sample() {
-        // 1 s of photon pass, 1/8 s per sample: 10 s fit 72 samples.
-        assert_eq!(spp_for_budget(10.0, 1.125, 1.25), 72);
-        // Pure per-sample cost.
-        assert_eq!(spp_for_budget(8.0, 0.5, 1.0), 16);
-        // A noisy, faster second render does not ask for millions of samples.
-        let spp = spp_for_budget(1.0, 0.02, 0.01);
-        assert!((1000..=2000).contains(&spp), "{spp}");
-        assert_eq!(spp_for_budget(0.001, 1.0, 2.0), 1);
-    }
-
-    #[test]
-    fn json_escapes_strings_and_writes_null_for_missing_numbers() {
-        assert_eq!(json_string("a\"b\\c\n"), "\"a\\\"b\\\\c\\n\"");
-        assert_eq!(json_number(f64::NAN), "null");
-        assert_eq!(json_number(0.0), "0");
-        assert_eq!(json_number(0.25), "0.25");
-    }
-
-    #[test]
-    fn photon_budgets_and_samples_grow_with_the_time() {
-        // A photon pass of 0.5 s at the scene's budgets, 0.05 s per sample per pixel: the
-        // scene's budgets belong to 1 s; 10 s gets ten times the photons and 100 spp.
-        let plan = Plan::PhotonsAndSamples {
-            per_sample: 0.05,
-            photon_pass: 0.5,
-            photons: vec![
-                ("integrators.photon.global_photons".into(), 200_000),
-                ("integrators.photon.caustic_photons".into(), 0),
+/// The labelled tiles: the renders in a row, and with a reference their differences from it
+/// in a second row.
+fn tiles(entries: &[Entry], reference: Option<&[Rgb]>, output: &Path) -> Vec<Tile> {
+    let mut tiles: Vec<Tile> = entries
+        .iter()
+        .map(|e| Tile {
+            image: render_image(&e.film, &e.display, output),
+            label: vec![
+                format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
+                // Narrow tiles: `k=50` wraps better than `k = 50`.
+                e.description.replace(" = ", "="),
             ],
-        };
-        assert_eq!(
-            plan.settings(10.0),
-            [
-                "render.spp=100",
-                "integrators.photon.global_photons=2000000",
-                "integrators.photon.caustic_photons=0"
-            ]
-        );
-        assert_eq!(
-            plan.settings(0.01)[..2],
-            ["render.spp=1", "integrators.photon.global_photons=2000"]
-        );
-        let cost = CostModel::from_times(1, 1.125, 1.25);
-        assert_eq!(
-            Plan::Iterations {
-                cost,
-                key: "integrators.sppm.iterations".into()
-            }
-            .settings(10.0),
-            ["integrators.sppm.iterations=72"]
-        );
-        assert_eq!(Plan::Samples(cost).settings(10.0), ["render.spp=72"]);
+        })
+        .collect();
+    if let Some(r) = reference {
+        for e in entries {
+            let er = e.errors.expect("errors are computed with a reference");
+            let bias = if er.bias.is_finite() {
+                format!("{:+.2}%", er.bias * 100.0)
+            } else {
+                "n/a (black reference)".into()
+            };
+            tiles.push(Tile {
+                image: difference_image(e.film.width, e.film.height, &e.film.pixels(), r),
+                label: vec![
+                    format!("{} vs reference", e.name),
+                    format!("rel. MSE {:.3e}", er.rel_mse),
+                    format!("bias {bias}"),
+                ],
+            });
+        }
     }
-
-    #[test]
-    fn curve_budgets_double_up_to_the_time() {
-        assert_eq!(curve_budgets(20.0, 5), [1.25, 2.5, 5.0, 10.0, 20.0]);
-        assert_eq!(curve_budgets(1.0, 2), [0.5, 1.0]);
-    }
+    tiles
 }

@@ -70,7 +70,8 @@ impl Image {
         }
     }
 
-    fn fill_rect(&mut self, x0: u32, y0: u32, w: u32, h: u32, c: Rgb) {
+    /// Fills `w` x `h` pixels from the corner (x0, y0) with `c`.
+    fn fill_rect(&mut self, (x0, y0): (u32, u32), (w, h): (u32, u32), c: Rgb) {
         for y in y0..(y0 + h).min(self.height) {
             for x in x0..(x0 + w).min(self.width) {
                 self.put(x as i64, y as i64, c);
@@ -181,9 +182,17 @@ pub fn band_height(lines: usize, scale: u32) -> u32 {
     scale * (2 * PAD + lines * GLYPH + (lines - 1) * LINE_GAP)
 }
 
-/// Draws one line of text with its top-left corner at (x, y), `scale` pixels per font pixel;
-/// nothing right of `x_max`. Characters outside ASCII are drawn as `?`.
-pub fn draw_text(img: &mut Image, x: u32, y: u32, x_max: u32, text: &str, scale: u32) {
+/// How [`draw_text`] draws: `scale` pixels per font pixel, nothing right of `x_max`.
+#[derive(Clone, Copy, Debug)]
+pub struct TextStyle {
+    pub scale: u32,
+    pub x_max: u32,
+}
+
+/// Draws one line of text with its top-left corner at (x, y). Characters outside ASCII are
+/// drawn as `?`.
+pub fn draw_text(img: &mut Image, (x, y): (u32, u32), text: &str, style: TextStyle) {
+    let TextStyle { scale, x_max } = style;
     let mut cx = x;
     for ch in text.chars() {
         if cx + GLYPH * scale > x_max {
@@ -237,10 +246,14 @@ pub fn grid(tiles: &[Tile], columns: usize) -> Image {
     for ((row, row_lines), band) in tiles.chunks(columns).zip(lines.chunks(columns)).zip(&bands) {
         for (i, (tile, lines)) in row.iter().zip(row_lines).enumerate() {
             let x0 = BORDER + i as u32 * (cell_w + BORDER);
-            img.fill_rect(x0, y0, cell_w, *band, BAND);
+            img.fill_rect((x0, y0), (cell_w, *band), BAND);
+            let style = TextStyle {
+                scale,
+                x_max: x0 + cell_w,
+            };
             for (l, line) in lines.iter().enumerate() {
                 let y = y0 + scale * (PAD + l as u32 * (GLYPH + LINE_GAP));
-                draw_text(&mut img, x0 + scale * PAD, y, x0 + cell_w, line, scale);
+                draw_text(&mut img, (x0 + scale * PAD, y), line, style);
             }
             img.blit_display(&tile.image, x0, y0 + band);
         }
@@ -275,9 +288,24 @@ pub const PLOT_HEIGHT: u32 = 480;
 /// The plot area inside it: left, top, right, bottom edges (the legend goes right of it).
 const PLOT_AREA: (u32, u32, u32, u32) = (72, 40, 496, 432);
 
-/// The plot area's background (linear; black), its grid lines and its frame.
-const GRID: Rgb = Rgb::splat(0.06);
-const FRAME: Rgb = Rgb::splat(0.35);
+/// The plot area's grid lines and frame (its background is black).
+const GRID: Pen = Pen {
+    width: 1,
+    colour: Rgb::splat(0.06),
+};
+const FRAME: Pen = Pen {
+    width: 1,
+    colour: Rgb::splat(0.35),
+};
+/// The width of the series' lines (each in its colour).
+const SERIES_WIDTH: u32 = 2;
+
+/// How a line is drawn: its width in pixels and its colour.
+#[derive(Clone, Copy, Debug)]
+struct Pen {
+    width: u32,
+    colour: Rgb,
+}
 
 /// One named series of (x, y) points, drawn as a polyline with a marker at each point.
 #[derive(Clone, Debug)]
@@ -359,16 +387,10 @@ pub fn tick_label(v: f64) -> String {
 }
 
 impl Image {
-    /// A line from (x0, y0) to (x1, y1), `width` pixels thick, kept inside `clip` (left, top,
-    /// right, bottom).
-    fn line(
-        &mut self,
-        from: (f64, f64),
-        to: (f64, f64),
-        width: u32,
-        c: Rgb,
-        clip: (u32, u32, u32, u32),
-    ) {
+    /// A line from `from` to `to` drawn with `pen`, kept inside `clip` (left, top, right,
+    /// bottom).
+    fn line(&mut self, from: (f64, f64), to: (f64, f64), pen: Pen, clip: (u32, u32, u32, u32)) {
+        let Pen { width, colour: c } = pen;
         let steps = ((to.0 - from.0).abs().max((to.1 - from.1).abs()) * 2.0)
             .ceil()
             .max(1.0) as u32;
@@ -426,7 +448,11 @@ impl Image {
 pub fn log_log_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]) -> Image {
     let mut img = Image::new(PLOT_WIDTH, PLOT_HEIGHT, BAND);
     let (left, top, right, bottom) = PLOT_AREA;
-    img.fill_rect(left, top, right - left + 1, bottom - top + 1, BACKGROUND);
+    img.fill_rect(
+        (left, top),
+        (right - left + 1, bottom - top + 1),
+        BACKGROUND,
+    );
 
     let plotted: Vec<Vec<(f64, f64)>> = series
         .iter()
@@ -467,20 +493,33 @@ pub fn log_log_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]
 
     // Grid and tick labels.
     let all_area = (0, 0, PLOT_WIDTH - 1, PLOT_HEIGHT - 1);
+    let text = TextStyle {
+        scale: 1,
+        x_max: PLOT_WIDTH,
+    };
     for &t in &x_ticks {
         let (x, _) = to_px(t, y_lo);
-        img.line((x, top as f64), (x, bottom as f64), 1, GRID, all_area);
+        img.line((x, top as f64), (x, bottom as f64), GRID, all_area);
         let label = tick_label(t);
         let w = label.len() as f64 * GLYPH as f64;
         let lx = (x - w / 2.0).clamp(0.0, (PLOT_WIDTH as f64 - w).max(0.0)) as u32;
-        draw_text(&mut img, lx, bottom + 6, PLOT_WIDTH, &label, 1);
+        draw_text(&mut img, (lx, bottom + 6), &label, text);
     }
     for &t in &y_ticks {
         let (_, y) = to_px(x_lo, t);
-        img.line((left as f64, y), (right as f64, y), 1, GRID, all_area);
+        img.line((left as f64, y), (right as f64, y), GRID, all_area);
         let label = tick_label(t);
         let lx = left.saturating_sub(6 + label.len() as u32 * GLYPH);
-        draw_text(&mut img, lx, (y - 4.0).max(0.0) as u32, left, &label, 1);
+        let left_of_area = TextStyle {
+            x_max: left,
+            ..text
+        };
+        draw_text(
+            &mut img,
+            (lx, (y - 4.0).max(0.0) as u32),
+            &label,
+            left_of_area,
+        );
     }
     for (from, to) in [
         ((left, top), (right, top)),
@@ -489,26 +528,29 @@ pub fn log_log_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]
         ((left, bottom), (left, top)),
     ] {
         let f = |p: (u32, u32)| (p.0 as f64, p.1 as f64);
-        img.line(f(from), f(to), 1, FRAME, all_area);
+        img.line(f(from), f(to), FRAME, all_area);
     }
 
     // Titles.
-    draw_text(&mut img, PAD * 2, 10, PLOT_WIDTH, title, 1);
-    draw_text(&mut img, PAD * 2, top - 14, PLOT_WIDTH, y_label, 1);
+    draw_text(&mut img, (PAD * 2, 10), title, text);
+    draw_text(&mut img, (PAD * 2, top - 14), y_label, text);
     let w = x_label.len() as u32 * GLYPH;
     let x = (left + right).saturating_sub(w) / 2;
-    draw_text(&mut img, x, bottom + 24, PLOT_WIDTH, x_label, 1);
+    draw_text(&mut img, (x, bottom + 24), x_label, text);
 
     // The series, then the legend.
     let area = (left, top, right, bottom);
     for (i, points) in plotted.iter().enumerate() {
         let c = series_colour(i);
+        let pen = Pen {
+            width: SERIES_WIDTH,
+            colour: c,
+        };
         for pair in points.windows(2) {
             img.line(
                 to_px(pair[0].0, pair[0].1),
                 to_px(pair[1].0, pair[1].1),
-                2,
-                c,
+                pen,
                 area,
             );
         }
@@ -521,15 +563,18 @@ pub fn log_log_plot(title: &str, x_label: &str, y_label: &str, series: &[Series]
         let c = series_colour(i);
         let y = top + 8 + i as u32 * 20;
         let x = right + 16;
+        let pen = Pen {
+            width: SERIES_WIDTH,
+            colour: c,
+        };
         img.line(
             (x as f64, y as f64),
             ((x + 24) as f64, y as f64),
-            2,
-            c,
+            pen,
             all_area,
         );
         img.marker((x + 12) as f64, y as f64, i, c);
-        draw_text(&mut img, x + 32, y - 4, PLOT_WIDTH, &s.name, 1);
+        draw_text(&mut img, (x + 32, y - 4), &s.name, text);
     }
     img
 }

@@ -1,4 +1,5 @@
-//! Renders split into parts, and their merge: `foton render --part I/N` and `foton merge`.
+//! The part files of a render split with `foton render --part I/N`, which `foton merge` adds
+//! up (`merge.rs`).
 //!
 //! A part file is an OpenEXR image. Its `R`, `G`, `B` channels are the part's own image (any
 //! EXR viewer shows it); what the merge uses are the exact sums: per pixel the sample count
@@ -8,27 +9,19 @@
 //! of the render done in one process. A film with splats (light paths connected to the camera,
 //! `bdpt`) stores its splat sums the same way, `splat.R.0` to `splat.B.3`: they are added
 //! apart from the pixels' own sums, and the merged image scales them by the samples of all the
-//! parts together, as the render in one process does (`Film::pixel`). The header carries what decides whether parts belong
-//! together (attributes `foton.*`, below): the scene's content hash, the integrator with its
-//! parameters, the seed, the build of foton, the part I/N, and how much of its share the part
-//! did (an interrupted part says so).
-//!
-//! The merge reads every header first (small) and refuses a set of parts that do not belong
-//! together before it reads any pixels; then it adds the parts one at a time into one film,
-//! so its memory is one film and one part whatever the number of parts. Its output is written
-//! atomically, so a failed merge leaves nothing behind.
+//! parts together, as the render in one process does (`Film::pixel`). The header carries what
+//! decides whether parts belong together (attributes `foton.*`, below): the scene's content
+//! hash, the integrator with its parameters, the seed, the build of foton, the part I/N, and
+//! how much of its share the part did (an interrupted part says so).
 
-use crate::write_atomic_with;
-use clap::Args;
+use crate::common::write_atomic_with;
 use exr::prelude::*;
 use foton_core::film::{DisplayTransform, Film, ImageFormat, RadianceSum, ToneMap, format_of};
 use foton_core::integrator::Part;
 use foton_core::scene::Scene;
 use foton_core::{Error, Result as FotonResult};
-use foton_loader::FilmFile;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::time::Instant;
+use std::path::Path;
 
 /// The version of the part file layout (attribute `foton.format`).
 /// 2 added the splat channels: a foton that read only format 1 would merge a splatting part
@@ -259,14 +252,10 @@ pub fn write_part(
         let mean = pixels.iter().map(|p| p[c]).collect();
         channels.push(AnyChannel::new(*name, FlatSamples::F32(mean)));
         for word in 0..4 {
-            let words = film
-                .sums()
-                .iter()
-                .map(|s| (s.0[c] >> (32 * word)) as u32)
-                .collect();
+            let words = sum_words(film.sums(), c, word);
             channels.push(AnyChannel::new(
                 format!("sum.{name}.{word}").as_str(),
-                FlatSamples::U32(words),
+                words,
             ));
         }
     }
@@ -275,14 +264,10 @@ pub fn write_part(
             break;
         }
         for word in 0..4 {
-            let words = film
-                .splats()
-                .iter()
-                .map(|s| (s.0[c] >> (32 * word)) as u32)
-                .collect();
+            let words = sum_words(film.splats(), c, word);
             channels.push(AnyChannel::new(
                 format!("splat.{name}.{word}").as_str(),
-                FlatSamples::U32(words),
+                words,
             ));
         }
     }
@@ -309,6 +294,15 @@ pub fn write_part(
             .to_file(tmp)
             .map_err(|e| std::io::Error::other(e.to_string()))
     })
+}
+
+/// Word `word` (0: the least significant) of colour channel `c` of each of `sums`.
+fn sum_words(sums: &[RadianceSum], c: usize, word: u32) -> FlatSamples {
+    FlatSamples::U32(
+        sums.iter()
+            .map(|s| (s.0[c] >> (32 * word)) as u32)
+            .collect(),
+    )
 }
 
 /// The text attributes of an EXR's header and its size.
@@ -405,159 +399,4 @@ pub fn read_part_film(path: &Path, info: &PartInfo) -> FotonResult<Film> {
     }
     Film::from_sums(info.width, info.height, sums, counts, splats)
         .ok_or_else(|| Error::io(path, "damaged part: channels of the wrong size"))
-}
-
-#[derive(Args)]
-pub(super) struct MergeArgs {
-    /// The part files (`foton render --part I/N -o part_I.exr`), in any order.
-    #[arg(required = true)]
-    parts: Vec<PathBuf>,
-    /// The merged image (.exr linear float32, or .png through the scene's exposure and
-    /// tonemap).
-    #[arg(short, long)]
-    output: PathBuf,
-    /// Merge the parts that are there when some are missing or interrupted (the image then
-    /// has fewer samples; it says which parts it lacks).
-    #[arg(long)]
-    partial: bool,
-}
-
-/// `foton merge`: checks that the parts belong together, then adds them one at a time.
-pub(super) fn run(
-    a: MergeArgs,
-    out: &mut dyn std::io::Write,
-    err: &mut dyn std::io::Write,
-) -> FotonResult<u8> {
-    foton_core::film::check_output(&a.output)?;
-    let start = Instant::now();
-    let mut parts: BTreeMap<u32, (PathBuf, PartInfo)> = BTreeMap::new();
-    let mut first: Option<(PathBuf, PartInfo)> = None;
-    for path in &a.parts {
-        let info = read_part_info(path)?;
-        if let Some((first_path, f)) = &first {
-            belongs_with(path, &info, first_path, f)?;
-        } else {
-            first = Some((path.clone(), info.clone()));
-        }
-        if let Some((other, _)) = parts.get(&info.part.index) {
-            return Err(Error::Usage(format!(
-                "part {} is given twice: {} and {}",
-                info.part,
-                other.display(),
-                path.display()
-            )));
-        }
-        parts.insert(info.part.index, (path.clone(), info));
-    }
-    let (_, f) = first.expect("clap requires one part");
-    let count = f.part.count;
-    let missing: Vec<String> = (0..count)
-        .filter(|i| !parts.contains_key(i))
-        .map(|i| format!("{i}/{count}"))
-        .collect();
-    let interrupted: Vec<String> = parts
-        .values()
-        .filter(|(_, p)| p.done < p.planned)
-        .map(|(path, p)| {
-            format!(
-                "{} (part {}: {} of {} {})",
-                path.display(),
-                p.part,
-                p.done,
-                p.planned,
-                p.work
-            )
-        })
-        .collect();
-    if !a.partial {
-        if !missing.is_empty() {
-            return Err(Error::Usage(format!(
-                "missing part(s) {} of the {count} (given {}); render them, or merge what is there with --partial",
-                missing.join(", "),
-                parts.len()
-            )));
-        }
-        if !interrupted.is_empty() {
-            return Err(Error::Usage(format!(
-                "interrupted part(s): {}; render them again, or merge what is there with --partial",
-                interrupted.join(", ")
-            )));
-        }
-    }
-    let mut film = Film::new(f.width, f.height);
-    for (path, info) in parts.values() {
-        let part = read_part_film(path, info)?;
-        film.merge(&part);
-    }
-    film.write(&a.output, &f.display())?;
-    if !missing.is_empty() {
-        let _ = writeln!(
-            err,
-            "warning: --partial: merged without part(s) {}",
-            missing.join(", ")
-        );
-    }
-    if !interrupted.is_empty() {
-        let _ = writeln!(
-            err,
-            "warning: --partial: merged interrupted part(s): {}",
-            interrupted.join(", ")
-        );
-    }
-    let _ = writeln!(
-        out,
-        "{}: {} of {count} parts, {}x{}, {} with {} -> {} ({:.2} s)",
-        f.scene,
-        parts.len(),
-        f.width,
-        f.height,
-        parts.values().map(|(_, p)| p.done).sum::<u64>().to_string() + " " + &f.work,
-        f.integrator,
-        a.output.display(),
-        start.elapsed().as_secs_f64()
-    );
-    Ok(0)
-}
-
-/// Whether the part at `path` comes from the same render as the first part given.
-fn belongs_with(path: &Path, p: &PartInfo, first_path: &Path, f: &PartInfo) -> FotonResult<()> {
-    let differs = |what: &str, this: String, that: String| {
-        Err(Error::Usage(format!(
-            "{} is not a part of the same render as {}: {what} {this} (the other: {that})",
-            path.display(),
-            first_path.display()
-        )))
-    };
-    if p.integrator != f.integrator {
-        return differs("integrator", p.integrator.clone(), f.integrator.clone());
-    }
-    if p.seed != f.seed {
-        return differs("seed", p.seed.to_string(), f.seed.to_string());
-    }
-    if p.part.count != f.part.count {
-        return differs(
-            "number of parts",
-            p.part.count.to_string(),
-            f.part.count.to_string(),
-        );
-    }
-    if p.build != f.build {
-        return differs("foton build", p.build.clone(), f.build.clone());
-    }
-    if (p.width, p.height) != (f.width, f.height) {
-        return differs(
-            "size",
-            format!("{}x{}", p.width, p.height),
-            format!("{}x{}", f.width, f.height),
-        );
-    }
-    // Last: overrides of the seed or integrator change the hash too, and are named above.
-    if p.scene_hash != f.scene_hash {
-        return differs(
-            "another scene or other overrides: scene hash",
-            format!("{} of {}", p.scene_hash, p.scene),
-            format!("{} of {}", f.scene_hash, f.scene),
-        );
-    }
-    Ok(())
 }

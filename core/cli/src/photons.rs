@@ -6,9 +6,8 @@
 //! for any integrator that exposes maps, a third party's included, and knows nothing of their
 //! budgets or classifications.
 
-use crate::{
-    INTERRUPTED, SceneArgs, TermProgress, beside_scene, prepare_args, scene_overrides, threads,
-};
+use crate::TermProgress;
+use crate::common::{INTERRUPTED, RunArgs, SceneArgs, blame_plugin, warn};
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::check_output;
@@ -42,12 +41,8 @@ pub(crate) struct PhotonsArgs {
     #[arg(long, default_value_t = 1, value_name = "PIXELS",
           value_parser = clap::value_parser!(u32).range(1..=64))]
     dot: u32,
-    /// Worker threads (default: all cores). The image does not depend on it.
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
 }
 
 /// Where a photon shows on the film, if the camera sees it: in front of the camera, inside
@@ -81,25 +76,20 @@ fn exposure(powers: &[Rgb]) -> f32 {
 }
 
 pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
-    let overrides = scene_overrides(&a.scene);
-    let p = prepare_args(&a.scene, &overrides)?;
+    let p = a.scene.prepare(&a.scene.overrides())?;
     let scene = &p.scene;
-    for w in &p.warnings {
-        let _ = writeln!(err, "warning: {w}");
-    }
+    warn(err, &p.warnings);
 
-    let progress = TermProgress::new(a.quiet);
+    let progress = TermProgress::new(a.run.quiet);
     INTERRUPTED.store(false, Ordering::SeqCst);
-    let threads = threads(a.threads);
+    let threads = a.run.threads();
     let ctx = RenderContext::new(threads, &INTERRUPTED, &progress);
     let name = p.integrator.name().to_string();
     let mut maps = p
         .integrator
         .photon_maps(scene, &ctx)
-        .map_err(|e| crate::blame_plugin(&p.plugin, e))?;
-    for w in progress.take_warnings() {
-        let _ = writeln!(err, "warning: {w}");
-    }
+        .map_err(|e| blame_plugin(&p.plugin, e))?;
+    warn(err, progress.take_warnings());
     if maps.is_empty() {
         return Err(Error::Usage(format!(
             "integrator `{name}` builds no photon maps; name one that does with --integrator (e.g. photon, vpm, sppm)"
@@ -119,7 +109,7 @@ pub(crate) fn run(a: PhotonsArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let output = a
         .output
         .clone()
-        .unwrap_or_else(|| beside_scene(&a.scene.scene, &format!("{}-photons.png", map.name)));
+        .unwrap_or_else(|| a.scene.file.beside(&format!("{}-photons.png", map.name)));
     check_output(&output)?;
     let photons = &map.photons;
 

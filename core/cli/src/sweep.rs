@@ -8,10 +8,13 @@
 //! sweep's signature and the cell's time), and `--assemble --cells-dir DIR` lays out the grid
 //! from those files, the same grid as one process makes but for the times.
 
+use crate::TermProgress;
+use crate::common::{
+    INTERRUPTED, Overrides, PluginArgs, Prepared, RunArgs, SceneFile, WarnOnce, render_prepared,
+    warn,
+};
 use crate::montage::{Tile, grid, render_image};
 use crate::part::{PartInfo, fnv_hex, read_part_film, read_part_header, write_part};
-use crate::threads;
-use crate::{INTERRUPTED, PluginArgs, TermProgress, beside_scene, prepare_xml, render_prepared};
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::check_output;
@@ -23,41 +26,24 @@ use std::sync::atomic::Ordering;
 pub const MAX_CELLS: usize = 256;
 
 #[derive(Args)]
-pub(super) struct SweepArgs {
-    /// The scene file (TOML, or a Mitsuba 3 scene: .xml).
-    scene: PathBuf,
-    /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> in every cell (repeatable).
-    #[arg(short = 'D', value_name = "NAME=VALUE")]
-    defines: Vec<String>,
-    /// Mitsuba XML scenes: leave out what foton cannot render yet (listed) instead of refusing.
-    #[arg(long)]
-    lenient: bool,
+pub(crate) struct SweepArgs {
+    #[command(flatten)]
+    file: SceneFile,
     /// KEY.PATH=VALUE[,VALUE...]: the values to sweep a scene value over (repeatable). Commas
     /// inside brackets, braces or quotes do not split: camera.position=[0,1,3],[0,1,4] is two
     /// values.
     #[arg(long = "set", value_name = "KEY.PATH=VALUES")]
     sets: Vec<String>,
-    /// Use this integrator plugin instead of the scene's render.integrator.
-    #[arg(long)]
-    integrator: Option<String>,
-    /// Samples per pixel (overrides render.spp).
-    #[arg(long, allow_negative_numbers = true, value_parser = crate::parse_spp)]
-    spp: Option<u32>,
-    /// Random seed (overrides render.seed).
-    #[arg(long)]
-    seed: Option<u64>,
+    #[command(flatten)]
+    overrides: Overrides,
     /// Output image (.png or .exr); default: <scene stem>-sweep.png beside the scene.
     #[arg(short, long)]
     output: Option<PathBuf>,
     /// Treat unknown (unused) scene fields and integrator parameters as errors.
     #[arg(long)]
     strict: bool,
-    /// Worker threads (default: all cores). The images do not depend on it.
-    #[arg(long)]
-    threads: Option<usize>,
-    /// No progress bar.
-    #[arg(short, long)]
-    quiet: bool,
+    #[command(flatten)]
+    run: RunArgs,
     /// Print the number of cells and do nothing else (to size an array job).
     #[arg(long, conflicts_with_all = ["cell", "assemble"])]
     cells: bool,
@@ -181,7 +167,7 @@ fn short_names(sets: &[&SweepSet]) -> Vec<String> {
         .collect()
 }
 
-pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+pub(crate) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
     let sets = a
         .sets
         .iter()
@@ -215,15 +201,7 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
             .zip(&choice)
             .map(|(s, &i)| format!("{}={}", s.key, s.values[i]))
             .collect();
-        if let Some(name) = &a.integrator {
-            overrides.push(format!("render.integrator={name:?}"));
-        }
-        if let Some(spp) = a.spp {
-            overrides.push(format!("render.spp={spp}"));
-        }
-        if let Some(seed) = a.seed {
-            overrides.push(format!("render.seed={seed}"));
-        }
+        a.overrides.push_onto(&mut overrides);
         let label: Vec<String> = sets
             .iter()
             .zip(&choice)
@@ -235,13 +213,20 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     };
     let signature = sweep_signature(&a)?;
     if let Some(cell) = a.cell {
-        let dir = a.cells_dir.as_deref().expect("clap requires --cells-dir");
-        return render_cell(&a, cell, &overrides_of(cell), &signature, dir, out, err);
+        let (overrides, label) = overrides_of(cell);
+        let task = CellTask {
+            cell,
+            overrides,
+            label,
+            signature: &signature,
+            dir: a.cells_dir.as_deref().expect("clap requires --cells-dir"),
+        };
+        return render_cell(&a, &task, out, err);
     }
     let output = a
         .output
         .clone()
-        .unwrap_or_else(|| beside_scene(&a.scene, "sweep.png"));
+        .unwrap_or_else(|| a.file.beside("sweep.png"));
     check_output(&output)?;
 
     if a.assemble {
@@ -297,28 +282,21 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     // Every cell's scene and integrator are created first, so that a bad value fails before
     // any render; they are loaded again one at a time to render (a sweep over a large scene
     // would not fit in memory many times over).
-    let mut warned: Vec<String> = Vec::new();
+    let mut warned = WarnOnce::default();
     for cell in 0..cells {
         let p = prepare_cell(&a, &overrides_of(cell).0)?;
-        for w in &p.warnings {
-            if !warned.contains(w) {
-                let _ = writeln!(err, "warning: {w}");
-                warned.push(w.clone());
-            }
-        }
+        warned.warn(err, &p.warnings);
     }
 
-    let threads = threads(a.threads);
+    let threads = a.run.threads();
     INTERRUPTED.store(false, Ordering::SeqCst);
     let mut tiles = Vec::new();
     for cell in 0..cells {
         let (overrides, mut label) = overrides_of(cell);
         let p = prepare_cell(&a, &overrides)?;
-        let progress = TermProgress::new(a.quiet);
+        let progress = TermProgress::new(a.run.quiet);
         let (film, elapsed) = render_prepared(&p, threads, &progress)?;
-        for w in progress.take_warnings() {
-            let _ = writeln!(err, "warning: {w}");
-        }
+        warn(err, progress.take_warnings());
         if INTERRUPTED.load(Ordering::SeqCst) {
             let _ = writeln!(err, "interrupted: nothing written");
             return Ok(130);
@@ -351,18 +329,11 @@ pub(super) fn run(a: SweepArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
     Ok(0)
 }
 
-fn prepare_cell(a: &SweepArgs, overrides: &[String]) -> Result<crate::Prepared> {
-    prepare_xml(
-        &a.scene,
-        overrides,
-        &a.defines,
-        a.lenient,
-        &a.plugins.plugin_dirs,
-        a.strict,
-    )
+fn prepare_cell(a: &SweepArgs, overrides: &[String]) -> Result<Prepared> {
+    a.file.prepare(overrides, &a.plugins, a.strict)
 }
 
-fn cell_work(film: &foton_core::film::Film, p: &crate::Prepared) -> String {
+fn cell_work(film: &foton_core::film::Film, p: &Prepared) -> String {
     if film.iterations > 0 {
         format!("{} iterations", film.iterations)
     } else {
@@ -377,36 +348,53 @@ fn cell_path(dir: &Path, cell: usize) -> PathBuf {
 /// What makes two sweeps the same: the scene file's bytes and every argument that changes the
 /// cells (the lists of values, the integrator, spp and seed).
 fn sweep_signature(a: &SweepArgs) -> Result<String> {
-    let scene = std::fs::read(&a.scene).map_err(|e| Error::io(&a.scene, e))?;
+    let path = &a.file.scene;
+    let scene = std::fs::read(path).map_err(|e| Error::io(path, e))?;
     let mut fields: Vec<Vec<u8>> = vec![scene];
     fields.extend(a.sets.iter().map(|s| s.as_bytes().to_vec()));
-    fields.extend(a.defines.iter().map(|d| format!("-D {d}").into_bytes()));
-    fields.push(format!("{:?} {:?} {:?}", a.integrator, a.spp, a.seed).into_bytes());
+    fields.extend(
+        a.file
+            .defines
+            .iter()
+            .map(|d| format!("-D {d}").into_bytes()),
+    );
+    let o = &a.overrides;
+    fields.push(format!("{:?} {:?} {:?}", o.integrator, o.spp, o.seed).into_bytes());
     Ok(fnv_hex(&fields))
 }
 
-/// `--cell I`: renders one cell into its file in `dir`.
+/// One task of an array job (`--cell I`): the cell, its scene values and label, the sweep's
+/// signature and the folder of the cell files.
+struct CellTask<'a> {
+    cell: usize,
+    overrides: Vec<String>,
+    label: Vec<String>,
+    signature: &'a str,
+    dir: &'a Path,
+}
+
+/// `--cell I`: renders one cell into its file in the cells' folder.
 fn render_cell(
     a: &SweepArgs,
-    cell: usize,
-    (overrides, label): &(Vec<String>, Vec<String>),
-    signature: &str,
-    dir: &Path,
+    task: &CellTask,
     out: &mut dyn Write,
     err: &mut dyn Write,
 ) -> Result<u8> {
-    let path = cell_path(dir, cell);
+    let CellTask {
+        cell,
+        overrides,
+        label,
+        signature,
+        dir,
+    } = task;
+    let path = cell_path(dir, *cell);
     check_output(&path)?;
     let p = prepare_cell(a, overrides)?;
-    for w in &p.warnings {
-        let _ = writeln!(err, "warning: {w}");
-    }
+    warn(err, &p.warnings);
     INTERRUPTED.store(false, Ordering::SeqCst);
-    let progress = TermProgress::new(a.quiet);
-    let (film, elapsed) = render_prepared(&p, threads(a.threads), &progress)?;
-    for w in progress.take_warnings() {
-        let _ = writeln!(err, "warning: {w}");
-    }
+    let progress = TermProgress::new(a.run.quiet);
+    let (film, elapsed) = render_prepared(&p, a.run.threads(), &progress)?;
+    warn(err, progress.take_warnings());
     if INTERRUPTED.load(Ordering::SeqCst) {
         let _ = writeln!(err, "interrupted: nothing written");
         return Ok(130);

@@ -1,0 +1,181 @@
+//! `foton render`: one scene to one image, or with `--part I/N` to a part file for
+//! `foton merge`; a summary line of the work done, and what an interrupted render kept.
+
+use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_part, warn};
+use crate::{TermProgress, part};
+use clap::Args;
+use foton_core::error::{Error, Result};
+use foton_core::film::{Film, ImageFormat, check_output, format_of};
+use foton_core::integrator::Part;
+use foton_core::scene::Scene;
+use foton_loader::FilmFile;
+use std::io::Write;
+use std::path::PathBuf;
+use std::sync::atomic::Ordering;
+use std::time::Duration;
+
+#[derive(Args)]
+pub(crate) struct RenderArgs {
+    #[command(flatten)]
+    scene: SceneArgs,
+    /// Output image (.exr or .png); default: film.output, relative to the scene file.
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    #[command(flatten)]
+    run: RunArgs,
+    /// Progressive integrators (sppm): write the image to the output file every N
+    /// iterations (atomically), so that it can be watched as it converges.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u64).range(1..))]
+    checkpoint: Option<u64>,
+    /// Render the I-th (from 0) of N disjoint shares of the work and write a part file (.exr)
+    /// for `foton merge`: camera samples are split (path, photon, vpm: every part builds the
+    /// same photon maps), or iterations (sppm, radius_schedule = "global" only). Default
+    /// output: <scene stem>-part-I-of-N.exr beside the scene.
+    #[arg(long, value_name = "I/N", value_parser = part::parse_part)]
+    part: Option<Part>,
+}
+
+pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
+    let overrides = a.scene.overrides();
+    let p = a.scene.prepare(&overrides)?;
+    let output = match (&a.output, a.part) {
+        (Some(o), _) => o.clone(),
+        (None, Some(part)) => a
+            .scene
+            .file
+            .beside(&format!("part-{}-of-{}.exr", part.index, part.count)),
+        (None, None) => p.scene.film().output.clone(),
+    };
+    check_output(&output)?;
+    if a.part.is_some() {
+        if format_of(&output)? != ImageFormat::Exr {
+            return Err(Error::Usage(format!(
+                "--part writes exact per-pixel sums, which only EXR can hold: name the output .exr, not {}",
+                output.display()
+            )));
+        }
+        if a.checkpoint.is_some() {
+            return Err(Error::Usage(
+                "--checkpoint and --part: a part's image is not the render's, merge the parts to see it".into(),
+            ));
+        }
+    }
+    warn(err, &p.warnings);
+    let mut progress = TermProgress::new(a.run.quiet);
+    if let Some(every) = a.checkpoint {
+        progress = progress.with_checkpoint(every, output.clone(), p.scene.film().display());
+    }
+    INTERRUPTED.store(false, Ordering::SeqCst);
+    let threads = a.run.threads();
+    let (film, elapsed) = render_part(&p, threads, &progress, a.part.unwrap_or(Part::WHOLE))?;
+    if a.checkpoint.is_some() && progress.checkpoints.load(Ordering::Relaxed) == 0 {
+        let _ = writeln!(
+            err,
+            "warning: --checkpoint: {} is not progressive and wrote no intermediate image",
+            p.integrator.describe()
+        );
+    }
+    warn(err, progress.take_warnings());
+    let of_part = match a.part {
+        Some(part) => {
+            // The defines change an XML scene as overrides do.
+            let mut hashed = overrides.clone();
+            hashed.extend(a.scene.file.defines.iter().map(|d| format!("-D {d}")));
+            let info = part::PartInfo::of(&p.scene, &hashed, &p.integrator.describe(), &film)?;
+            part::write_part(&output, &film, &info, &[])?;
+            format!(", part {part}")
+        }
+        None => {
+            film.write(&output, &p.scene.film().display())?;
+            String::new()
+        }
+    };
+    let _ = writeln!(
+        out,
+        "{}: {}x{}{of_part}, {} with {} -> {}",
+        p.scene.file().display(),
+        film.width,
+        film.height,
+        work_done(&film, elapsed, threads),
+        p.integrator.describe(),
+        output.display()
+    );
+    if INTERRUPTED.load(Ordering::SeqCst) {
+        let _ = writeln!(
+            err,
+            "interrupted: {}",
+            kept_after_interrupt(&film, &p.scene)
+        );
+        return Ok(130);
+    }
+    Ok(0)
+}
+
+/// A rate with a unit prefix that keeps its digits: "1.27 M", "4.8 k" (a progressive render of
+/// a few thousand photons a pass read "0.00 M photons/s").
+fn rate(per_second: f64) -> String {
+    if per_second >= 1e6 {
+        format!("{:.2} M", per_second / 1e6)
+    } else if per_second >= 1e3 {
+        format!("{:.1} k", per_second / 1e3)
+    } else {
+        format!("{per_second:.0}")
+    }
+}
+
+/// What a render did, for its summary line: the iterations and photons of a progressive
+/// integrator (its camera samples are one per pixel per iteration, a meaningless rate), or the
+/// samples of the others.
+fn work_done(film: &Film, elapsed: Duration, threads: usize) -> String {
+    let secs = elapsed.as_secs_f64();
+    let per_second = |n: u64| n as f64 / secs.max(1e-9);
+    if film.iterations > 0 {
+        format!(
+            "{} iterations, {} photons in {secs:.2} s ({} photons/s, {:.2} iterations/s, {threads} threads)",
+            film.iterations,
+            film.photons,
+            rate(per_second(film.photons)),
+            per_second(film.iterations),
+        )
+    } else {
+        let samples = film.total_samples();
+        format!(
+            "{samples} samples in {secs:.2} s ({} samples/s, {threads} threads)",
+            rate(per_second(samples))
+        )
+    }
+}
+
+/// What an interrupted render wrote: the estimate of the iterations done (an iteration is
+/// kept whole or dropped), or the samples done.
+fn kept_after_interrupt(film: &Film, scene: &Scene) -> String {
+    if film.iterations > 0 || film.iterations_planned > 0 {
+        let of = match film.iterations_planned {
+            0 => String::new(),
+            n => format!(" of {n}"),
+        };
+        format!(
+            "wrote the estimate of the {}{of} iterations done",
+            film.iterations
+        )
+    } else {
+        let share = film.part.share(scene.render().spp as u64);
+        let full = film.width as u64 * film.height as u64 * (share.end - share.start);
+        format!(
+            "wrote the image of the {} of {full} samples done so far",
+            film.total_samples()
+        )
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rate;
+
+    #[test]
+    fn rates_keep_their_digits() {
+        assert_eq!(rate(1_270_000.0), "1.27 M");
+        assert_eq!(rate(4_796.0), "4.8 k");
+        assert_eq!(rate(12.4), "12");
+    }
+}
