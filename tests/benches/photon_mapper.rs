@@ -6,7 +6,7 @@
 use foton_cli::{TermProgress, prepare, render_prepared};
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
-use foton_photonmap::map::{Estimate, PhotonMap};
+use foton_photonmap::map::{Disc, Estimate, PhotonMap};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use foton_tests::{plugin_dir, repo_root};
 use std::sync::atomic::AtomicBool;
@@ -61,7 +61,11 @@ fn main() {
     let mut sum = 0.0f32;
     for p in photons.iter().step_by(photons.len() / queries + 1) {
         sum += map
-            .irradiance(p.position, p.normal(), 16, &estimate, &mut scratch)
+            .irradiance(
+                &Disc::new(p.position, p.normal(), 16),
+                &estimate,
+                &mut scratch,
+            )
             .x;
     }
     let done = photons.len().div_ceil(photons.len() / queries + 1);

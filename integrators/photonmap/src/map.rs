@@ -9,7 +9,7 @@
 //! incrementally (Arya and Mount), which prunes more than the distance to the last plane.
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
-use foton_core::api::{Bsdf, Hit, Lobe, NormalizedKernel, Phase, Ray, Rgb, Scene, offset_origin};
+use foton_core::api::{Bsdf, Lobe, NormalizedKernel, Phase, Ray, Rgb, Scene, offset_origin};
 use glam::{Vec2, Vec3};
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
@@ -140,6 +140,36 @@ pub struct DiscClip {
     /// The tangent frame (u, v) of the probes.
     frame: (Vec3, Vec3),
     p: Vec3,
+}
+
+/// Where a surface estimate gathers: the disc around `p` in the tangent plane of `n` (the
+/// normal on the side looked at), from photons of at most `max_depth` scattering events,
+/// clipped at the walls of `clip`.
+#[derive(Clone, Copy, Debug)]
+pub struct Disc<'a> {
+    pub p: Vec3,
+    pub n: Vec3,
+    pub max_depth: u32,
+    pub clip: &'a DiscClip,
+}
+
+impl Disc<'static> {
+    /// A whole disc (no wall clips it).
+    pub fn new(p: Vec3, n: Vec3, max_depth: u32) -> Disc<'static> {
+        Disc {
+            p,
+            n,
+            max_depth,
+            clip: &DiscClip::NONE,
+        }
+    }
+}
+
+impl<'a> Disc<'a> {
+    /// The disc clipped at the walls of `clip`.
+    pub fn clipped(self, clip: &'a DiscClip) -> Disc<'a> {
+        Disc { clip, ..self }
+    }
 }
 
 impl DiscClip {
@@ -636,41 +666,30 @@ impl PhotonMap {
         sum
     }
 
-    /// Radiance reflected at a surface point p (normal `n` on the side looked at) from the
-    /// photons of a disc around it: sum over the k nearest photons (see `knn_estimate`) of
+    /// Radiance reflected at the disc's point p (normal n on the side looked at) from the
+    /// photons of the disc around it: sum over the k nearest photons (see `knn_estimate`) of
     /// f(wi_p) Phi_p K2(d_p, r), with `f` the BSDF towards the viewer evaluated with each
     /// photon's own incoming direction, so that any BSDF, glossy ones included, is right.
     ///
     /// Photons are taken from a disc, not a ball: stored on the same side of a surface facing
-    /// the same way (normals within about 25 degrees), with paths of at most `max_depth`
-    /// scattering events, and no farther from the tangent plane than [`DISC_THICKNESS`] times
-    /// the radius.
-    #[allow(clippy::too_many_arguments)]
+    /// the same way (normals within about 25 degrees), with paths of at most the disc's
+    /// `max_depth` scattering events, and no farther from the tangent plane than
+    /// [`DISC_THICKNESS`] times the radius. With the disc clipped at the walls around p
+    /// ([`DiscClip`]): only photons on p's side of every wall, divided by the kernel's mass on
+    /// that side.
     pub fn radiance(
         &self,
-        p: Vec3,
-        n: Vec3,
-        max_depth: u32,
+        disc: &Disc<'_>,
         estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
         f: impl Fn(Vec3) -> Rgb,
     ) -> Rgb {
-        self.radiance_clipped(p, n, max_depth, estimate, &DiscClip::NONE, scratch, f)
-    }
-
-    /// [`PhotonMap::radiance`] with the disc clipped at the walls around p ([`DiscClip`]):
-    /// only photons on p's side of every wall, divided by the kernel's mass on that side.
-    #[allow(clippy::too_many_arguments)]
-    pub fn radiance_clipped(
-        &self,
-        p: Vec3,
-        n: Vec3,
-        max_depth: u32,
-        estimate: &Estimate<'_>,
-        clip: &DiscClip,
-        scratch: &mut Vec<Neighbour>,
-        f: impl Fn(Vec3) -> Rgb,
-    ) -> Rgb {
+        let &Disc {
+            p,
+            n,
+            max_depth,
+            clip,
+        } = disc;
         let thickness2 = DISC_THICKNESS * DISC_THICKNESS;
         let height2 = |ph: &Photon| {
             let h = (ph.position - p).dot(n);
@@ -702,37 +721,17 @@ impl PhotonMap {
         }
     }
 
-    /// Radiance reflected towards `wo` by `bsdf` at `hit` (`n`: the normal on the side
-    /// looked at) from the photons of at most `max_depth` scattering events: the surface
-    /// estimate every photon integrator makes, with the BSDF evaluated per photon
-    /// (`Bsdf::eval_density`). Uses this thread's scratch buffer.
-    #[allow(clippy::too_many_arguments)]
+    /// Radiance reflected towards `wo` by `bsdf` at the disc's point from the photons of the
+    /// disc: the surface estimate every photon integrator makes, with the BSDF evaluated per
+    /// photon (`Bsdf::eval_density`). Uses this thread's scratch buffer.
     pub fn reflected(
         &self,
         estimate: &Estimate<'_>,
+        disc: &Disc<'_>,
         bsdf: &Bsdf,
-        hit: &Hit,
         wo: Vec3,
-        n: Vec3,
-        max_depth: u32,
     ) -> Rgb {
-        self.reflected_clipped(estimate, &DiscClip::NONE, bsdf, hit, wo, n, max_depth)
-    }
-
-    /// [`PhotonMap::reflected`] with the disc clipped at the walls around the point
-    /// ([`DiscClip`]).
-    #[allow(clippy::too_many_arguments)]
-    pub fn reflected_clipped(
-        &self,
-        estimate: &Estimate<'_>,
-        clip: &DiscClip,
-        bsdf: &Bsdf,
-        hit: &Hit,
-        wo: Vec3,
-        n: Vec3,
-        max_depth: u32,
-    ) -> Rgb {
-        if self.is_empty() || max_depth == 0 {
+        if self.is_empty() || disc.max_depth == 0 {
             return Rgb::ZERO;
         }
         with_scratch(|scratch| {
@@ -742,14 +741,11 @@ impl PhotonMap {
                 // A Lambertian BSDF without a shading normal is the same for every photon of
                 // the disc (each arrived on the side looked at): f once, outside the sum, and
                 // no direction to decode.
-                let f = bsdf.eval_density(wo, n);
-                let e = self
-                    .radiance_clipped(hit.p, n, max_depth, estimate, clip, scratch, |_| Rgb::ONE);
+                let f = bsdf.eval_density(wo, disc.n);
+                let e = self.radiance(disc, estimate, scratch, |_| Rgb::ONE);
                 return f * e;
             }
-            self.radiance_clipped(hit.p, n, max_depth, estimate, clip, scratch, |wi| {
-                bsdf.eval_density(wo, wi)
-            })
+            self.radiance(disc, estimate, scratch, |wi| bsdf.eval_density(wo, wi))
         })
     }
 
@@ -757,13 +753,11 @@ impl PhotonMap {
     /// power times the surface kernel K2 over the photons of the disc.
     pub fn irradiance(
         &self,
-        p: Vec3,
-        n: Vec3,
-        max_depth: u32,
+        disc: &Disc<'_>,
         estimate: &Estimate<'_>,
         scratch: &mut Vec<Neighbour>,
     ) -> Rgb {
-        self.radiance(p, n, max_depth, estimate, scratch, |_| Rgb::ONE)
+        self.radiance(disc, estimate, scratch, |_| Rgb::ONE)
     }
 
     /// In-scattered radiance at a point in a medium towards the camera, sigma_s times the

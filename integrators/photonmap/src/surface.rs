@@ -11,7 +11,7 @@
 //! The **caustic** pass stores the L S+ D photons, traced to their first diffuse hit only.
 //! Each light path is thus counted once (docs/photon-mapping.md).
 
-use crate::map::{CLIP_PROBES, DiscClip, Estimate, Photon, PhotonMap};
+use crate::map::{CLIP_PROBES, Disc, DiscClip, Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
 use foton_core::api::{
     Bsdf, Direct, Film, Hit, Mis, NormalizedKernel, Parameter, PhotonMapView, Properties, Ray,
@@ -337,22 +337,17 @@ impl SurfaceMaps {
         } else {
             DiscClip::NONE
         };
+        let disc = Disc::new(hit.p, n, depth).clipped(&clip);
         let mut l = match (direct, &self.direct) {
-            (Direct::Photons, Some(map)) => {
-                map.reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth)
-            }
+            (Direct::Photons, Some(map)) => map.reflected(estimate, &disc, bsdf, wo),
             _ => {
                 let at = Scatter::Surface { hit, bsdf };
                 estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
             }
         };
-        l += self
-            .caustic
-            .reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth);
+        l += self.caustic.reflected(estimate, &disc, bsdf, wo);
         if indirect {
-            l += self
-                .indirect
-                .reflected_clipped(estimate, &clip, bsdf, hit, wo, n, depth);
+            l += self.indirect.reflected(estimate, &disc, bsdf, wo);
         }
         l
     }
@@ -372,10 +367,11 @@ impl SurfaceMaps {
         } else {
             -hit.ng
         };
-        let mut l = self.caustic.reflected(estimate, bsdf, hit, wo, n, depth)
-            + self.indirect.reflected(estimate, bsdf, hit, wo, n, depth);
+        let disc = Disc::new(hit.p, n, depth);
+        let mut l = self.caustic.reflected(estimate, &disc, bsdf, wo)
+            + self.indirect.reflected(estimate, &disc, bsdf, wo);
         if let Some(direct) = &self.direct {
-            l += direct.reflected(estimate, bsdf, hit, wo, n, depth);
+            l += direct.reflected(estimate, &disc, bsdf, wo);
         }
         l
     }

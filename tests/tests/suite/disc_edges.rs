@@ -8,7 +8,7 @@ use foton_core::Rgb;
 use foton_core::kernel::{BoxKernel, ConeKernel, NormalizedKernel};
 use foton_core::sampling::Rng;
 use foton_core::scene::Scene;
-use foton_photonmap::map::{DiscClip, Estimate, Photon, PhotonMap};
+use foton_photonmap::map::{Disc, DiscClip, Estimate, Photon, PhotonMap};
 use foton_tests::{temp_dir, write};
 use glam::Vec3;
 
@@ -71,7 +71,8 @@ fn estimate(scene: &Scene, map: &PhotonMap, kernel: &NormalizedKernel, p: Vec3, 
         DiscClip::NONE
     };
     let mut scratch = Vec::new();
-    let e = map.radiance_clipped(p, Vec3::Y, 16, &estimate, &clip, &mut scratch, |_| Rgb::ONE);
+    let disc = Disc::new(p, Vec3::Y, 16).clipped(&clip);
+    let e = map.radiance(&disc, &estimate, &mut scratch, |_| Rgb::ONE);
     e.x / DENSITY
 }
 

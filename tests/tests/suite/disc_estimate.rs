@@ -6,7 +6,7 @@ use foton_cli::{TermProgress, prepare, render_prepared};
 use foton_core::film::Film;
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
 use foton_core::scene::Scene;
-use foton_photonmap::map::{DISC_THICKNESS, Estimate, Photon, PhotonMap};
+use foton_photonmap::map::{DISC_THICKNESS, Disc, Estimate, Photon, PhotonMap};
 use foton_tests::{header, plugin_dir, region_mean, temp_dir, write};
 use glam::Vec3;
 
@@ -45,9 +45,7 @@ fn photons_on_a_parallel_surface_within_the_radius_are_not_counted() {
     // At x = 0.1 the disc of radius 0.2 reaches half-way over the box top: a ball would count
     // its ten times brighter photons there too.
     let e = map.irradiance(
-        Vec3::new(0.1, 0.0, 0.0),
-        Vec3::Y,
-        16,
+        &Disc::new(Vec3::new(0.1, 0.0, 0.0), Vec3::Y, 16),
         &estimate,
         &mut scratch,
     );

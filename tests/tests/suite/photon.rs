@@ -5,7 +5,7 @@
 use foton_core::integrator::{NoProgress, RenderContext};
 use foton_core::kernel::{BoxKernel, NormalizedKernel};
 use foton_core::scene::Scene;
-use foton_photonmap::map::{Estimate, PhotonMap};
+use foton_photonmap::map::{Disc, Estimate, PhotonMap};
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_one, trace_photons};
 use foton_tests::stats::{Tolerance, assert_blocks_agree, assert_blocks_agree_by, rel_err};
 use foton_tests::{
@@ -167,9 +167,7 @@ intensity = [1.0, 1.0, 1.0]
         let x = -1.5 + 3.0 * i as f32 / (points - 1) as f32;
         let p = Vec3::new(x, 0.0, 0.3);
         let e = map.irradiance(
-            p,
-            Vec3::Y,
-            1,
+            &Disc::new(p, Vec3::Y, 1),
             &Estimate {
                 k,
                 max_radius: 1.0,
