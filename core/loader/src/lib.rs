@@ -11,6 +11,7 @@
 //! stands for), with its meshes ([`mesh`]: OBJ and [`ply`]) and images ([`texture`]: texture
 //! tables and bitmaps; [`image`]: image files read and written).
 
+mod build;
 pub mod document;
 pub mod image;
 mod load;
@@ -19,6 +20,7 @@ pub mod mitsuba;
 pub mod ply;
 pub mod texture;
 
+pub use build::from_document;
 pub use document::TomlDocument;
 pub use image::FilmFile;
-pub use load::{from_document, load, load_with, set_relative_radius};
+pub use load::{load, load_with, set_relative_radius};
