@@ -4,9 +4,9 @@
 
 use crate::build::from_document;
 use crate::document::TomlDocument;
+use crate::reader::{self, Options};
 use foton_core::error::Result;
 use foton_core::scene::Scene;
-use foton_core::value::Document;
 use std::path::Path;
 
 /// Loads a scene file, applying `--set` style overrides first.
@@ -24,39 +24,18 @@ pub fn load_with(
     defines: &[String],
     lenient: bool,
 ) -> Result<Scene> {
-    let is_xml = path
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("xml"));
-    let (mut doc, report) = if is_xml {
-        if path.is_dir() {
-            return Err(foton_core::Error::io(
-                path,
-                "is a directory, not a scene file",
-            ));
-        }
-        let (doc, report) = crate::mitsuba::read_xml(path, defines, lenient)?;
-        (doc, Some(report))
-    } else {
-        if let Some(d) = defines.first() {
-            return Err(foton_core::Error::Usage(format!(
-                "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
-            )));
-        }
-        (Document::load(path)?, None)
-    };
+    let (mut doc, report) = reader::read(path, &Options { defines, lenient })?;
     for o in overrides {
         doc.set(o)?;
     }
     let mut scene = from_document(doc)?;
-    if let Some(report) = report {
-        if let Some((integrator, factor, line)) = &report.relative_radius {
-            set_relative_radius(&mut scene, integrator, *factor, *line);
-        }
-        scene.ignored.extend(report.warnings);
-        scene.sources.extend(report.included);
-        let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
-        scene.warnings.extend(left_out.chain(report.notes));
+    if let Some((integrator, factor, line)) = &report.relative_radius {
+        set_relative_radius(&mut scene, integrator, *factor, *line);
     }
+    scene.ignored.extend(report.warnings);
+    scene.sources.extend(report.included);
+    let left_out = report.left_out.iter().map(|l| format!("left out: {l}"));
+    scene.warnings.extend(left_out.chain(report.notes));
     Ok(scene)
 }
 

@@ -2,7 +2,7 @@
 //! with the medium it sits in).
 
 use super::medium::medium_ref;
-use super::{Geometry, Index, Loader, array_of_tables, read_transform_at};
+use super::{Geometry, Index, Loader, array_of_tables, read_transform_at, type_of};
 use crate::texture::load_bitmap;
 use foton_core::Rgb;
 use foton_core::error::Result;
@@ -21,12 +21,7 @@ pub(super) fn read_lights(
     g: &mut Geometry,
 ) -> Result<()> {
     for l in array_of_tables(root, "lights")? {
-        let ty = l.string_opt("type")?.ok_or_else(|| {
-            l.error(
-                "type",
-                format!("missing; expected one of: {}", LIGHT_TYPES.join(", ")),
-            )
-        })?;
+        let ty = type_of(&l, LIGHT_TYPES)?;
         if !LIGHT_TYPES.contains(&ty) {
             return Err(l.error(
                 "type",

@@ -1,7 +1,7 @@
 //! `[materials]`: each material's type and parameters (textures through [`crate::texture`]),
 //! its index of refraction and microfacet distribution.
 
-use super::{Index, Loader};
+use super::{Index, Loader, type_of};
 use crate::texture::read_texture_param;
 use foton_core::Rgb;
 use foton_core::error::Result;
@@ -38,12 +38,7 @@ pub(super) fn read_materials(
     let names: Vec<&str> = all.keys().collect();
     for name in names {
         let m = all.table(name)?.unwrap();
-        let ty = m.string_opt("type")?.ok_or_else(|| {
-            m.error(
-                "type",
-                format!("missing; expected one of: {}", MATERIAL_TYPES.join(", ")),
-            )
-        })?;
+        let ty = type_of(&m, MATERIAL_TYPES)?;
         // A colour that may be a texture; a reflectance above 1 is warned about.
         let mut texture = |key: &str, default: Rgb, reflectance: bool| -> Result<Texture> {
             let (t, bag) = read_texture_param(&m, key, default, &ld.dir)?;

@@ -1,6 +1,6 @@
 //! `[media]`, and a medium named by a shape, the camera or a light (`vacuum`: none).
 
-use super::{Index, Loader, undefined};
+use super::{Index, Loader, type_of, undefined};
 use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::medium::{Homogeneous, Phase};
@@ -50,12 +50,7 @@ pub(super) fn read_media(
                 "`vacuum` is reserved: it names no medium (in `interior`, `exterior` and `medium`); call this medium something else",
             ));
         }
-        let ty = m.string_opt("type")?.ok_or_else(|| {
-            m.error(
-                "type",
-                format!("missing; expected one of: {}", MEDIUM_TYPES.join(", ")),
-            )
-        })?;
+        let ty = type_of(&m, MEDIUM_TYPES)?;
         if ty != "homogeneous" {
             return Err(m.error(
                 "type",

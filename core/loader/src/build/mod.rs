@@ -190,6 +190,16 @@ fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {
     }
 }
 
+/// A table's `type`, which must be given: the error lists the `types` there are.
+fn type_of<'a>(t: &Properties<'a>, types: &[&str]) -> Result<&'a str> {
+    t.string_opt("type")?.ok_or_else(|| {
+        t.error(
+            "type",
+            format!("missing; expected one of: {}", types.join(", ")),
+        )
+    })
+}
+
 type Index = HashMap<String, u32>;
 
 /// The `[[shapes]]` or `[[lights]]` array: (key path, bag) per element.

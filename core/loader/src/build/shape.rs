@@ -2,7 +2,7 @@
 //! material, its emission (an area light) and the media on its two sides.
 
 use super::medium::medium_ref;
-use super::{Geometry, Index, Loader, array_of_tables, read_transform_at, undefined};
+use super::{Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined};
 use crate::mesh::{MeshOptions, load_mesh};
 use foton_core::error::Result;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
@@ -27,12 +27,7 @@ pub(super) fn read_shapes(
     g: &mut Geometry,
 ) -> Result<()> {
     for s in array_of_tables(root, "shapes")? {
-        let ty = s.string_opt("type")?.ok_or_else(|| {
-            s.error(
-                "type",
-                format!("missing; expected one of: {}", SHAPE_TYPES.join(", ")),
-            )
-        })?;
+        let ty = type_of(&s, SHAPE_TYPES)?;
         let mut closed = ty == "sphere";
         let flip = s.bool("flip_normals", false)?;
         let mut attrs = Vec::new();

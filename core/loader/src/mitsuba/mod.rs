@@ -2,7 +2,7 @@
 //! into the document a TOML scene makes: `foton render scene.xml` renders what the same scene
 //! written in TOML would (`foton convert` writes that TOML), and every value keeps the XML
 //! line it came from, so the loader's errors name the XML file and line. Parameters foton
-//! understands but ignores are warnings with their file:line (`XmlReport::warnings`), errors
+//! understands but ignores are warnings with their file:line (`Report::warnings`), errors
 //! with `--strict`.
 //!
 //! Mitsuba's conventions, as its documentation states them: `<default>` and `$name`
@@ -33,6 +33,7 @@ mod shape;
 mod texture;
 mod upgrade;
 
+use crate::reader::{Options, Report};
 use foton_core::error::{Error, Result};
 use foton_core::value::{Document, Node, Table, Value};
 use glam::{DMat4, DVec3};
@@ -41,26 +42,16 @@ use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
-/// What reading an XML scene produced besides the document.
-#[derive(Debug, Default)]
-pub struct XmlReport {
-    /// Elements and parameters left out (`lenient`), each with its file:line.
-    pub left_out: Vec<String>,
-    /// Things rendered differently from Mitsuba, each with its file:line.
-    pub notes: Vec<String>,
-    /// The files it included (`<include>`), which make the scene as much as its own file.
-    pub included: Vec<PathBuf>,
-    /// Parameters foton understands but ignores (or renders otherwise), each with its
-    /// file:line: warnings, errors with `--strict`.
-    pub warnings: Vec<String>,
-    /// A photon lookup radius Mitsuba gives relative to the scene's bounding sphere: the
-    /// integrator, the factor and its line; the loader sets `max_radius` once it knows the
-    /// scene's bounds.
-    pub relative_radius: Option<(String, f64, u32)>,
+/// The Mitsuba format's reader ([`crate::reader`]): [`read_xml`] of a file.
+pub fn read(path: &Path, options: &Options<'_>) -> Result<(Document, Report)> {
+    if path.is_dir() {
+        return Err(Error::io(path, "is a directory, not a scene file"));
+    }
+    read_xml(path, options.defines, options.lenient)
 }
 
 /// Reads a Mitsuba XML scene (3.x, 2.x, or 0.x and 1.x upgraded). `defines` are `NAME=VALUE` overrides of its `<default>`s.
-pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Document, XmlReport)> {
+pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Document, Report)> {
     let mut defaults = HashMap::new();
     for d in defines {
         let (name, value) = d
@@ -74,7 +65,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         defined: defaults.keys().cloned().collect(),
         defaults,
         lenient,
-        report: XmlReport::default(),
+        report: Report::default(),
         root: Table::default(),
         shapes: Vec::new(),
         lights: Vec::new(),
@@ -173,7 +164,7 @@ struct Reader {
     /// Names set by -D (a `<default>` does not override them).
     defined: Vec<String>,
     lenient: bool,
-    report: XmlReport,
+    report: Report,
     root: Table,
     shapes: Vec<Node>,
     lights: Vec<Node>,
