@@ -6,7 +6,7 @@
 //! still loads. Core keeps the scene as plugins see it and builds it from the parts read here
 //! ([`foton_core::scene::Scene::new`]).
 //!
-//! [`load`] is three steps. A format's reader ([`reader`]: chosen by the file's extension)
+//! [`load`] is three steps. A format's reader ([`reader`]; chosen by the file's extension, [`formats`])
 //! reads the file into core's `Document`, a tree of values each with its file and line:
 //! TOML ([`document`]: TOML text into the `Document`, `--set`) or Mitsuba XML ([`mitsuba`]:
 //! Mitsuba 3 and 0.4 to 0.6, read as the TOML document it stands for). `--set` overrides
@@ -16,6 +16,7 @@
 
 mod build;
 pub mod document;
+pub mod formats;
 pub mod image;
 mod load;
 pub mod mesh;

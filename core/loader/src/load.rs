@@ -4,7 +4,8 @@
 
 use crate::build::from_document;
 use crate::document::TomlDocument;
-use crate::reader::{self, Options};
+use crate::formats;
+use crate::reader::Options;
 use foton_core::error::Result;
 use foton_core::scene::Scene;
 use std::path::Path;
@@ -24,7 +25,7 @@ pub fn load_with(
     defines: &[String],
     lenient: bool,
 ) -> Result<Scene> {
-    let (mut doc, report) = reader::read(path, &Options { defines, lenient })?;
+    let (mut doc, report) = formats::read(path, &Options { defines, lenient })?;
     for o in overrides {
         doc.set(o)?;
     }

@@ -3,12 +3,14 @@
 //! line it came from, and a [`Report`] of what it noticed besides; the builder
 //! ([`crate::from_document`]) turns any document into a `Scene` without knowing the format,
 //! so its errors name the line of whatever file the value came from. A file's format is
-//! chosen by its extension ([`format_of`]).
+//! chosen by its extension ([`crate::formats`]).
 //!
 //! The formats: TOML ([`crate::document::read`], docs/scene-format.md) and Mitsuba XML
 //! ([`crate::mitsuba::read`], read as the TOML document it stands for). A new format is a
 //! module with a [`ReadFn`] that reads a file into the document a TOML scene of the same
-//! content would parse to, and one entry in [`FORMATS`]; nothing after the document changes.
+//! content would parse to, and one entry in [`crate::formats::FORMATS`]; nothing after the
+//! document changes. This module names only what they share, so that the formats and the
+//! list of them import it, and it none of them.
 
 use foton_core::error::Result;
 use foton_core::value::Document;
@@ -44,37 +46,3 @@ pub struct Report {
 
 /// A format's reader: a scene file into the document and the report.
 pub type ReadFn = fn(&Path, &Options<'_>) -> Result<(Document, Report)>;
-
-/// A scene format: the extensions of its files and its reader.
-pub struct Format {
-    /// Lower case, without the dot; matched ignoring case.
-    pub extensions: &'static [&'static str],
-    pub read: ReadFn,
-}
-
-/// The scene formats foton reads. The first, TOML, also reads a file whose extension no
-/// format claims.
-pub static FORMATS: &[Format] = &[
-    Format {
-        extensions: &["toml"],
-        read: crate::document::read,
-    },
-    Format {
-        extensions: &["xml"],
-        read: crate::mitsuba::read,
-    },
-];
-
-/// The format of the scene file `path`, by its extension.
-pub fn format_of(path: &Path) -> &'static Format {
-    let claims = |f: &&Format| {
-        path.extension()
-            .is_some_and(|e| f.extensions.iter().any(|x| e.eq_ignore_ascii_case(x)))
-    };
-    FORMATS.iter().find(claims).unwrap_or(&FORMATS[0])
-}
-
-/// Reads the scene file `path` with its format's reader.
-pub fn read(path: &Path, options: &Options<'_>) -> Result<(Document, Report)> {
-    (format_of(path).read)(path, options)
-}

@@ -1,8 +1,8 @@
 //! `[[lights]]`: point, spot, directional, constant and envmap lights (a point or spot light
 //! with the medium it sits in).
 
+use super::common::{Geometry, Index, Loader, array_of_tables, read_transform_at, type_of};
 use super::medium::medium_ref;
-use super::{Geometry, Index, Loader, array_of_tables, read_transform_at, type_of};
 use crate::texture::load_bitmap;
 use foton_core::Rgb;
 use foton_core::error::Result;

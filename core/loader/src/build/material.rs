@@ -1,7 +1,7 @@
 //! `[materials]`: each material's type and parameters (textures through [`crate::texture`]),
 //! its index of refraction and microfacet distribution.
 
-use super::{Index, Loader, type_of};
+use super::common::{Index, Loader, type_of};
 use crate::texture::read_texture_param;
 use foton_core::Rgb;
 use foton_core::error::Result;

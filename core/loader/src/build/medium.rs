@@ -1,6 +1,6 @@
 //! `[media]`, and a medium named by a shape, the camera or a light (`vacuum`: none).
 
-use super::{Index, Loader, type_of, undefined};
+use super::common::{Index, Loader, type_of, undefined};
 use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::medium::{Homogeneous, Phase};

@@ -1,7 +1,7 @@
 //! `[render]`, `[film]` (with its reconstruction filter) and `[camera]`.
 
+use super::common::{Index, Loader};
 use super::medium::medium_ref;
-use super::{Index, Loader};
 use foton_core::camera::Camera;
 use foton_core::error::Result;
 use foton_core::filter::{Filter, FilterSampler};

@@ -1,8 +1,10 @@
 //! `[[shapes]]`: spheres, quads, disks and meshes (read through [`crate::mesh`]), each with its
 //! material, its emission (an area light) and the media on its two sides.
 
+use super::common::{
+    Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined,
+};
 use super::medium::medium_ref;
-use super::{Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined};
 use crate::mesh::{MeshOptions, load_mesh};
 use foton_core::error::Result;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
