@@ -2,12 +2,24 @@
 //! `--set KEY.PATH=VALUE` overrides, and a document back to TOML text: core keeps the tree,
 //! which plugins read, and no TOML parser. The methods are a trait on core's type, so that
 //! `Document::parse`, `Document::load`, `doc.set(...)` and `doc.to_toml()` read as before
-//! wherever this trait is in scope.
+//! wherever this trait is in scope. [`read`] is the TOML format's reader ([`crate::reader`]).
 
+use crate::reader::{Options, Report};
 use foton_core::error::{Error, Location, Result};
 use foton_core::value::{Document, Node, Table, Value};
 use std::path::Path;
 use toml::de::{DeTable, DeValue};
+
+/// The TOML format's reader ([`crate::reader`]): the file parsed. A TOML scene has no defaults
+/// for `-D` to override (`--set` changes any value) and nothing it leaves out.
+pub fn read(path: &Path, options: &Options<'_>) -> Result<(Document, Report)> {
+    if let Some(d) = options.defines.first() {
+        return Err(Error::Usage(format!(
+            "-D {d}: defaults are for Mitsuba XML scenes; use --set KEY.PATH=VALUE for a TOML scene"
+        )));
+    }
+    Ok((Document::load(path)?, Report::default()))
+}
 
 /// Reading and writing a [`Document`] as TOML text.
 pub trait TomlDocument: Sized {

@@ -6,19 +6,26 @@
 //! still loads. Core keeps the scene as plugins see it and builds it from the parts read here
 //! ([`foton_core::scene::Scene::new`]).
 //!
-//! [`load`] reads a TOML scene ([`document`]: TOML text into core's `Document`, `--set`) or a
-//! Mitsuba XML one ([`mitsuba`]: Mitsuba 3 and 0.4 to 0.6, read as the TOML document it
-//! stands for), with its meshes ([`mesh`]: OBJ and [`ply`]) and images ([`texture`]: texture
-//! tables and bitmaps; [`image`]: image files read and written).
+//! [`load`] is three steps. A format's reader ([`reader`]; chosen by the file's extension, [`formats`])
+//! reads the file into core's `Document`, a tree of values each with its file and line:
+//! TOML ([`document`]: TOML text into the `Document`, `--set`) or Mitsuba XML ([`mitsuba`]:
+//! Mitsuba 3 and 0.4 to 0.6, read as the TOML document it stands for). `--set` overrides
+//! change the document. The builder ([`from_document`]) turns any document into the `Scene`,
+//! reading meshes ([`mesh`]: OBJ and [`ply`]) and images ([`texture`]: texture tables and
+//! bitmaps; [`image`]: image files read and written).
 
+mod build;
 pub mod document;
+pub mod formats;
 pub mod image;
 mod load;
 pub mod mesh;
 pub mod mitsuba;
-pub mod ply;
+pub mod reader;
 pub mod texture;
 
+pub use build::from_document;
 pub use document::TomlDocument;
 pub use image::FilmFile;
-pub use load::{from_document, load, load_with, set_relative_radius};
+pub use load::{load, load_with, set_relative_radius};
+pub use mesh::ply;

@@ -1,31 +1,22 @@
 //! Triangle meshes: OBJ and PLY files, and whether a triangle set is closed (needed for a
 //! medium inside it).
+//!
+//! Each file format reads into a [`RawMesh`] (`raw`): `obj` (through tobj) and [`ply`]. A new
+//! format is a file here and one arm in `load_mesh`'s match on the extension; what follows
+//! (transform, normals, texture coordinates, closedness) is shared.
 
-use crate::ply;
+mod obj;
+pub mod ply;
+mod raw;
+
 use foton_core::error::Result;
 use foton_core::geometry::{Shape, TriangleAttrs};
 use foton_core::props::Properties;
 use glam::{Mat3, Mat4, Vec2, Vec3};
+pub use raw::RawMesh;
 use rayon::prelude::*;
 use std::io::Read;
 use std::path::Path;
-
-/// A mesh as a file describes it, before the shape's transform.
-#[derive(Clone, Debug, Default)]
-pub struct RawMesh {
-    pub positions: Vec<Vec3>,
-    /// Indices into `positions`.
-    pub triangles: Vec<[u32; 3]>,
-    /// How the format numbers its first vertex (1 in OBJ, 0 in PLY), for messages.
-    pub first_index: u32,
-    /// Vertex normals and, per triangle, the indices of its corners' normals (empty if the
-    /// file has none).
-    pub normals: Vec<Vec3>,
-    pub normal_triangles: Vec<[u32; 3]>,
-    /// Texture coordinates, likewise.
-    pub uvs: Vec<Vec2>,
-    pub uv_triangles: Vec<[u32; 3]>,
-}
 
 /// How a mesh is shaded (Mitsuba's `face_normals` and the OBJ reader's `flip_tex_coords`).
 #[derive(Clone, Copy, Debug)]
@@ -60,7 +51,7 @@ pub(super) fn load_mesh(
         .map(str::to_ascii_lowercase);
     let raw = match extension.as_deref() {
         Some("obj") => {
-            let mut raw = read_obj(open(s, path)?).map_err(fail)?;
+            let mut raw = obj::read(open(s, path)?).map_err(fail)?;
             if options.flip_tex_coords {
                 for uv in &mut raw.uvs {
                     uv.y = 1.0 - uv.y;
@@ -97,65 +88,6 @@ fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {
     }
     std::fs::File::open(path)
         .map_err(|e| s.error("file", format!("cannot open mesh {}: {e}", path.display())))
-}
-
-fn read_obj(file: std::fs::File) -> std::result::Result<RawMesh, String> {
-    let mut reader = std::io::BufReader::new(file);
-    let options = tobj::LoadOptions {
-        triangulate: true,
-        single_index: false,
-        ..Default::default()
-    };
-    // Material libraries are not followed: materials come from the scene file.
-    let (models, _) = tobj::load_obj_buf(&mut reader, &options, |_| {
-        Err(tobj::LoadError::OpenFileFailed)
-    })
-    .map_err(|e| format!("malformed OBJ: {e}"))?;
-    // tobj numbers the vertices of each model from 0: one mesh needs them offset.
-    let mut raw = RawMesh {
-        first_index: 1,
-        ..RawMesh::default()
-    };
-    let corners = |indices: &[u32], base: usize| -> Vec<[u32; 3]> {
-        let base = base as u32;
-        indices
-            .chunks_exact(3)
-            .map(|f| [f[0], f[1], f[2]].map(|i| base.saturating_add(i)))
-            .collect()
-    };
-    // A model without normals (or texture coordinates) leaves the mesh without them: Mitsuba
-    // computes all the normals then, and a texture lookup without coordinates is meaningless.
-    let all_normals = models.iter().all(|m| !m.mesh.normal_indices.is_empty());
-    let all_uvs = models.iter().all(|m| !m.mesh.texcoord_indices.is_empty());
-    for model in &models {
-        let mesh = &model.mesh;
-        raw.triangles
-            .extend(corners(&mesh.indices, raw.positions.len()));
-        raw.positions.extend(
-            mesh.positions
-                .chunks_exact(3)
-                .map(|p| Vec3::new(p[0], p[1], p[2])),
-        );
-        if all_normals {
-            raw.normal_triangles
-                .extend(corners(&mesh.normal_indices, raw.normals.len()));
-            raw.normals.extend(
-                mesh.normals
-                    .chunks_exact(3)
-                    .map(|n| Vec3::new(n[0], n[1], n[2])),
-            );
-        }
-        if all_uvs {
-            raw.uv_triangles
-                .extend(corners(&mesh.texcoord_indices, raw.uvs.len()));
-            raw.uvs.extend(
-                mesh.texcoords
-                    .chunks_exact(2)
-                    .map(|t| Vec2::new(t[0], t[1])),
-            );
-        }
-    }
-    Ok(raw)
 }
 
 /// The mesh's triangles in the scene (degenerate ones dropped), their shading attributes and

@@ -5,7 +5,7 @@
 //! the same way tobj triangulates OBJ faces, so that an OBJ and a PLY of one model give the
 //! same triangles. Errors are plain text; the caller adds the file and the scene key.
 
-use crate::mesh::RawMesh;
+use super::raw::RawMesh;
 use glam::{Vec2, Vec3};
 
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -1,0 +1,196 @@
+//! `[render]`, `[film]` (with its reconstruction filter) and `[camera]`.
+
+use super::common::{Index, Loader};
+use super::medium::medium_ref;
+use foton_core::camera::Camera;
+use foton_core::error::Result;
+use foton_core::filter::{Filter, FilterSampler};
+use foton_core::props::Properties;
+use foton_core::sampling::SamplerKind;
+use foton_core::scene::{FilmSettings, RenderSettings};
+use foton_core::value::Value;
+use glam::Vec3;
+use std::path::PathBuf;
+
+pub(super) fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings> {
+    let t = root
+        .table("render")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "render"));
+    let integrator = t.string("integrator", "path")?.to_string();
+    let spp = t.u32("spp", 16)?;
+    if spp == 0 {
+        return Err(t.error("spp", "must be at least 1"));
+    }
+    let settings = RenderSettings {
+        integrator,
+        spp,
+        seed: t.u64("seed", 0)?,
+        max_depth: t.u32("max_depth", 16)?,
+        hide_emitters: t.bool("hide_emitters", false)?,
+        sampler: read_sampler(&t)?,
+    };
+    ld.done(&t);
+    Ok(settings)
+}
+
+/// `[render] sampler` and, for `stratified`, `jitter`.
+fn read_sampler(t: &Properties<'_>) -> Result<SamplerKind> {
+    let name = t.choice("sampler", &SamplerKind::NAMES, "sobol")?;
+    let jitter = t.bool("jitter", true)?;
+    let kind = SamplerKind::from_name(name, jitter).expect("a name of SamplerKind::NAMES");
+    if t.has("jitter") && !matches!(kind, SamplerKind::Stratified { .. }) {
+        return Err(t.error(
+            "jitter",
+            format!(
+                "applies to sampler = \"stratified\" only, not {:?}",
+                kind.name()
+            ),
+        ));
+    }
+    Ok(kind)
+}
+
+pub(super) fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSettings> {
+    let t = root
+        .table("film")?
+        .unwrap_or_else(|| Properties::empty(root.file(), "film"));
+    let width = t.u32("width", 256)?;
+    let height = t.u32("height", 256)?;
+    for (k, v) in [("width", width), ("height", height)] {
+        if v == 0 || v > 1 << 15 {
+            return Err(t.error(k, format!("must be between 1 and 32768, found {v}")));
+        }
+    }
+    let output = t.string("output", "out.exr")?;
+    let out = PathBuf::from(output);
+    foton_core::film::format_of(&out).map_err(|_| {
+        t.error(
+            "output",
+            format!("{output:?}: unsupported format; expected a .exr or .png file name"),
+        )
+    })?;
+    use foton_core::film::ToneMap;
+    // 2^64 still fits a float with room to spare; beyond, an image is all black or all
+    // white whatever the scene, which is surely a typo.
+    const MAX_EXPOSURE: f32 = 64.0;
+    let exposure = t.f32("exposure", 0.0)?;
+    if exposure.abs() > MAX_EXPOSURE {
+        return Err(t.error(
+            "exposure",
+            format!("must be between -{MAX_EXPOSURE} and {MAX_EXPOSURE} stops, found {exposure}"),
+        ));
+    }
+    let tonemap =
+        ToneMap::from_name(t.choice("tonemap", &ToneMap::NAMES, "clamp")?).unwrap_or_default();
+    let filter = read_filter(&t, ld)?;
+    let film = FilmSettings {
+        width,
+        height,
+        output: ld.dir.join(out),
+        exposure,
+        tonemap,
+        filter: FilterSampler::new(filter),
+    };
+    ld.done(&t);
+    Ok(film)
+}
+
+/// `[film] filter`: "box" (the default), "tent", "gaussian", or a table with `type` and the
+/// filter's parameter (`radius` of the tent, default 1; `stddev` of the gaussian, default
+/// 0.5), in pixels.
+fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
+    const TYPES: [&str; 3] = ["box", "tent", "gaussian"];
+    let expected = "expected \"box\", \"tent\", \"gaussian\" or a table such as { type = \"tent\", radius = 1.0 }";
+    let ty = match t.node("filter").map(|n| &n.value) {
+        None => return Ok(Filter::Box),
+        Some(Value::Str(s)) if TYPES.contains(&s.as_str()) => s.as_str(),
+        Some(Value::Str(s)) => {
+            return Err(t.error("filter", format!("unknown filter {s:?}; {expected}")));
+        }
+        Some(Value::Table(_)) => {
+            let f = t.table("filter")?.unwrap();
+            let ty = f.choice("type", &TYPES, "box")?;
+            let positive = |key: &str, default: f32| -> Result<f32> {
+                let x = f.f32(key, default)?;
+                if !(x > 0.0 && x <= 64.0) {
+                    return Err(f.error(key, format!("must be in (0, 64] pixels, found {x}")));
+                }
+                Ok(x)
+            };
+            let filter = match ty {
+                "tent" => Filter::Tent {
+                    radius: positive("radius", 1.0)?,
+                },
+                "gaussian" => Filter::Gaussian {
+                    stddev: positive("stddev", 0.5)?,
+                },
+                _ => Filter::Box,
+            };
+            ld.done(&f);
+            return Ok(filter);
+        }
+        Some(other) => {
+            return Err(t.error(
+                "filter",
+                format!("{expected}, found {} `{}`", other.type_name(), other.show()),
+            ));
+        }
+    };
+    Ok(match ty {
+        "tent" => Filter::Tent { radius: 1.0 },
+        "gaussian" => Filter::Gaussian { stddev: 0.5 },
+        _ => Filter::Box,
+    })
+}
+
+/// The camera, and the medium the file puts it in (None: found from where it stands).
+pub(super) fn read_camera(
+    root: &Properties<'_>,
+    film: &FilmSettings,
+    media: &Index,
+    ld: &mut Loader,
+) -> Result<(Camera, Option<Option<u32>>)> {
+    let Some(t) = root.table("camera")? else {
+        return Err(root.error(
+            "camera",
+            "missing section [camera]; expected position, look_at, up, fov",
+        ));
+    };
+    let position = t.vec3_required("position")?;
+    let look_at = t.vec3_required("look_at")?;
+    let up = t.vec3("up", Vec3::Y)?;
+    let fov = t.f32("fov", 39.3)?;
+    if !(fov > 0.0 && fov < 180.0) {
+        return Err(t.error("fov", format!("must be in (0, 180) degrees, found {fov}")));
+    }
+    // Which extent of the image `fov` spans (Mitsuba's fov_axis); the camera takes the
+    // vertical one. tan of the half angles: horizontal = aspect x vertical.
+    let axis = t.choice(
+        "fov_axis",
+        &["y", "x", "diagonal", "smaller", "larger"],
+        "y",
+    )?;
+    let aspect = film.width as f32 / film.height as f32;
+    let tan_half = (fov.to_radians() * 0.5).tan();
+    let wide = film.width >= film.height;
+    let tan_vertical = match axis {
+        "x" => tan_half / aspect,
+        "diagonal" => tan_half / (1.0 + aspect * aspect).sqrt(),
+        "smaller" if wide => tan_half,
+        "smaller" => tan_half / aspect,
+        "larger" if wide => tan_half / aspect,
+        _ => tan_half,
+    };
+    let fov = 2.0 * tan_vertical.atan().to_degrees();
+    let forward = look_at - position;
+    if forward.length_squared() == 0.0 {
+        return Err(t.error("look_at", "is the same point as position"));
+    }
+    if forward.normalize().cross(up).length_squared() < 1e-12 {
+        return Err(t.error("up", "is zero or parallel to the viewing direction"));
+    }
+    let medium = medium_ref(&t, "medium", media)?;
+    ld.done(&t);
+    let camera = Camera::new(position, look_at, up, fov, film.width, film.height);
+    Ok((camera, medium))
+}

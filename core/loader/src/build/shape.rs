@@ -1,0 +1,184 @@
+//! `[[shapes]]`: spheres, quads, disks and meshes (read through [`crate::mesh`]), each with its
+//! material, its emission (an area light) and the media on its two sides.
+
+use super::common::{
+    Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined,
+};
+use super::medium::medium_ref;
+use crate::mesh::{MeshOptions, load_mesh};
+use foton_core::error::Result;
+use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
+use foton_core::light::area_light;
+use foton_core::material::Material;
+use foton_core::props::Properties;
+use foton_core::scene::{Named, Object};
+use glam::Mat4;
+
+const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
+
+fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
+    read_transform_at(s, "transform", ld)
+}
+
+pub(super) fn read_shapes(
+    root: &Properties<'_>,
+    ld: &mut Loader,
+    material_defs: &[Named<Material>],
+    materials: &Index,
+    media: &Index,
+    g: &mut Geometry,
+) -> Result<()> {
+    for s in array_of_tables(root, "shapes")? {
+        let ty = type_of(&s, SHAPE_TYPES)?;
+        let mut closed = ty == "sphere";
+        let flip = s.bool("flip_normals", false)?;
+        let mut attrs = Vec::new();
+        let mut shapes = match ty {
+            "sphere" => {
+                let center = s.vec3_required("center")?;
+                let radius = s.f32_required("radius")?;
+                if radius <= 0.0 {
+                    return Err(s.error("radius", format!("must be positive, found {radius}")));
+                }
+                vec![Shape::sphere(center, radius)]
+            }
+            "quad" => {
+                let origin = s.vec3_required("origin")?;
+                let u = s.vec3_required("u")?;
+                let v = s.vec3_required("v")?;
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(
+                        s.error("v", "u and v are parallel or zero: the quad has zero area")
+                    );
+                }
+                vec![Shape::quad(origin, u, v)]
+            }
+            "disk" => {
+                let center = s.vec3_required("center")?;
+                // Either the two semi-axes (an ellipse; Mitsuba's disk under its to_world, which
+                // also fixes where the angle of its texture coordinates starts) or a circle.
+                let (u, v) = if s.has("u") || s.has("v") {
+                    (s.vec3_required("u")?, s.vec3_required("v")?)
+                } else {
+                    let normal = s.vec3_required("normal")?;
+                    let radius = s.f32_required("radius")?;
+                    if radius <= 0.0 {
+                        return Err(s.error("radius", format!("must be positive, found {radius}")));
+                    }
+                    if normal.length_squared() == 0.0 {
+                        return Err(s.error("normal", "must not be the zero vector"));
+                    }
+                    let f = foton_core::bsdf::Frame::from_normal(normal.normalize());
+                    (f.s * radius, f.t * radius)
+                };
+                if u.cross(v).length_squared() == 0.0 {
+                    return Err(
+                        s.error("v", "u and v are parallel or zero: the disk has zero area")
+                    );
+                }
+                vec![Shape::disk(center, u, v)]
+            }
+            "mesh" => {
+                let file = s.string_required("file")?;
+                let transform = read_transform(&s, ld)?;
+                let options = MeshOptions {
+                    face_normals: s.bool("face_normals", false)?,
+                    flip_tex_coords: s.bool("flip_tex_coords", true)?,
+                    flip_normals: flip,
+                };
+                let path = ld.dir.join(file);
+                let mesh = load_mesh(&s, &path, transform, options)?;
+                ld.sources.push(path);
+                closed = mesh.closed;
+                attrs = mesh.attrs;
+                mesh.triangles
+            }
+            other => {
+                return Err(s.error(
+                    "type",
+                    format!(
+                        "unknown shape type {other:?}; expected one of: {}",
+                        SHAPE_TYPES.join(", ")
+                    ),
+                ));
+            }
+        };
+        if flip {
+            if ty == "sphere" && s.has("interior") && !s.has("exterior") {
+                return Err(s.error(
+                    "flip_normals",
+                    "a sphere turned inside out cannot hold an interior medium (its inside would be all of space outside it)",
+                ));
+            }
+            if ty != "mesh" {
+                // The mesh reader reversed its triangles itself.
+                shapes.iter_mut().for_each(Shape::flip);
+            }
+        }
+        let material_name = s.string_required("material")?;
+        let material = *materials
+            .get(material_name)
+            .ok_or_else(|| s.error("material", undefined("material", material_name, materials)))?;
+        // With `exterior` the file names both sides (Mitsuba's media: interior behind the
+        // normal, exterior in front, whatever the shape); with `interior` alone the shape
+        // must close its medium in, and its outside is found from where it lies.
+        let exterior = medium_ref(&s, "exterior", media)?;
+        let interior = medium_ref(&s, "interior", media)?;
+        if let (Some(inside), None) = (interior, exterior) {
+            if inside.is_none() {
+                return Err(s.error(
+                    "interior",
+                    "`vacuum` as the only medium of a shape says nothing; give `exterior` too",
+                ));
+            }
+            if !closed {
+                return Err(s.error(
+                    "interior",
+                    format!("a {ty} that is not closed cannot hold an interior medium by itself: light would leak out of the medium through its edges (a mesh needs every edge shared by exactly two consistently oriented triangles); close it, or give `exterior` too (the medium on the side its normal points to) if other shapes close the medium"),
+                ));
+            }
+        }
+        let explicit_media = exterior.is_some();
+        let (interior, exterior) = (interior.flatten(), exterior.flatten());
+        let object = g.objects.len() as u32;
+        let mut light = None;
+        if let Some(emission) = s.rgb_opt("emission")?
+            && emission.max_element() > 0.0
+        {
+            if material_defs[material as usize].value.is_null() {
+                return Err(s.error(
+                    "emission",
+                    "a shape with the null material is invisible and cannot emit; give it a real material (e.g. a black diffuse one)",
+                ));
+            }
+            light = Some(g.lights.len() as u32);
+            g.lights.push(area_light(shapes.clone(), emission, object));
+            // Mitsuba's area emitter emits into its shape's exterior.
+            g.light_media.push(explicit_media.then_some(exterior));
+        }
+        g.objects.push(Object {
+            name: s.path().to_string(),
+            material,
+            light,
+            interior,
+            exterior,
+            explicit_media,
+            closed,
+        });
+        let first_attrs = g.triangle_attrs.len() as u32;
+        let with_attrs = !attrs.is_empty();
+        g.triangle_attrs.extend(attrs);
+        g.primitives
+            .extend(shapes.into_iter().enumerate().map(|(i, shape)| Primitive {
+                shape,
+                object,
+                attrs: if with_attrs {
+                    first_attrs + i as u32
+                } else {
+                    NO_ATTRS
+                },
+            }));
+        ld.done(&s);
+    }
+    Ok(())
+}

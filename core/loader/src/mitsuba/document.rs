@@ -1,0 +1,561 @@
+//! The XML document: the file parsed, `<include>`d files read in place (each upgraded by its
+//! own version), `<default>`s and `$name` substituted (`-D` overrides a default), `<alias>`
+//! ids, each element into an `Obj` with its properties, and `<transform>` operations composed
+//! in document order. What the document's elements mean is the element-family files' work.
+
+use super::Reader;
+use super::object::{Obj, Prop};
+use super::upgrade::upgrade_v1;
+use foton_core::error::{Error, Location, Result};
+use glam::{DMat4, DVec3};
+use std::path::Path;
+
+impl Reader {
+    /// A `-D NAME=...` that no `<default>` declares and no `$NAME` uses is a typo.
+    pub(super) fn check_defines(&self, path: &Path) -> Result<()> {
+        let used = self.used.borrow();
+        for name in &self.defined {
+            if !self.declared.contains(name) && !used.contains(name) {
+                let known: Vec<&str> = self
+                    .declared
+                    .iter()
+                    .chain(used.iter())
+                    .map(String::as_str)
+                    .collect();
+                let mut sorted = known.clone();
+                sorted.sort_unstable();
+                sorted.dedup();
+                return Err(Error::Usage(format!(
+                    "-D {name}: {} never uses `${name}`{}; its parameters: {}",
+                    path.display(),
+                    foton_core::error::suggestion(name, known),
+                    if sorted.is_empty() {
+                        "none".to_string()
+                    } else {
+                        sorted.join(", ")
+                    }
+                )));
+            }
+        }
+        Ok(())
+    }
+
+    pub(super) fn read_file(&mut self, path: &Path, text: &str) -> Result<()> {
+        let doc = roxmltree::Document::parse(text).map_err(|e| {
+            let pos = e.pos();
+            Error::XmlSyntax {
+                location: Location {
+                    file: path.to_path_buf(),
+                    line: pos.row,
+                    column: pos.col,
+                },
+                message: e.to_string(),
+            }
+        })?;
+        let scene = doc.root_element();
+        let is_main = path == self.file;
+        let line_of = |n: roxmltree::Node<'_, '_>| {
+            // Lines of an included file do not belong to the scene file's document.
+            if is_main {
+                doc.text_pos_at(n.range().start).row
+            } else {
+                0
+            }
+        };
+        if scene.tag_name().name() != "scene" {
+            return Err(syntax(
+                path,
+                line_of(scene),
+                "the root element must be <scene>",
+            ));
+        }
+        // Each file is upgraded by its own version, as Mitsuba 3 does with included files.
+        let version = scene.attribute("version").ok_or_else(|| {
+            syntax(
+                path,
+                line_of(scene),
+                "<scene> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")",
+            )
+        })?;
+        let major = version
+            .split('.')
+            .next()
+            .and_then(|m| m.trim().parse::<u32>().ok())
+            .filter(|m| *m <= 3)
+            .ok_or_else(|| {
+                syntax(
+                    path,
+                    line_of(scene),
+                    &format!(
+                        "<scene version=\"{version}\">: expected a Mitsuba version, 0.4.0 to 3.x"
+                    ),
+                )
+            })?;
+        let outer_v1 = std::mem::replace(&mut self.v1, major < 2);
+        self.read_scene_children(path, scene, &line_of)?;
+        self.v1 = outer_v1;
+        Ok(())
+    }
+
+    fn read_scene_children(
+        &mut self,
+        path: &Path,
+        scene: roxmltree::Node<'_, '_>,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+    ) -> Result<()> {
+        for child in scene.children().filter(|n| n.is_element()) {
+            let line = line_of(child);
+            match child.tag_name().name() {
+                "default" => {
+                    let name = attr(child, "name", path, line)?;
+                    let value = attr(child, "value", path, line)?;
+                    self.declared.insert(name.clone());
+                    if !self.defined.contains(&name) {
+                        self.defaults.entry(name).or_insert(value);
+                    }
+                }
+                "include" => {
+                    let file = self.subst(&attr(child, "filename", path, line)?, path, line)?;
+                    let inc = path.parent().unwrap_or(Path::new("")).join(file);
+                    let text = std::fs::read_to_string(&inc).map_err(|e| Error::io(&inc, e))?;
+                    self.report.included.push(inc.clone());
+                    self.read_file(&inc, &text)?;
+                }
+                "alias" => {
+                    let id = self.subst(&attr(child, "id", path, line)?, path, line)?;
+                    let alias = self.subst(&attr(child, "as", path, line)?, path, line)?;
+                    let mut found = false;
+                    for map in [&mut self.bsdfs, &mut self.media] {
+                        if let Some(name) = map.get(&id).cloned() {
+                            map.insert(alias.clone(), name);
+                            found = true;
+                        }
+                    }
+                    if let Some(t) = self.textures.get(&id).cloned() {
+                        self.textures.insert(alias.clone(), t);
+                        found = true;
+                    }
+                    if !found {
+                        return Err(syntax(
+                            path,
+                            line,
+                            &format!(
+                                "<alias id=\"{id}\">: no BSDF, medium or texture with that id before it"
+                            ),
+                        ));
+                    }
+                }
+                "path" => {
+                    return Err(syntax(
+                        path,
+                        line,
+                        "<path> (a folder searched for files) is not supported: give file names relative to the scene",
+                    ));
+                }
+                _ => {
+                    let obj = self.object(child, path, line_of)?;
+                    self.top_level(obj)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// `$name` replaced by the default's value.
+    fn subst(&self, s: &str, file: &Path, line: u32) -> Result<String> {
+        let mut out = String::new();
+        let mut rest = s;
+        while let Some(i) = rest.find('$') {
+            out.push_str(&rest[..i]);
+            let after = &rest[i + 1..];
+            let end = after
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            let name = &after[..end];
+            self.used.borrow_mut().insert(name.to_string());
+            let value = self.defaults.get(name).ok_or_else(|| {
+                syntax(
+                    file,
+                    line,
+                    &format!("`${name}`: no <default name=\"{name}\"> and no -D {name}=..."),
+                )
+            })?;
+            out.push_str(value);
+            rest = &after[end..];
+        }
+        out.push_str(rest);
+        Ok(out)
+    }
+
+    fn object(
+        &self,
+        n: roxmltree::Node<'_, '_>,
+        file: &Path,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+    ) -> Result<Obj> {
+        let line = line_of(n);
+        let get = |name: &str| -> Result<Option<String>> {
+            n.attribute(name)
+                .map(|v| self.subst(v, file, line))
+                .transpose()
+        };
+        let mut obj = Obj {
+            tag: n.tag_name().name().to_string(),
+            ty: get("type")?.unwrap_or_default(),
+            id: get("id")?,
+            line,
+            file: file.to_path_buf(),
+            props: Vec::new(),
+        };
+        for c in n.children().filter(|c| c.is_element()) {
+            let cl = line_of(c);
+            let cget = |name: &str| -> Result<Option<String>> {
+                c.attribute(name)
+                    .map(|v| self.subst(v, file, cl))
+                    .transpose()
+            };
+            let name = cget("name")?.unwrap_or_default();
+            let value =
+                || cget("value")?.ok_or_else(|| syntax(file, cl, "missing attribute `value`"));
+            let bad = |what: &str, v: &str| syntax(file, cl, &format!("`{name}`: {what} `{v}`"));
+            let tag = c.tag_name().name();
+            let prop = match tag {
+                "float" => {
+                    let v = value()?;
+                    Prop::Float(v.trim().parse().map_err(|_| bad("not a number", &v))?)
+                }
+                "integer" => {
+                    let v = value()?;
+                    Prop::Int(v.trim().parse().map_err(|_| bad("not an integer", &v))?)
+                }
+                "boolean" => {
+                    let v = value()?;
+                    Prop::Bool(match v.trim() {
+                        "true" => true,
+                        "false" => false,
+                        _ => return Err(bad("not true or false", &v)),
+                    })
+                }
+                "string" => Prop::Str(value()?),
+                "rgb" | "spectrum" => {
+                    let v = value()?;
+                    let xs = numbers(&v).ok_or_else(|| bad("not a list of numbers", &v))?;
+                    match (tag, xs.len()) {
+                        (_, 1) => Prop::Color(DVec3::splat(xs[0])),
+                        ("rgb", 3) => Prop::Color(DVec3::new(xs[0], xs[1], xs[2])),
+                        _ => {
+                            return Err(bad(
+                                "expected one value or three (r, g, b); wavelength:value spectra are not supported",
+                                &v,
+                            ));
+                        }
+                    }
+                }
+                "point" | "vector" => {
+                    let p = match cget("value")? {
+                        Some(v) => {
+                            let xs = numbers(&v).ok_or_else(|| bad("not three numbers", &v))?;
+                            if xs.len() != 3 {
+                                return Err(bad("not three numbers", &v));
+                            }
+                            DVec3::new(xs[0], xs[1], xs[2])
+                        }
+                        None => {
+                            let coord = |k: &str| -> Result<f64> {
+                                cget(k)?.map_or(Ok(0.0), |v| {
+                                    v.trim().parse().map_err(|_| bad("not a number", &v))
+                                })
+                            };
+                            DVec3::new(coord("x")?, coord("y")?, coord("z")?)
+                        }
+                    };
+                    Prop::Point(p)
+                }
+                "transform" => Prop::Transform(self.transform(c, file, line_of)?),
+                "ref" => {
+                    let id = cget("id")?.ok_or_else(|| syntax(file, cl, "<ref> without id"))?;
+                    Prop::Ref(id)
+                }
+                // Mitsuba 0.6's sRGB colour: "#rrggbb" or numbers, both sRGB-encoded.
+                "srgb" => {
+                    let v = value()?;
+                    let xs = match v.trim().strip_prefix('#') {
+                        Some(hex) if hex.len() == 6 => (0..3)
+                            .map(|i| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok())
+                            .map(|x| x.map(|x| f64::from(x) / 255.0))
+                            .collect::<Option<Vec<f64>>>(),
+                        Some(_) => None,
+                        None => numbers(&v),
+                    }
+                    .filter(|xs| xs.len() == 1 || xs.len() == 3)
+                    .ok_or_else(|| bad("expected #rrggbb or one or three numbers", &v))?;
+                    let c = if xs.len() == 1 {
+                        DVec3::splat(xs[0])
+                    } else {
+                        DVec3::new(xs[0], xs[1], xs[2])
+                    };
+                    Prop::Color(DVec3::from_array(c.to_array().map(srgb_to_linear)))
+                }
+                "bsdf" | "emitter" | "medium" | "phase" | "texture" | "rfilter" | "sampler"
+                | "film" | "shape" | "sensor" | "integrator" => {
+                    Prop::Object(self.object(c, file, line_of)?)
+                }
+                other if KNOWN_UNREAD.contains(&other) => {
+                    return Err(syntax(
+                        file,
+                        cl,
+                        &format!("<{other}> in <{}> is not supported", obj.tag),
+                    ));
+                }
+                other => {
+                    let known = PROPERTY_TAGS.iter().chain(OBJECT_TAGS).copied();
+                    return Err(syntax(
+                        file,
+                        cl,
+                        &format!(
+                            "unknown element <{other}> in <{}>{}",
+                            obj.tag,
+                            foton_core::error::suggestion(other, known)
+                        ),
+                    ));
+                }
+            };
+            obj.props.push((name, prop, cl));
+        }
+        if self.v1 {
+            upgrade_v1(&mut obj);
+        }
+        Ok(obj)
+    }
+
+    /// A `<transform>`'s operations, each applied after the ones before it.
+    fn transform(
+        &self,
+        n: roxmltree::Node<'_, '_>,
+        file: &Path,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+    ) -> Result<DMat4> {
+        let mut m = DMat4::IDENTITY;
+        for op in n.children().filter(|c| c.is_element()) {
+            let l = line_of(op);
+            let get = |name: &str| -> Result<Option<String>> {
+                op.attribute(name)
+                    .map(|v| self.subst(v, file, l))
+                    .transpose()
+            };
+            let bad = |v: &str| {
+                syntax(
+                    file,
+                    l,
+                    &format!("<{}>: bad value `{v}`", op.tag_name().name()),
+                )
+            };
+            let num = |name: &str, default: f64| -> Result<f64> {
+                get(name)?.map_or(Ok(default), |v| v.trim().parse().map_err(|_| bad(&v)))
+            };
+            let xyz = |default: f64| -> Result<DVec3> {
+                match get("value")? {
+                    Some(v) => {
+                        let xs = numbers(&v).ok_or_else(|| bad(&v))?;
+                        match xs.len() {
+                            1 => Ok(DVec3::splat(xs[0])),
+                            3 => Ok(DVec3::new(xs[0], xs[1], xs[2])),
+                            _ => Err(bad(&v)),
+                        }
+                    }
+                    None => Ok(DVec3::new(
+                        num("x", default)?,
+                        num("y", default)?,
+                        num("z", default)?,
+                    )),
+                }
+            };
+            let vec = |name: &str| -> Result<DVec3> {
+                let v = get(name)?
+                    .ok_or_else(|| syntax(file, l, &format!("<lookat> without `{name}`")))?;
+                let xs = numbers(&v)
+                    .filter(|x| x.len() == 3)
+                    .ok_or_else(|| bad(&v))?;
+                Ok(DVec3::new(xs[0], xs[1], xs[2]))
+            };
+            let step = match op.tag_name().name() {
+                "translate" => DMat4::from_translation(xyz(0.0)?),
+                "scale" => DMat4::from_scale(xyz(1.0)?),
+                "rotate" => {
+                    let axis = xyz(0.0)?;
+                    if axis.length_squared() == 0.0 {
+                        return Err(syntax(file, l, "<rotate> about the zero vector"));
+                    }
+                    DMat4::from_axis_angle(axis.normalize(), num("angle", 0.0)?.to_radians())
+                }
+                "matrix" => {
+                    let v = get("value")?.ok_or_else(|| bad(""))?;
+                    let xs = numbers(&v).ok_or_else(|| bad(&v))?;
+                    match xs.len() {
+                        16 => DMat4::from_cols_slice(&xs).transpose(),
+                        9 => DMat4::from_mat3(glam::DMat3::from_cols_slice(&xs).transpose()),
+                        _ => return Err(bad(&v)),
+                    }
+                }
+                "lookat" => {
+                    let (origin, target) = (vec("origin")?, vec("target")?);
+                    let dir = (target - origin).normalize();
+                    // Without `up` (or with a zero one), Mitsuba completes the direction to
+                    // an orthonormal basis (its coordinate_system) and takes the first vector.
+                    let up = match get("up")? {
+                        Some(_) => vec("up")?,
+                        None => DVec3::ZERO,
+                    };
+                    let up = if up == DVec3::ZERO && dir.is_finite() {
+                        coordinate_system(dir).0
+                    } else {
+                        up
+                    };
+                    let left = up.cross(dir).normalize();
+                    if !dir.is_finite() || !left.is_finite() {
+                        return Err(syntax(
+                            file,
+                            l,
+                            "<lookat>: degenerate origin, target and up",
+                        ));
+                    }
+                    let new_up = dir.cross(left);
+                    DMat4::from_cols(
+                        left.extend(0.0),
+                        new_up.extend(0.0),
+                        dir.extend(0.0),
+                        origin.extend(1.0),
+                    )
+                }
+                other => {
+                    let ops = ["translate", "scale", "rotate", "matrix", "lookat"];
+                    return Err(syntax(
+                        file,
+                        l,
+                        &format!(
+                            "unknown transform operation <{other}>{}",
+                            foton_core::error::suggestion(other, ops)
+                        ),
+                    ));
+                }
+            };
+            m = step * m;
+        }
+        Ok(m)
+    }
+}
+
+fn syntax(file: &Path, line: u32, message: &str) -> Error {
+    Error::XmlSyntax {
+        location: Location {
+            file: file.to_path_buf(),
+            line,
+            column: if line > 0 { 1 } else { 0 },
+        },
+        message: message.to_string(),
+    }
+}
+
+fn attr(n: roxmltree::Node<'_, '_>, name: &str, file: &Path, line: u32) -> Result<String> {
+    n.attribute(name).map(str::to_string).ok_or_else(|| {
+        syntax(
+            file,
+            line,
+            &format!("<{}> without `{name}`", n.tag_name().name()),
+        )
+    })
+}
+
+/// Numbers separated by commas and/or spaces.
+fn numbers(s: &str) -> Option<Vec<f64>> {
+    s.split(|c: char| c == ',' || c.is_whitespace())
+        .filter(|x| !x.is_empty())
+        .map(|x| x.parse().ok())
+        .collect()
+}
+
+/// The property elements of Mitsuba 3's parser (and 0.6's `srgb`) that foton reads.
+const PROPERTY_TAGS: &[&str] = &[
+    "float",
+    "integer",
+    "boolean",
+    "string",
+    "rgb",
+    "srgb",
+    "spectrum",
+    "point",
+    "vector",
+    "transform",
+    "ref",
+];
+
+/// The object elements of Mitsuba's parser.
+const OBJECT_TAGS: &[&str] = &[
+    "bsdf",
+    "emitter",
+    "medium",
+    "phase",
+    "texture",
+    "rfilter",
+    "sampler",
+    "film",
+    "shape",
+    "sensor",
+    "integrator",
+];
+
+/// Elements Mitsuba (3 or 0.6) reads that foton does not: "not supported", not "unknown".
+const KNOWN_UNREAD: &[&str] = &[
+    "volume",
+    "blackbody",
+    "animation",
+    "alias",
+    "path",
+    "include",
+    "default",
+    "subsurface",
+    "luminaire",
+    "null",
+];
+
+/// Completes the unit vector `n` to an orthonormal basis (Duff et al. 2017, "Building an
+/// orthonormal basis, revisited"), as Mitsuba 3's `coordinate_system` does: `<lookat>`
+/// without `up` takes the first vector, so foton's camera is Mitsuba's.
+fn coordinate_system(n: DVec3) -> (DVec3, DVec3) {
+    let sign = 1.0f64.copysign(n.z);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    (
+        DVec3::new(n.x * n.x * a * sign + 1.0, b * sign, -n.x * sign),
+        DVec3::new(b, sign + n.y * n.y * a, -n.y),
+    )
+}
+
+/// The sRGB transfer curve inverted (IEC 61966-2-1): Mitsuba 0.6's `<srgb>` colours.
+fn srgb_to_linear(v: f64) -> f64 {
+    if v <= 0.04045 {
+        v / 12.92
+    } else {
+        ((v + 0.055) / 1.055).powf(2.4)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn coordinate_system_is_orthonormal() {
+        for n in [
+            DVec3::Z,
+            -DVec3::Z,
+            DVec3::new(0.3, -0.5, 0.2).normalize(),
+            DVec3::X,
+        ] {
+            let (s, t) = coordinate_system(n);
+            assert!((s.length() - 1.0).abs() < 1e-12 && (t.length() - 1.0).abs() < 1e-12);
+            assert!(s.dot(n).abs() < 1e-12 && t.dot(n).abs() < 1e-12 && s.dot(t).abs() < 1e-12);
+            assert!((s.cross(t) - n).length() < 1e-12, "right-handed for {n}");
+        }
+    }
+}

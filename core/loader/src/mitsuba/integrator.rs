@@ -1,0 +1,264 @@
+//! `<integrator>`: the foton plugin that renders Mitsuba's integrator, and its parameters
+//! translated (Mitsuba's path-segment depths to foton's scattering events; a photon mapper's
+//! budgets and radii). Read after the rest of the scene, since a photon mapper in a scene with
+//! media is foton's volumetric one.
+
+use super::object::{Obj, Prop, show};
+use super::upgrade::camel_to_snake;
+use super::{Reader, at, table_mut};
+use foton_core::error::Result;
+use foton_core::value::Value;
+
+impl Reader {
+    /// Mitsuba's integrator: the foton plugin that renders it, its parameters translated
+    /// (each one foton has no equivalent for is a warning). Read after the rest of the scene.
+    pub(super) fn integrator(&mut self, mut o: Obj) -> Result<()> {
+        // Mitsuba 3 reads integrators' names as written; 0.6 files are upgraded. Accept the
+        // 0.6 spelling in either (older exporters mix them).
+        for (name, _, _) in &mut o.props {
+            *name = camel_to_snake(name);
+        }
+        let has_media = !self.media.is_empty();
+        let Some(name) = foton_integrator(&o.ty, has_media) else {
+            o.props.clear();
+            let message = if MITSUBA_INTEGRATORS.contains(&o.ty.as_str()) {
+                format!(
+                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm and bdpt",
+                    o.ty
+                )
+            } else {
+                format!(
+                    "unknown integrator `{}`{}",
+                    o.ty,
+                    foton_core::error::suggestion(&o.ty, MITSUBA_INTEGRATORS.iter().copied())
+                )
+            };
+            return self.unsupported(&o, &message);
+        };
+        let line = o.line;
+        table_mut(&mut self.root, "render").insert("integrator", at(Value::Str(name.into()), line));
+        if o.ty == "ppm" {
+            self.note(
+                &o,
+                "rendered by sppm (the stochastic variant of progressive photon mapping converges to the same image)",
+            );
+        }
+        // Mitsuba's max_depth counts path segments (1: emitters seen directly, 2: direct
+        // light); foton's counts scattering events, one less. -1 is unbounded in both
+        // Mitsubas: a cap no path reaches (Russian roulette ends them long before).
+        let max_depth = if o.ty == "direct" {
+            2
+        } else {
+            o.int("max_depth", -1)?
+        };
+        let bounces = match max_depth {
+            -1 => 65_536,
+            d if d >= 1 => d - 1,
+            d => {
+                return Err(o.error(format!(
+                    "max_depth = {d}: renders nothing (1 is emitters seen directly, -1 unbounded)"
+                )));
+            }
+        };
+        table_mut(&mut self.root, "render").insert("max_depth", at(Value::Int(bounces), line));
+        if o.boolean("hide_emitters", false)? {
+            table_mut(&mut self.root, "render")
+                .insert("hide_emitters", at(Value::Bool(true), line));
+        }
+        let mut params: Vec<(&str, Value)> = Vec::new();
+        let rr = o.take("rr_depth");
+        match name {
+            "path" | "bdpt" => {
+                // Mitsuba starts Russian roulette at path depth rr_depth (segments, 5 unless
+                // the file says): foton counts scattering events.
+                if let Some((p, l)) = rr {
+                    o.props.push(("rr_depth".into(), p, l));
+                }
+                let rr = o.int("rr_depth", 5)?;
+                params.push(("rr_depth", Value::Int(rr.max(1) - 1)));
+            }
+            _ => {
+                if let Some((p, l)) = rr {
+                    self.warn(
+                        &o,
+                        l,
+                        &format!(
+                            "`rr_depth` = {}: ignored ({name} traces photons with its own Russian roulette)",
+                            show(&p)
+                        ),
+                    );
+                }
+            }
+        }
+        let same = |_: &Prop| false;
+        self.ignored(
+            &mut o,
+            "strict_normals",
+            &|p| matches!(p, Prop::Bool(false)),
+            "ignored (foton does not end paths whose shading and geometric normals disagree)",
+        );
+        let noise = "ignored (it changes the noise, not the image: foton takes one sample per camera sample; raise spp)";
+        match o.ty.as_str() {
+            "direct" => {
+                for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
+                    self.ignored(&mut o, k, &same, noise);
+                }
+            }
+            "photonmapper" => {
+                // Mitsuba 0.6's defaults, written out: the budgets and k are its meaning.
+                let photons = |o: &mut Obj, k: &str| o.int(k, 250_000);
+                params.push((
+                    "global_photons",
+                    Value::Int(photons(&mut o, "global_photons")?),
+                ));
+                params.push((
+                    "caustic_photons",
+                    Value::Int(photons(&mut o, "caustic_photons")?),
+                ));
+                let volume = photons(&mut o, "volume_photons")?;
+                let lookup = o.int("lookup_size", 120)?;
+                let k = o.int("global_lookup_size", lookup)?;
+                params.push(("k", Value::Int(k)));
+                let kc = o.int("caustic_lookup_size", lookup)?;
+                if kc != k {
+                    let why = format!(
+                        "`caustic_lookup_size` = {kc}: foton's photon maps share one k ({k}, the global lookup size)"
+                    );
+                    self.warn(&o, line, &why);
+                }
+                let kv = o.int("volume_lookup_size", lookup)?;
+                if name == "vpm" {
+                    params.push(("volume_photons", Value::Int(volume)));
+                    params.push(("k_volume", Value::Int(kv)));
+                }
+                // Mitsuba's lookup radii are fractions of the bounding sphere's radius.
+                let rg = o.float("global_lookup_radius", 0.05)?;
+                self.report.relative_radius = Some((name.to_string(), rg, line));
+                if let Some((p, l)) = o.take("caustic_lookup_radius") {
+                    let why = format!(
+                        "`caustic_lookup_radius` = {}: foton's photon maps share one largest radius (the global lookup radius)",
+                        show(&p)
+                    );
+                    self.warn(&o, l, &why);
+                }
+                for k in ["direct_samples", "glossy_samples"] {
+                    self.ignored(&mut o, k, &same, noise);
+                }
+                self.ignored(
+                    &mut o,
+                    "max_specular_depth",
+                    &same,
+                    "ignored (foton follows specular bounces up to max_depth)",
+                );
+                for k in ["granularity", "gather_locally", "auto_cancel_gathering"] {
+                    self.ignored(&mut o, k, &|_| true, "");
+                }
+            }
+            "sppm" | "ppm" => {
+                if let Some(n) = o
+                    .take("photon_count")
+                    .or_else(|| o.take("photons_per_iteration"))
+                {
+                    o.props.push(("photon_count".into(), n.0, n.1));
+                    params.push((
+                        "photons_per_iteration",
+                        Value::Int(o.int("photon_count", 250_000)?),
+                    ));
+                }
+                // 0 (Mitsuba's default): a radius guessed from the scene, as foton's is.
+                let r = o.float("initial_radius", 0.0)?;
+                if r > 0.0 {
+                    params.push(("initial_radius", Value::Float(r)));
+                }
+                if let Some((p, l)) = o.take("alpha") {
+                    o.props.push(("alpha".into(), p, l));
+                    params.push(("alpha", Value::Float(o.float("alpha", 0.7)?)));
+                }
+                let passes = match o.take("passes").or_else(|| o.take("max_passes")) {
+                    Some((p, l)) => {
+                        o.props.push(("passes".into(), p, l));
+                        Some((o.int("passes", -1)?, l))
+                    }
+                    None => None,
+                };
+                match passes {
+                    Some((n, _)) if n >= 1 => params.push(("iterations", Value::Int(n))),
+                    Some((n, l)) => {
+                        let why = format!(
+                            "passes = {n} (until stopped): foton runs its default number of iterations; give integrators.sppm.iterations or time"
+                        );
+                        self.warn(&o, l, &why);
+                    }
+                    None => {}
+                }
+                for k in ["granularity", "auto_cancel_gathering", "samples_per_pass"] {
+                    self.ignored(&mut o, k, &|_| true, "");
+                }
+            }
+            "bdpt" => {
+                // lightImage = false: no strategy connects light paths to the camera.
+                if !o.boolean("light_image", true)? {
+                    params.push(("light_image", Value::Bool(false)));
+                }
+                // sampleDirect changes how often next-event strategies are taken, not the
+                // image: foton's bdpt takes every strategy once per camera sample.
+                self.ignored(
+                    &mut o,
+                    "sample_direct",
+                    &|p| matches!(p, Prop::Bool(true)),
+                    "ignored",
+                );
+            }
+            _ => {}
+        }
+        let t = table_mut(table_mut(&mut self.root, "integrators"), name);
+        for (k, v) in params {
+            t.insert(k, at(v, line));
+        }
+        self.leftovers(&o)
+    }
+}
+
+/// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
+const MITSUBA_INTEGRATORS: &[&str] = &[
+    "path",
+    "volpath",
+    "volpath_simple",
+    "volpathmis",
+    "direct",
+    "photonmapper",
+    "sppm",
+    "ppm",
+    "bdpt",
+    "ao",
+    "aov",
+    "depth",
+    "moment",
+    "stokes",
+    "prb",
+    "prbvolpath",
+    "direct_projective",
+    "prb_projective",
+    "ptracer",
+    "vpl",
+    "irrcache",
+    "adaptive",
+    "field",
+    "multichannel",
+    "mlt",
+    "pssmlt",
+    "erpt",
+];
+
+/// The foton plugin that renders a Mitsuba integrator, or None (not supported). A photon
+/// mapper in a scene with media is foton's volumetric one.
+fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
+    Some(match mitsuba {
+        "path" | "volpath" | "volpath_simple" | "volpathmis" | "direct" => "path",
+        "photonmapper" if has_media => "vpm",
+        "photonmapper" => "photon",
+        "sppm" | "ppm" => "sppm",
+        "bdpt" => "bdpt",
+        _ => return None,
+    })
+}

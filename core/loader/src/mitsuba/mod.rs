@@ -1,0 +1,296 @@
+//! Mitsuba XML scenes (Mitsuba 3, and 0.4 to 0.6 upgraded as Mitsuba 3 upgrades them), read
+//! into the document a TOML scene makes: `foton render scene.xml` renders what the same scene
+//! written in TOML would (`foton convert` writes that TOML), and every value keeps the XML
+//! line it came from, so the loader's errors name the XML file and line. Parameters foton
+//! understands but ignores are warnings with their file:line (`Report::warnings`), errors
+//! with `--strict`.
+//!
+//! Mitsuba's conventions, as its documentation states them: `<default>` and `$name`
+//! substitution (`-D name=value` overrides a default), `ref`/`id`, `include`; transforms
+//! composed in document order; `max_depth` counts path segments (-1: unbounded), so foton's
+//! count of scattering events is one less; area emitters emit on their normal's side; the
+//! sensor looks down its local +z with +y up. What foton cannot render yet is an error naming
+//! the element, its type and file:line, or with `lenient` is left out and listed.
+//!
+//! The reader is laid out as Mitsuba 3's parser and plugin folders are. `document` reads the
+//! XML: `<include>`, `<default>` and `$name`, `<alias>`, each element into an `Obj` (its
+//! property list, `object`), `<transform>` composed; `upgrade` holds the version upgrade
+//! rules for files older than 2.0. Then one file per element family turns an element into the
+//! tables of the TOML document: `shape`, `bsdf`, `emitter`, `medium`, `texture`, `sensor`
+//! (with its film, reconstruction filter and sampler) and `integrator`, each an
+//! `impl Reader` block. `plugins` lists Mitsuba's plugins, so that a type foton does not read
+//! is "not supported" or "unknown" as Mitsuba would know it.
+
+mod bsdf;
+mod document;
+mod emitter;
+mod integrator;
+mod medium;
+mod object;
+mod plugins;
+mod sensor;
+mod shape;
+mod texture;
+mod upgrade;
+
+use crate::reader::{Options, Report};
+use foton_core::error::{Error, Result};
+use foton_core::value::{Document, Node, Table, Value};
+use glam::{DMat4, DVec3};
+use object::{Obj, Prop, show};
+use std::cell::RefCell;
+use std::collections::{HashMap, HashSet};
+use std::path::{Path, PathBuf};
+
+/// The Mitsuba format's reader ([`crate::reader`]): [`read_xml`] of a file.
+pub fn read(path: &Path, options: &Options<'_>) -> Result<(Document, Report)> {
+    if path.is_dir() {
+        return Err(Error::io(path, "is a directory, not a scene file"));
+    }
+    read_xml(path, options.defines, options.lenient)
+}
+
+/// Reads a Mitsuba XML scene (3.x, 2.x, or 0.x and 1.x upgraded). `defines` are `NAME=VALUE` overrides of its `<default>`s.
+pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Document, Report)> {
+    let mut defaults = HashMap::new();
+    for d in defines {
+        let (name, value) = d
+            .split_once('=')
+            .ok_or_else(|| Error::Usage(format!("-D {d}: expected NAME=VALUE, e.g. -D spp=16")))?;
+        defaults.insert(name.trim().to_string(), value.trim().to_string());
+    }
+    let mut r = Reader {
+        file: path.to_path_buf(),
+        dir: path.parent().map(Path::to_path_buf).unwrap_or_default(),
+        defined: defaults.keys().cloned().collect(),
+        defaults,
+        lenient,
+        report: Report::default(),
+        root: Table::default(),
+        shapes: Vec::new(),
+        lights: Vec::new(),
+        bsdfs: HashMap::new(),
+        textures: HashMap::new(),
+        media: HashMap::new(),
+        sensor_medium: None,
+        shape_media: false,
+        anonymous: 0,
+        v1: false,
+        used: RefCell::default(),
+        declared: HashSet::new(),
+        integrator: None,
+    };
+    let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
+    r.read_file(path, &text)?;
+    r.check_defines(path)?;
+    r.place_sensor_medium();
+    if let Some(o) = r.integrator.take() {
+        r.integrator(o)?;
+    }
+    let mut root = std::mem::take(&mut r.root);
+    if !r.shapes.is_empty() {
+        root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
+    }
+    if !r.lights.is_empty() {
+        root.insert("lights", at(Value::Array(std::mem::take(&mut r.lights)), 0));
+    }
+    // Mitsuba samples independently when a file names no sampler; foton's TOML default
+    // (sobol) would render such a file with other noise than Mitsuba's.
+    let render = table_mut(&mut root, "render");
+    if render.get("sampler").is_none() {
+        render.insert("sampler", at(Value::Str("independent".into()), 0));
+    }
+    let film = table_mut(&mut root, "film");
+    if film.get("output").is_none() {
+        let stem = path
+            .file_stem()
+            .map_or_else(|| "scene".into(), |s| s.to_string_lossy().into_owned());
+        film.insert("output", at(Value::Str(format!("{stem}.exr")), 0));
+    }
+    Ok((
+        Document {
+            file: path.to_path_buf(),
+            root,
+        },
+        r.report,
+    ))
+}
+
+fn at(value: Value, line: u32) -> Node {
+    Node {
+        value,
+        line,
+        column: if line > 0 { 1 } else { 0 },
+    }
+}
+
+fn table_mut<'t>(t: &'t mut Table, key: &str) -> &'t mut Table {
+    if t.get(key).is_none() {
+        t.insert(key, at(Value::Table(Table::default()), 0));
+    }
+    match &mut t.get_mut(key).expect("inserted").value {
+        Value::Table(inner) => inner,
+        _ => unreachable!("only tables are inserted under section keys"),
+    }
+}
+
+/// A transform as the TOML `{ matrix = [16 numbers, row-major] }` table.
+fn matrix_table(m: DMat4, line: u32) -> Node {
+    let rows: Vec<Node> = (0..4)
+        .flat_map(|r| m.row(r).to_array())
+        .map(|x| at(Value::Float(x), line))
+        .collect();
+    let mut t = Table::default();
+    t.insert("matrix", at(Value::Array(rows), line));
+    at(Value::Table(t), line)
+}
+
+fn vec3(v: DVec3, line: u32) -> Node {
+    at(
+        Value::Array(
+            v.to_array()
+                .iter()
+                .map(|x| at(Value::Float(*x), line))
+                .collect(),
+        ),
+        line,
+    )
+}
+
+struct Reader {
+    file: PathBuf,
+    dir: PathBuf,
+    defaults: HashMap<String, String>,
+    /// Names set by -D (a `<default>` does not override them).
+    defined: Vec<String>,
+    lenient: bool,
+    report: Report,
+    root: Table,
+    shapes: Vec<Node>,
+    lights: Vec<Node>,
+    /// BSDF ids to their material names in `[materials]`.
+    bsdfs: HashMap<String, String>,
+    /// The sensor's medium (its name in `[media]`, line).
+    sensor_medium: Option<(String, u32)>,
+    /// Whether any shape names an interior or exterior medium.
+    shape_media: bool,
+    /// Top-level `<texture id="...">`s, as the inline tables a material field takes.
+    textures: HashMap<String, Table>,
+    /// Medium ids to their names in `[media]`.
+    media: HashMap<String, String>,
+    anonymous: usize,
+    /// The file being read is Mitsuba 0.x or 1.x: its properties are upgraded as Mitsuba 3
+    /// upgrades them (camelCase to snake_case...).
+    v1: bool,
+    /// The `$name`s substituted so far (a `-D` nobody uses is a typo).
+    used: RefCell<HashSet<String>>,
+    /// The `<default>`s declared.
+    declared: HashSet<String>,
+    /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
+    /// the scene has media.
+    integrator: Option<Obj>,
+}
+
+impl Reader {
+    /// Something foton cannot render: an error, or with `lenient` a line in the report.
+    fn unsupported(&mut self, obj: &Obj, what: &str) -> Result<()> {
+        if self.lenient {
+            self.report
+                .left_out
+                .push(format!("{}: {}: {what}", obj.place(), obj.what()));
+            Ok(())
+        } else {
+            Err(obj.error(format!("{what} (--lenient renders without it)")))
+        }
+    }
+
+    /// Properties nobody read: Mitsuba parameters foton does not know.
+    fn leftovers(&mut self, obj: &Obj) -> Result<()> {
+        for (name, _, line) in obj.props.clone() {
+            let o = Obj {
+                line,
+                ..obj.clone()
+            };
+            self.unsupported(&o, &format!("parameter `{name}` is not supported"))?;
+        }
+        Ok(())
+    }
+
+    /// A parameter foton understands but ignores or renders otherwise (at `line`).
+    fn warn(&mut self, obj: &Obj, line: u32, what: &str) {
+        self.report.warnings.push(format!(
+            "{}:{line}: {}: {what}",
+            obj.file.display(),
+            obj.what()
+        ));
+    }
+
+    /// Takes a parameter foton does not honour: a warning unless `same` says its value asks
+    /// for what foton does anyway (`why` empty: it changes nothing foton renders).
+    fn ignored(&mut self, o: &mut Obj, name: &str, same: &dyn Fn(&Prop) -> bool, why: &str) {
+        if let Some((p, line)) = o.take(name)
+            && !same(&p)
+        {
+            let why = if why.is_empty() {
+                "ignored (it changes how Mitsuba runs, not the image)"
+            } else {
+                why
+            };
+            self.warn(o, line, &format!("`{name}` = {}: {why}", show(&p)));
+        }
+    }
+
+    fn note(&mut self, obj: &Obj, what: &str) {
+        self.report
+            .notes
+            .push(format!("{}: {}: {what}", obj.place(), obj.what()));
+    }
+
+    fn new_name(&mut self, prefix: &str, id: &Option<String>) -> String {
+        id.clone().unwrap_or_else(|| {
+            self.anonymous += 1;
+            format!("{prefix}_{}", self.anonymous)
+        })
+    }
+
+    /// The element's required `filename`, relative to the XML file, as the TOML document's
+    /// path (relative to the main scene's folder, or absolute).
+    fn filename(&self, o: &mut Obj) -> Result<Node> {
+        let file = o
+            .string("filename")?
+            .ok_or_else(|| o.error("missing `filename`"))?;
+        let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
+        let rel = path
+            .strip_prefix(&self.dir)
+            .map_or(path.clone(), Path::to_path_buf);
+        Ok(at(Value::Str(rel.to_string_lossy().into_owned()), o.line))
+    }
+
+    fn top_level(&mut self, obj: Obj) -> Result<()> {
+        match obj.tag.as_str() {
+            "integrator" => {
+                if self.integrator.is_some() {
+                    return Err(obj.error("a second <integrator>: a scene has one"));
+                }
+                self.integrator = Some(obj);
+                Ok(())
+            }
+            "sensor" => self.sensor(obj),
+            "bsdf" => self.bsdf(obj).map(|_| ()),
+            "medium" => self.medium(obj).map(|_| ()),
+            "shape" => self.shape(obj),
+            "emitter" => self.emitter(obj),
+            "texture" => {
+                let id = obj.id.clone();
+                let Some(t) = self.texture_table(obj)? else {
+                    return Ok(());
+                };
+                if let Some(id) = id {
+                    self.textures.insert(id, t);
+                }
+                Ok(())
+            }
+            other => Err(obj.error(format!("<{other}> is not a top-level element of a scene"))),
+        }
+    }
+}
