@@ -3,7 +3,7 @@
 //! has those features (core's `plugin::search_path`). A `#[target_feature]` copy of the path
 //! loop does not get the gain, because core's walk, scene and BSDF functions are then no
 //! longer inlined into it; the whole crate and core compiled with `-C target-cpu=x86-64-v3`
-//! do (docs/PERFORMANCE.md, session 27). Cargo has no per-package target CPU, so this script
+//! do (docs/PERFORMANCE.md). Cargo has no per-package target CPU, so this script
 //! runs cargo again, on this package alone, in its own target folder (sharing the outer
 //! build's job slots). Release builds on x86-64 only; `FOTON_NO_CPU_VARIANTS=1` skips it. A
 //! failure is a warning: the baseline plugin is built regardless and works everywhere.

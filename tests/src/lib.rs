@@ -155,7 +155,7 @@ output = "out.exr"
 /// from seed to seed. And outside the fog: inside it, the path tracer's next-event estimate
 /// from the scattering points of multiply scattered paths has infinite variance (1 / r^2 from
 /// vertices whose density near the light is flat: the integral of r^-2 at 0), so its
-/// reference at max_depth 8 was off by up to +18 % for some seeds (PERFORMANCE, session 28);
+/// reference at max_depth 8 was off by up to +18 % for some seeds;
 /// at 0.2 from the nearest fog, 1 / r^2 is bounded. `phase` as in TOML; `tables`: TOML
 /// appended (the integrator's table).
 pub fn point_light_fog(

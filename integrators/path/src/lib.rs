@@ -44,7 +44,7 @@
 //!
 //! **Built twice.** Release builds for x86-64 also build this crate with `-C
 //! target-cpu=x86-64-v3` (`build.rs`), loaded instead where the processor has it: the same
-//! images, 6 to 8 % less time on the Cornell box (docs/PERFORMANCE.md, session 27).
+//! images, 6 to 8 % less time on the Cornell box (docs/PERFORMANCE.md).
 
 use foton_core::api::{
     Film, HeroChannel, Integrator, Mis, Parameter, Properties, Ray, RayWalk, Reached,

@@ -42,24 +42,23 @@
 //! (`PhotonMap::reflected`) is L = sum_p f(x, w_p, w) Phi_p K(d_p, r) over the k nearest
 //! photons of a disc around x, r the distance to the k-th (which, on the boundary, is not
 //! summed). At the camera's visible point the disc is clipped at the walls around x
-//! (`PhotonMap::reflected_clipped` with foton-photonmap's `DiscClip`: eight probe rays in the
+//! (`PhotonMap::reflected` on a `Disc` clipped by foton-photonmap's `DiscClip`: eight probe rays in the
 //! tangent plane; beside a crease the disc would reach behind the wall, where no photon of
 //! this surface lands, and darken a band as wide as r); the gather rays' estimates are not.
 //!
-//! **What changed** (with foton-photonmap and core's `walk` and `direct` modules):
+//! How the maps are used:
 //!
-//! * `caustic_photons = 0` no longer drops the caustics: without a caustic map the global
-//!   pass keeps its L S+ D photons in the indirect map, so caustics come from the global
-//!   budget (fewer photons, more blur) instead of vanishing. With a caustic budget the global
-//!   pass drops them, as before (the caustic pass counts those paths). With `final_gather`,
-//!   which reads the caustic map at x but not the indirect one, they go to the caustic map
-//!   instead (before, final gathering without a caustic map lost every L S+ D path).
+//! * With `caustic_photons = 0` the global pass keeps its L S+ D photons in the indirect map,
+//!   so caustics come from the global budget (fewer photons, more blur). With a caustic
+//!   budget the global pass drops them (the caustic pass counts those paths). With
+//!   `final_gather`, which reads the caustic map at x but not the indirect one, they go to
+//!   the caustic map.
 //! * The BSDF is evaluated per photon with the photon's own incoming direction w_p (not a
 //!   reflectance times the density), so the estimate is right for any BSDF.
 //! * Photons are taken from a disc, not a ball: on the same side of a surface facing the same
 //!   way (stored normals within about 25 degrees) and no farther from the tangent plane than
-//!   `DISC_THICKNESS` = 1/4 of the radius, so photons on a parallel surface within the radius
-//!   (the top of a low box beside the floor) no longer leak into the estimate.
+//!   `DISC_THICKNESS` = 1/4 of the radius, so that photons on a parallel surface within the
+//!   radius (the top of a low box beside the floor) stay out of the estimate.
 //! * The camera walk (null boundaries crossed by core's one crossing loop, with its limit of
 //!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
 //!   the gather rays' walk (`first_surface`) and the direct light (`estimate_direct`) are

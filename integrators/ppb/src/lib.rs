@@ -75,12 +75,12 @@
 //! foggy Cornell box at 256 x 256, whatever the beams' width or kind); 100000 surface photons
 //! take its noise away for about a tenth more time, and then a smaller first radius (1.25
 //! footprints instead of `sppm`'s 3) took the corners' bias down. The beams then afford
-//! fewer photons (2500): the same error in three quarters of the time. Since the disc is
-//! clipped at the walls (session 27: no corner bias to trade against), the first radius is
+//! fewer photons (2500): the same error in three quarters of the time. With the disc
+//! clipped at the walls (no corner bias to trade against), the first radius is
 //! `sppm`'s 3 footprints again: the surfaces' noise, which decided the per-pixel error
 //! (more surface photons or a wider disc took it down; narrower beams raised it), falls by a
-//! half to two thirds (README). Since session 28 a pass's beam gather costs a third less
-//! (screen bins for the primary rays); at equal CPU time on the volumetric caustic 5000 beam
+//! half to two thirds (README). With the screen bins for the primary rays a pass's beam
+//! gather costs a third less; at equal CPU time on the volumetric caustic 5000 beam
 //! photons, or 50000 or 200000 surface photons, gave no lower error than these (README), so
 //! they stay.
 //!

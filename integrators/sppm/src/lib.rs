@@ -74,8 +74,7 @@
 //! from a kd-tree built in a fixed order (foton-photonmap's `PhotonMap`), so images are
 //! identical for any number of threads. Memory is bounded: one iteration's photons at a time.
 //!
-//! **What changed** (with foton-photonmap and core's `walk` and `direct` modules): the gather
-//! selects a disc (above) and evaluates the BSDF per photon; the camera walk (null boundaries
+//! The gather selects a disc (above) and evaluates the BSDF per photon; the camera walk (null boundaries
 //! crossed by core's one crossing loop, a ray ended past `MAX_NULL_CROSSINGS` crossings in a
 //! row) and the direct light are core's, the same code as `path`, `photon` and `vpm` use.
 

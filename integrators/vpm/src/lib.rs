@@ -102,10 +102,10 @@
 //! the volume map's first-event photons), everything else by the volume map; at surfaces as in
 //! `photon` (docs/photon-mapping.md).
 //!
-//! **What changed** (with foton-photonmap and core's `walk`, `direct` and `Medium`):
+//! At surfaces and in the walk:
 //!
 //! * `caustic_photons = 0` keeps the L S+ D surface photons of the global pass in the indirect
-//!   map (caustics come from the global budget) instead of dropping them.
+//!   map (caustics come from the global budget).
 //! * Surface estimates (`PhotonMap::reflected`) evaluate the BSDF per photon with its own
 //!   incoming direction, and take photons from a disc: same side of the same surface (normals
 //!   within about 25 degrees), no farther from the tangent plane than `DISC_THICKNESS` = 1/4 of
@@ -113,7 +113,7 @@
 //! * The camera walk, the null-boundary crossing (one loop in core, with its limit of
 //!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
 //!   the direct light and every medium query (`dyn Medium`) are core's, shared with `path`,
-//!   `photon` and `sppm`; the gap after a crossing is now sampled, as `path` samples it.
+//!   `photon` and `sppm`; the gap after a crossing is sampled, as `path` samples it.
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Film, Integrator, Medium, Mis, NormalizedKernel, Parameter,
