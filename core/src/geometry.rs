@@ -122,7 +122,7 @@ pub struct Hit {
 /// nearest in range, a shadow ray's crossings both.
 // Forced inline: the body of the sphere's primitive test, like `Shape::intersect`.
 #[inline(always)]
-pub fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
+pub(crate) fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
     let f = ray.origin - center;
     let b = -f.dot(ray.dir);
     let l = f + b * ray.dir;

@@ -203,7 +203,7 @@ impl Microfacet {
 /// by Newton's method on P_n in f64, for integrals over the sample space of the visible
 /// normals ([`Microfacet::for_each_normal_on_grid`]: the rough coat's tables) and the tests'
 /// integrals of pdfs.
-pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
     let legendre = |x: f64| {
         let (mut p0, mut p1) = (1.0, x);
         for k in 2..=n {
