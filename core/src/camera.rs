@@ -178,6 +178,19 @@ impl Camera {
 mod tests {
     use super::*;
 
+    /// A 64 x 48 camera looking down and to the side, its up vector not orthogonal to its
+    /// view direction.
+    fn oblique_camera() -> Camera {
+        Camera::new(
+            Vec3::new(0.3, 1.2, 3.0),
+            Vec3::new(-0.2, 0.8, 0.0),
+            Vec3::Y,
+            50.0,
+            64,
+            48,
+        )
+    }
+
     #[test]
     fn right_is_right_and_up_is_up() {
         let cam = Camera::new(
@@ -203,14 +216,7 @@ mod tests {
 
     #[test]
     fn a_point_on_a_camera_ray_projects_to_its_pixel() {
-        let cam = Camera::new(
-            Vec3::new(0.3, 1.2, 3.0),
-            Vec3::new(-0.2, 0.8, 0.0),
-            Vec3::Y,
-            50.0,
-            64,
-            48,
-        );
+        let cam = oblique_camera();
         for film in [
             Vec2::new(0.5, 0.5),
             Vec2::new(13.25, 40.75),
@@ -234,14 +240,7 @@ mod tests {
     /// draws, and `sample_wi` lands where `generate_ray` started.
     #[test]
     fn importance_is_normalised_and_consistent_with_camera_rays() {
-        let cam = Camera::new(
-            Vec3::new(0.3, 1.2, 3.0),
-            Vec3::new(-0.2, 0.8, 0.0),
-            Vec3::Y,
-            50.0,
-            64,
-            48,
-        );
+        let cam = oblique_camera();
         // Monte Carlo over the sphere of directions: the integral of pdf_dir is 1, and so is
         // the integral of We cos (the importance of the whole image).
         let mut rng = crate::sampling::Rng::new(&[7]);

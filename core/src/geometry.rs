@@ -116,6 +116,28 @@ pub struct Hit {
     pub prim: u32,
 }
 
+/// The distances along `ray` at which it meets the sphere of `center` and `radius`, both roots,
+/// unordered; None if it misses. The numerically careful form of Ray Tracing Gems ch. 7,
+/// which avoids cancellation for distant or small spheres. `Shape::intersect` takes the
+/// nearest in range, a shadow ray's crossings both.
+// Forced inline: the body of the sphere's primitive test, like `Shape::intersect`.
+#[inline(always)]
+pub(crate) fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32, f32)> {
+    let f = ray.origin - center;
+    let b = -f.dot(ray.dir);
+    let l = f + b * ray.dir;
+    let disc = radius * radius - l.dot(l);
+    if disc < 0.0 {
+        return None;
+    }
+    let c = f.dot(f) - radius * radius;
+    let q = b + b.signum() * disc.sqrt();
+    if q == 0.0 {
+        return None;
+    }
+    Some((c / q, q))
+}
+
 impl Shape {
     pub fn quad(origin: Vec3, u: Vec3, v: Vec3) -> Shape {
         let n = u.cross(v);
@@ -195,21 +217,7 @@ impl Shape {
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<f32> {
         match *self {
             Shape::Sphere { center, radius, .. } => {
-                // Numerically careful form (Ray Tracing Gems ch. 7): avoids cancellation for
-                // distant or small spheres.
-                let f = ray.origin - center;
-                let b = -f.dot(ray.dir);
-                let l = f + b * ray.dir;
-                let disc = radius * radius - l.dot(l);
-                if disc < 0.0 {
-                    return None;
-                }
-                let c = f.dot(f) - radius * radius;
-                let q = b + b.signum() * disc.sqrt();
-                if q == 0.0 {
-                    return None;
-                }
-                let (mut t0, mut t1) = (c / q, q);
+                let (mut t0, mut t1) = sphere_roots(ray, center, radius)?;
                 if t0 > t1 {
                     std::mem::swap(&mut t0, &mut t1);
                 }

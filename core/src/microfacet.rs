@@ -199,6 +199,38 @@ impl Microfacet {
     }
 }
 
+/// Gauss-Legendre nodes and weights on [-1, 1] (Mitsuba's `quad::gauss_legendre`): the nodes
+/// by Newton's method on P_n in f64, for integrals over the sample space of the visible
+/// normals ([`Microfacet::for_each_normal_on_grid`]: the rough coat's tables) and the tests'
+/// integrals of pdfs.
+pub(crate) fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
+    let legendre = |x: f64| {
+        let (mut p0, mut p1) = (1.0, x);
+        for k in 2..=n {
+            let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
+            p0 = p1;
+            p1 = p2;
+        }
+        // P_n and its derivative.
+        (p1, n as f64 * (x * p1 - p0) / (x * x - 1.0))
+    };
+    (0..n)
+        .map(|i| {
+            let mut x = (std::f64::consts::PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
+            for _ in 0..100 {
+                let (p, dp) = legendre(x);
+                let dx = p / dp;
+                x -= dx;
+                if dx.abs() < 1e-15 {
+                    break;
+                }
+            }
+            let (_, dp) = legendre(x);
+            (x, 2.0 / ((1.0 - x * x) * dp * dp))
+        })
+        .collect()
+}
+
 /// Slopes of the visible normals of the GGX surface with alpha = 1 seen at cos(theta_i), in a
 /// frame where wi lies in the xz plane (Heitz 2018: a uniform point on the disc, squeezed onto
 /// the visible half of the projected hemisphere, lifted back onto it; Mitsuba's variant).
@@ -304,6 +336,7 @@ fn erfinv(y: f64) -> f64 {
 /// sphere, in the manner of pbrt's and Mitsuba's tests (shared with `glossy`'s tests).
 #[cfg(test)]
 pub(crate) mod chi2 {
+    use super::gauss_legendre;
     use crate::sampling::Rng;
     use glam::Vec3;
     use std::f64::consts::{PI, TAU};
@@ -335,36 +368,6 @@ pub(crate) mod chi2 {
             c.clamp(0, N_COS as isize - 1) as usize * N_PHI
                 + p.clamp(0, N_PHI as isize - 1) as usize,
         )
-    }
-
-    /// Gauss-Legendre nodes and weights on [-1, 1] (Newton on P_n, f64).
-    pub fn gauss_legendre(n: usize) -> Vec<(f64, f64)> {
-        (0..n)
-            .map(|i| {
-                let mut x = (PI * (i as f64 + 0.75) / (n as f64 + 0.5)).cos();
-                loop {
-                    let (mut p0, mut p1) = (1.0, x);
-                    for k in 2..=n {
-                        let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                        p0 = p1;
-                        p1 = p2;
-                    }
-                    let dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                    let dx = p1 / dp;
-                    x -= dx;
-                    if dx.abs() < 1e-15 {
-                        let (mut p0, mut p1) = (1.0, x);
-                        for k in 2..=n {
-                            let p2 = ((2 * k - 1) as f64 * x * p1 - (k - 1) as f64 * p0) / k as f64;
-                            p0 = p1;
-                            p1 = p2;
-                        }
-                        let dp = n as f64 * (x * p1 - p0) / (x * x - 1.0);
-                        return (x, 2.0 / ((1.0 - x * x) * dp * dp));
-                    }
-                }
-            })
-            .collect()
     }
 
     /// The integral of `pdf` over each cell (in (cos theta, phi), whose Jacobian is one), by

@@ -3,7 +3,7 @@
 //! `Properties`, pbrt-v4's `ParameterDictionary`). It remembers which keys were read, so that
 //! unknown (misspelt) parameters can be reported afterwards.
 
-use crate::error::{Error, Location, Result, did_you_mean};
+use crate::error::{Error, Location, Result, did_you_mean, edit_distance};
 use crate::kernel::{BUILTIN_KERNELS, KernelPlugin, NormalizedKernel};
 use crate::value::{Node, Table, Value};
 use glam::Vec3;
@@ -417,7 +417,8 @@ impl<'a> Properties<'a> {
 }
 
 /// "unknown value "sobl" (did you mean "sobol"?); expected one of: ...": the suggestion is
-/// the option nearest in edit distance, when it is near enough to be a typing slip.
+/// the option nearest in edit distance ([`edit_distance`], which counts a swap of neighbouring
+/// characters as one edit), when it is near enough to be a typing slip.
 pub fn unknown_value(value: &str, options: &[&str]) -> String {
     let nearest = options
         .iter()
@@ -431,22 +432,4 @@ pub fn unknown_value(value: &str, options: &[&str]) -> String {
         "unknown value {value:?}{hint}; expected one of: {}",
         options.join(", ")
     )
-}
-
-/// Levenshtein distance between two strings (by characters).
-fn edit_distance(a: &str, b: &str) -> usize {
-    let b: Vec<char> = b.chars().collect();
-    let mut row: Vec<usize> = (0..=b.len()).collect();
-    for (i, ca) in a.chars().enumerate() {
-        let mut diagonal = row[0];
-        row[0] = i + 1;
-        for (j, &cb) in b.iter().enumerate() {
-            let above = row[j + 1];
-            row[j + 1] = (above + 1)
-                .min(row[j] + 1)
-                .min(diagonal + usize::from(ca != cb));
-            diagonal = above;
-        }
-    }
-    row[b.len()]
 }

@@ -65,6 +65,7 @@ pub fn fresnel_conductor(cos_i: f32, eta: f32, k: f32) -> f32 {
     (0.5 * (norm(r_parl) + norm(r_perp))) as f32
 }
 
+/// Mirror reflection of `wo` about the normal `n` (a surface's, or a microfacet's).
 #[inline]
 pub fn reflect(wo: Vec3, n: Vec3) -> Vec3 {
     2.0 * wo.dot(n) * n - wo

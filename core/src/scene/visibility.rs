@@ -3,7 +3,7 @@
 
 use super::Scene;
 use crate::Rgb;
-use crate::geometry::{Hit, Ray, Shape, offset_origin};
+use crate::geometry::{Hit, Ray, Shape, offset_origin, sphere_roots};
 use crate::walk::MAX_NULL_CROSSINGS;
 use glam::Vec3;
 
@@ -191,21 +191,11 @@ const MAX_COLLECTED_CROSSINGS: usize = 16;
 fn segment_crossings(shape: &Shape, ray: &Ray, tmax: f32) -> [Option<f32>; 2] {
     match *shape {
         Shape::Sphere { center, radius, .. } => {
-            // As Shape::intersect (Ray Tracing Gems ch. 7), keeping both roots.
-            let f = ray.origin - center;
-            let b = -f.dot(ray.dir);
-            let l = f + b * ray.dir;
-            let disc = radius * radius - l.dot(l);
-            if disc < 0.0 {
+            let Some((t0, t1)) = sphere_roots(ray, center, radius) else {
                 return [None, None];
-            }
-            let c = f.dot(f) - radius * radius;
-            let q = b + b.signum() * disc.sqrt();
-            if q == 0.0 {
-                return [None, None];
-            }
+            };
             let inside = |t: f32| (t > 0.0 && t < tmax).then_some(t);
-            [inside(c / q), inside(q)]
+            [inside(t0), inside(t1)]
         }
         _ => [shape.intersect(ray, tmax), None],
     }

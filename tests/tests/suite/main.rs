@@ -9,6 +9,9 @@
 //! render watches, and would stop the renders of tests running beside them.
 
 mod bad_input;
+mod bad_input_output;
+mod bad_input_plugins;
+mod bad_input_values;
 mod bdpt;
 mod beams;
 mod bitterli;
@@ -39,6 +42,9 @@ mod ply;
 mod ppb;
 mod samplers;
 mod sampling;
+mod sampling_lights;
+mod sampling_materials;
+mod sampling_media;
 mod scenes;
 mod shapes;
 mod sphere_light;
