@@ -2,7 +2,7 @@
 //! change to the `foton` program, to the scene loader (core/loader: the TOML, XML, PLY, OBJ
 //! and image readers) or to a dependency only they link leaves it as it is (plugins built
 //! before still load), a change to core or to one of its dependencies changes it (such
-//! plugins are refused, with both identifiers named: bad_input.rs). The function tested here
+//! plugins are refused, with both identifiers named: bad_input_plugins.rs). The function tested here
 //! is the one build.rs runs: it reproduces this build's identifier.
 
 #[path = "../../../core/build_id.rs"]

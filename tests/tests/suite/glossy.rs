@@ -1,7 +1,7 @@
 //! Glossy materials (issue 10): Mitsuba's `roughconductor`, `roughdielectric`, `plastic` and
 //! `roughplastic` in every integrator. The lobes themselves (chi-square of their samplers,
 //! pdfs that integrate to one, furnaces of the lobes alone, Mitsuba's values) are tested in
-//! core/src/glossy.rs and microfacet.rs; here, whole renders:
+//! core/src/glossy/ and microfacet.rs; here, whole renders:
 //!
 //! * white furnaces: inside a constant environment L, a sphere of a lossless material never
 //!   shows more than L (energy is never gained), and single-scattering microfacet lobes lose

@@ -3,7 +3,7 @@
 //! against closed forms: single scattering from a point light against a quadrature of its
 //! integral, an albedo-1 medium in a white furnace, empty media that must change nothing, and
 //! determinism. The samplers (free flight, phase functions) are chi-square tested in
-//! sampling.rs.
+//! sampling_media.rs.
 
 use foton_core::Rgb;
 use foton_core::scene::Scene;
