@@ -23,6 +23,8 @@
 // The plugin and its declaration.
 pub use crate::declare_integrator;
 pub use crate::error::{Error, Result};
+#[doc(hidden)]
+pub use crate::integrator::CreateIntegrator;
 pub use crate::integrator::{
     Budget, Integrator, MapPhoton, NoProgress, ParamValue, Parameter, Part, PhotonMapView,
     Progress, RenderContext, Work, describe,

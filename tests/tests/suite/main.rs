@@ -23,6 +23,7 @@ mod deploy;
 mod directional;
 mod disc_edges;
 mod disc_estimate;
+mod docs;
 mod environment;
 mod filter;
 mod glossy;
