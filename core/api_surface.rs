@@ -26,12 +26,13 @@ struct Module {
     items: Vec<Item>,
 }
 
-fn is_test_cfg(attrs: &[Attribute]) -> bool {
+/// Whether an attribute `#[name(args)]` is among `attrs` (`cfg(test)`, `doc(hidden)`).
+fn has_attr(attrs: &[Attribute], name: &str, args: &str) -> bool {
     attrs.iter().any(|a| {
-        a.path().is_ident("cfg")
+        a.path().is_ident(name)
             && a.meta
                 .require_list()
-                .is_ok_and(|l| l.tokens.to_string().trim() == "test")
+                .is_ok_and(|l| l.tokens.to_string().trim() == args)
     })
 }
 
@@ -39,7 +40,7 @@ fn collect_modules(path: Vec<String>, items: Vec<Item>, out: &mut Vec<Module>) {
     for item in &items {
         if let Item::Mod(m) = item
             && let Some((_, inner)) = &m.content
-            && !is_test_cfg(&m.attrs)
+            && !has_attr(&m.attrs, "cfg", "test")
         {
             let mut p = path.clone();
             p.push(m.ident.to_string());
@@ -125,12 +126,7 @@ fn is_pub(vis: &Visibility) -> bool {
 /// `#[doc(hidden)]`: public for the host's crates, not promised to plugins (the rule
 /// cargo-semver-checks follows too).
 fn is_hidden(attrs: &[Attribute]) -> bool {
-    attrs.iter().any(|a| {
-        a.path().is_ident("doc")
-            && a.meta
-                .require_list()
-                .is_ok_and(|l| l.tokens.to_string().trim() == "hidden")
-    })
+    has_attr(attrs, "doc", "hidden")
 }
 
 /// The identifiers of the paths a piece of syntax names (types, traits), for the chain.

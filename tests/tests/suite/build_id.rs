@@ -12,7 +12,7 @@ use core_build_id::{Inputs, build_id, dependency_closure};
 use foton_tests::{repo_root, temp_dir};
 use std::path::Path;
 
-fn copy_dir(from: &Path, to: &Path) {
+pub(crate) fn copy_dir(from: &Path, to: &Path) {
     std::fs::create_dir_all(to).unwrap();
     for entry in std::fs::read_dir(from).unwrap() {
         let path = entry.unwrap().path();

@@ -7,6 +7,7 @@
 #[path = "../../../core/api_surface.rs"]
 mod api_surface;
 
+use crate::build_id::copy_dir;
 use foton_core::plugin::PLUGIN_API_VERSION;
 use foton_tests::{repo_root, temp_dir};
 use std::path::{Path, PathBuf};
@@ -109,19 +110,6 @@ fn the_version_is_the_hash_of_the_api_surface() {
     assert!(
         surface.contains("pub fn intersect (& self , ray : & Ray , tmax : f32) -> Option < Hit >")
     );
-}
-
-fn copy_dir(from: &Path, to: &Path) {
-    std::fs::create_dir_all(to).unwrap();
-    for entry in std::fs::read_dir(from).unwrap() {
-        let path = entry.unwrap().path();
-        let dest = to.join(path.file_name().unwrap());
-        if path.is_dir() {
-            copy_dir(&path, &dest);
-        } else {
-            std::fs::copy(&path, &dest).unwrap();
-        }
-    }
 }
 
 /// The version of core's sources with `file`'s text `from` replaced by `to` (which must be
