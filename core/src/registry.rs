@@ -5,7 +5,7 @@
 //! Each built-in lives in its own file, which ends with its factory: its name in scene files,
 //! a one-line description, and `create`, which reads the plugin's parameters by name from its
 //! [`Properties`] bag, with the defaults and the errors written there and nowhere else. The
-//! kind's module lists its files in one [`builtins!`] invocation, one line each; that line
+//! kind's module lists its files in one `builtins!` invocation, one line each; that line
 //! both declares the file's module and adds its factory to the kind's table. Everything that
 //! lists or builds the kind (the loader, `foton check`, the docs' tests) reads the table.
 //!
