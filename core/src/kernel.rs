@@ -1,4 +1,6 @@
-//! Radial density-estimation kernels for photon mapping.
+//! Radial density-estimation kernels for photon mapping: the `Kernel` interface, its
+//! normalisation, kernel plugins, and the table of built-in kernels ([`KERNELS`]), one file
+//! each in `kernel/` that ends with its factory. docs/extending.md adds a kernel.
 //!
 //! A kernel is a radial profile w(t), t = d / r in [0, 1]. The profile need not be normalised:
 //! [`NormalizedKernel`] scales it so that it integrates to exactly one over the disc of radius
@@ -34,46 +36,21 @@ pub trait Kernel: Send + Sync {
     }
 }
 
-/// 1 / (pi r^2) on the disc.
-pub struct BoxKernel;
-impl Kernel for BoxKernel {
-    fn name(&self) -> &str {
-        "box"
-    }
-    fn profile(&self, _: f64) -> f64 {
-        1.0
-    }
+crate::registry::builtins! {
+    /// The built-in kernels, one line each (a file in `kernel/` that ends with its `FACTORY`):
+    /// what `kernel = NAME` finds before the kernel plugins.
+    pub const KERNELS: [dyn Kernel] = [
+        box_kernel,
+        cone_kernel,
+        gaussian_kernel,
+    ];
 }
+pub use box_kernel::BoxKernel;
+pub use cone_kernel::ConeKernel;
+pub use gaussian_kernel::GaussianKernel;
 
-/// Jensen's cone filter w = 1 - t / c, c >= 1.
-pub struct ConeKernel {
-    pub c: f64,
-}
-impl Kernel for ConeKernel {
-    fn name(&self) -> &str {
-        "cone"
-    }
-    fn profile(&self, t: f64) -> f64 {
-        1.0 - t / self.c
-    }
-    fn parameters(&self) -> Vec<(&'static str, f64)> {
-        vec![("cone_c", self.c)]
-    }
-}
-
-/// Jensen's Gaussian filter with alpha = 0.918, beta = 1.953 (the normalisation that follows
-/// replaces alpha, which on its own makes the filter integrate to about one half).
-pub struct GaussianKernel;
-impl Kernel for GaussianKernel {
-    fn name(&self) -> &str {
-        "gaussian"
-    }
-    fn profile(&self, t: f64) -> f64 {
-        const ALPHA: f64 = 0.918;
-        const BETA: f64 = 1.953;
-        ALPHA * (1.0 - (1.0 - (-BETA * t * t / 2.0).exp()) / (1.0 - (-BETA).exp()))
-    }
-}
+/// The names of [`KERNELS`], in its order.
+pub const BUILTIN_KERNELS: &[&str] = &crate::registry::name_array::<_, { KERNELS.len() }>(KERNELS);
 
 /// A kernel with its 2-D and 3-D normalisation constants.
 pub struct NormalizedKernel {
@@ -207,17 +184,23 @@ impl NormalizedKernel {
     }
 }
 
-/// The built-in kernel `name`; `cone_c` parameterises the cone.
+/// The built-in kernel `name`; `cone_c` parameterises the cone (read as the scene files'
+/// single-precision `cone_c`). None for an unknown name or a `cone_c` below 1.
 pub fn builtin(name: &str, cone_c: f64) -> Option<Box<dyn Kernel>> {
-    match name {
-        "box" => Some(Box::new(BoxKernel)),
-        "cone" => Some(Box::new(ConeKernel { c: cone_c })),
-        "gaussian" => Some(Box::new(GaussianKernel)),
-        _ => None,
-    }
+    use crate::value::{Node, Table, Value};
+    let at = |value| Node {
+        value,
+        line: 0,
+        column: 0,
+    };
+    let table = at(Value::Table(Table(vec![(
+        "cone_c".into(),
+        at(Value::Float(cone_c)),
+    )])));
+    let props = crate::props::Properties::new(std::path::Path::new(""), "", &table).ok()?;
+    let factory = crate::registry::find(KERNELS, name)?;
+    (factory.create)(&props, &mut Vec::new()).ok()
 }
-
-pub const BUILTIN_KERNELS: &[&str] = &["box", "cone", "gaussian"];
 
 /// A loaded kernel plugin (C ABI, found by [`crate::plugin`]): here, below `props`, which
 /// hands a plugin the host's kernel plugins, so that `props` need not import `plugin`.

@@ -31,6 +31,7 @@ pub mod param;
 pub mod part;
 pub mod plugin;
 pub mod props;
+pub mod registry;
 pub mod render;
 pub mod sampling;
 pub mod scattering;

@@ -1,7 +1,9 @@
-//! Participating media: the `Medium` interface every integrator uses, the homogeneous medium,
-//! phase functions, transmittance and free-flight distance sampling. Where media are in a scene (which medium a point or ray is in, and how
-//! it changes at boundaries) is the scene's business: `Scene::medium_at`,
-//! `Scene::medium_after` and `Scene::transmittance`.
+//! Participating media: the `Medium` interface every integrator uses, free-flight distance
+//! sampling and its weights, and the table of built-in media ([`MEDIA`]), one file each in
+//! `medium/` (`homogeneous.rs`) that reads its parameters and ends with its factory; phase
+//! functions are `medium/phase.rs`. Where media are in a scene (which medium a point or ray is
+//! in, and how it changes at boundaries) is the scene's business: `Scene::medium_at`,
+//! `Scene::medium_after` and `Scene::transmittance`. docs/extending.md adds a medium.
 //!
 //! Free-flight sampling in a chromatic medium uses one-sample MIS over the colour channels
 //! (the "spectral MIS" of Wilkie et al. 2014 with the balance heuristic): t is drawn from
@@ -15,49 +17,19 @@
 
 use crate::Rgb;
 use crate::geometry::Ray;
-use crate::sampling::{to_world, uniform_sphere};
-use glam::{Vec2, Vec3};
-use std::f32::consts::PI;
+use glam::Vec3;
 
-/// Phase functions, in terms of the angle between the direction light travels before and
-/// after scattering (cos = 1: straight on). g > 0 scatters forward.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Phase {
-    Isotropic,
-    HenyeyGreenstein { g: f32 },
+mod phase;
+pub use phase::Phase;
+
+crate::registry::builtins! {
+    /// The built-in kinds of medium, one line each (a file in `medium/` that ends with its
+    /// `FACTORY`): what a `[media]` table's `type` names.
+    pub const MEDIA: [dyn Medium] = [
+        homogeneous,
+    ];
 }
-
-impl Phase {
-    /// p(cos theta), normalised over the sphere of directions.
-    pub fn eval(&self, cos_theta: f32) -> f32 {
-        match *self {
-            Phase::Isotropic => 1.0 / (4.0 * PI),
-            Phase::HenyeyGreenstein { g } => {
-                let denom = 1.0 + g * g - 2.0 * g * cos_theta;
-                (1.0 - g * g) / (4.0 * PI * denom * denom.max(1e-12).sqrt())
-            }
-        }
-    }
-
-    /// Samples a new travel direction for light travelling along `dir`; the pdf equals `eval`.
-    pub fn sample(&self, dir: Vec3, u: Vec2) -> (Vec3, f32) {
-        match *self {
-            Phase::Isotropic => (uniform_sphere(u), 1.0 / (4.0 * PI)),
-            Phase::HenyeyGreenstein { g } => {
-                let cos_theta = if g.abs() < 1e-3 {
-                    1.0 - 2.0 * u.x
-                } else {
-                    let s = (1.0 - g * g) / (1.0 + g - 2.0 * g * u.x);
-                    ((1.0 + g * g - s * s) / (2.0 * g)).clamp(-1.0, 1.0)
-                };
-                let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
-                let phi = 2.0 * PI * u.y;
-                let local = Vec3::new(sin_theta * phi.cos(), sin_theta * phi.sin(), cos_theta);
-                (to_world(local, dir), self.eval(cos_theta))
-            }
-        }
-    }
-}
+pub use homogeneous::Homogeneous;
 
 /// A free-flight distance sample along a ray segment of length `tmax` (to the next surface, or
 /// infinity).
@@ -179,76 +151,6 @@ pub trait Medium: Send + Sync + std::fmt::Debug {
     /// inline rather than through this trait's virtual calls; what they compute is the same.
     fn homogeneous(&self) -> Option<Homogeneous> {
         None
-    }
-}
-
-/// A medium with the same coefficients everywhere.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Homogeneous {
-    pub sigma_a: Rgb,
-    pub sigma_s: Rgb,
-    pub phase: Phase,
-}
-
-impl Homogeneous {
-    pub fn sigma_t(&self) -> Rgb {
-        self.sigma_a + self.sigma_s
-    }
-
-    /// Transmittance over a distance `d` (which may be infinite).
-    #[inline]
-    pub fn transmittance_over(&self, d: f32) -> Rgb {
-        transmittance_homogeneous(self.sigma_t(), d)
-    }
-}
-
-impl Medium for Homogeneous {
-    fn is_vacuum(&self) -> bool {
-        self.sigma_t().max_element() == 0.0
-    }
-    fn sigma_a(&self, _: Vec3) -> Rgb {
-        self.sigma_a
-    }
-    fn sigma_s(&self, _: Vec3) -> Rgb {
-        self.sigma_s
-    }
-    fn phase(&self) -> Phase {
-        self.phase
-    }
-    /// Beer-Lambert: exp(-sigma_t d) per channel.
-    fn transmittance(&self, _ray: &Ray, d: f32) -> Rgb {
-        self.transmittance_over(d)
-    }
-    /// t is drawn from sigma_t,c exp(-sigma_t,c t) for the given channel c.
-    fn sample_free_flight(&self, _ray: &Ray, tmax: f32, channel: usize, u: f32) -> FreeFlight {
-        let sigma_t = self.sigma_t();
-        let s = sigma_t[channel];
-        // 1 - u is in (0, 1]: the logarithm is finite.
-        let t = if s > 0.0 {
-            -(1.0 - u).ln() / s
-        } else {
-            f32::INFINITY
-        };
-        if t < tmax {
-            let tr = transmittance_homogeneous(sigma_t, t);
-            FreeFlight {
-                t,
-                scattered: true,
-                f: self.sigma_s * tr,
-                pdf: sigma_t * tr,
-            }
-        } else {
-            let tr = transmittance_homogeneous(sigma_t, tmax);
-            FreeFlight {
-                t: tmax,
-                scattered: false,
-                f: tr,
-                pdf: tr,
-            }
-        }
-    }
-    fn homogeneous(&self) -> Option<Homogeneous> {
-        Some(*self)
     }
 }
 

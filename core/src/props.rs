@@ -4,7 +4,7 @@
 //! unknown (misspelt) parameters can be reported afterwards.
 
 use crate::error::{Error, Location, Result, did_you_mean, edit_distance};
-use crate::kernel::{BUILTIN_KERNELS, KernelPlugin, NormalizedKernel};
+use crate::kernel::{KERNELS, KernelPlugin, NormalizedKernel};
 use crate::value::{Node, Table, Value};
 use glam::Vec3;
 use std::cell::RefCell;
@@ -111,28 +111,21 @@ impl<'a> Properties<'a> {
     /// in 2-D and 3-D. The error for an unknown name lists the kernels found.
     pub fn kernel(&self, name: &str, default: &'a str) -> Result<NormalizedKernel> {
         let kind = self.string(name, default)?;
-        let cone_c = if kind == "cone" {
-            self.f32("cone_c", 1.0)?
-        } else {
-            1.0
-        };
-        if cone_c < 1.0 {
-            return Err(self.error("cone_c", format!("must be >= 1, found {cone_c}")));
-        }
-        let kernel: Box<dyn crate::kernel::Kernel> = if let Some(k) =
-            crate::kernel::builtin(kind, cone_c as f64)
-        {
-            k
-        } else if let Some(k) = self.plugins.iter().find(|k| k.name == kind) {
-            Box::new(k.clone())
-        } else {
-            let mut known: Vec<String> = BUILTIN_KERNELS.iter().map(|s| s.to_string()).collect();
-            known.extend(self.plugins.iter().map(|k| format!("{} (plugin)", k.name)));
-            return Err(self.error(
-                name,
-                format!("unknown kernel {kind:?}; available: {}", known.join(", ")),
-            ));
-        };
+        // A built-in reads its own parameters (`cone_c`) from this bag.
+        let kernel: Box<dyn crate::kernel::Kernel> =
+            if let Some(factory) = crate::registry::find(KERNELS, kind) {
+                (factory.create)(self, &mut Vec::new())?
+            } else if let Some(k) = self.plugins.iter().find(|k| k.name == kind) {
+                Box::new(k.clone())
+            } else {
+                let mut known: Vec<String> =
+                    crate::registry::names(KERNELS).map(String::from).collect();
+                known.extend(self.plugins.iter().map(|k| format!("{} (plugin)", k.name)));
+                return Err(self.error(
+                    name,
+                    format!("unknown kernel {kind:?}; available: {}", known.join(", ")),
+                ));
+            };
         NormalizedKernel::new(kernel).map_err(|e| self.error(name, e.to_string()))
     }
 

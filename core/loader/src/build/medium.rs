@@ -1,15 +1,13 @@
-//! `[media]`, and a medium named by a shape, the camera or a light (`vacuum`: none).
+//! `[media]`, and a medium named by a shape, the camera or a light (`vacuum`: none). A
+//! medium's `type` is looked up in `foton_core::medium::MEDIA`, whose factory reads the rest.
 
 use super::common::{Index, Loader, type_of, undefined};
-use foton_core::Rgb;
 use foton_core::error::Result;
-use foton_core::medium::{Homogeneous, Phase};
+use foton_core::medium::MEDIA;
 use foton_core::props::Properties;
+use foton_core::registry;
 use foton_core::scene::{BoxedMedium, Named};
-use foton_core::value::Value;
 use std::collections::HashMap;
-
-const MEDIUM_TYPES: &[&str] = &["homogeneous"];
 
 /// A medium named at `key` (`interior`, `exterior`, a camera's or a light's `medium`):
 /// None if the key is absent, Some(None) for `"vacuum"`, which names no medium (Mitsuba's
@@ -50,61 +48,19 @@ pub(super) fn read_media(
                 "`vacuum` is reserved: it names no medium (in `interior`, `exterior` and `medium`); call this medium something else",
             ));
         }
-        let ty = type_of(&m, MEDIUM_TYPES)?;
-        if ty != "homogeneous" {
-            return Err(m.error(
-                "type",
-                format!(
-                    "unknown medium type {ty:?}; expected one of: {}",
-                    MEDIUM_TYPES.join(", ")
-                ),
-            ));
+        let types: Vec<&str> = registry::names(MEDIA).collect();
+        let ty = type_of(&m, &types)?;
+        let factory = registry::find(MEDIA, ty)
+            .ok_or_else(|| m.error("type", registry::unknown("medium type", ty, MEDIA)))?;
+        let mut nested = Vec::new();
+        let medium = (factory.create)(&m, &mut nested)?;
+        for bag in &nested {
+            ld.done(bag);
         }
-        let sigma_a = m.rgb("sigma_a", Rgb::ZERO)?;
-        let sigma_s = m.rgb("sigma_s", Rgb::ZERO)?;
-        let phase = match m.node("phase").map(|n| &n.value) {
-            None => Phase::Isotropic,
-            Some(Value::Str(s)) if s == "isotropic" => Phase::Isotropic,
-            Some(Value::Str(s)) => {
-                return Err(m.error(
-                    "phase",
-                    format!("unknown phase function {s:?}; expected \"isotropic\" or {{ type = \"hg\", g = ... }}"),
-                ));
-            }
-            Some(Value::Table(_)) => {
-                let p = m.table("phase")?.unwrap();
-                let ty = p.choice("type", &["hg", "isotropic"], "hg")?;
-                let phase = if ty == "isotropic" {
-                    Phase::Isotropic
-                } else {
-                    let g = p.f32("g", 0.0)?;
-                    if g.abs() >= 1.0 {
-                        return Err(p.error("g", format!("must satisfy |g| < 1, found {g}")));
-                    }
-                    Phase::HenyeyGreenstein { g }
-                };
-                ld.done(&p);
-                phase
-            }
-            Some(other) => {
-                return Err(m.error(
-                    "phase",
-                    format!(
-                        "expected \"isotropic\" or {{ type = \"hg\", g = ... }}, found {} `{}`",
-                        other.type_name(),
-                        other.show()
-                    ),
-                ));
-            }
-        };
         index.insert(name.to_string(), out.len() as u32);
         out.push(Named {
             name: name.to_string(),
-            value: Box::new(Homogeneous {
-                sigma_a,
-                sigma_s,
-                phase,
-            }),
+            value: medium,
         });
         ld.done(&m);
     }
