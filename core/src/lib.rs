@@ -63,10 +63,12 @@ pub const BUILD_ID: &str = env!("FOTON_BUILD_ID");
 /// The settings hashed into [`BUILD_ID`] (`;`-separated), for the tests that recompute it.
 pub const BUILD_SETTINGS: &str = env!("FOTON_BUILD_SETTINGS");
 
-/// The plugin guide of docs/, compiled here as doc-tests so that its examples cannot drift
-/// from the API they describe.
+/// The plugin and extension guides of docs/, compiled here as doc-tests so that their examples
+/// cannot drift from the API they describe.
 #[doc(hidden)]
 pub mod guides {
     #[doc = include_str!("../../docs/plugins.md")]
     pub mod plugins {}
+    #[doc = include_str!("../../docs/extending.md")]
+    pub mod extending {}
 }
