@@ -107,7 +107,7 @@ use foton_photonmap::beams::{
 use foton_photonmap::map::{CLIP_PROBES, DiscClip, Photon, PhotonMap};
 use foton_photonmap::progressive::{
     PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc_clipped,
-    global_radius2_scale, pixel_angle, run_passes,
+    global_radius2_scale, per_pixel, pixel_angle, run_passes,
 };
 use foton_photonmap::screen::ScreenBeams;
 use foton_photonmap::trace::{
@@ -392,10 +392,7 @@ impl Integrator for Ppb {
         let mut passes = PpbPasses {
             ppb: self,
             scene,
-            sums: vec![
-                RadianceSum::default();
-                scene.film().width as usize * scene.film().height as usize
-            ],
+            sums: per_pixel(scene),
             angle: pixel_angle(scene),
             tally: &tally,
         };
