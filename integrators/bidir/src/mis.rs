@@ -351,9 +351,9 @@ mod tests {
                 // The running quantities along the camera subpath (x1 .. x_{k-1}).
                 let mut cam = vec![Running::default(); k + 1];
                 let mut r = Running::camera(filter_pdf * pdf_we);
-                for i in 1..=k {
+                for (i, at) in cam.iter_mut().enumerate().skip(1) {
                     r.arrive(Some(d2(i - 1, i)), cos(i, dir(i, i - 1)));
-                    cam[i] = r;
+                    *at = r;
                     if i < k {
                         let (wo, wi) = (dir(i, i - 1), dir(i, i + 1));
                         diffuse_scatter(&mut r, i, wo, wi);
