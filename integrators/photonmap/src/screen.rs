@@ -212,28 +212,6 @@ impl ScreenBeams {
 
     /// Calls `visit(piece, crossing)` for every piece of `map` (the map the bins were built
     /// from) that `BeamMap::cross` accepts on the camera segment `ray` (0 to `t_end`, medium
-    /// `medium`), a segment on the primary ray through the film point `film`, and returns
-    /// true; or returns false without calling `visit` if the bins cannot answer for this
-    /// segment ([`ScreenBeams::answers`]). What the screen's estimate does, for the tests.
-    #[cfg(test)]
-    fn along_primary(
-        &self,
-        map: &BeamMap,
-        film: Vec2,
-        ray: &Ray,
-        t_end: f32,
-        medium: u32,
-        visit: &mut impl FnMut(u32, &Crossing),
-    ) -> bool {
-        let answers = self.answers(film, ray);
-        if answers {
-            self.along(map, film, ray, t_end, medium, visit);
-        }
-        answers
-    }
-
-    /// Calls `visit(piece, crossing)` for every piece of `map` (the map the bins were built
-    /// from) that `BeamMap::cross` accepts on the camera segment `ray` (0 to `t_end`, medium
     /// `medium`), a segment on the primary ray through the film point `film` that the bins
     /// answer for ([`ScreenBeams::answers`]).
     fn along(
@@ -473,10 +451,12 @@ mod tests {
                     want.push((id, c.t_c.to_bits()))
                 });
                 let mut got = Vec::new();
-                let answered =
-                    screen.along_primary(&map, film, &ray, t_end, medium, &mut |id, c| {
+                let answered = screen.answers(film, &ray);
+                if answered {
+                    screen.along(&map, film, &ray, t_end, medium, &mut |id, c| {
                         got.push((id, c.t_c.to_bits()))
                     });
+                }
                 let inside =
                     film.x >= -1.5 && film.y >= -1.5 && film.x <= w + 1.5 && film.y <= h + 1.5;
                 if off <= 1.0 && inside {
