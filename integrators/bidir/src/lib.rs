@@ -437,26 +437,23 @@ impl Bidir {
 
             // ---- s = 0: an area light reached ----
             if side == Side::Camera
-                && let Some((id, light)) = scene.area_light(&hit)
+                && let Some((id, light, le)) = seg.emitted(scene)
             {
-                let le = light.emitted(hit.ng, wo);
-                if le != Rgb::ZERO {
-                    let w = self.weight_emitter(length + 1, specular, || {
-                        let pick = scene.light_pmf(id as usize);
-                        let (pos, pdf_dir) = light.pdf_le(hit.ng, wo);
-                        // The point sampled by the other strategy that ends here: next-event
-                        // estimation from the previous vertex, or, seen from the camera, the
-                        // light's emission connected to the camera (s = 1, t = 1).
-                        let direct = if length == 1 {
-                            pick * pos
-                        } else {
-                            pick * light.pdf_li(prev, hit.p, hit.ng) * hit.ng.dot(wo).abs()
-                                / prev.distance_squared(hit.p)
-                        };
-                        weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
-                    });
-                    radiance += beta * le * w;
-                }
+                let w = self.weight_emitter(length + 1, specular, || {
+                    let pick = scene.light_pmf(id as usize);
+                    let (pos, pdf_dir) = light.pdf_le(hit.ng, wo);
+                    // The point sampled by the other strategy that ends here: next-event
+                    // estimation from the previous vertex, or, seen from the camera, the
+                    // light's emission connected to the camera (s = 1, t = 1).
+                    let direct = if length == 1 {
+                        pick * pos
+                    } else {
+                        pick * light.pdf_li(prev, hit.p, hit.ng) * hit.ng.dot(wo).abs()
+                            / prev.distance_squared(hit.p)
+                    };
+                    weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
+                });
+                radiance += beta * le * w;
             }
             if side == Side::Camera && length > self.max_depth {
                 break;
