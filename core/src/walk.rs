@@ -21,6 +21,7 @@ use crate::bsdf::Bsdf;
 use crate::direct::{Mis, Scatter, estimate_direct};
 use crate::error::Result;
 use crate::geometry::{Hit, Ray, offset_origin};
+use crate::light::Light;
 use crate::material::TransportMode;
 use crate::medium::Medium;
 use crate::props::Properties;
@@ -88,6 +89,16 @@ impl Segment {
     #[inline]
     pub fn start(&self) -> Ray {
         Ray::new(self.ray.at(-self.gap), self.ray.dir)
+    }
+
+    /// The radiance the surface that ends the segment emits back along the ray, with its
+    /// light and the light's index; None if it emits none that way (or there is no surface).
+    #[inline]
+    pub fn emitted<'a>(&self, scene: &'a Scene) -> Option<(u32, &'a Light, Rgb)> {
+        let hit = self.hit.as_ref()?;
+        let (id, light) = scene.area_light(hit)?;
+        let le = light.emitted(hit.ng, -self.ray.dir);
+        (le != Rgb::ZERO).then_some((id, light, le))
     }
 
     /// The segment's medium, if it absorbs or scatters (a vacuum medium is skipped, so that it
@@ -333,12 +344,9 @@ pub fn walk_to_diffuse(
             Reached::Ended => break,
         };
         let wo = -seg.ray.dir;
-        if let Some((light_id, light)) = scene.area_light(&hit) {
-            let le = light.emitted(hit.ng, wo);
-            if le != Rgb::ZERO {
-                let w = emission_weight(scene, glossy_from, light_id, Some(hit.p), hit.ng);
-                emitted += beta * le * w;
-            }
+        if let Some((light_id, _, le)) = seg.emitted(scene) {
+            let w = emission_weight(scene, glossy_from, light_id, Some(hit.p), hit.ng);
+            emitted += beta * le * w;
         }
         if bounces >= how.max_depth {
             break;

@@ -338,21 +338,25 @@ mod tests {
                 let total: f64 = (0..=k).map(|s| density(s).powi(2)).sum::<f64>()
                     + (1..k).map(|i| merge(i).powi(2)).sum::<f64>();
 
+                // A diffuse bounce at x_i from wo to wi.
+                let diffuse_scatter = |r: &mut Running, i: usize, wo: Vec3, wi: Vec3| {
+                    r.scatter(
+                        cos(i, wi),
+                        diffuse_pdf(ns[i], wi),
+                        diffuse_pdf(ns[i], wo),
+                        false,
+                        &f,
+                    )
+                };
                 // The running quantities along the camera subpath (x1 .. x_{k-1}).
                 let mut cam = vec![Running::default(); k + 1];
                 let mut r = Running::camera(filter_pdf * pdf_we);
-                for i in 1..=k {
+                for (i, at) in cam.iter_mut().enumerate().skip(1) {
                     r.arrive(Some(d2(i - 1, i)), cos(i, dir(i, i - 1)));
-                    cam[i] = r;
+                    *at = r;
                     if i < k {
                         let (wo, wi) = (dir(i, i - 1), dir(i, i + 1));
-                        r.scatter(
-                            cos(i, wi),
-                            diffuse_pdf(ns[i], wi),
-                            diffuse_pdf(ns[i], wo),
-                            false,
-                            &f,
-                        );
+                        diffuse_scatter(&mut r, i, wo, wi);
                     }
                 }
                 // Along the light subpath (x_k, x_{k-1}, ..., x1).
@@ -373,13 +377,7 @@ mod tests {
                     lig[i] = r;
                     if i > 1 {
                         let (wo, wi) = (dir(i, i + 1), dir(i, i - 1));
-                        r.scatter(
-                            cos(i, wi),
-                            diffuse_pdf(ns[i], wi),
-                            diffuse_pdf(ns[i], wo),
-                            false,
-                            &f,
-                        );
+                        diffuse_scatter(&mut r, i, wo, wi);
                     }
                 }
 

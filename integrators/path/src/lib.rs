@@ -147,16 +147,13 @@ impl PathTracer {
             let wo = -seg.ray.dir;
 
             // ---- Emission (weighted against light sampling at the previous vertex) ----
-            if let Some((light_id, light)) = scene.area_light(&hit) {
-                let le = light.emitted(hit.ng, wo);
-                if le != Rgb::ZERO {
-                    if specular {
-                        radiance += beta * le;
-                    } else {
-                        let pdf_light = scene.light_pmf(light_id as usize)
-                            * light.pdf_li(prev_p, hit.p, hit.ng);
-                        radiance += beta * le * power_heuristic(prev_pdf, pdf_light);
-                    }
+            if let Some((light_id, light, le)) = seg.emitted(scene) {
+                if specular {
+                    radiance += beta * le;
+                } else {
+                    let pdf_light =
+                        scene.light_pmf(light_id as usize) * light.pdf_li(prev_p, hit.p, hit.ng);
+                    radiance += beta * le * power_heuristic(prev_pdf, pdf_light);
                 }
             }
             if depth >= self.max_depth {

@@ -42,10 +42,9 @@
 //! beam lies within the piece, so a beam is counted once.
 
 use crate::map::Photon;
-use crate::screen::ScreenBeams;
 use foton_core::api::{
     Accel, Medium, NO_ATTRS, NormalizedKernel, Phase, Primitive, Properties, Ray, Result, Rgb,
-    Scene, Shape, Vec2, Vec3, transmittance_homogeneous,
+    Scene, Shape, Vec3, transmittance_homogeneous,
 };
 
 /// Which flight segments a photon records (module comment).
@@ -280,7 +279,7 @@ pub struct BeamMap {
     beams: Vec<Beam>,
     /// Indexed by the BVH primitives' `object`.
     pub(crate) pieces: Vec<Piece>,
-    bvh: Accel,
+    pub(crate) bvh: Accel,
     radius: f32,
 }
 
@@ -429,36 +428,10 @@ impl BeamMap {
         });
         sum
     }
-
-    /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
-    /// point `film` (a segment of the camera path before any scattering: from the pinhole, or
-    /// past null boundaries on the same line), with the candidate pieces from the pass's
-    /// screen bins `screen` where they apply (`ScreenBeams::along_primary`); the same
-    /// estimate, summed in piece order.
-    #[allow(clippy::too_many_arguments)]
-    pub fn in_scattered_primary(
-        &self,
-        scene: &Scene,
-        kernel: &Kernel1d<'_>,
-        screen: &ScreenBeams,
-        film: Vec2,
-        ray: &Ray,
-        t_end: f32,
-        medium: u32,
-        depth: u32,
-    ) -> Rgb {
-        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
-        let mut sum = Rgb::ZERO;
-        let mut add = |id, c: &Crossing| gather.add(&mut sum, id, c);
-        if !screen.along_primary(self, film, ray, t_end, medium, &mut add) {
-            self.traverse(&self.bvh, ray, t_end, medium, &mut add)
-        }
-        sum
-    }
 }
 
 /// One segment's beam x beam estimate: what each accepted crossing adds (module comment).
-struct Gather<'a> {
+pub(crate) struct Gather<'a> {
     map: &'a BeamMap,
     coefficients: Coefficients<'a>,
     phase: Phase,
@@ -468,7 +441,7 @@ struct Gather<'a> {
 }
 
 impl<'a> Gather<'a> {
-    fn new(
+    pub(crate) fn new(
         map: &'a BeamMap,
         scene: &'a Scene,
         kernel: &'a Kernel1d<'a>,
@@ -487,8 +460,9 @@ impl<'a> Gather<'a> {
         }
     }
 
+    /// Adds what the crossing `c` of piece `id` contributes to `sum`.
     #[inline]
-    fn add(&self, sum: &mut Rgb, id: u32, c: &Crossing) {
+    pub(crate) fn add(&self, sum: &mut Rgb, id: u32, c: &Crossing) {
         let beam = self.map.beam_of(id);
         if beam.depth > self.depth {
             return;
@@ -616,6 +590,23 @@ pub fn exit_distance(ray: &Ray, (lo, hi): (Vec3, Vec3)) -> f32 {
 }
 
 #[cfg(test)]
+impl Beam {
+    /// A short beam from `a` to `b` in medium `medium` carrying unit flux, for tests.
+    pub(crate) fn unit_test(a: Vec3, b: Vec3, medium: u32) -> Beam {
+        Beam {
+            origin: a,
+            dir: (b - a).normalize(),
+            length: (b - a).length(),
+            flux: Rgb::ONE,
+            hero_r: Rgb::ONE,
+            medium,
+            depth: 1,
+            kind: BeamKind::Short,
+        }
+    }
+}
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use foton_core::api::{BoxKernel, ConeKernel};
@@ -682,16 +673,7 @@ mod tests {
                     let axis = [Vec3::X, Vec3::Y, Vec3::Z][(i as usize / 4) % 3];
                     b = a + axis * (b - a).dot(axis);
                 }
-                Beam {
-                    origin: a,
-                    dir: (b - a).normalize(),
-                    length: (b - a).length(),
-                    flux: Rgb::ONE,
-                    hero_r: Rgb::ONE,
-                    medium: i % 2,
-                    depth: 1,
-                    kind: BeamKind::Short,
-                }
+                Beam::unit_test(a, b, i % 2)
             })
             .collect();
         let r = 0.05;

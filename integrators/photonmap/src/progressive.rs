@@ -234,6 +234,12 @@ pub fn global_radius2_scale(iteration: u64, alpha: f64) -> f64 {
     (1..iteration).fold(1.0, |s, j| s * (j as f64 + alpha) / (j as f64 + 1.0))
 }
 
+/// One `T::default()` per pixel of the scene's film, in row order: a progressive
+/// integrator's per-pixel state.
+pub fn per_pixel<T: Clone + Default>(scene: &Scene) -> Vec<T> {
+    vec![T::default(); scene.film().width as usize * scene.film().height as usize]
+}
+
 /// The angle one pixel subtends at the centre of the image.
 pub fn pixel_angle(scene: &Scene) -> f32 {
     let (w, h) = (scene.film().width as f32, scene.film().height as f32);

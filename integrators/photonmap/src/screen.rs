@@ -35,8 +35,8 @@
 //! small BVH that the screen's query traverses too; pieces wholly behind the camera are left
 //! out (no point of a camera ray is near them).
 
-use crate::beams::{BeamMap, Crossing};
-use foton_core::api::{Accel, Camera, Ray, Vec2, Vec3};
+use crate::beams::{BeamMap, Crossing, Gather, Kernel1d};
+use foton_core::api::{Accel, Camera, Ray, Rgb, Scene, Vec2, Vec3};
 
 /// Bins are this many rows' bands wide (a band is one row up to 511 rows, [`ROWS`] more
 /// rows a band above). Narrower bins mean fewer pieces scanned and more entries built: 4, 8
@@ -197,12 +197,24 @@ impl ScreenBeams {
         self.bins.iter().map(Vec::len).sum()
     }
 
+    /// Whether the bins answer for a camera segment on `ray`, the primary ray through the
+    /// film point `film`: false if its line is too far from the pinhole, or `film` outside
+    /// the image's margin.
+    fn answers(&self, film: Vec2, ray: &Ray) -> bool {
+        let off = (ray.origin - self.position).cross(ray.dir);
+        let (w, h, m) = (self.width as f32, self.height as f32, self.margin);
+        off.length_squared() <= self.reach * self.reach
+            && film.x >= -m
+            && film.y >= -m
+            && film.x <= w + m
+            && film.y <= h + m
+    }
+
     /// Calls `visit(piece, crossing)` for every piece of `map` (the map the bins were built
     /// from) that `BeamMap::cross` accepts on the camera segment `ray` (0 to `t_end`, medium
-    /// `medium`), a segment on the primary ray through the film point `film`, and returns
-    /// true; or returns false without calling `visit` if the bins cannot answer for this
-    /// segment (its line too far from the pinhole, or `film` outside the image's margin).
-    pub(crate) fn along_primary(
+    /// `medium`), a segment on the primary ray through the film point `film` that the bins
+    /// answer for ([`ScreenBeams::answers`]).
+    fn along(
         &self,
         map: &BeamMap,
         film: Vec2,
@@ -210,17 +222,7 @@ impl ScreenBeams {
         t_end: f32,
         medium: u32,
         visit: &mut impl FnMut(u32, &Crossing),
-    ) -> bool {
-        let off = (ray.origin - self.position).cross(ray.dir);
-        let (w, h, m) = (self.width as f32, self.height as f32, self.margin);
-        if !(off.length_squared() <= self.reach * self.reach
-            && film.x >= -m
-            && film.y >= -m
-            && film.x <= w + m
-            && film.y <= h + m)
-        {
-            return false;
-        }
+    ) {
         let bin = &self.bins[self.band_of(film.y) * self.chunks as usize + self.chunk_of(film.x)];
         for span in bin {
             if span.x0 <= film.x
@@ -233,7 +235,37 @@ impl ScreenBeams {
         if let Some(near) = &self.near {
             map.traverse(near, ray, t_end, medium, visit);
         }
-        true
+    }
+}
+
+// The estimate with the screen's candidates is the map's, but lives here, beside the bins:
+// the map (beams.rs) knows nothing of the screen built from it.
+impl BeamMap {
+    /// [`BeamMap::in_scattered`] along a camera segment on the primary ray through the film
+    /// point `film` (a segment of the camera path before any scattering: from the pinhole, or
+    /// past null boundaries on the same line), with the candidate pieces from the pass's
+    /// screen bins `screen` where they apply ([`ScreenBeams::answers`]); the same
+    /// estimate, summed in piece order.
+    #[allow(clippy::too_many_arguments)]
+    pub fn in_scattered_primary(
+        &self,
+        scene: &Scene,
+        kernel: &Kernel1d<'_>,
+        screen: &ScreenBeams,
+        film: Vec2,
+        ray: &Ray,
+        t_end: f32,
+        medium: u32,
+        depth: u32,
+    ) -> Rgb {
+        if !screen.answers(film, ray) {
+            return self.in_scattered(scene, kernel, ray, t_end, medium, depth);
+        }
+        let gather = Gather::new(self, scene, kernel, ray, medium, depth);
+        let mut sum = Rgb::ZERO;
+        let mut add = |id, c: &Crossing| gather.add(&mut sum, id, c);
+        screen.along(self, film, ray, t_end, medium, &mut add);
+        sum
     }
 }
 
@@ -314,8 +346,7 @@ impl Pinhole {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::beams::{Beam, BeamKind};
-    use foton_core::api::Rgb;
+    use crate::beams::Beam;
     use foton_core::api::Rng;
 
     /// Random beams in front of a camera, some through the pinhole's plane and behind it, two
@@ -343,16 +374,7 @@ mod tests {
                 } else {
                     (point(rng, Vec3::ZERO, 2.0), point(rng, Vec3::ZERO, 2.0))
                 };
-                Beam {
-                    origin: a,
-                    dir: (b - a).normalize(),
-                    length: (b - a).length(),
-                    flux: Rgb::ONE,
-                    hero_r: Rgb::ONE,
-                    medium: (i % 7 == 6) as u32,
-                    depth: 1,
-                    kind: BeamKind::Short,
-                }
+                Beam::unit_test(a, b, (i % 7 == 6) as u32)
             })
             .collect()
     }
@@ -429,10 +451,12 @@ mod tests {
                     want.push((id, c.t_c.to_bits()))
                 });
                 let mut got = Vec::new();
-                let answered =
-                    screen.along_primary(&map, film, &ray, t_end, medium, &mut |id, c| {
+                let answered = screen.answers(film, &ray);
+                if answered {
+                    screen.along(&map, film, &ray, t_end, medium, &mut |id, c| {
                         got.push((id, c.t_c.to_bits()))
                     });
+                }
                 let inside =
                     film.x >= -1.5 && film.y >= -1.5 && film.x <= w + 1.5 && film.y <= h + 1.5;
                 if off <= 1.0 && inside {

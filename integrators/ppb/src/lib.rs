@@ -107,7 +107,7 @@ use foton_photonmap::beams::{
 use foton_photonmap::map::{CLIP_PROBES, DiscClip, Photon, PhotonMap};
 use foton_photonmap::progressive::{
     PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc_clipped,
-    global_radius2_scale, pixel_angle, run_passes,
+    global_radius2_scale, per_pixel, pixel_angle, run_passes,
 };
 use foton_photonmap::screen::ScreenBeams;
 use foton_photonmap::trace::{
@@ -150,6 +150,8 @@ struct Pass {
     screen: ScreenBeams,
     /// R_i / R_1 for the surface gather.
     surface_shrink: f64,
+    /// The angle one pixel subtends (for the automatic first radius).
+    pixel_angle: f32,
 }
 
 impl Ppb {
@@ -210,18 +212,17 @@ impl Ppb {
             screen: ScreenBeams::build(&beams, scene.camera(), margin),
             beams,
             surface_shrink: scale.sqrt(),
+            pixel_angle: pixel_angle(scene),
         })
     }
 
     /// Pass `iteration`'s estimate of the radiance through pixel `pixel` at (x, y).
-    #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
         scene: &Scene,
         pass: &Pass,
         iteration: u64,
         (x, y): (u32, u32),
-        angle: f32,
         rays: &mut u64,
         bad_photons: &mut u64,
     ) -> Rgb {
@@ -300,7 +301,7 @@ impl Ppb {
             }
             let r1 = match self.initial_radius {
                 Some(r) => r as f64,
-                None => auto_radius(scene, angle, vp.distance, FOOTPRINTS),
+                None => auto_radius(scene, pass.pixel_angle, vp.distance, FOOTPRINTS),
             };
             let r = (r1 * pass.surface_shrink) as f32;
             *rays += CLIP_PROBES as u64;
@@ -323,7 +324,6 @@ struct PpbPasses<'a> {
     ppb: &'a Ppb,
     scene: &'a Scene,
     sums: Vec<RadianceSum>,
-    angle: f32,
     tally: &'a Tally,
 }
 
@@ -334,7 +334,7 @@ impl Passes for PpbPasses<'_> {
         if quiet.cancelled() {
             return Ok(None);
         }
-        let (width, angle) = (scene.film().width as usize, self.angle);
+        let width = scene.film().width as usize;
         with_pool(quiet.threads, || {
             self.sums
                 .par_chunks_mut(width)
@@ -347,7 +347,6 @@ impl Passes for PpbPasses<'_> {
                             &pass,
                             iteration,
                             (x as u32, y as u32),
-                            angle,
                             &mut row_rays,
                             &mut row_bad,
                         );
@@ -392,11 +391,7 @@ impl Integrator for Ppb {
         let mut passes = PpbPasses {
             ppb: self,
             scene,
-            sums: vec![
-                RadianceSum::default();
-                scene.film().width as usize * scene.film().height as usize
-            ],
-            angle: pixel_angle(scene),
+            sums: per_pixel(scene),
             tally: &tally,
         };
         // Passes are independent (r_1 from each pass's own visible point): any split works.

@@ -85,7 +85,8 @@ use foton_core::api::{
 };
 use foton_photonmap::map::PhotonMap;
 use foton_photonmap::progressive::{
-    PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc, pixel_angle, run_passes,
+    PassBudget, Passes, SPPM_FOOTPRINTS, Tally, auto_radius, gather_disc, per_pixel, pixel_angle,
+    run_passes,
 };
 use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_photons};
 use glam::DVec3;
@@ -416,10 +417,7 @@ impl Integrator for Sppm {
         let mut passes = SppmPasses {
             sppm: self,
             scene,
-            stats: vec![
-                PixelStats::default();
-                scene.film().width as usize * scene.film().height as usize
-            ],
+            stats: per_pixel(scene),
             angle: pixel_angle(scene),
             tally: &tally,
             started: false,

@@ -11,6 +11,7 @@ use foton_core::api::Vec3;
 pub struct HashGrid {
     min: Vec3,
     inv_cell: f32,
+    radius: f32,
     radius2: f32,
     /// Bucket b holds `indices[starts[b]..starts[b + 1]]`.
     starts: Vec<u32>,
@@ -29,6 +30,7 @@ impl HashGrid {
         let mut grid = HashGrid {
             min,
             inv_cell,
+            radius,
             radius2: radius * radius,
             starts: vec![0; buckets + 1],
             indices: vec![0; positions.len()],
@@ -51,6 +53,12 @@ impl HashGrid {
         }
         grid.positions = positions;
         grid
+    }
+
+    /// The query radius the grid was built for.
+    #[inline]
+    pub fn radius(&self) -> f32 {
+        self.radius
     }
 
     /// The (continuous) cell coordinates of `p`.

@@ -280,14 +280,12 @@ impl Vcm {
 
     /// The camera pass: every pixel's camera subpath, its connections with its own light
     /// subpath (whose t = 1 splats it also makes) and its merges.
-    #[allow(clippy::too_many_arguments)]
     fn camera_pass(
         &self,
         scene: &Scene,
         bidir: &Bidir,
         lights: &LightPaths,
         grid: Option<&HashGrid>,
-        radius: f32,
         iteration: u64,
     ) -> Vec<Row> {
         let (width, height) = (scene.film().width, scene.film().height);
@@ -338,8 +336,7 @@ impl Vcm {
                             }
                             if let Some(grid) = grid {
                                 // ---- merges ----
-                                l += self.merge(bidir, c, &lights.vertices, grid, radius)
-                                    / light_paths;
+                                l += self.merge(bidir, c, &lights.vertices, grid) / light_paths;
                             }
                         }
                     }
@@ -356,19 +353,13 @@ impl Vcm {
             .collect()
     }
 
-    /// The merges of camera vertex `c` with the light vertices within `radius`: sum_v
+    /// The merges of camera vertex `c` with the light vertices within the grid's radius: sum_v
     /// K f beta_c beta_v w_v (divided by the light path count by the caller).
-    fn merge(
-        &self,
-        bidir: &Bidir,
-        c: &Vertex,
-        vertices: &[Vertex],
-        grid: &HashGrid,
-        radius: f32,
-    ) -> Rgb {
+    fn merge(&self, bidir: &Bidir, c: &Vertex, vertices: &[Vertex], grid: &HashGrid) -> Rgb {
         let At::Surface { hit, bsdf } = &c.at else {
             return Rgb::ZERO;
         };
+        let radius = grid.radius();
         let r2 = radius * radius;
         let thickness = DISC_THICKNESS * radius;
         let mut sum = Rgb::ZERO;
@@ -430,7 +421,7 @@ impl Passes for VcmPasses<'_> {
                 .mode
                 .merges()
                 .then(|| HashGrid::build(lights.vertices.iter().map(|v| v.p).collect(), radius));
-            let rows = vcm.camera_pass(scene, &bidir, &lights, grid.as_ref(), radius, iteration);
+            let rows = vcm.camera_pass(scene, &bidir, &lights, grid.as_ref(), iteration);
             (rows, light_rays)
         })?;
         if quiet.cancelled() {

@@ -18,10 +18,10 @@
 //! relative slack. Every render is seeded, so each comparison is one fixed draw; z = 4.5 keeps
 //! the chance that a correct estimator fails any of the few hundred block channels below 1 %.
 
+use crate::parts::assert_three_parts_merge;
 use foton_core::film::Film;
 use foton_tests::stats::{Tolerance, assert_blocks_agree, film_of};
-use foton_tests::{foton, foton_with_plugins, render_file, render_toml, temp_dir, write};
-use std::path::Path;
+use foton_tests::{render_file, render_toml, temp_dir, write};
 
 const SIZE: u32 = 32;
 const Z: Tolerance = Tolerance {
@@ -467,55 +467,13 @@ fn the_splatting_film_is_the_same_for_any_thread_count() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn bytes(path: &Path) -> Vec<u8> {
-    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
 /// `foton render --part I/N` of a splatting render, merged: the whole render's EXR byte for
 /// byte (the splat sums are stored and added apart, and scaled by the samples of all parts).
 #[test]
 fn bdpt_parts_merge_to_the_whole_render() {
     let dir = temp_dir("bdpt-parts");
     let scene = write(&dir, "scene.toml", &diffuse_box());
-    let render = |extra: &[&str]| {
-        let mut args = vec![
-            "render",
-            scene.to_str().unwrap(),
-            "-q",
-            "--integrator",
-            "bdpt",
-            "--spp",
-            "6",
-        ];
-        args.extend(extra);
-        let run = foton_with_plugins(&args);
-        assert_eq!(run.code, 0, "{}", run.stderr);
-    };
-    let whole = dir.join("whole.exr");
-    render(&["--threads", "1", "-o", whole.to_str().unwrap()]);
-    let mut parts = Vec::new();
-    for i in (0..3).rev() {
-        let out = dir.join(format!("part-{i}.exr"));
-        render(&[
-            "--threads",
-            "2",
-            "--part",
-            &format!("{i}/3"),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        parts.push(out);
-    }
-    let merged = dir.join("merged.exr");
-    let mut args = vec!["merge"];
-    args.extend(parts.iter().map(|p| p.to_str().unwrap()));
-    args.extend(["-o", merged.to_str().unwrap()]);
-    let run = foton(&args);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert!(
-        bytes(&merged) == bytes(&whole),
-        "the merge of 3 bdpt parts differs from the whole render"
-    );
+    assert_three_parts_merge("bdpt", &scene, &["--integrator", "bdpt", "--spp", "6"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

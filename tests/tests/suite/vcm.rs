@@ -15,10 +15,10 @@
 //! (`foton_tests::stats::compare_blocks`), as in tests/tests/suite/bdpt.rs; where merges are used the
 //! radius bias is allowed for as a relative term derived in the test's comment.
 
+use crate::parts::assert_three_parts_merge;
 use foton_core::film::Film;
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
-use foton_tests::{foton, foton_with_plugins, render_file, render_toml, temp_dir, write};
-use std::path::Path;
+use foton_tests::{render_file, render_toml, temp_dir, write};
 
 const SIZE: u32 = 32;
 const Z: Tolerance = Tolerance {
@@ -257,54 +257,21 @@ fn vcm_is_the_same_for_any_thread_count() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-fn bytes(path: &Path) -> Vec<u8> {
-    std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
-}
-
 /// `foton render --part I/N` splits the iterations; the merged parts are the whole render's
 /// EXR byte for byte.
 #[test]
 fn vcm_parts_merge_to_the_whole_render() {
     let dir = temp_dir("vcm-parts");
     let scene = write(&dir, "scene.toml", &cornell("glass", "white"));
-    let render = |extra: &[&str]| {
-        let mut args = vec![
-            "render",
-            scene.to_str().unwrap(),
-            "-q",
+    assert_three_parts_merge(
+        "vcm",
+        &scene,
+        &[
             "--integrator",
             "vcm",
             "--set",
             "integrators.vcm.iterations=5",
-        ];
-        args.extend(extra);
-        let run = foton_with_plugins(&args);
-        assert_eq!(run.code, 0, "{}", run.stderr);
-    };
-    let whole = dir.join("whole.exr");
-    render(&["--threads", "1", "-o", whole.to_str().unwrap()]);
-    let mut parts = Vec::new();
-    for i in (0..3).rev() {
-        let out = dir.join(format!("part-{i}.exr"));
-        render(&[
-            "--threads",
-            "2",
-            "--part",
-            &format!("{i}/3"),
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        parts.push(out);
-    }
-    let merged = dir.join("merged.exr");
-    let mut args = vec!["merge"];
-    args.extend(parts.iter().map(|p| p.to_str().unwrap()));
-    args.extend(["-o", merged.to_str().unwrap()]);
-    let run = foton(&args);
-    assert_eq!(run.code, 0, "{}", run.stderr);
-    assert!(
-        bytes(&merged) == bytes(&whole),
-        "the merge of 3 vcm parts differs from the whole render"
+        ],
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
