@@ -445,7 +445,7 @@ impl Integrator for Ppb {
             foton_photonmap::view(
                 "iteration",
                 "one pass's surface photons (but L D with direct = \"nee\")",
-                self.passes.photons_per_iteration,
+                self.surface_photons,
                 &photons,
             ),
             foton_photonmap::view(

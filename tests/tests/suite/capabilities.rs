@@ -165,3 +165,32 @@ fn photon_maps_are_the_integrators_own() {
         .collect();
     assert_eq!(names, ["global", "caustic", "volume"]);
 }
+
+/// `ppb`'s maps count the photons of the passes that filled them: its surface photons come
+/// from a pass of `surface_photons` (when that is more than `photons_per_iteration`), its
+/// beams from a pass of `photons_per_iteration`.
+#[test]
+fn ppb_photon_maps_count_their_own_passes() {
+    let cancel = AtomicBool::new(false);
+    let ctx =
+        foton_core::integrator::RenderContext::new(2, &cancel, &foton_core::integrator::NoProgress);
+    let p = prepared(
+        "ppb",
+        &[
+            "integrators.ppb.photons_per_iteration=500".into(),
+            "integrators.ppb.surface_photons=4000".into(),
+        ],
+    );
+    let maps = p.integrator.photon_maps(&p.scene, &ctx).unwrap();
+    let names: Vec<&str> = maps.iter().map(|m| m.name.as_str()).collect();
+    assert_eq!(names, ["iteration", "beams"]);
+    assert_eq!((maps[0].emitted, maps[1].emitted), (4000, 500));
+    // The surface photons' flux is the lights' power over the 4000 emitted, times the mean
+    // number of diffuse hits (about 3 in this box): over 500 it would be eight times that.
+    let stored: glam::Vec3 = maps[0].photons.iter().map(|ph| ph.power).sum();
+    let power = p.scene.total_power();
+    assert!(
+        stored.x > 0.0 && stored.x < 5.0 * power.x,
+        "{stored} against {power}"
+    );
+}
