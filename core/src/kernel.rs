@@ -199,7 +199,7 @@ pub fn builtin(name: &str, cone_c: f64) -> Option<Box<dyn Kernel>> {
     )])));
     let props = crate::props::Properties::new(std::path::Path::new(""), "", &table).ok()?;
     let factory = crate::registry::find(KERNELS, name)?;
-    (factory.create)(&props, &mut Vec::new()).ok()
+    (factory.create)(&props, &mut Vec::new(), &mut crate::registry::NoResources).ok()
 }
 
 /// A loaded kernel plugin (C ABI, found by [`crate::plugin`]): here, below `props`, which

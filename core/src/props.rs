@@ -114,7 +114,7 @@ impl<'a> Properties<'a> {
         // A built-in reads its own parameters (`cone_c`) from this bag.
         let kernel: Box<dyn crate::kernel::Kernel> =
             if let Some(factory) = crate::registry::find(KERNELS, kind) {
-                (factory.create)(self, &mut Vec::new())?
+                (factory.create)(self, &mut Vec::new(), &mut crate::registry::NoResources)?
             } else if let Some(k) = self.plugins.iter().find(|k| k.name == kind) {
                 Box::new(k.clone())
             } else {

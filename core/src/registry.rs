@@ -11,13 +11,58 @@
 //!
 //! docs/extending.md walks through adding one of each.
 
-use crate::error::{Result, did_you_mean};
+use crate::Rgb;
+use crate::error::{Error, Result, did_you_mean};
 use crate::props::Properties;
+use crate::texture::{Bitmap, Texture};
+use glam::Mat4;
 
 /// How a built-in plugin is made from its bag. Nested tables it reads (a medium's
 /// `phase = { type = "hg", g = 0.8 }`) are pushed onto `nested`, so that the caller reports
-/// their unknown keys like those of the bag itself.
-pub type Create<T> = for<'a> fn(&Properties<'a>, &mut Vec<Properties<'a>>) -> Result<Box<T>>;
+/// their unknown keys like those of the bag itself; files, textures and transforms come from
+/// `resources`, the scene reader's.
+pub type Create<T> =
+    for<'a> fn(&Properties<'a>, &mut Vec<Properties<'a>>, &mut dyn Resources) -> Result<Box<T>>;
+
+/// What a built-in reads beyond its bag's numbers and strings, from the scene reader, which
+/// knows the scene file's folder and its textures and collects its warnings.
+pub trait Resources {
+    /// The image named by the string parameter `key` (a path relative to the scene file's
+    /// folder), in linear RGB (`raw`: the stored values, without decoding sRGB); the file
+    /// becomes one of the scene's sources.
+    fn bitmap(&mut self, bag: &Properties<'_>, key: &str, raw: bool) -> Result<Bitmap>;
+    /// The transform table `key` (`matrix`, or translate, rotate and scale; the identity
+    /// when absent).
+    fn transform(&mut self, bag: &Properties<'_>, key: &str) -> Result<Mat4>;
+    /// A colour parameter that may vary over the surface: `[r, g, b]` or a texture table;
+    /// `default` when absent.
+    fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture>;
+    /// A warning about parameter `key`, reported with the scene's others.
+    fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String);
+}
+
+/// The resources of a bag read outside a scene file (an integrator's `kernel`): none, so
+/// asking for a file or a texture is an error; warnings are dropped.
+pub struct NoResources;
+
+impl NoResources {
+    fn none(bag: &Properties<'_>, key: &str) -> Error {
+        bag.error(key, "files and textures are read only in a scene file")
+    }
+}
+
+impl Resources for NoResources {
+    fn bitmap(&mut self, bag: &Properties<'_>, key: &str, _: bool) -> Result<Bitmap> {
+        Err(Self::none(bag, key))
+    }
+    fn transform(&mut self, bag: &Properties<'_>, key: &str) -> Result<Mat4> {
+        Err(Self::none(bag, key))
+    }
+    fn texture(&mut self, bag: &Properties<'_>, key: &str, _: Rgb) -> Result<Texture> {
+        Err(Self::none(bag, key))
+    }
+    fn warn(&mut self, _: &Properties<'_>, _: &str, _: String) {}
+}
 
 /// A built-in plugin of a kind `T` (`dyn Medium`, `dyn Kernel`): what its file registers.
 pub struct Factory<T: ?Sized + 'static> {
@@ -147,7 +192,8 @@ mod tests {
         ]);
         let props = Properties::new(Path::new("test.toml"), "media.fog", &table).unwrap();
         let mut nested = Vec::new();
-        let m = (find(MEDIA, "homogeneous").unwrap().create)(&props, &mut nested).unwrap();
+        let m = (find(MEDIA, "homogeneous").unwrap().create)(&props, &mut nested, &mut NoResources)
+            .unwrap();
         let direct = Homogeneous {
             sigma_a: crate::Rgb::new(0.1, 0.2, 0.3),
             sigma_s: crate::Rgb::new(0.5, 0.25, 0.0),
@@ -172,7 +218,8 @@ mod tests {
     fn a_kernel_from_the_table_equals_one_built_directly() {
         let table = bag(&[("cone_c", Value::Float(1.5))]);
         let props = Properties::new(Path::new("test.toml"), "integrators.photon", &table).unwrap();
-        let k = (find(KERNELS, "cone").unwrap().create)(&props, &mut Vec::new()).unwrap();
+        let k = (find(KERNELS, "cone").unwrap().create)(&props, &mut Vec::new(), &mut NoResources)
+            .unwrap();
         let direct = crate::kernel::ConeKernel { c: 1.5 };
         assert_eq!(k.name(), direct.name());
         assert_eq!(k.parameters(), direct.parameters());

@@ -18,5 +18,5 @@ impl Kernel for BoxKernel {
 pub const FACTORY: Factory<dyn Kernel> = Factory {
     name: "box",
     description: "constant weight over the disc or ball",
-    create: |_, _| Ok(Box::new(BoxKernel)),
+    create: |_, _, _| Ok(Box::new(BoxKernel)),
 };

@@ -23,7 +23,7 @@ impl Kernel for ConeKernel {
 pub const FACTORY: Factory<dyn Kernel> = Factory {
     name: "cone",
     description: "Jensen's cone filter 1 - t / cone_c",
-    create: |p, _| {
+    create: |p, _, _| {
         let c = p.f32("cone_c", 1.0)?;
         if c < 1.0 {
             return Err(p.error("cone_c", format!("must be >= 1, found {c}")));

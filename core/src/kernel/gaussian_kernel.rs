@@ -21,5 +21,5 @@ impl Kernel for GaussianKernel {
 pub const FACTORY: Factory<dyn Kernel> = Factory {
     name: "gaussian",
     description: "Jensen's Gaussian filter (alpha = 0.918, beta = 1.953)",
-    create: |_, _| Ok(Box::new(GaussianKernel)),
+    create: |_, _, _| Ok(Box::new(GaussianKernel)),
 };

@@ -85,7 +85,7 @@ impl Medium for Homogeneous {
 pub const FACTORY: Factory<dyn Medium> = Factory {
     name: "homogeneous",
     description: "constant absorption and scattering, isotropic or Henyey-Greenstein phase",
-    create: |m, nested| {
+    create: |m, nested, _| {
         let sigma_a = m.rgb("sigma_a", Rgb::ZERO)?;
         let sigma_s = m.rgb("sigma_s", Rgb::ZERO)?;
         let phase = Phase::read(m, nested)?;

@@ -2,11 +2,15 @@
 //! shapes and lights fill, names defined in a section, a table's `type`, arrays of tables and
 //! transform tables.
 
+use crate::texture::{load_bitmap, read_texture_param};
+use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::geometry::{Primitive, TriangleAttrs};
 use foton_core::light::Light;
 use foton_core::props::{Properties, Unused};
+use foton_core::registry::Resources;
 use foton_core::scene::Object;
+use foton_core::texture::{Bitmap, Texture};
 use foton_core::value::Value;
 use glam::{Mat4, Vec3};
 use std::collections::HashMap;
@@ -24,8 +28,29 @@ impl Loader {
     pub(super) fn done(&mut self, bag: &Properties<'_>) {
         self.bags.push(bag.unused());
     }
+}
 
-    pub(super) fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String) {
+impl Resources for Loader {
+    fn bitmap(&mut self, bag: &Properties<'_>, key: &str, raw: bool) -> Result<Bitmap> {
+        let path = self.dir.join(bag.string_required(key)?);
+        let bitmap = load_bitmap(&path, raw).map_err(|e| bag.error(key, e.to_string()))?;
+        self.sources.push(path);
+        Ok(bitmap)
+    }
+
+    fn transform(&mut self, bag: &Properties<'_>, key: &str) -> Result<Mat4> {
+        read_transform_at(bag, key, self)
+    }
+
+    fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture> {
+        let (texture, table) = read_texture_param(bag, key, default, &self.dir)?;
+        if let Some(table) = table {
+            self.done(&table);
+        }
+        Ok(texture)
+    }
+
+    fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String) {
         self.warnings.push(format!(
             "{}: `{}`: {message}",
             bag.location(key),

@@ -9,6 +9,7 @@ use foton_core::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic}
 use foton_core::material::Material;
 use foton_core::microfacet::{Microfacet, MicrofacetKind};
 use foton_core::props::Properties;
+use foton_core::registry::Resources;
 use foton_core::scene::Named;
 use foton_core::texture::Texture;
 use std::collections::HashMap;

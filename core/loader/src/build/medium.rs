@@ -53,7 +53,7 @@ pub(super) fn read_media(
         let factory = registry::find(MEDIA, ty)
             .ok_or_else(|| m.error("type", registry::unknown("medium type", ty, MEDIA)))?;
         let mut nested = Vec::new();
-        let medium = (factory.create)(&m, &mut nested)?;
+        let medium = (factory.create)(&m, &mut nested, ld)?;
         for bag in &nested {
             ld.done(bag);
         }
