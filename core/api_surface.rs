@@ -9,7 +9,9 @@
 //! a macro's whole text; an external item's path. For each exposed type, the signatures of
 //! its public inherent methods and constants and the headers of the traits it implements;
 //! and, since a plugin reaches them through those signatures and fields, the same again for
-//! every type of the crate that they name, to the end of that chain. Members marked
+//! every type of the crate that they name, to the end of that chain. Items written inside a
+//! macro invocation (a registration list such as `lights! { pub enum Light { .. } }`) are
+//! read as items, with the macro's text, which adds their methods. Members marked
 //! `#[doc(hidden)]` are the host's and not part of it. Doc comments, other
 //! comments, formatting, function bodies and everything the chain does not reach are not
 //! part of it.
@@ -24,6 +26,9 @@ use syn::{Attribute, Item, UseTree, Visibility};
 struct Module {
     path: Vec<String>,
     items: Vec<Item>,
+    /// The items written inside a macro invocation (`lights! { pub enum Light { .. } }`),
+    /// which are among `items`, with the name of the macro that expands them.
+    expanded_by: BTreeMap<String, String>,
 }
 
 /// Whether an attribute `#[name(args)]` is among `attrs` (`cfg(test)`, `doc(hidden)`).
@@ -36,7 +41,32 @@ fn has_attr(attrs: &[Attribute], name: &str, args: &str) -> bool {
     })
 }
 
-fn collect_modules(path: Vec<String>, items: Vec<Item>, out: &mut Vec<Module>) {
+fn collect_modules(path: Vec<String>, mut items: Vec<Item>, out: &mut Vec<Module>) {
+    // A registration macro's input that is itself items (an enum the macro emits with its
+    // dispatch) is read as items; the macro's text goes on the surface with them (see
+    // `surface`), since its expansion adds their methods.
+    let mut expanded_by = BTreeMap::new();
+    let invocations: Vec<syn::ItemMacro> = items
+        .iter()
+        .filter_map(|i| match i {
+            Item::Macro(m) if m.ident.is_none() => Some(m.clone()),
+            _ => None,
+        })
+        .collect();
+    for m in invocations {
+        let Ok(file) = syn::parse2::<syn::File>(m.mac.tokens.clone()) else {
+            continue;
+        };
+        let Some(macro_name) = m.mac.path.segments.last().map(|s| s.ident.to_string()) else {
+            continue;
+        };
+        for inner in file.items {
+            if let Some(name) = item_name(&inner) {
+                expanded_by.insert(name, macro_name.clone());
+                items.push(inner);
+            }
+        }
+    }
     for item in &items {
         if let Item::Mod(m) = item
             && let Some((_, inner)) = &m.content
@@ -47,7 +77,11 @@ fn collect_modules(path: Vec<String>, items: Vec<Item>, out: &mut Vec<Module>) {
             collect_modules(p, inner.clone(), out);
         }
     }
-    out.push(Module { path, items });
+    out.push(Module {
+        path,
+        items,
+        expanded_by,
+    });
 }
 
 fn read_modules(dir: &Path, prefix: &[String], out: &mut Vec<Module>) -> Result<(), String> {
@@ -129,13 +163,18 @@ fn is_hidden(attrs: &[Attribute]) -> bool {
     has_attr(attrs, "doc", "hidden")
 }
 
-/// The identifiers of the paths a piece of syntax names (types, traits), for the chain.
+/// The identifiers of the paths a piece of syntax names (types, traits), and the paths of
+/// more than one segment whole (`point::PointLight`), for the chain.
 #[derive(Default)]
-struct Names(BTreeSet<String>);
+struct Names(BTreeSet<String>, BTreeSet<Vec<String>>);
 impl<'a> Visit<'a> for Names {
     fn visit_path(&mut self, p: &'a syn::Path) {
         for seg in &p.segments {
             self.0.insert(seg.ident.to_string());
+        }
+        if p.segments.len() > 1 {
+            self.1
+                .insert(p.segments.iter().map(|s| s.ident.to_string()).collect());
         }
         syn::visit::visit_path(self, p);
     }
@@ -386,6 +425,15 @@ pub fn surface(src: &Path) -> Result<String, String> {
         let mut mentioned: Vec<(Vec<String>, Names)> = vec![(def.0.clone(), names)];
         let key = format!("{}::{}", def.0.join("::"), def.1);
         lines.insert(format!("{key}: {text}"));
+        if let Some(name) = krate.module(&def.0).and_then(|m| m.expanded_by.get(&def.1)) {
+            let mac = krate.modules.iter().flat_map(|m| &m.items).find(
+                |i| matches!(i, Item::Macro(m) if m.ident.as_ref().is_some_and(|i| i == name)),
+            );
+            if let Some(Item::Macro(mac)) = mac {
+                let text = quote::ToTokens::to_token_stream(&mac.mac).to_string();
+                lines.insert(format!("{key}: expanded by {name}: {text}"));
+            }
+        }
         if matches!(
             item,
             Item::Struct(_) | Item::Enum(_) | Item::Trait(_) | Item::Type(_) | Item::Union(_)
@@ -442,12 +490,17 @@ pub fn surface(src: &Path) -> Result<String, String> {
                 }
             }
         }
-        for (module, name) in mentioned
-            .into_iter()
-            .flat_map(|(m, n)| n.0.into_iter().map(move |n| (m.clone(), n)))
-        {
-            if let Some(next) = krate.resolve_in(&module, &name)
-                && !seen.contains(&next)
+        let mut reached = Vec::new();
+        for (module, names) in mentioned {
+            for name in names.0 {
+                reached.extend(krate.resolve_in(&module, &name));
+            }
+            for path in names.1 {
+                reached.extend(krate.resolve_path(&module, &path, 0));
+            }
+        }
+        for next in reached {
+            if !seen.contains(&next)
                 && krate.item(&next).is_some_and(|i| {
                     matches!(
                         i,

@@ -46,7 +46,7 @@ pub use crate::accel::Accel;
 pub use crate::bsdf::{Bsdf, Lobe};
 pub use crate::camera::Camera;
 pub use crate::geometry::{Hit, NO_ATTRS, Primitive, Ray, Shape, offset_origin};
-pub use crate::light::Light;
+pub use crate::light::{Light, LightType};
 pub use crate::material::TransportMode;
 pub use crate::medium::{HeroChannel, Medium, Phase, channel, transmittance_homogeneous};
 pub use crate::scene::Scene;

@@ -157,6 +157,7 @@ mod tests {
     #[test]
     fn every_table_holds_distinct_names() {
         distinct("media", MEDIA);
+        distinct("lights", crate::light::LIGHTS);
         distinct("kernels", KERNELS);
         assert_eq!(names(KERNELS).collect::<Vec<_>>(), BUILTIN_KERNELS);
     }

@@ -4,7 +4,8 @@
 use crate::common::{SceneArgs, warn};
 use clap::Args;
 use foton_core::error::Result;
-use foton_core::light::Light;
+use foton_core::light::LIGHTS;
+use foton_core::registry;
 use std::io::Write;
 
 #[derive(Args)]
@@ -52,20 +53,10 @@ pub(crate) fn run(a: CheckArgs, out: &mut dyn Write, err: &mut dyn Write) -> Res
         s.objects().len(),
         s.accel().primitives().len()
     );
-    let count = |f: fn(&Light) -> bool| s.lights().iter().filter(|l| f(l)).count();
-    let kinds = [
-        ("point", count(|l| matches!(l, Light::Point { .. }))),
-        ("spot", count(|l| matches!(l, Light::Spot { .. }))),
-        (
-            "directional",
-            count(|l| matches!(l, Light::Directional { .. })),
-        ),
-        ("environment", count(Light::is_environment)),
-        ("area", count(|l| matches!(l, Light::Area { .. }))),
-    ];
-    let listed: Vec<String> = kinds
-        .iter()
-        .filter(|(kind, n)| *n > 0 || matches!(*kind, "point" | "area"))
+    // By kind, in the order of the light table; points and areas even when there are none.
+    let listed: Vec<String> = registry::names(LIGHTS)
+        .map(|kind| (kind, s.lights().iter().filter(|l| l.name() == kind).count()))
+        .filter(|&(kind, n)| n > 0 || matches!(kind, "point" | "area"))
         .map(|(kind, n)| format!("{n} {kind}"))
         .collect();
     let power = s.total_power();

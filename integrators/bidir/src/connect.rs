@@ -4,7 +4,7 @@
 
 use crate::mis::{Factors, Running, mis, weight_connect, weight_direct, weight_to_camera};
 use crate::{At, Bidir, Origin, SplatSink, Vertex};
-use foton_core::api::{Light, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Vec3};
+use foton_core::api::{LightType, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Vec3};
 
 impl Bidir {
     /// t = 1 for a light vertex: connected to the pinhole and splatted on the pixels whose
@@ -143,12 +143,12 @@ impl Bidir {
             // Emission's density of reaching c per unit area there, over next-event
             // estimation's of the light point per unit area on it (per solid angle for lights
             // at infinity; a point light's position is a discrete choice).
-            let emission_ratio = match light {
-                Light::Area { .. } => emission_pdf * cos_x / (direct_pdf * ls.n.dot(ls.wi).abs()),
-                Light::Point { .. } | Light::Spot { .. } => {
-                    emission_pdf * cos_x / (pick * ls.dist * ls.dist)
+            let emission_ratio = match light.light_type() {
+                LightType::Area => emission_pdf * cos_x / (direct_pdf * ls.n.dot(ls.wi).abs()),
+                LightType::DeltaPosition => emission_pdf * cos_x / (pick * ls.dist * ls.dist),
+                LightType::DeltaDirection | LightType::Infinite => {
+                    emission_pdf * cos_x / direct_pdf
                 }
-                _ => emission_pdf * cos_x / direct_pdf,
             };
             let hit_pdf = if ls.delta { 0.0 } else { c.pdf(c.wo, ls.wi) };
             weight_direct(

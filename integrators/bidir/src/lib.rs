@@ -30,8 +30,8 @@ mod vertex;
 pub use vertex::{At, Vertex};
 
 use foton_core::api::{
-    Light, PixelSample, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Splats, TransportMode, Vec3,
-    channel, offset_origin, russian_roulette,
+    Light, LightType, PixelSample, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Splats,
+    TransportMode, Vec3, channel, offset_origin, russian_roulette,
 };
 use mis::{Factors, Running, weight_emitter_hit};
 
@@ -269,7 +269,7 @@ impl Bidir {
         let light = &scene.lights()[id];
         let e = light.sample_emission(u_pos, u_dir, u_shape);
         let medium = light_media.get(id).copied().flatten();
-        let origin = matches!(light, Light::Area { .. }).then_some(Origin {
+        let origin = (light.light_type() == LightType::Area).then_some(Origin {
             light: id,
             p: e.origin,
             n: e.n,
@@ -346,12 +346,10 @@ impl Bidir {
             {
                 // Next-event estimation's density of the light's origin, seen from x.
                 let direct = e.pick
-                    * match e.light {
-                        Light::Area { .. } => {
-                            e.light.pdf_li(x, e.origin, e.n) * e.cos_light / dist2
-                        }
-                        l if l.is_delta() => 1.0,
-                        l => l.pdf_li(x, x - e.dir, Vec3::ZERO),
+                    * match e.light.light_type() {
+                        LightType::Area => e.light.pdf_li(x, e.origin, e.n) * e.cos_light / dist2,
+                        LightType::DeltaPosition | LightType::DeltaDirection => 1.0,
+                        LightType::Infinite => e.light.pdf_li(x, x - e.dir, Vec3::ZERO),
                     };
                 running.first_hit(direct, e.emission_pdf);
             }

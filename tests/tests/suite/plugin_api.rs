@@ -101,6 +101,10 @@ fn the_version_is_the_hash_of_the_api_surface() {
         "walk::RayWalk",
         "kernel::NormalizedKernel",
         "plugin::declaration::declare_integrator",
+        // Written inside a registration macro, and reached through it.
+        "light::Light",
+        "light::point::PointLight",
+        "light::area::AreaLight",
     ] {
         assert!(
             api_surface::keys(&surface).contains_key(key),
@@ -110,6 +114,8 @@ fn the_version_is_the_hash_of_the_api_surface() {
     assert!(
         surface.contains("pub fn intersect (& self , ray : & Ray , tmax : f32) -> Option < Hit >")
     );
+    // The methods a registration macro adds are on the surface through its text.
+    assert!(surface.contains("light::Light: expanded by lights: macro_rules !"));
 }
 
 /// The version of core's sources with `file`'s text `from` replaced by `to` (which must be
@@ -165,6 +171,13 @@ fn changes_off_the_surface_keep_the_version() {
             "scene/mod.rs",
             "impl Scene {",
             "impl Scene {\n    pub(crate) fn extra(&self, _: u64) -> u8 { 0 }\n    fn other(&self) {}",
+        ),
+        // A light kind's arithmetic, in the file the registration line names.
+        (
+            "kind body",
+            "light/point.rs",
+            "4.0 * PI * self.intensity",
+            "self.intensity * (4.0 * PI)",
         ),
         // A public item that nothing on the surface reaches.
         (
@@ -234,6 +247,27 @@ fn changes_to_the_surface_change_the_version() {
             "api.rs",
             "pub use crate::props::Properties;",
             "pub use crate::props::Properties;\npub use crate::filter::FilterSampler;",
+        ),
+        // A light kind registered (a variant of `Light`, written in the `lights!` line).
+        (
+            "registered",
+            "light/mod.rs",
+            "        Area(area::AreaLight),\n    }",
+            "        Area(area::AreaLight),\n        Extra(point::PointLight),\n    }",
+        ),
+        // A field of a light kind, reached through the variant's path.
+        (
+            "kind field",
+            "light/point.rs",
+            "pub struct PointLight {",
+            "pub struct PointLight {\n    pub extra: u8,",
+        ),
+        // A method the registration macro adds to `Light`.
+        (
+            "dispatch",
+            "light/mod.rs",
+            "pub fn power(&self) -> Rgb {",
+            "pub fn power(&self) -> crate::Rgb {",
         ),
         // A type that a plugin reaches through a signature: `Scene::bsdf` returns a `Bsdf`.
         (

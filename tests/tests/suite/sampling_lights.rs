@@ -8,7 +8,7 @@ use crate::sampling::{
 use foton_core::Rgb;
 use foton_core::envmap::EnvironmentMap;
 use foton_core::geometry::Shape;
-use foton_core::light::{Light, area_light};
+use foton_core::light::{EnvmapLight, Light, PointLight, SceneSphere, area_light};
 use foton_core::sampling::Rng;
 use foton_core::texture::Bitmap;
 use foton_tests::stats::{assert_close, assert_rel};
@@ -555,10 +555,10 @@ fn triangle_light_emission() {
 fn point_light_emission_is_uniform_with_its_power() {
     let position = Vec3::new(0.4, -1.0, 2.0);
     let intensity = Rgb::new(2.0, 1.0, 0.5);
-    let light = Light::Point {
+    let light = Light::Point(PointLight {
         position,
         intensity,
-    };
+    });
     let power = light.power();
     assert!(rgb_close(power, (4.0 * PI) as f32 * intensity, 1e-6));
     let grid = SphereGrid::full_sphere(DVec3::new(-0.3, 0.2, 0.9), 10, 20);
@@ -606,11 +606,13 @@ fn envmap_light() -> (Light, Mat3) {
     let to_world = Mat3::from_axis_angle(Vec3::new(1.0, 0.5, -0.3).normalize(), 0.7);
     let bitmap = Bitmap::new(w, h, texels).unwrap();
     let map = EnvironmentMap::new(&bitmap, 1.5, to_world).unwrap();
-    let light = Light::Envmap {
+    let light = Light::Envmap(EnvmapLight {
         map: Arc::new(map),
-        centre: Vec3::new(0.1, 0.2, 0.3),
-        radius: 2.0,
-    };
+        sphere: SceneSphere {
+            centre: Vec3::new(0.1, 0.2, 0.3),
+            radius: 2.0,
+        },
+    });
     (light, to_world)
 }
 
@@ -663,7 +665,11 @@ fn envmap_sample_li_matches_pdf_li() {
 #[test]
 fn envmap_emission_follows_its_pdf_with_its_power() {
     let (light, to_world) = envmap_light();
-    let Light::Envmap { centre, radius, .. } = light else {
+    let Light::Envmap(EnvmapLight {
+        sphere: SceneSphere { centre, radius },
+        ..
+    }) = light
+    else {
         unreachable!()
     };
     let pdf = |w: DVec3| light.pdf_li(Vec3::ZERO, -w.as_vec3(), Vec3::ZERO) as f64;

@@ -2,7 +2,7 @@
 //! plane against the formulas, and path and photon mapping agreeing under it.
 
 use foton_core::Rgb;
-use foton_core::light::{Light, spot_falloff, spot_solid_angle};
+use foton_core::light::{Light, SpotLight, spot_falloff, spot_solid_angle};
 use foton_core::sampling::Rng;
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
 use foton_tests::{header, render_toml};
@@ -10,13 +10,13 @@ use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 
 fn spot() -> Light {
-    Light::Spot {
+    Light::Spot(SpotLight {
         position: Vec3::new(0.0, 2.0, 0.0),
         axis: Vec3::NEG_Y,
         intensity: Rgb::new(3.0, 2.0, 1.0),
         beam_width: 15f32.to_radians(),
         cutoff: 30f32.to_radians(),
-    }
+    })
 }
 
 /// Full intensity inside the beam, none past the cutoff, linear in the angle between.
