@@ -44,7 +44,7 @@ pub trait SamplerImpl: Clone + std::fmt::Debug {
 
 /// What a sampler's file registers (its `FACTORY`): its name in scene files (`[render]
 /// sampler`), a one-line description, and `create`, which reads the kind's parameters from the
-/// `[render]` bag into its settings. [`samplers!`] makes of it the `registry::Factory` of the
+/// `[render]` bag into its settings. `samplers!` makes of it the `registry::Factory` of the
 /// table, which wraps the settings in a [`SamplerKind`]. Unlike a medium's, a
 /// sampler's factory makes no object (a sampler is made per camera sample, from the settings)
 /// and reads neither nested tables nor files.
