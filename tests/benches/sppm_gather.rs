@@ -12,6 +12,7 @@
 //!   cargo bench -p foton-tests --bench sppm_gather
 
 use foton_core::integrator::{NoProgress, RenderContext};
+use foton_core::sampling::independent::Independent;
 use foton_core::sampling::{Sampler, SamplerKind};
 use foton_core::walk::{CameraWalk, GLOSSY_ROUGHNESS, trace_to_diffuse};
 use foton_photonmap::map::PhotonMap;
@@ -46,8 +47,14 @@ fn main() {
     let mut rays = 0;
     let vps: Vec<Vp> = (0..w * h)
         .filter_map(|i| {
-            let mut s =
-                Sampler::with_keys(SamplerKind::Independent, &[1, i as u64], 1, i as u64, 0, 1);
+            let mut s = Sampler::with_keys(
+                SamplerKind::from(Independent),
+                &[1, i as u64],
+                1,
+                i as u64,
+                0,
+                1,
+            );
             let film = Vec2::new((i % w) as f32, (i / w) as f32) + s.next_2d();
             let path = trace_to_diffuse(
                 &scene,

@@ -1,87 +1,248 @@
-//! The [`Sampler`] every integrator draws from, and the kinds it comes in (pbrt-v4's
-//! `IndependentSampler`, `StratifiedSampler` and a padded, Owen-scrambled `SobolSampler`).
+//! The [`Sampler`] every integrator draws from: the interface each kind of sampler implements
+//! ([`SamplerImpl`], pbrt-v4's `Sampler` interface), the [`samplers!`] macro that makes the
+//! dispatching enums and the table of factories from one line per kind, and how a camera
+//! sample's sampler is made ([`Sampler::new`], [`PixelSamplers`]).
+//!
+//! The kinds are one file each in `sampling/` (`independent.rs`, `stratified.rs`, `sobol.rs`),
+//! listed in `sampling/mod.rs`. docs/extending.md adds one.
+//!
+//! A sampler is a tagged union of the kinds with static dispatch (pbrt-v4's `Sampler`), not a
+//! trait object: it is in the innermost loop, and each request is a `match` on the tag, which
+//! is the same for a whole render and so predicts perfectly, then the kind's own code, inlined
+//! (a call only for `stratified`'s permutations and for each block of `sobol` points).
 
-use super::rng::{ONE_MINUS_EPSILON, RNG_KEYS_START, Rng, hash_keys, splitmix64};
-use super::sobol::{SOBOL_BLOCK, SobolBlock, sobol_block};
+use super::rng::{Rng, hash_keys, splitmix64};
+use super::{AnyKind, AnySampler, SAMPLERS};
+use crate::error::Result;
+use crate::props::Properties;
+use crate::registry;
 use glam::Vec2;
 
-/// Which points a [`Sampler`] hands out (`[render] sampler`).
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum SamplerKind {
-    /// Independent uniform numbers: one PCG stream per camera sample.
-    #[default]
-    Independent,
-    /// Per-dimension strata, one per sample of the pixel, randomly permuted per dimension
-    /// (pbrt's `StratifiedSampler`); `jitter = false` takes each stratum's centre.
-    Stratified { jitter: bool },
-    /// Owen-scrambled Sobol points (Burley 2020), padded: every 1-D or 2-D request takes the
-    /// first two Sobol dimensions with its own index shuffle and scramble. The least error at
-    /// equal time on every scene measured, and the TOML scenes' default (docs/PERFORMANCE.md).
-    Sobol,
+/// What a kind of sampler implements (one file each in `sampling/`): the numbers one camera
+/// sample draws, dimension after dimension (pbrt-v4's `StartPixelSample`, then `Get1D` /
+/// `Get2D` in a fixed order), which depend on the kind's settings and on (seed, pixel, sample
+/// index) alone, so that an image is the same for any thread count and any split into parts.
+pub trait SamplerImpl: Clone + std::fmt::Debug {
+    /// The kind's parameters as the scene gives them (`stratified`'s `jitter`; a unit struct
+    /// for none): what a [`SamplerKind`] of the kind holds, made by its factory. Each kind's
+    /// is a type of its own (`SamplerKind` is `From` each).
+    type Settings: Copy + std::fmt::Debug + PartialEq + Eq;
+    /// Whether [`SampleStart::rng`] is made: the camera sample's independent stream (a hash
+    /// of its keys), which a sampler that draws no random numbers (`sobol`) does not need.
+    const USES_RNG: bool = true;
+    /// Whether [`SampleStart::pixel_key`] is made (the independent sampler has no pattern to
+    /// decorrelate between pixels).
+    const USES_PIXEL_KEY: bool = true;
+
+    /// The sampler of one camera sample.
+    fn start(settings: Self::Settings, sample: SampleStart) -> Self;
+    /// Uniform in [0, 1).
+    fn next_f32(&mut self) -> f32;
+    /// Uniform in [0, 1)^2, the two coordinates stratified together where the kind can.
+    fn next_2d(&mut self) -> Vec2;
 }
+
+/// What a sampler's file registers (its `FACTORY`): its name in scene files (`[render]
+/// sampler`), a one-line description, and `create`, which reads the kind's parameters from the
+/// `[render]` bag into its settings. `samplers!` makes of it the `registry::Factory` of the
+/// table, which wraps the settings in a [`SamplerKind`]. Unlike a medium's, a
+/// sampler's factory makes no object (a sampler is made per camera sample, from the settings)
+/// and reads neither nested tables nor files.
+pub struct SamplerFactory<S: SamplerImpl> {
+    pub name: &'static str,
+    pub description: &'static str,
+    pub create: fn(&Properties<'_>) -> Result<S::Settings>,
+}
+
+/// Which camera sample a sampler draws for.
+#[derive(Clone, Debug)]
+pub struct SampleStart {
+    /// The sample's independent stream, keyed by (seed, pixel, index) or the integrator's keys
+    /// ([`Sampler::with_keys`]); a stream never to be drawn from when not `USES_RNG`.
+    pub rng: Rng,
+    /// Hash of (seed, pixel): what decorrelates the patterns of neighbouring pixels; zero
+    /// when not `USES_PIXEL_KEY`.
+    pub pixel_key: u64,
+    /// The sample's index within its pixel (past `spp` for integrators that take samples
+    /// without a bound, as sppm's iterations).
+    pub index: u32,
+    /// Samples the pixel takes, at least 1.
+    pub spp: u32,
+}
+
+/// Declares the files of the samplers and what is made of them, one line per file:
+///
+/// ```text
+/// samplers! {
+///     /// The built-in samplers.
+///     pub const SAMPLERS = [
+///         independent::IndependentSampler,
+///     ];
+/// }
+/// ```
+///
+/// declares `pub mod independent;` (the file `sampling/independent.rs`, which defines
+/// `IndependentSampler`, implementing [`SamplerImpl`], and ends with `pub const FACTORY:
+/// SamplerFactory<IndependentSampler>`), re-exports `IndependentSampler`, and makes
+///
+/// * `AnyKind`, what a [`SamplerKind`] holds: a variant per line (named by the module) holding
+///   the kind's `Settings`, and `From` each kind's `Settings` for `SamplerKind`;
+/// * `AnySampler`, what a [`Sampler`] holds: a variant per line holding the kind's sampler,
+///   with `next_f32` and `next_2d`, each a `match` on the variant;
+/// * `SAMPLERS`, the table of the factories (`registry::Factory<SamplerKind>`, each the
+///   file's `FACTORY` with its settings wrapped in a `SamplerKind`), in the lines' order.
+macro_rules! samplers {
+    (
+        $(#[$attr:meta])*
+        $vis:vis const $table:ident = [$($module:ident::$ty:ident),* $(,)?];
+    ) => {
+        $(pub mod $module;)*
+        $(pub use $module::$ty;)*
+
+        $(#[$attr])*
+        $vis const $table: &[$crate::registry::Factory<SamplerKind>] = &[$(
+            $crate::registry::Factory {
+                name: $module::FACTORY.name,
+                description: $module::FACTORY.description,
+                create: |bag, _, _| Ok(Box::new(($module::FACTORY.create)(bag)?.into())),
+            }
+        ),*];
+
+        /// The settings of a kind of sampler (see [`SamplerKind`]).
+        #[allow(non_camel_case_types)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+        enum AnyKind {
+            $($module(<$ty as $crate::sampling::SamplerImpl>::Settings),)*
+        }
+
+        $(
+            impl From<<$ty as $crate::sampling::SamplerImpl>::Settings> for SamplerKind {
+                fn from(settings: <$ty as $crate::sampling::SamplerImpl>::Settings) -> Self {
+                    SamplerKind(AnyKind::$module(settings))
+                }
+            }
+        )*
+
+        impl AnyKind {
+            fn name(&self) -> &'static str {
+                match self {
+                    $(AnyKind::$module(_) => $module::FACTORY.name,)*
+                }
+            }
+
+            #[inline]
+            fn uses_rng(&self) -> bool {
+                match self {
+                    $(AnyKind::$module(_) =>
+                        <$ty as $crate::sampling::SamplerImpl>::USES_RNG,)*
+                }
+            }
+
+            #[inline]
+            fn uses_pixel_key(&self) -> bool {
+                match self {
+                    $(AnyKind::$module(_) =>
+                        <$ty as $crate::sampling::SamplerImpl>::USES_PIXEL_KEY,)*
+                }
+            }
+
+            /// The sampler of camera sample `index` of `spp`; the stream and the pixel key are
+            /// made only for the kinds that use them.
+            #[inline]
+            fn start(
+                &self,
+                rng: impl FnOnce() -> $crate::sampling::Rng,
+                pixel_key: impl FnOnce() -> u64,
+                index: u32,
+                spp: u32,
+            ) -> AnySampler {
+                use $crate::sampling::SamplerImpl;
+                match *self {
+                    $(AnyKind::$module(settings) => AnySampler::$module(<$ty>::start(
+                        settings,
+                        $crate::sampling::SampleStart {
+                            rng: if <$ty>::USES_RNG {
+                                rng()
+                            } else {
+                                $crate::sampling::Rng::UNUSED
+                            },
+                            pixel_key: if <$ty>::USES_PIXEL_KEY { pixel_key() } else { 0 },
+                            index,
+                            spp: spp.max(1),
+                        },
+                    )),)*
+                }
+            }
+        }
+
+        /// The sampler of one camera sample, of any kind (see [`Sampler`]).
+        #[allow(non_camel_case_types)]
+        // A one-byte tag: the requests' test loads a byte (with a tag as wide as the
+        // fields, `sobol` renders took about 0.05 % more instructions).
+        #[derive(Clone, Debug)]
+        #[repr(u8)]
+        enum AnySampler {
+            $($module($ty),)*
+        }
+
+        impl AnySampler {
+            #[inline]
+            fn next_f32(&mut self) -> f32 {
+                match self {
+                    $(AnySampler::$module(s) => $crate::sampling::SamplerImpl::next_f32(s),)*
+                }
+            }
+
+            #[inline]
+            fn next_2d(&mut self) -> glam::Vec2 {
+                match self {
+                    $(AnySampler::$module(s) => $crate::sampling::SamplerImpl::next_2d(s),)*
+                }
+            }
+        }
+    };
+}
+pub(crate) use samplers;
+
+/// Which points a render's [`Sampler`]s hand out (`[render] sampler` and its parameters): one
+/// of the kinds of [`SAMPLERS`](super::SAMPLERS), with its settings. Made by the kind's
+/// factory, or from its settings: `SamplerKind::from(Stratified { jitter: true })`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SamplerKind(pub(super) AnyKind);
 
 impl SamplerKind {
-    /// The names `[render] sampler` takes.
-    pub const NAMES: [&'static str; 3] = ["independent", "stratified", "sobol"];
+    /// The names `[render] sampler` takes: those of the table, in its order.
+    pub const NAMES: [&'static str; SAMPLERS.len()] =
+        registry::name_array::<_, { SAMPLERS.len() }>(SAMPLERS);
 
-    /// The sampler named `name`; `jitter` applies to `stratified` only.
-    pub fn from_name(name: &str, jitter: bool) -> Option<SamplerKind> {
-        match name {
-            "independent" => Some(SamplerKind::Independent),
-            "stratified" => Some(SamplerKind::Stratified { jitter }),
-            "sobol" => Some(SamplerKind::Sobol),
-            _ => None,
-        }
-    }
-
+    /// Its name in scene files.
     pub fn name(&self) -> &'static str {
-        match self {
-            SamplerKind::Independent => "independent",
-            SamplerKind::Stratified { .. } => "stratified",
-            SamplerKind::Sobol => "sobol",
-        }
+        self.0.name()
     }
 }
 
-/// The numbers one camera sample draws, dimension after dimension (pbrt-v4's `Sampler`:
-/// `StartPixelSample`, then `Get1D` / `Get2D` in a fixed order). The first 2-D request is
+/// The numbers one camera sample draws, dimension after dimension: the first 2-D request is
 /// the position on the film. Integrators call [`Sampler::next_f32`] and [`Sampler::next_2d`];
-/// which points come back depends on the kind, and on (seed, pixel, sample index) alone, so an
-/// image is the same for any thread count and any split into parts.
-///
-/// A concrete enum rather than a trait object: the sampler is in the innermost loop, and the
-/// branch on the kind is the same for a whole render, so it predicts perfectly.
+/// which points come back depends on the kind ([`SamplerImpl`]), and on (seed, pixel, sample
+/// index) alone.
 #[derive(Clone, Debug)]
-pub struct Sampler {
-    kind: SamplerKind,
-    /// `kind` without its payload, for the requests' one test (see [`Request`]).
-    request: Request,
-    /// The independent stream; for `stratified`, the jitter inside strata.
-    rng: Rng,
-    /// Hash of (seed, pixel): what decorrelates the patterns of neighbouring pixels.
-    pub(super) pixel_key: u64,
-    /// The sample's index within its pixel.
-    index: u32,
-    /// `index` with its bits reversed (`sobol` only; see [`sobol_block`]).
-    index_reversed: u32,
-    /// Samples the pixel takes in all (strata per dimension).
-    spp: u32,
-    /// The next dimension to hand out (`stratified`; `sobol` counts in blocks).
-    dimension: u32,
-    /// `sobol`: the points of dimensions `block_start..block_start + SOBOL_BLOCK`, computed
-    /// together ([`sobol_block`]); before the first block, `0 - SOBOL_BLOCK` (the first block
-    /// starts `SOBOL_BLOCK` past it).
-    block_start: u32,
-    /// `sobol`: the place in `block` of the next dimension to hand out (`SOBOL_BLOCK`: the
-    /// next block is to be computed). Requests come in order, so the next dimension is
-    /// `block_start + block_pos`: one counter moved on per request.
-    block_pos: u32,
-    block: SobolBlock,
-}
+pub struct Sampler(pub(super) AnySampler);
 
 impl Sampler {
+    /// Uniform in [0, 1).
+    #[inline]
+    pub fn next_f32(&mut self) -> f32 {
+        self.0.next_f32()
+    }
+
+    /// Uniform in [0, 1)^2; the two coordinates are stratified together.
+    #[inline]
+    pub fn next_2d(&mut self) -> Vec2 {
+        self.0.next_2d()
+    }
+
     /// Sample `index` of `spp` of `pixel` (any number that names the pixel, e.g. y width + x).
-    /// With `Independent` the numbers are those of `Rng::new(&[seed, pixel, index])`.
+    /// With `independent` the numbers are those of `Rng::new(&[seed, pixel, index])`.
     /// (A loop over the samples of one pixel makes them with [`PixelSamplers`], which hashes
     /// the seed and the pixel once.)
     #[inline]
@@ -101,155 +262,18 @@ impl Sampler {
         index: u32,
         spp: u32,
     ) -> Sampler {
-        let rng = if kind == SamplerKind::Sobol {
-            Rng::UNUSED
-        } else {
-            Rng::new(keys)
-        };
-        Sampler::from_parts(kind, rng, pixel_key(kind, seed, pixel), index, spp)
-    }
-
-    /// The sampler of sample `index` with its stream and pixel key made.
-    #[inline]
-    fn from_parts(kind: SamplerKind, rng: Rng, pixel_key: u64, index: u32, spp: u32) -> Sampler {
-        Sampler {
-            kind,
-            request: match kind {
-                SamplerKind::Independent => Request::Independent,
-                SamplerKind::Sobol => Request::Sobol,
-                SamplerKind::Stratified { .. } => Request::Stratified,
-            },
-            rng,
-            pixel_key,
-            index,
-            index_reversed: index.reverse_bits(),
-            spp: spp.max(1),
-            dimension: 0,
-            block_start: 0u32.wrapping_sub(SOBOL_BLOCK as u32),
-            block_pos: SOBOL_BLOCK as u32,
-            block: SobolBlock::EMPTY,
-        }
-    }
-
-    pub fn kind(&self) -> SamplerKind {
-        self.kind
-    }
-
-    /// Uniform in [0, 1).
-    #[inline]
-    pub fn next_f32(&mut self) -> f32 {
-        // Independent first, by one byte compare (see [`Request`]).
-        if self.request == Request::Independent {
-            self.rng.next_f32()
-        } else if self.request == Request::Sobol {
-            // Two loads while the block lasts, inlined like the independent stream's draw.
-            self.sobol_point().0
-        } else {
-            self.next_1d_stratified()
-        }
-    }
-
-    /// Uniform in [0, 1)^2; the two coordinates are stratified together.
-    #[inline]
-    pub fn next_2d(&mut self) -> Vec2 {
-        if self.request == Request::Independent {
-            self.rng.next_2d()
-        } else if self.request == Request::Sobol {
-            let (x, y) = self.sobol_point();
-            Vec2::new(x, y)
-        } else {
-            self.next_2d_stratified()
-        }
-    }
-
-    /// Hash of (pixel, dimension), and the dimension counter moved on.
-    #[inline]
-    fn dimension_key(&mut self) -> u64 {
-        let d = self.dimension;
-        self.dimension += 1;
-        dimension_key(self.pixel_key, d)
-    }
-
-    /// Index within the pixel's strata, and a key for the round when the index is past spp
-    /// (sppm's iterations without a bound): each round is a new random permutation.
-    #[inline]
-    fn stratum_index(&self, key: u64) -> (u32, u32) {
-        let round = (self.index / self.spp) as u64;
-        let key = if round == 0 {
-            key
-        } else {
-            splitmix64(key ^ round)
-        };
-        let p = permutation_element(self.index % self.spp, self.spp, key as u32);
-        (p, (key >> 32) as u32)
-    }
-
-    /// The next dimension's Sobol point (both coordinates; a 1-D request takes the first,
-    /// which is what it would compute alone), from the block of [`SOBOL_BLOCK`] dimensions
-    /// that holds it, computed when the block's first dimension is asked for.
-    #[inline(always)]
-    fn sobol_point(&mut self) -> (f32, f32) {
-        let mut k = self.block_pos;
-        if k >= SOBOL_BLOCK as u32 {
-            self.next_sobol_block();
-            k = 0;
-        }
-        self.block_pos = k + 1;
-        (self.block.x[k as usize], self.block.y[k as usize])
-    }
-
-    /// Computes the block after the current one (the first block, before any).
-    #[inline(never)]
-    fn next_sobol_block(&mut self) {
-        self.block_start = self.block_start.wrapping_add(SOBOL_BLOCK as u32);
-        sobol_block(
-            self.pixel_key,
-            self.index_reversed,
-            self.block_start,
-            &mut self.block,
-        );
-    }
-
-    fn next_1d_stratified(&mut self) -> f32 {
-        let SamplerKind::Stratified { jitter } = self.kind else {
-            unreachable!("called for the stratified sampler only")
-        };
-        let key = self.dimension_key();
-        let (stratum, _) = self.stratum_index(key);
-        let offset = if jitter { self.rng.next_f32() } else { 0.5 };
-        ((stratum as f32 + offset) / self.spp as f32).min(ONE_MINUS_EPSILON)
-    }
-
-    fn next_2d_stratified(&mut self) -> Vec2 {
-        let SamplerKind::Stratified { jitter } = self.kind else {
-            unreachable!("called for the stratified sampler only")
-        };
-        let key = self.dimension_key();
-        let (stratum, _) = self.stratum_index(key);
-        let (nx, ny) = strata_2d(self.spp);
-        let (sx, sy) = (stratum % nx, stratum / nx);
-        let (jx, jy) = if jitter {
-            (self.rng.next_f32(), self.rng.next_f32())
-        } else {
-            (0.5, 0.5)
-        };
-        Vec2::new(
-            ((sx as f32 + jx) / nx as f32).min(ONE_MINUS_EPSILON),
-            ((sy as f32 + jy) / ny as f32).min(ONE_MINUS_EPSILON),
+        Sampler(
+            kind.0
+                .start(|| Rng::new(keys), || pixel_key(seed, pixel), index, spp),
         )
     }
 }
 
 /// A sampler's pixel key: the hash of (seed, pixel) that decorrelates the patterns of
-/// neighbouring pixels. Not needed by the independent stream, whose samples should cost what
-/// they did.
+/// neighbouring pixels.
 #[inline]
-fn pixel_key(kind: SamplerKind, seed: u64, pixel: u64) -> u64 {
-    if kind == SamplerKind::Independent {
-        0
-    } else {
-        splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
-    }
+fn pixel_key(seed: u64, pixel: u64) -> u64 {
+    splitmix64(splitmix64(seed ^ 0x5A3F_C0DE) ^ pixel)
 }
 
 /// What the samplers of one pixel share: the hashes of the seed and the pixel (the pixel key,
@@ -258,7 +282,8 @@ fn pixel_key(kind: SamplerKind, seed: u64, pixel: u64) -> u64 {
 #[derive(Clone, Copy, Debug)]
 pub struct PixelSamplers {
     kind: SamplerKind,
-    /// `Rng::new`'s hash of (seed, pixel), before the sample index (not for `sobol`).
+    /// `Rng::new`'s hash of (seed, pixel), before the sample index (for the kinds that use
+    /// the stream).
     keys_hash: u64,
     pixel_key: u64,
     spp: u32,
@@ -270,12 +295,16 @@ impl PixelSamplers {
     pub fn new(kind: SamplerKind, seed: u64, pixel: u64, spp: u32) -> PixelSamplers {
         PixelSamplers {
             kind,
-            keys_hash: if kind == SamplerKind::Sobol {
-                0
+            keys_hash: if kind.0.uses_rng() {
+                hash_keys(super::rng::RNG_KEYS_START, &[seed, pixel])
             } else {
-                hash_keys(RNG_KEYS_START, &[seed, pixel])
+                0
             },
-            pixel_key: pixel_key(kind, seed, pixel),
+            pixel_key: if kind.0.uses_pixel_key() {
+                pixel_key(seed, pixel)
+            } else {
+                0
+            },
             spp,
         }
     }
@@ -283,98 +312,31 @@ impl PixelSamplers {
     /// The sampler of the pixel's sample `index`: `Sampler::new(kind, seed, pixel, index, spp)`.
     #[inline]
     pub fn sample(&self, index: u32) -> Sampler {
-        let rng = if self.kind == SamplerKind::Sobol {
-            Rng::UNUSED
-        } else {
-            Rng::from_hash(hash_keys(self.keys_hash, &[index as u64]))
-        };
-        Sampler::from_parts(self.kind, rng, self.pixel_key, index, self.spp)
+        Sampler(self.kind.0.start(
+            || Rng::from_hash(hash_keys(self.keys_hash, &[index as u64])),
+            || self.pixel_key,
+            index,
+            self.spp,
+        ))
     }
-}
-
-/// How a [`Sampler`]'s requests are answered: [`SamplerKind`] without `stratified`'s payload.
-/// `SamplerKind` keeps its `jitter` in the byte that tells the kinds apart, so a `match` on it
-/// in every request compiled to a chain of compares (about 7 instructions a request on the
-/// Cornell box, against 2 when only the independent arm was inline: `independent` renders
-/// lost 3 to 4 %); a plain byte tested for `Independent` first is one compare and a branch.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u8)]
-enum Request {
-    Independent,
-    Sobol,
-    Stratified,
-}
-
-/// The hash of (pixel, dimension) that seeds a `stratified` dimension's permutation.
-#[inline(always)]
-fn dimension_key(pixel_key: u64, dimension: u32) -> u64 {
-    splitmix64(pixel_key ^ (dimension as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15))
-}
-
-/// The 2-D strata of `spp` samples: nx x ny = spp with nx the largest divisor of spp not above
-/// its square root (a prime spp gives 1 x spp bands: stratified in y alone).
-pub fn strata_2d(spp: u32) -> (u32, u32) {
-    let mut nx = (spp as f64).sqrt() as u32;
-    while nx > 1 && !spp.is_multiple_of(nx) {
-        nx -= 1;
-    }
-    let nx = nx.max(1);
-    (nx, spp / nx)
-}
-
-/// Element `i` of a random permutation of 0..n chosen by `seed` (Kensler 2013, "Correlated
-/// multi-jittered sampling": a hash that is a bijection on the next power of two, walked until
-/// it lands below n).
-pub fn permutation_element(mut i: u32, n: u32, seed: u32) -> u32 {
-    if n <= 1 {
-        return 0;
-    }
-    let mut w = n - 1;
-    w |= w >> 1;
-    w |= w >> 2;
-    w |= w >> 4;
-    w |= w >> 8;
-    w |= w >> 16;
-    let p = seed;
-    loop {
-        i ^= p;
-        i = i.wrapping_mul(0xe170_893d);
-        i ^= p >> 16;
-        i ^= (i & w) >> 4;
-        i ^= p >> 8;
-        i = i.wrapping_mul(0x0929_eb3f);
-        i ^= p >> 23;
-        i ^= (i & w) >> 1;
-        i = i.wrapping_mul(1 | p >> 27);
-        i = i.wrapping_mul(0x6935_fa69);
-        i ^= (i & w) >> 11;
-        i = i.wrapping_mul(0x74dc_b303);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0x9e50_1cc3);
-        i ^= (i & w) >> 2;
-        i = i.wrapping_mul(0xc860_a3df);
-        i &= w;
-        i ^= i >> 5;
-        if i < n {
-            break;
-        }
-    }
-    (i.wrapping_add(p)) % n
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sampling::independent::Independent;
+    use crate::sampling::sobol::Sobol;
+    use crate::sampling::stratified::Stratified;
 
     /// A pixel's samplers made once per pixel draw what each sample's sampler keyed by
     /// (seed, pixel, index) draws, for every kind.
     #[test]
     fn pixel_samplers_draw_what_keyed_samplers_draw() {
         for kind in [
-            SamplerKind::Independent,
-            SamplerKind::Stratified { jitter: true },
-            SamplerKind::Stratified { jitter: false },
-            SamplerKind::Sobol,
+            SamplerKind::from(Independent),
+            SamplerKind::from(Stratified { jitter: true }),
+            SamplerKind::from(Stratified { jitter: false }),
+            SamplerKind::from(Sobol),
         ] {
             for (seed, pixel) in [(0u64, 0u64), (7, 12345), (u64::MAX, 65535)] {
                 let pixel_samplers = PixelSamplers::new(kind, seed, pixel, 16);

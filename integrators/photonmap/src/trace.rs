@@ -50,7 +50,7 @@ pub struct TraceOptions {
 impl TraceOptions {
     /// Sobol emission when the scene's sampler is other than `independent`.
     pub fn emission_for(kind: SamplerKind) -> bool {
-        kind != SamplerKind::Independent
+        kind.name() != "independent"
     }
 }
 

@@ -6,20 +6,25 @@
 //! images: `sobol` and `stratified` converge to the `independent` image (no bias) and `sobol`
 //! has clearly less error at 16 spp on an area-lit scene.
 
+use foton_core::sampling::independent::Independent;
+use foton_core::sampling::sobol::Sobol;
+use foton_core::sampling::stratified::Stratified;
 use foton_core::sampling::{
-    Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, owen_scramble, shuffled_index,
-    sobol_dimension, strata_2d,
+    Rng, SAMPLERS, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, owen_scramble,
+    shuffled_index, sobol_dimension, strata_2d,
 };
 use foton_tests::render_toml;
 use foton_tests::stats::rel_rmse;
 use glam::Vec2;
 
-const KINDS: [SamplerKind; 4] = [
-    SamplerKind::Independent,
-    SamplerKind::Stratified { jitter: true },
-    SamplerKind::Stratified { jitter: false },
-    SamplerKind::Sobol,
-];
+fn kinds() -> [SamplerKind; 4] {
+    [
+        SamplerKind::from(Independent),
+        SamplerKind::from(Stratified { jitter: true }),
+        SamplerKind::from(Stratified { jitter: false }),
+        SamplerKind::from(Sobol),
+    ]
+}
 
 /// The draws of one camera sample: 2-D, 1-D, 2-D, 1-D, ... (as a path asks for them).
 fn draws(s: &mut Sampler, n: usize) -> Vec<Vec2> {
@@ -46,7 +51,7 @@ fn independent_is_the_old_stream_bit_for_bit() {
     for key in 0..200u64 {
         let (seed, px, i) = (key % 3, key * 7919, (key % 17) as u32);
         let mut old = Rng::new(&[seed, px, i as u64]);
-        let mut new = Sampler::new(SamplerKind::Independent, seed, px, i, 16);
+        let mut new = Sampler::new(SamplerKind::from(Independent), seed, px, i, 16);
         for d in 0..40 {
             if d % 3 == 0 {
                 assert_eq!(old.next_2d(), new.next_2d());
@@ -60,7 +65,7 @@ fn independent_is_the_old_stream_bit_for_bit() {
 #[test]
 fn stratified_hits_every_stratum_of_every_dimension_once_per_pixel() {
     for jitter in [true, false] {
-        let kind = SamplerKind::Stratified { jitter };
+        let kind = SamplerKind::from(Stratified { jitter });
         for spp in [1, 2, 7, 12, 16, 30] {
             let (nx, ny) = strata_2d(spp);
             assert_eq!(nx * ny, spp);
@@ -114,7 +119,7 @@ fn sobol_gives_every_pixel_a_net_in_every_dimension_pair_even_far_down_the_path(
     let m = 6;
     for px in [0u64, 1, 12345] {
         // 200 draws: dimensions of a path a hundred bounces long are still padded pairs.
-        let samples = pixel(SamplerKind::Sobol, 3, px, 1 << m, 200);
+        let samples = pixel(SamplerKind::from(Sobol), 3, px, 1 << m, 200);
         for d in 0..200 {
             let points: Vec<Vec2> = samples.iter().map(|s| s[d]).collect();
             if d % 2 == 0 {
@@ -128,7 +133,7 @@ fn sobol_gives_every_pixel_a_net_in_every_dimension_pair_even_far_down_the_path(
             }
         }
         // Neighbouring pixels do not share a pattern.
-        let next = pixel(SamplerKind::Sobol, 3, px + 1, 1 << m, 2);
+        let next = pixel(SamplerKind::from(Sobol), 3, px + 1, 1 << m, 2);
         assert!(samples[0][0] != next[0][0] && samples[1][1] != next[1][1]);
     }
 }
@@ -150,9 +155,9 @@ fn chi_square(counts: &[u32]) -> f64 {
 fn every_sampler_is_uniform_per_dimension_and_per_pair_over_pixels() {
     const BOUND: f64 = 131.0;
     // Centred strata are a lattice by design (16 values per draw), not uniform in 64 bins.
-    for kind in KINDS
+    for kind in kinds()
         .into_iter()
-        .filter(|k| *k != SamplerKind::Stratified { jitter: false })
+        .filter(|k| *k != SamplerKind::from(Stratified { jitter: false }))
     {
         let spp = 16;
         let pixels: Vec<Vec<Vec<Vec2>>> =
@@ -184,7 +189,7 @@ fn every_sampler_is_uniform_per_dimension_and_per_pair_over_pixels() {
 #[test]
 fn stratified_with_more_samples_than_strata_starts_new_permutations() {
     // sppm's iterations without a bound: index past spp, each round still one per stratum.
-    let kind = SamplerKind::Stratified { jitter: true };
+    let kind = SamplerKind::from(Stratified { jitter: true });
     let mut hit = [[0u32; 4]; 3];
     for i in 0..12 {
         let u = Sampler::new(kind, 1, 7, i, 4).next_f32();
@@ -441,4 +446,50 @@ fn sobol_is_the_toml_default_and_check_names_it() {
         "{}",
         run.stdout
     );
+}
+
+/// The table of samplers is what `[render] sampler` accepts and what the error for an
+/// unknown name lists: each name loads a scene whose sampler has that name and whose every
+/// number is in [0, 1), the names are those of `SamplerKind::NAMES`, and docs/scene-format.md
+/// lists them in the `sampler` row of `[render]`.
+#[test]
+fn the_table_of_samplers_is_what_scenes_name() {
+    let names: Vec<&str> = SAMPLERS.iter().map(|f| f.name).collect();
+    assert_eq!(names, SamplerKind::NAMES);
+    let dir = foton_tests::temp_dir("samplers-table");
+    let path = foton_tests::write(&dir, "scene.toml", &area_lit(4));
+    for name in &names {
+        let set = format!("render.sampler={name:?}");
+        let scene = foton_loader::load(&path, &[set]).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let kind = scene.render().sampler;
+        assert_eq!(kind.name(), *name);
+        for (px, index) in [(0u64, 0u32), (5, 3), (1 << 40, 17)] {
+            let mut s = Sampler::new(kind, 9, px, index, 4);
+            for d in 0..100 {
+                let (u, v) = (s.next_f32(), s.next_2d());
+                for x in [u, v.x, v.y] {
+                    assert!((0.0..1.0).contains(&x), "{name}: draw {d} is {x}");
+                }
+            }
+        }
+    }
+    let e = match foton_loader::load(&path, &["render.sampler=\"nope\"".into()]) {
+        Ok(_) => panic!("an unknown sampler loaded"),
+        Err(e) => e.to_string(),
+    };
+    assert!(
+        e.contains(&format!("expected one of: {}", names.join(", "))),
+        "{e}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+
+    let doc = foton_tests::repo_root().join("docs/scene-format.md");
+    let text = std::fs::read_to_string(doc).unwrap();
+    let row = text
+        .lines()
+        .find(|l| l.starts_with("| `sampler`"))
+        .expect("a `sampler` row in docs/scene-format.md");
+    let listed: Vec<String> = names.iter().map(|n| format!("{n:?}")).collect();
+    let listed = format!("| `{}` |", listed.join("`, `"));
+    assert!(row.contains(&listed), "{row} should list {listed}");
 }

@@ -6,9 +6,10 @@ use foton_core::camera::Camera;
 use foton_core::error::Result;
 use foton_core::filter::{Filter, FilterSampler};
 use foton_core::props::Properties;
-use foton_core::sampling::SamplerKind;
+use foton_core::registry::{self, NoResources};
+use foton_core::sampling::{SAMPLERS, SamplerKind};
 use foton_core::scene::{FilmSettings, RenderSettings};
-use foton_core::value::Value;
+use foton_core::value::{Node, Value};
 use glam::Vec3;
 use std::path::PathBuf;
 
@@ -27,25 +28,43 @@ pub(super) fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<Rend
         seed: t.u64("seed", 0)?,
         max_depth: t.u32("max_depth", 16)?,
         hide_emitters: t.bool("hide_emitters", false)?,
-        sampler: read_sampler(&t)?,
+        sampler: read_sampler(&t, root.node("render"), ld)?,
     };
     ld.done(&t);
     Ok(settings)
 }
 
-/// `[render] sampler` and, for `stratified`, `jitter`.
-fn read_sampler(t: &Properties<'_>) -> Result<SamplerKind> {
-    let name = t.choice("sampler", &SamplerKind::NAMES, "sobol")?;
-    let jitter = t.bool("jitter", true)?;
-    let kind = SamplerKind::from_name(name, jitter).expect("a name of SamplerKind::NAMES");
-    if t.has("jitter") && !matches!(kind, SamplerKind::Stratified { .. }) {
-        return Err(t.error(
-            "jitter",
-            format!(
-                "applies to sampler = \"stratified\" only, not {:?}",
-                kind.name()
-            ),
-        ));
+/// `[render] sampler`, looked up in `SAMPLERS`, whose factory reads the sampler's parameters
+/// (`stratified`'s `jitter`) from `[render]`. A parameter that the sampler does not read but
+/// others do is an error that names them, rather than an unknown field.
+fn read_sampler(t: &Properties<'_>, node: Option<&Node>, ld: &mut Loader) -> Result<SamplerKind> {
+    let name = t.string("sampler", "sobol")?;
+    let factory = registry::find(SAMPLERS, name)
+        .ok_or_else(|| t.error("sampler", registry::unknown("sampler", name, SAMPLERS)))?;
+    let kind = *(factory.create)(t, &mut Vec::new(), ld)?;
+    let Some(node) = node else {
+        return Ok(kind);
+    };
+    let unused: Vec<String> = t.unused().into_iter().map(|u| u.key).collect();
+    for key in t.keys().filter(|k| unused.contains(&t.key_path(k))) {
+        let mut readers = Vec::new();
+        for other in SAMPLERS.iter().filter(|f| f.name != name) {
+            // Which keys the other sampler reads: its errors are not this scene's.
+            let probe = Properties::new(t.file(), t.path(), node)?;
+            let _ = (other.create)(&probe, &mut Vec::new(), &mut NoResources);
+            if !probe.unused().iter().any(|u| u.key == t.key_path(key)) {
+                readers.push(format!("{:?}", other.name));
+            }
+        }
+        if !readers.is_empty() {
+            return Err(t.error(
+                key,
+                format!(
+                    "applies to sampler = {} only, not {name:?}",
+                    readers.join(" or ")
+                ),
+            ));
+        }
     }
     Ok(kind)
 }
