@@ -41,8 +41,9 @@ pub trait Resources {
     fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String);
 }
 
-/// The resources of a bag read outside a scene file (an integrator's `kernel`): none, so
-/// asking for a file or a texture is an error; warnings are dropped.
+/// The resources of a bag read outside a scene file (an integrator's `kernel`, a test): no
+/// files, so asking for an image, a transform or a texture table is an error; a colour given
+/// as `[r, g, b]` (or absent) is the constant it says; warnings are dropped.
 pub struct NoResources;
 
 impl NoResources {
@@ -58,8 +59,14 @@ impl Resources for NoResources {
     fn transform(&mut self, bag: &Properties<'_>, key: &str) -> Result<Mat4> {
         Err(Self::none(bag, key))
     }
-    fn texture(&mut self, bag: &Properties<'_>, key: &str, _: Rgb) -> Result<Texture> {
-        Err(Self::none(bag, key))
+    fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture> {
+        if bag
+            .node(key)
+            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
+        {
+            return Err(Self::none(bag, key));
+        }
+        Ok(Texture::Constant(bag.rgb(key, default)?))
     }
     fn warn(&mut self, _: &Properties<'_>, _: &str, _: String) {}
 }
@@ -231,6 +238,41 @@ mod tests {
         for d in [0.0, 0.3, 0.9] {
             assert_eq!(a.weight_2d(d, 1.0), b.weight_2d(d, 1.0));
         }
+    }
+
+    /// Outside a scene file, a colour is a constant or its default; a texture table, an image
+    /// or a transform is an error naming the parameter.
+    #[test]
+    fn no_resources_gives_constants_only() {
+        use crate::Rgb;
+        let table = bag(&[
+            ("reflectance", floats([0.25, 0.5, 0.75])),
+            (
+                "pattern",
+                bag(&[("type", Value::Str("checkerboard".into()))]).value,
+            ),
+            ("filename", Value::Str("sky.exr".into())),
+        ]);
+        let props = Properties::new(Path::new("t.toml"), "m", &table).unwrap();
+        let mut none = NoResources;
+        let constant = |t: Texture| match t {
+            Texture::Constant(c) => c,
+            other => panic!("{other:?}"),
+        };
+        let given = none.texture(&props, "reflectance", Rgb::ONE).unwrap();
+        assert_eq!(constant(given), Rgb::new(0.25, 0.5, 0.75));
+        let absent = none.texture(&props, "specular", Rgb::splat(0.5)).unwrap();
+        assert_eq!(constant(absent), Rgb::splat(0.5));
+        let e = none
+            .texture(&props, "pattern", Rgb::ONE)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("m.pattern") && e.contains("only in a scene file"),
+            "{e}"
+        );
+        assert!(none.bitmap(&props, "filename", false).is_err());
+        assert!(none.transform(&props, "to_world").is_err());
     }
 
     #[test]
