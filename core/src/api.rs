@@ -43,11 +43,11 @@ pub use glam::{DVec3, Vec2, Vec3};
 
 // The scene and its queries.
 pub use crate::accel::Accel;
-pub use crate::bsdf::{Bsdf, Lobe};
+pub use crate::bsdf::Bsdf;
 pub use crate::camera::Camera;
 pub use crate::geometry::{Hit, NO_ATTRS, Primitive, Ray, Shape, offset_origin};
 pub use crate::light::{Light, LightType};
-pub use crate::material::TransportMode;
+pub use crate::material::{Lobe, TransportMode};
 pub use crate::medium::{HeroChannel, Medium, Phase, channel, transmittance_homogeneous};
 pub use crate::scene::Scene;
 

@@ -15,13 +15,14 @@
 //! forms where ns = ng.
 
 use crate::Rgb;
-use crate::glossy::{Plastic, RoughConductor, RoughDielectric, RoughPlastic};
-use crate::scattering::{TransportMode, fresnel_conductor, fresnel_dielectric};
-
-use crate::sampling::{basis, cosine_hemisphere};
-pub use crate::scattering::LocalSample;
+use crate::geometry::SurfacePoint;
+use crate::material::diffuse::DiffuseBxdf;
+use crate::material::{Lobe, Material};
+use crate::sampling::basis;
+use crate::scattering::TransportMode;
 use glam::{Vec2, Vec3};
-use std::f32::consts::FRAC_1_PI;
+
+pub use crate::scattering::LocalSample;
 
 /// An orthonormal frame: `n` the normal, `s` and `t` the tangents.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -82,208 +83,6 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
-/// A material's scattering at one point, its textures resolved (see [`crate::material`] for
-/// the meaning of each).
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum Lobe {
-    Diffuse {
-        reflectance: Rgb,
-        twosided: bool,
-    },
-    Mirror {
-        reflectance: Rgb,
-    },
-    Conductor {
-        eta: Rgb,
-        k: Rgb,
-        specular_reflectance: Rgb,
-    },
-    Dielectric {
-        ior: f32,
-    },
-    ThinDielectric {
-        ior: f32,
-    },
-    RoughConductor(RoughConductor),
-    RoughDielectric(RoughDielectric),
-    Plastic(Plastic),
-    RoughPlastic(RoughPlastic),
-}
-
-/// The diffuse lobe's f |cos theta_i| from the cosines of `wo` and `wi` with the normal:
-/// both on one side, and that side the front unless `twosided`.
-#[inline]
-fn diffuse_eval(reflectance: Rgb, twosided: bool, cos_o: f32, cos_i: f32) -> Rgb {
-    if cos_o * cos_i > 0.0 && (twosided || cos_o > 0.0) {
-        reflectance * (FRAC_1_PI * cos_i.abs())
-    } else {
-        Rgb::ZERO
-    }
-}
-
-/// The diffuse lobe's pdf (cosine-weighted), as [`diffuse_eval`].
-#[inline]
-fn diffuse_pdf(twosided: bool, cos_o: f32, cos_i: f32) -> f32 {
-    if cos_o * cos_i > 0.0 && (twosided || cos_o > 0.0) {
-        cos_i.abs() * FRAC_1_PI
-    } else {
-        0.0
-    }
-}
-
-#[inline]
-fn reflect_local(w: Vec3) -> Vec3 {
-    Vec3::new(-w.x, -w.y, w.z)
-}
-
-impl Lobe {
-    /// True when the lobe is a sum of Dirac deltas (mirror, smooth glass): it cannot be
-    /// evaluated for a given pair of directions, only sampled.
-    #[inline]
-    pub fn is_delta(&self) -> bool {
-        matches!(
-            self,
-            Lobe::Mirror { .. }
-                | Lobe::Conductor { .. }
-                | Lobe::Dielectric { .. }
-                | Lobe::ThinDielectric { .. }
-        )
-    }
-
-    /// f(wo, wi) |cos theta_i| (zero for delta lobes).
-    #[inline]
-    pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        match *self {
-            Lobe::Diffuse {
-                reflectance,
-                twosided,
-            } => diffuse_eval(reflectance, twosided, wo.z, wi.z),
-            Lobe::RoughConductor(l) => l.eval(wo, wi, TransportMode::Radiance),
-            Lobe::RoughDielectric(l) => l.eval(wo, wi, TransportMode::Radiance),
-            Lobe::Plastic(l) => l.eval(wo, wi, TransportMode::Radiance),
-            Lobe::RoughPlastic(l) => l.eval(wo, wi, TransportMode::Radiance),
-            _ => Rgb::ZERO,
-        }
-    }
-
-    /// Solid-angle pdf with which `sample` produces wi (zero for delta lobes).
-    #[inline]
-    pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        match *self {
-            Lobe::Diffuse { twosided, .. } => diffuse_pdf(twosided, wo.z, wi.z),
-            Lobe::RoughConductor(l) => l.pdf(wo, wi),
-            Lobe::RoughDielectric(l) => l.pdf(wo, wi),
-            Lobe::Plastic(l) => l.pdf(wo, wi),
-            Lobe::RoughPlastic(l) => l.pdf(wo, wi),
-            _ => 0.0,
-        }
-    }
-
-    /// Samples wi for `wo`: `u` within a lobe, `uc` between lobes (reflection or refraction).
-    #[inline]
-    pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
-        let cos_o = wo.z;
-        if cos_o == 0.0 {
-            return None;
-        }
-        let delta = |wi: Vec3, weight: Rgb, pdf: f32| {
-            Some(LocalSample {
-                wi,
-                weight,
-                pdf,
-                delta: true,
-            })
-        };
-        match *self {
-            Lobe::Diffuse {
-                reflectance,
-                twosided,
-            } => {
-                if !twosided && cos_o < 0.0 {
-                    return None;
-                }
-                diffuse_sample(reflectance, cos_o, u)
-            }
-            Lobe::Mirror { reflectance } => delta(reflect_local(wo), reflectance, 1.0),
-            Lobe::Conductor {
-                eta,
-                k,
-                specular_reflectance,
-            } => {
-                let c = cos_o.abs();
-                let f = Rgb::new(
-                    fresnel_conductor(c, eta.x, k.x),
-                    fresnel_conductor(c, eta.y, k.y),
-                    fresnel_conductor(c, eta.z, k.z),
-                );
-                delta(reflect_local(wo), specular_reflectance * f, 1.0)
-            }
-            Lobe::Dielectric { ior } => {
-                let eta = if cos_o > 0.0 { ior } else { 1.0 / ior };
-                let f = fresnel_dielectric(cos_o.abs(), eta);
-                if uc < f {
-                    return delta(reflect_local(wo), Rgb::ONE, f);
-                }
-                let n = if cos_o > 0.0 { Vec3::Z } else { Vec3::NEG_Z };
-                let wi = crate::scattering::refract(wo, n, eta)?;
-                let scale = match mode {
-                    TransportMode::Radiance => 1.0 / (eta * eta),
-                    TransportMode::Importance => 1.0,
-                };
-                delta(wi, Rgb::splat(scale), 1.0 - f)
-            }
-            Lobe::ThinDielectric { ior } => {
-                // Air-glass-air: the same reflectance from either side; the infinite series of
-                // reflections inside the sheet sums to R' = R + T^2 R / (1 - R^2) = 2R / (1 + R).
-                let r = fresnel_dielectric(cos_o.abs(), ior);
-                let r = 2.0 * r / (1.0 + r);
-                if uc < r {
-                    return delta(reflect_local(wo), Rgb::ONE, r);
-                }
-                // Straight through: the two refractions undo each other (no 1/eta^2 either).
-                delta(-wo, Rgb::ONE, 1.0 - r)
-            }
-            Lobe::RoughConductor(l) => l.sample(wo, u, uc, mode),
-            Lobe::RoughDielectric(l) => l.sample(wo, u, uc, mode),
-            Lobe::Plastic(l) => l.sample(wo, u, uc, mode),
-            Lobe::RoughPlastic(l) => l.sample(wo, u, uc, mode),
-        }
-    }
-
-    /// How rough the lobe's non-delta part is: 0 for delta lobes, infinite for diffuse ones
-    /// (a microfacet lobe gives its alpha). Camera paths of the photon integrators continue
-    /// through lobes below their `glossy_roughness` by sampling.
-    #[inline]
-    pub fn roughness(&self) -> f32 {
-        match self {
-            // A smooth plastic's non-delta part is its diffuse base.
-            Lobe::Diffuse { .. } | Lobe::Plastic(_) => f32::INFINITY,
-            Lobe::RoughConductor(l) => l.roughness(),
-            Lobe::RoughDielectric(l) => l.roughness(),
-            Lobe::RoughPlastic(l) => l.roughness(),
-            _ => 0.0,
-        }
-    }
-
-    /// Whether a non-delta part transmits light through the surface (a rough dielectric).
-    /// Camera paths follow such lobes by sampling whatever their roughness: a surface
-    /// estimate gathers the photons of one side only.
-    #[inline]
-    pub fn transmits(&self) -> bool {
-        matches!(self, Lobe::RoughDielectric(_))
-    }
-
-    /// The probability that `sample` picks a delta part for `wo`, for lobes that mix a delta
-    /// part with a non-delta one (0 for the others).
-    #[inline]
-    pub fn delta_probability(&self, wo: Vec3) -> f32 {
-        match self {
-            Lobe::Plastic(l) => l.delta_probability(wo),
-            _ => 0.0,
-        }
-    }
-}
-
 /// The BSDF at a surface point.
 #[derive(Clone, Copy, Debug)]
 pub struct Bsdf {
@@ -329,13 +128,9 @@ impl Bsdf {
     /// f(wo, wi) |cos theta_i| (radiance: the cosine from the shading normal).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if let Lobe::Diffuse {
-            reflectance,
-            twosided,
-        } = self.lobe
-        {
+        if let Lobe::Diffuse(d) = &self.lobe {
             let (cos_o, cos_i) = self.cosines(wo, wi);
-            return diffuse_eval(reflectance, twosided || self.twosided, cos_o, cos_i);
+            return d.eval_cos(d.twosided || self.twosided, cos_o, cos_i);
         }
         let (wo, wi) = self.local(wo, wi);
         self.lobe.eval(wo, wi)
@@ -356,16 +151,12 @@ impl Bsdf {
     /// directions taken to the local frame once.
     #[inline]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
-        if let Lobe::Diffuse {
-            reflectance,
-            twosided,
-        } = self.lobe
-        {
+        if let Lobe::Diffuse(d) = &self.lobe {
             let (cos_o, cos_i) = self.cosines(wo, wi);
-            let twosided = twosided || self.twosided;
+            let twosided = d.twosided || self.twosided;
             return (
-                diffuse_eval(reflectance, twosided, cos_o, cos_i),
-                diffuse_pdf(twosided, cos_o, cos_i),
+                d.eval_cos(twosided, cos_o, cos_i),
+                DiffuseBxdf::pdf_cos(twosided, cos_o, cos_i),
             );
         }
         let (wo, wi) = self.local(wo, wi);
@@ -375,9 +166,9 @@ impl Bsdf {
     /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
     #[inline]
     pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
-        if let Lobe::Diffuse { twosided, .. } = self.lobe {
+        if let Lobe::Diffuse(d) = &self.lobe {
             let (cos_o, cos_i) = self.cosines(wo, wi);
-            return diffuse_pdf(twosided || self.twosided, cos_o, cos_i);
+            return DiffuseBxdf::pdf_cos(d.twosided || self.twosided, cos_o, cos_i);
         }
         let (wo, wi) = self.local(wo, wi);
         self.lobe.pdf(wo, wi)
@@ -387,19 +178,15 @@ impl Bsdf {
     /// shading-normal correction (module comment).
     #[inline]
     pub fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<BsdfSample> {
-        let s = if let Lobe::Diffuse {
-            reflectance,
-            twosided,
-        } = self.lobe
-        {
-            // The diffuse lobe reads only wo's cosine (see `Bsdf::cosines`): `Lobe::sample`'s
-            // diffuse case with the two-sided mirroring folded in. Black from below a
-            // one-sided lobe; the cosine-weighted direction is taken to wo's side.
+        let s = if let Lobe::Diffuse(d) = &self.lobe {
+            // The diffuse lobe reads only wo's cosine (see `Bsdf::cosines`): its `sample`
+            // with the two-sided mirroring folded in. Black from below a one-sided lobe; the
+            // cosine-weighted direction is taken to wo's side.
             let cos_o = wo.dot(self.frame.n);
-            if cos_o == 0.0 || (cos_o < 0.0 && !(twosided || self.twosided)) {
+            if cos_o == 0.0 || (cos_o < 0.0 && !(d.twosided || self.twosided)) {
                 return None;
             }
-            diffuse_sample(reflectance, cos_o, u)?
+            d.sample_cos(cos_o, u)?
         } else {
             let mut local_wo = self.frame.to_local(wo);
             let below = self.twosided && local_wo.z < 0.0;
@@ -443,29 +230,49 @@ impl Bsdf {
     }
 }
 
-/// A cosine-weighted direction of the diffuse lobe in local coordinates, on the side of wo
-/// (`cos_o`, not zero).
-#[inline(always)]
-fn diffuse_sample(reflectance: Rgb, cos_o: f32, u: Vec2) -> Option<LocalSample> {
-    let mut wi = cosine_hemisphere(u);
-    if wi.z <= 0.0 {
-        return None;
+impl Material {
+    /// The BSDF at surface point `sp` (None for the null material, which does not scatter).
+    #[inline]
+    pub fn bsdf(&self, sp: &SurfacePoint) -> Option<Bsdf> {
+        // Without a tangent (not needed, or none), any frame: isotropic lobes do not care.
+        let frame = || {
+            if sp.dpdu == Vec3::ZERO {
+                Frame::from_normal(sp.ns)
+            } else {
+                Frame::from_normal_tangent(sp.ns, sp.dpdu)
+            }
+        };
+        self.bsdf_in(sp.uv, sp.ng, frame)
     }
-    let pdf = wi.z * FRAC_1_PI;
-    if cos_o < 0.0 {
-        wi.z = -wi.z;
+
+    /// The BSDF at a point of a flat surface whose material needs no texture coordinates and
+    /// no tangent ([`Material::needs_coordinates`] false): the shading normal is the
+    /// geometric one `ng`, and the frame any frame around it, as [`Material::bsdf`] makes it
+    /// for such a point. (The scene's hit queries call this where they can: the frame is then
+    /// built without testing a tangent that is known to be zero.)
+    #[inline]
+    pub fn flat_bsdf(&self, ng: Vec3) -> Option<Bsdf> {
+        self.bsdf_in(Vec2::ZERO, ng, || Frame::from_normal(ng))
     }
-    Some(LocalSample {
-        wi,
-        weight: reflectance,
-        pdf,
-        delta: false,
-    })
+
+    /// The BSDF with its textures looked up at `uv`, the geometric normal `ng`, and the
+    /// shading frame `frame` makes (not made for the null material).
+    #[inline(always)]
+    fn bsdf_in(&self, uv: Vec2, ng: Vec3, frame: impl FnOnce() -> Frame) -> Option<Bsdf> {
+        let (lobe, twosided) = self.lobe_at(uv)?;
+        Some(Bsdf {
+            lobe,
+            frame: frame(),
+            ng,
+            twosided,
+        })
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f32::consts::FRAC_1_PI;
 
     #[test]
     fn frames_are_orthonormal_and_invert() {
@@ -496,10 +303,10 @@ mod tests {
             for twosided in [false, true] {
                 let n = dir();
                 let bsdf = Bsdf {
-                    lobe: Lobe::Diffuse {
+                    lobe: Lobe::Diffuse(DiffuseBxdf {
                         reflectance: Rgb::new(0.7, 0.4, 0.2),
                         twosided: twosided_lobe,
-                    },
+                    }),
                     frame: Frame::from_normal_tangent(n, dir()),
                     ng: n,
                     twosided,
@@ -528,10 +335,10 @@ mod tests {
 
     #[test]
     fn shading_correction_only_where_normals_differ() {
-        let lobe = Lobe::Diffuse {
+        let lobe = Lobe::Diffuse(DiffuseBxdf {
             reflectance: Rgb::splat(0.5),
             twosided: true,
-        };
+        });
         let ng = Vec3::Z;
         let flat = Bsdf {
             lobe,

@@ -1,11 +1,12 @@
-//! What every scattering model shares, below them all (pbrt-v4's `util/scattering.h` and the
-//! `TransportMode` of `base/bxdf.h`): the quantity a path carries, the Fresnel terms, the
-//! reflected and refracted directions, and a lobe's local sample. `bsdf` (the smooth lobes),
-//! `glossy` (the microfacet lobes) and `material` (which builds them) use it; it uses none of
-//! them, so that the three do not import each other in a circle.
+//! What every scattering model shares, below them all (pbrt-v4's `util/scattering.h` and
+//! `base/bxdf.h`): the quantity a path carries, the Fresnel terms, the reflected and refracted
+//! directions, a lobe's local sample and the [`Bxdf`] interface every lobe implements.
+//! `glossy` (the microfacet lobes), `material` (the materials and their lobes) and `bsdf`
+//! (which puts a lobe in a frame) use it; it uses none of them, so that they do not import
+//! each other in a circle.
 
 use crate::Rgb;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Which quantity a path carries: radiance (camera paths) or importance/flux (photon paths).
 /// It matters at refraction, where radiance is scaled by 1/eta^2 and flux is not (Veach 1997,
@@ -91,4 +92,46 @@ pub struct LocalSample {
     pub weight: Rgb,
     pub pdf: f32,
     pub delta: bool,
+}
+
+/// A material's scattering at one point in the local shading frame, its textures looked up
+/// (pbrt-v4's `BxDF`): z is the shading normal, both directions point away from the surface,
+/// `wo` towards the viewer (or where a photon came from), `wi` the other one. `eval` is
+/// f(wo, wi) |cos theta_i| (Mitsuba 3's convention: the cosine included), `pdf` the
+/// solid-angle density with which `sample` produces `wi` (non-delta parts, times their
+/// selection probability), `sample` a direction with the weight f |cos theta_i| / pdf.
+pub trait Bxdf {
+    /// Whether every part is a Dirac delta (a mirror, smooth glass): such a lobe is only
+    /// sampled, never evaluated for a given pair of directions, and photons are not stored
+    /// on it.
+    const DELTA: bool = false;
+
+    /// f(wo, wi) |cos theta_i| (zero for a delta lobe).
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb;
+
+    /// The solid-angle density with which `sample` produces `wi` (zero for a delta lobe).
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32;
+
+    /// Samples `wi` for `wo` (`wo.z` not zero): `u` within a lobe, `uc` between lobes
+    /// (reflection or refraction); `mode` scales refraction for radiance. None where the
+    /// sampled direction carries nothing.
+    fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample>;
+
+    /// How rough the non-delta part is: 0 for a delta lobe, infinite for a diffuse one (a
+    /// microfacet lobe gives its alpha). Camera paths of the photon integrators continue
+    /// through lobes below their `glossy_roughness` by sampling.
+    fn roughness(&self) -> f32;
+
+    /// Whether a non-delta part transmits light through the surface (a rough dielectric).
+    /// Camera paths follow such lobes by sampling whatever their roughness: a surface
+    /// estimate gathers the photons of one side only.
+    fn transmits(&self) -> bool {
+        false
+    }
+
+    /// The probability that `sample` picks a delta part for `wo`, for a lobe that mixes a
+    /// delta part with a non-delta one (a smooth plastic's coat); 0 for the others.
+    fn delta_probability(&self, _wo: Vec3) -> f32 {
+        0.0
+    }
 }

@@ -316,7 +316,7 @@ fn conductor_conserves_energy_and_tends_to_the_smooth_one() {
             }
         }
         // Gold, nearly smooth: the smooth conductor's Fresnel reflectance.
-        let (eta, k) = crate::material::conductor("Au").unwrap();
+        let (eta, k) = crate::material::conductor_ior("Au").unwrap();
         let gold = RoughConductor {
             distribution: Microfacet::isotropic(kind, 0.01),
             eta,
@@ -562,7 +562,7 @@ fn matches_mitsuba_3_9_1() {
 #[allow(clippy::excessive_precision)] // Mitsuba's values as printed
 fn matches_mitsuba_3_9_1_on_glossy_caustic() {
     let n = |x: f32, y: f32, z: f32| Vec3::new(x, y, z).normalize();
-    let (eta, k) = crate::material::conductor("Au").unwrap();
+    let (eta, k) = crate::material::conductor_ior("Au").unwrap();
     let gold = Lobe::Conductor(RoughConductor {
         distribution: Microfacet::isotropic(GGX, 0.2),
         eta,

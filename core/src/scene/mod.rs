@@ -12,13 +12,14 @@ use volumes::Volume;
 
 use crate::Rgb;
 use crate::accel::Accel;
-use crate::bsdf::{Bsdf, Frame, Lobe};
+use crate::bsdf::{Bsdf, Frame};
 use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::film::{DisplayTransform, ToneMap};
 use crate::geometry::{Hit, Primitive, Ray, SurfacePoint, TriangleAttrs};
 use crate::light::Light;
-use crate::material::Material;
+use crate::material::diffuse::{DiffuseBxdf, DiffuseMaterial};
+use crate::material::{Lobe, Material};
 use crate::medium::Medium;
 use crate::props::Properties;
 use crate::props::Unused;
@@ -403,16 +404,16 @@ impl Scene {
         // general case below tests the material's kind twice (for its coordinates and for
         // its lobe), each a jump table.
         if flat
-            && let Material::Diffuse {
+            && let Material::Diffuse(DiffuseMaterial {
                 reflectance: Texture::Constant(reflectance),
                 twosided,
-            } = *material
+            }) = *material
         {
             return Some(Bsdf {
-                lobe: Lobe::Diffuse {
+                lobe: Lobe::Diffuse(DiffuseBxdf {
                     reflectance,
                     twosided,
-                },
+                }),
                 frame: Frame::from_normal(hit.ng),
                 ng: hit.ng,
                 twosided: false,

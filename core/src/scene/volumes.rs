@@ -292,12 +292,7 @@ pub(super) fn medium_interfaces(
         let bounds = if o.explicit_media {
             !inside_out[i]
         } else {
-            o.interior.is_some()
-                || m.is_null()
-                || matches!(
-                    m,
-                    Material::Dielectric { .. } | Material::RoughDielectric { .. }
-                )
+            o.interior.is_some() || m.is_null() || m.encloses_volume()
         };
         if o.closed && bounds {
             index[i] = Some(volumes.len());

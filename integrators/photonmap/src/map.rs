@@ -735,7 +735,7 @@ impl PhotonMap {
             return Rgb::ZERO;
         }
         with_scratch(|scratch| {
-            if let Lobe::Diffuse { .. } = bsdf.lobe
+            if let Lobe::Diffuse(_) = bsdf.lobe
                 && bsdf.frame.n == bsdf.ng
             {
                 // A Lambertian BSDF without a shading normal is the same for every photon of

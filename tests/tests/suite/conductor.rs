@@ -4,7 +4,7 @@
 //! integrator; named materials are Mitsuba's; bad parameters are clear errors.
 
 use foton_core::Rgb;
-use foton_core::material::conductor;
+use foton_core::material::conductor_ior;
 use foton_tests::{foton_with_plugins, header, render_toml, temp_dir, write};
 
 fn normal_reflectance(eta: Rgb, k: Rgb) -> Rgb {
@@ -48,7 +48,7 @@ caustic_photons = 1000
 
 #[test]
 fn a_conductor_reflects_the_fresnel_reflectance_of_its_ior() {
-    let (au_eta, au_k) = conductor("Au").unwrap();
+    let (au_eta, au_k) = conductor_ior("Au").unwrap();
     let custom = (Rgb::new(0.2, 0.9, 1.1), Rgb::new(3.9, 2.4, 2.1));
     for (material, eta, k, scale) in [
         ("material = \"Au\"", au_eta, au_k, Rgb::ONE),

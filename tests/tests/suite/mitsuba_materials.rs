@@ -13,7 +13,10 @@ use foton_tests::{foton, repo_root, temp_dir, write};
 /// diagonal.
 #[test]
 fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
-    use foton_core::material::Material;
+    use foton_core::material::{
+        Material, PlasticMaterial, RoughConductorMaterial, RoughDielectricMaterial,
+        RoughPlasticMaterial,
+    };
     use foton_core::microfacet::MicrofacetKind;
     let dir = scene_folder("mitsuba-glossy");
     let text = r#"<scene version="3.0.0">
@@ -49,7 +52,8 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
     assert!(converted.contains("fov_axis = \"diagonal\""), "{converted}");
     assert!(converted.contains("fov = 46.79"), "{converted}");
     let material = |i: usize| &scene.materials()[scene.objects()[i].material as usize].value;
-    let Material::RoughConductor { lobe, twosided, .. } = material(0) else {
+    let Material::RoughConductor(RoughConductorMaterial { lobe, twosided, .. }) = material(0)
+    else {
         panic!("{:?}", material(0))
     };
     assert!(!*twosided);
@@ -60,25 +64,25 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
     );
     assert_eq!(
         (lobe.eta, lobe.k),
-        foton_core::material::conductor("Au").unwrap()
+        foton_core::material::conductor_ior("Au").unwrap()
     );
-    let Material::RoughPlastic { lobe, twosided, .. } = material(1) else {
+    let Material::RoughPlastic(RoughPlasticMaterial { lobe, twosided, .. }) = material(1) else {
         panic!("{:?}", material(1))
     };
     assert!(*twosided);
     assert_eq!(lobe.distribution.kind, MicrofacetKind::Beckmann);
     assert_eq!(lobe.distribution.alpha_u, 0.1);
     assert!((lobe.eta - 1.6 / 1.000277).abs() < 1e-6);
-    let Material::RoughDielectric { lobe, .. } = material(2) else {
+    let Material::RoughDielectric(RoughDielectricMaterial { lobe, .. }) = material(2) else {
         panic!("{:?}", material(2))
     };
     assert!((lobe.eta - 1.333 / 1.2).abs() < 1e-6, "{}", lobe.eta);
-    let Material::Plastic {
+    let Material::Plastic(PlasticMaterial {
         lobe,
         twosided,
         diffuse_reflectance,
         ..
-    } = material(3)
+    }) = material(3)
     else {
         panic!("{:?}", material(3))
     };

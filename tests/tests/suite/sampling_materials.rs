@@ -7,7 +7,10 @@ use crate::sampling::{
 use foton_core::Rgb;
 use foton_core::bsdf::Bsdf;
 use foton_core::geometry::SurfacePoint;
-use foton_core::material::{Material, TransportMode, fresnel_dielectric, refract};
+use foton_core::material::{
+    DielectricMaterial, DiffuseMaterial, Material, MirrorMaterial, TransportMode,
+    fresnel_dielectric, refract,
+};
 use foton_core::sampling::{self, Rng};
 use foton_core::texture::Texture;
 use foton_tests::stats::assert_close;
@@ -32,10 +35,10 @@ fn flat(mat: &Material, ng: Vec3) -> Bsdf {
 #[test]
 fn diffuse_sampling_matches_its_pdf_on_both_sides() {
     let reflectance = Rgb::new(0.8, 0.5, 0.2);
-    let mat = Material::Diffuse {
+    let mat = Material::from(DiffuseMaterial {
         reflectance: Texture::Constant(reflectance),
         twosided: true,
-    };
+    });
     let ng = Vec3::new(0.3, -0.4, 0.866).normalize();
     let front = Vec3::new(0.5, 0.2, 0.8).normalize();
     let back = Vec3::new(-0.1, 0.7, -0.6).normalize();
@@ -127,7 +130,7 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
     const N: usize = 100_000;
     let ng = Vec3::new(-0.2, 0.5, 0.84).normalize();
     for (k, &(ior, inside, cos)) in DIELECTRIC_CASES.iter().enumerate() {
-        let mat = Material::Dielectric { ior };
+        let mat = Material::from(DielectricMaterial { ior });
         let (wo, n) = dielectric_wo(ng, inside, cos);
         let (n_o, n_t) = if inside {
             (ior as f64, 1.0)
@@ -224,7 +227,7 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
 fn dielectric_totally_reflects_beyond_the_critical_angle() {
     let ng = Vec3::new(-0.2, 0.5, 0.84).normalize();
     for (k, &(ior, inside, cos)) in TIR_CASES.iter().enumerate() {
-        let mat = Material::Dielectric { ior };
+        let mat = Material::from(DielectricMaterial { ior });
         let (wo, n) = dielectric_wo(ng, inside, cos);
         let (n_o, n_t) = if inside {
             (ior as f64, 1.0)
@@ -255,9 +258,9 @@ fn dielectric_totally_reflects_beyond_the_critical_angle() {
 #[test]
 fn mirror_reflects_exactly() {
     let reflectance = Rgb::new(0.9, 0.6, 0.3);
-    let mat = Material::Mirror {
+    let mat = Material::from(MirrorMaterial {
         reflectance: Texture::Constant(reflectance),
-    };
+    });
     let mut rng = Rng::new(&[22]);
     for _ in 0..100_000 {
         let ng = sampling::uniform_sphere(rng.next_2d());

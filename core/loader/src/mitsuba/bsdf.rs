@@ -103,7 +103,7 @@ impl Reader {
                 match (eta, k) {
                     (None, None) => {
                         let name = material.unwrap_or_else(|| "none".into());
-                        if name != "none" && foton_core::material::conductor(&name).is_none() {
+                        if name != "none" && foton_core::material::conductor_ior(&name).is_none() {
                             return Err(o.error(format!("`material`: unknown conductor `{name}`")));
                         }
                         t.insert("material", at(Value::Str(name), line));

@@ -1,0 +1,364 @@
+//! Materials: what a scene says a surface is made of, one file per kind, each listed on one
+//! line of the `materials!` invocation below (Mitsuba 3's BSDF plugins, pbrt-v4's
+//! `Material`s).
+//!
+//! A kind implements [`SurfaceMaterial`]: at a surface point it gives its lobe, a [`Bxdf`]
+//! with the kind's textures looked up there. [`Material`] is the tagged union of the kinds
+//! and [`Lobe`] that of their lobes, which the integrators call without a virtual call (BSDF
+//! evaluation and sampling are in their innermost loops); [`Material::bsdf`] puts the lobe in
+//! the point's shading frame ([`crate::bsdf::Bsdf`]). [`MATERIALS`] is the table of their
+//! factories, which the scene reader looks a `[materials]` entry's `type` up in.
+//!
+//! Mirror surfaces are two-sided, diffuse ones unless made one-sided (Mitsuba's BSDFs are
+//! one-sided: black seen from behind).
+
+use crate::Rgb;
+use crate::error::Result;
+use crate::glossy;
+use crate::microfacet::{Microfacet, MicrofacetKind};
+use crate::props::Properties;
+use crate::registry::{Factory, Resources};
+use crate::scattering::Bxdf;
+use crate::texture::Texture;
+use glam::{Vec2, Vec3};
+
+pub use crate::scattering::{
+    LocalSample, TransportMode, fresnel_conductor, fresnel_dielectric, reflect, refract,
+};
+pub use conductor::{CONDUCTORS, conductor_ior};
+
+materials! {
+    /// A material of any kind: one variant per file of this folder, each line naming the
+    /// kind and its lobe, and `Null`, the invisible boundary of a medium (rays cross it
+    /// without scattering), which the macro adds.
+    #[derive(Clone, Debug)]
+    pub enum Material {
+        Diffuse(diffuse::DiffuseMaterial, diffuse::DiffuseBxdf),
+        Mirror(mirror::MirrorMaterial, mirror::MirrorBxdf),
+        Conductor(conductor::ConductorMaterial, conductor::ConductorBxdf),
+        Dielectric(dielectric::DielectricMaterial, dielectric::DielectricBxdf),
+        ThinDielectric(thindielectric::ThinDielectricMaterial, thindielectric::ThinDielectricBxdf),
+        RoughConductor(roughconductor::RoughConductorMaterial, glossy::RoughConductor),
+        RoughDielectric(roughdielectric::RoughDielectricMaterial, glossy::RoughDielectric),
+        Plastic(plastic::PlasticMaterial, glossy::Plastic),
+        RoughPlastic(roughplastic::RoughPlasticMaterial, glossy::RoughPlastic),
+    }
+
+    /// A material's scattering at one point, its textures looked up: one variant per kind of
+    /// [`Material`] but `Null`, holding the kind's [`Bxdf`].
+    #[derive(Clone, Copy, Debug, PartialEq)]
+    pub enum Lobe {}
+}
+
+/// One kind of material: what [`Material`] dispatches to.
+pub trait SurfaceMaterial {
+    /// Its scattering at a point.
+    type Bxdf: Bxdf;
+
+    /// The lobe at surface coordinates `uv`, its textures looked up there
+    /// ([`Texture::at`]).
+    fn bxdf(&self, uv: Vec2) -> Self::Bxdf;
+
+    /// Whether the lobe depends on the surface's texture coordinates or tangent: a texture
+    /// that varies, or an anisotropic lobe. Without them the BSDF is built in any frame
+    /// around the geometric normal, without the surface's parametrisation.
+    fn needs_coordinates(&self) -> bool;
+
+    /// Whether the BSDF mirrors both directions to the upper side when seen from below
+    /// (Mitsuba's `twosided` around a one-sided lobe). A lobe that handles both sides itself
+    /// (the diffuse one, a dielectric) says false.
+    fn twosided(&self) -> bool {
+        false
+    }
+
+    /// Whether a closed shape of this material bounds a volume of its own (an interface
+    /// into a medium, as glass is) when the scene does not say which media it separates.
+    fn encloses_volume(&self) -> bool {
+        false
+    }
+}
+
+/// Declares the material kinds' files and the [`Material`] and [`Lobe`] unions over them, one
+/// line per kind: `Variant(file::Kind, Lobe)` declares `pub mod file;` (which defines `Kind`,
+/// implementing [`SurfaceMaterial`] with `type Bxdf = Lobe`, and
+/// `pub const FACTORY: Factory<Kind>`), re-exports `Kind`, adds the factory to [`MATERIALS`],
+/// `Variant(Kind)` to `Material` and `Variant(Lobe)` to `Lobe`, and the variant to the
+/// unions' methods, which dispatch to the kind's [`SurfaceMaterial`] and its lobe's [`Bxdf`].
+macro_rules! materials {
+    (
+        $(#[$attr:meta])*
+        pub enum Material { $($variant:ident($module:ident::$kind:ident, $bxdf:ty)),* $(,)? }
+
+        $(#[$lobe_attr:meta])*
+        pub enum Lobe {}
+    ) => {
+        $(pub mod $module;)*
+        $(pub use $module::$kind;)*
+
+        $(#[$attr])*
+        pub enum Material {
+            $($variant($kind),)*
+            Null,
+        }
+
+        $(#[$lobe_attr])*
+        pub enum Lobe {
+            $($variant($bxdf),)*
+        }
+
+        /// The built-in materials: a `[materials]` entry's `type` is looked up here.
+        pub const MATERIALS: &[Factory<Material>] = &[$(Factory {
+            name: $module::FACTORY.name,
+            description: $module::FACTORY.description,
+            create: |bag, nested, resources| {
+                let material = ($module::FACTORY.create)(bag, nested, resources)?;
+                Ok(Box::new(Material::$variant(*material)))
+            },
+        },)* NULL];
+
+        $(impl From<$kind> for Material {
+            fn from(material: $kind) -> Material {
+                Material::$variant(material)
+            }
+        })*
+
+        impl Material {
+            /// True when the material scatters only in Dirac deltas (mirror, smooth glass).
+            #[inline]
+            pub fn is_delta(&self) -> bool {
+                match self {
+                    $(Material::$variant(_) => <$bxdf as Bxdf>::DELTA,)*
+                    Material::Null => false,
+                }
+            }
+
+            /// See [`SurfaceMaterial::needs_coordinates`].
+            #[inline]
+            pub fn needs_coordinates(&self) -> bool {
+                match self {
+                    $(Material::$variant(m) => m.needs_coordinates(),)*
+                    Material::Null => false,
+                }
+            }
+
+            /// See [`SurfaceMaterial::encloses_volume`].
+            pub fn encloses_volume(&self) -> bool {
+                match self {
+                    $(Material::$variant(m) => m.encloses_volume(),)*
+                    Material::Null => false,
+                }
+            }
+
+            /// The lobe at `uv` and whether the BSDF mirrors directions from below (see
+            /// [`SurfaceMaterial`]); None for the null material, which does not scatter.
+            #[inline(always)]
+            pub(crate) fn lobe_at(&self, uv: Vec2) -> Option<(Lobe, bool)> {
+                match self {
+                    $(Material::$variant(m) => Some((Lobe::$variant(m.bxdf(uv)), m.twosided())),)*
+                    Material::Null => None,
+                }
+            }
+        }
+
+        impl Lobe {
+            /// True when the lobe is a sum of Dirac deltas (see [`Bxdf::DELTA`]).
+            #[inline]
+            pub fn is_delta(&self) -> bool {
+                match self {
+                    $(Lobe::$variant(_) => <$bxdf as Bxdf>::DELTA,)*
+                }
+            }
+
+            /// See [`Bxdf::eval`].
+            #[inline]
+            pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::eval(l, wo, wi),)*
+                }
+            }
+
+            /// See [`Bxdf::pdf`].
+            #[inline]
+            pub fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::pdf(l, wo, wi),)*
+                }
+            }
+
+            /// See [`Bxdf::sample`]; None for `wo` in the surface's plane.
+            #[inline]
+            pub fn sample(
+                &self,
+                wo: Vec3,
+                u: Vec2,
+                uc: f32,
+                mode: TransportMode,
+            ) -> Option<LocalSample> {
+                if wo.z == 0.0 {
+                    return None;
+                }
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::sample(l, wo, u, uc, mode),)*
+                }
+            }
+
+            /// See [`Bxdf::roughness`].
+            #[inline]
+            pub fn roughness(&self) -> f32 {
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::roughness(l),)*
+                }
+            }
+
+            /// See [`Bxdf::transmits`].
+            #[inline]
+            pub fn transmits(&self) -> bool {
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::transmits(l),)*
+                }
+            }
+
+            /// See [`Bxdf::delta_probability`].
+            #[inline]
+            pub fn delta_probability(&self, wo: Vec3) -> f32 {
+                match self {
+                    $(Lobe::$variant(l) => Bxdf::delta_probability(l, wo),)*
+                }
+            }
+        }
+    };
+}
+use materials;
+
+impl Material {
+    pub fn is_null(&self) -> bool {
+        matches!(self, Material::Null)
+    }
+}
+
+/// `null`: an invisible boundary (of a medium).
+const NULL: Factory<Material> = Factory {
+    name: "null",
+    description: "an invisible boundary of a medium: rays cross it without scattering",
+    create: |_, _, _| Ok(Box::new(Material::Null)),
+};
+
+/// A reflectance that may vary over the surface (`key`, `default` when absent); one above 1
+/// is warned about, since the material then creates energy.
+pub fn reflectance(
+    m: &Properties<'_>,
+    key: &str,
+    default: Rgb,
+    resources: &mut dyn Resources,
+) -> Result<Texture> {
+    let t = resources.texture(m, key, default)?;
+    if t.max().max_element() > 1.0 {
+        resources.warn(m, key, "is above 1: the material creates energy".into());
+    }
+    Ok(t)
+}
+
+/// A relative index of refraction `ior` (inside over outside), positive.
+pub fn read_ior(m: &Properties<'_>, default: f32) -> Result<f32> {
+    let ior = m.f32("ior", default)?;
+    if ior <= 0.0 || !ior.is_finite() {
+        return Err(m.error("ior", format!("must be positive, found {ior}")));
+    }
+    Ok(ior)
+}
+
+/// A microfacet distribution: `distribution` (`beckmann`, Mitsuba's default, or `ggx`) and
+/// `alpha` (default 0.1), or `alpha_u` and `alpha_v` where `anisotropic` lobes are allowed.
+pub fn read_microfacet(m: &Properties<'_>, anisotropic: bool) -> Result<Microfacet> {
+    let kind = match m.string("distribution", "beckmann")? {
+        "beckmann" => MicrofacetKind::Beckmann,
+        "ggx" => MicrofacetKind::Ggx,
+        other => {
+            return Err(m.error(
+                "distribution",
+                format!("unknown distribution {other:?}; expected beckmann or ggx"),
+            ));
+        }
+    };
+    let positive = |key: &str, x: f32| {
+        if x > 0.0 && x.is_finite() {
+            Ok(x)
+        } else {
+            Err(m.error(key, format!("must be positive, found {x}")))
+        }
+    };
+    if m.has("alpha_u") || m.has("alpha_v") {
+        if !anisotropic {
+            return Err(m.error(
+                if m.has("alpha_u") {
+                    "alpha_u"
+                } else {
+                    "alpha_v"
+                },
+                "this material's roughness is isotropic: give `alpha`",
+            ));
+        }
+        if m.has("alpha") {
+            return Err(m.error("alpha", "give either `alpha` or `alpha_u` and `alpha_v`"));
+        }
+        let u = positive("alpha_u", m.f32_required("alpha_u")?)?;
+        let v = positive("alpha_v", m.f32_required("alpha_v")?)?;
+        return Ok(Microfacet::new(kind, u, v));
+    }
+    let alpha = positive("alpha", m.f32("alpha", 0.1)?)?;
+    Ok(Microfacet::isotropic(kind, alpha))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fresnel_normal_incidence() {
+        let f = fresnel_dielectric(1.0, 1.5);
+        assert!((f - 0.04).abs() < 1e-6);
+        assert_eq!(fresnel_dielectric(0.1, 1.0 / 1.5), 1.0);
+    }
+
+    #[test]
+    fn fresnel_conductor_against_its_limits() {
+        // Normal incidence: ((n - 1)^2 + k^2) / ((n + 1)^2 + k^2).
+        for (n, k) in [(0.143f32, 3.983f32), (1.5, 0.0), (2.5, 1.0), (0.2, 0.0)] {
+            let expected = ((n - 1.0).powi(2) + k * k) / ((n + 1.0).powi(2) + k * k);
+            assert!(
+                (fresnel_conductor(1.0, n, k) - expected).abs() < 1e-6,
+                "{n} {k}"
+            );
+        }
+        // No absorption: the dielectric's reflectance (below the critical angle, eta > 1).
+        for cos in [1.0f32, 0.8, 0.5, 0.2, 0.05] {
+            let (c, d) = (
+                fresnel_conductor(cos, 1.5, 0.0),
+                fresnel_dielectric(cos, 1.5),
+            );
+            assert!((c - d).abs() < 1e-6, "{cos}: {c} vs {d}");
+        }
+        // Grazing incidence reflects everything; reflectance stays in [0, 1].
+        assert!((fresnel_conductor(0.0, 0.2, 3.9) - 1.0).abs() < 1e-6);
+        for (_, eta, k) in CONDUCTORS {
+            for i in 0..=20 {
+                let f = fresnel_conductor(i as f32 / 20.0, eta.x, k.x);
+                assert!((0.0..=1.0).contains(&f), "{f}");
+            }
+        }
+        let (au_eta, au_k) = conductor_ior("Au").unwrap();
+        assert!((au_eta.x - 0.143).abs() < 1e-3 && (au_k.x - 3.983).abs() < 1e-3);
+        assert_eq!(conductor_ior("gold"), None);
+    }
+
+    #[test]
+    fn refraction_obeys_snell() {
+        let n = Vec3::Z;
+        let wo = Vec3::new(0.6, 0.0, 0.8);
+        let wi = refract(wo, n, 1.5).unwrap();
+        let sin_i = 0.6;
+        let sin_t = (1.0 - wi.z * wi.z).sqrt();
+        assert!((sin_i - 1.5 * sin_t).abs() < 1e-5);
+        assert!(wi.z < 0.0 && wi.x < 0.0);
+    }
+}
