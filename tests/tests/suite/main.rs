@@ -34,6 +34,7 @@ mod media_sides;
 mod medium_kind;
 mod mitsuba;
 mod mitsuba05;
+mod mitsuba_document;
 mod mitsuba_materials;
 mod one_sided;
 mod parts;
