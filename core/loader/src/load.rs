@@ -60,8 +60,10 @@ pub fn load_with(
 /// Mitsuba 0.6's camera for a scene without one (`Scene::configure`): on the axis of the
 /// bounds' centre in x and y, in front of their near (-z) face, looking down +z from the
 /// distance at which `fov` spans the larger of their width and height. Empty bounds leave the
-/// camera as the reader wrote it.
-fn place_default_camera(doc: &mut Document, (lo, hi): (Vec3, Vec3), fov: f64) {
+/// camera as the reader wrote it. For a reader's [`crate::reader::Report::default_camera`]:
+/// `load_with` places it; a tool that writes the document out calls it with the bounds of a
+/// first build.
+pub fn place_default_camera(doc: &mut Document, (lo, hi): (Vec3, Vec3), fov: f64) {
     let extent = hi - lo;
     if !(extent.is_finite() && extent.min_element() >= 0.0) {
         return;

@@ -443,7 +443,8 @@ fn bitmap_filter_and_wrap_modes() {
 }
 
 /// An area emitter defined at the top level and given to a shape by `<ref>` is the shape's
-/// emitter; XML that does not parse is reported at its line and column.
+/// emitter, a medium given by an unnamed `<ref>` the sensor's or the light's; XML that does
+/// not parse is reported at its line and column.
 #[test]
 fn referenced_area_emitters_and_syntax_error_columns() {
     let dir = temp_dir("mitsuba-refs");
@@ -458,6 +459,15 @@ fn referenced_area_emitters_and_syntax_error_columns() {
         vector(&doc.root, "shapes.0.emission"),
         Vec3::new(3.0, 2.0, 1.0)
     );
+
+    // An unnamed reference to a medium is a sensor's or a light's medium, not a BSDF.
+    let body = r#"<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.1"/></medium>
+<sensor type="perspective"><ref id="fog"/></sensor>
+<emitter type="point"><ref id="fog"/></emitter>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "camera.medium"), "fog");
+    assert_eq!(text(&doc.root, "lights.0.medium"), "fog");
 
     let broken = "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"1\"/ >\n    </shape>\n</scene>\n";
     let xml = write(&dir, "scene.xml", broken);

@@ -388,6 +388,11 @@ impl Reader {
             // (Mitsuba names every nested object; files write `name="rfilter"`...).
             let name = match &prop {
                 Prop::Object(o) if ONE_OF_A_KIND.contains(&o.tag.as_str()) => String::new(),
+                // An unnamed reference to a medium is the parent's `medium` (a sensor's, an
+                // emitter's; a shape's must say interior or exterior), not a BSDF.
+                Prop::Ref(id) if name.is_empty() && self.media.contains_key(id) => {
+                    "medium".to_string()
+                }
                 _ => name,
             };
             obj.props.push((name, prop, cl));
