@@ -442,8 +442,8 @@ fn bitmap_filter_and_wrap_modes() {
     }
 }
 
-/// An area emitter defined at the top level and given to a shape by `<ref>` is the shape's
-/// emitter, a medium given by an unnamed `<ref>` the sensor's or the light's; XML that does
+/// An area emitter defined at the top level and given to a shape by `<ref>` (before or after
+/// it) is the shape's emitter, a medium given by an unnamed `<ref>` the sensor's or the light's; XML that does
 /// not parse is reported at its line and column.
 #[test]
 fn referenced_area_emitters_and_syntax_error_columns() {
@@ -460,6 +460,28 @@ fn referenced_area_emitters_and_syntax_error_columns() {
         Vec3::new(3.0, 2.0, 1.0)
     );
 
+    // Mitsuba resolves references once the file is read: the official Cornell box gives its
+    // light by a <ref> before the emitter, in an included file.
+    let body = format!(
+        r#"{SENSOR}
+<include filename="shapes.xml"/>
+<bsdf type="diffuse" id="white"/>
+<emitter type="area" id="glow"><rgb name="radiance" value="5, 5, 5"/></emitter>"#
+    );
+    write(
+        &dir,
+        "shapes.xml",
+        "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n        <ref id=\"white\"/>\n        <ref id=\"glow\"/>\n    </shape>\n</scene>\n",
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(
+        vector(&doc.root, "shapes.0.emission"),
+        Vec3::new(5.0, 5.0, 5.0)
+    );
+    assert_eq!(text(&doc.root, "shapes.0.material"), "white");
+    assert_eq!(node(&doc.root, "shapes.0").line, 0);
+
     // An unnamed reference to a medium is a sensor's or a light's medium, not a BSDF.
     let body = r#"<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.1"/></medium>
 <sensor type="perspective"><ref id="fog"/></sensor>
@@ -468,6 +490,16 @@ fn referenced_area_emitters_and_syntax_error_columns() {
     let (doc, _) = read(&xml, false).unwrap();
     assert_eq!(text(&doc.root, "camera.medium"), "fog");
     assert_eq!(text(&doc.root, "lights.0.medium"), "fog");
+
+    // A property of the wrong kind is named as the file writes it, not as a debug dump.
+    let body = r#"<sensor type="perspective"><texture type="checkerboard" name="fov"/></sensor>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("`fov`: expected a number, found <texture type=\"checkerboard\">"),
+        "{e}"
+    );
+    assert!(!e.contains("Obj {"), "{e}");
 
     let broken = "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"1\"/ >\n    </shape>\n</scene>\n";
     let xml = write(&dir, "scene.xml", broken);

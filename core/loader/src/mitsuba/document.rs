@@ -10,7 +10,7 @@ use super::object::{Obj, Prop};
 use super::upgrade::upgrade_v1;
 use super::{Reader, forget_line, forget_lines, shown};
 use foton_core::error::{Error, Location, Result};
-use foton_core::value::Table;
+use foton_core::value::{Node, Table, Value};
 use glam::{DMat4, DVec3};
 use std::path::Path;
 
@@ -130,10 +130,6 @@ impl Reader {
                     })?;
                     let text = std::fs::read_to_string(&inc).map_err(|e| Error::io(&inc, e))?;
                     self.report.included.push(inc.clone());
-                    // What the included file adds to the document keeps no line: the
-                    // document's lines are the scene file's.
-                    let before = (self.root.clone(), self.shapes.len(), self.lights.len());
-                    let textures = self.textures.clone();
                     // Mitsuba resolves the included file's own includes from the folder of
                     // the file that includes it, and forgets the included file's <path>s.
                     let mark = self.search.len();
@@ -142,49 +138,124 @@ impl Reader {
                     let read = self.read_file(&inc, &text);
                     self.search.truncate(mark);
                     read?;
-                    forget_lines(&before.0, &mut self.root);
-                    for node in self.shapes[before.1..]
-                        .iter_mut()
-                        .chain(&mut self.lights[before.2..])
-                    {
-                        forget_line(node);
-                    }
-                    for (id, t) in &mut self.textures {
-                        if textures.get(id) != Some(&*t) {
-                            forget_lines(&Table::default(), t);
-                        }
-                    }
                 }
+                // Resolved with the references, once every id is known.
                 "alias" => {
                     let id = self.subst(&attr(child, "id", path, pos)?, path, pos)?;
                     let alias = self.subst(&attr(child, "as", path, pos)?, path, pos)?;
-                    let mut found = false;
-                    for map in [&mut self.bsdfs, &mut self.media] {
-                        if let Some(name) = map.get(&id).cloned() {
-                            map.insert(alias.clone(), name);
-                            found = true;
-                        }
-                    }
-                    if let Some(t) = self.textures.get(&id).cloned() {
-                        self.textures.insert(alias.clone(), t);
-                        found = true;
-                    }
-                    if !found {
-                        return Err(syntax(
-                            path,
-                            pos,
-                            &format!(
-                                "<alias id=\"{id}\">: no BSDF, medium or texture with that id before it"
-                            ),
-                        ));
-                    }
+                    self.pending.push(Obj {
+                        tag: "alias".into(),
+                        ty: alias,
+                        id: Some(id),
+                        line: pos.line,
+                        file: path.to_path_buf(),
+                        props: Vec::new(),
+                        v1: self.v1,
+                    });
                 }
                 "path" => self.path(child, path, pos)?,
                 _ => {
                     let obj = self.object(child, path, line_of)?;
-                    self.top_level(obj)?;
+                    self.pending.push(obj);
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// The top-level objects read, made once every id is known (Mitsuba resolves references
+    /// after reading the whole file, so a `<ref>` may come before its object): textures,
+    /// media and the objects taken by reference first, then BSDFs, aliases, and the rest,
+    /// each kind in document order. What an included file's objects add to the document
+    /// keeps no line: the document's lines are the scene file's.
+    pub(super) fn make_objects(&mut self) -> Result<()> {
+        let mut pending = std::mem::take(&mut self.pending);
+        let rank = |o: &Obj| match o.tag.as_str() {
+            "texture" | "medium" | "sampler" | "film" | "rfilter" => 0,
+            "emitter" if o.ty == "area" => 0,
+            "bsdf" => 1,
+            "alias" => 2,
+            _ => 3,
+        };
+        pending.sort_by_key(rank);
+        for mut obj in pending {
+            self.expand_refs(&mut obj, 0);
+            self.v1 = obj.v1;
+            if obj.tag == "alias" {
+                self.alias(&obj)?;
+                continue;
+            }
+            if obj.file == self.file {
+                self.top_level(obj)?;
+                continue;
+            }
+            let before = Snapshot::of(&self.root);
+            let (shapes, lights) = (self.shapes.len(), self.lights.len());
+            let textures = self.textures.clone();
+            self.top_level(obj)?;
+            before.forget_since(&mut self.root);
+            for node in self.shapes[shapes..]
+                .iter_mut()
+                .chain(&mut self.lights[lights..])
+            {
+                forget_line(node);
+            }
+            for (id, t) in &mut self.textures {
+                if textures.get(id) != Some(&*t) {
+                    forget_lines(&Table::default(), t);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A `<ref>` to a sampler, film, filter or area emitter is that object, made where it is
+    /// taken; an unnamed one to a medium is its parent's `medium` (a sensor's, an emitter's;
+    /// a shape's says interior or exterior), not a BSDF.
+    fn expand_refs(&self, o: &mut Obj, depth: u32) {
+        for (name, p, _) in &mut o.props {
+            match p {
+                Prop::Ref(id) if depth < 16 => {
+                    if let Some(obj) = self.objects.get(id.as_str()) {
+                        let mut obj = obj.clone();
+                        self.expand_refs(&mut obj, depth + 1);
+                        if ONE_OF_A_KIND.contains(&obj.tag.as_str()) {
+                            name.clear();
+                        }
+                        *p = Prop::Object(obj);
+                    } else if name.is_empty() && self.media.contains_key(id.as_str()) {
+                        *name = "medium".into();
+                    }
+                }
+                Prop::Object(child) if depth < 16 => self.expand_refs(child, depth + 1),
+                _ => {}
+            }
+        }
+    }
+
+    /// `<alias id="a" as="b">`: `b` names what `a` does.
+    fn alias(&mut self, o: &Obj) -> Result<()> {
+        let (id, alias) = (o.id.clone().unwrap_or_default(), o.ty.clone());
+        let mut found = false;
+        for map in [&mut self.bsdfs, &mut self.media] {
+            if let Some(name) = map.get(&id).cloned() {
+                map.insert(alias.clone(), name);
+                found = true;
+            }
+        }
+        if let Some(t) = self.textures.get(&id).cloned() {
+            self.textures.insert(alias.clone(), t);
+            found = true;
+        }
+        if !found {
+            return Err(syntax(
+                &o.file,
+                Pos {
+                    line: o.line,
+                    column: 1,
+                },
+                &format!("<alias id=\"{id}\">: no BSDF, medium or texture with that id"),
+            ));
         }
         Ok(())
     }
@@ -265,6 +336,7 @@ impl Reader {
             line,
             file: file.to_path_buf(),
             props: Vec::new(),
+            v1: self.v1,
         };
         for c in n.children().filter(|c| c.is_element()) {
             let cpos = line_of(c);
@@ -334,11 +406,7 @@ impl Reader {
                 "transform" => Prop::Transform(self.transform(c, file, line_of)?),
                 "ref" => {
                     let id = cget("id")?.ok_or_else(|| syntax(file, cpos, "<ref> without id"))?;
-                    // A sampler, film, filter or area emitter made where it is taken.
-                    match self.objects.get(&id) {
-                        Some(o) => Prop::Object(o.clone()),
-                        None => Prop::Ref(id),
-                    }
+                    Prop::Ref(id)
                 }
                 // Mitsuba 0.6's sRGB colour: "#rrggbb" or numbers, both sRGB-encoded.
                 "srgb" => {
@@ -388,11 +456,6 @@ impl Reader {
             // (Mitsuba names every nested object; files write `name="rfilter"`...).
             let name = match &prop {
                 Prop::Object(o) if ONE_OF_A_KIND.contains(&o.tag.as_str()) => String::new(),
-                // An unnamed reference to a medium is the parent's `medium` (a sensor's, an
-                // emitter's; a shape's must say interior or exterior), not a BSDF.
-                Prop::Ref(id) if name.is_empty() && self.media.contains_key(id) => {
-                    "medium".to_string()
-                }
                 _ => name,
             };
             obj.props.push((name, prop, cl));
@@ -525,6 +588,46 @@ impl Reader {
             m = step * m;
         }
         Ok(m)
+    }
+}
+
+/// The document's sections as they were, to tell what one object added: the tables of
+/// named entries (materials, media) by their length, the others whole.
+struct Snapshot(Vec<(String, Result<usize, Node>)>);
+
+impl Snapshot {
+    fn of(root: &Table) -> Snapshot {
+        Snapshot(
+            root.0
+                .iter()
+                .map(|(k, n)| match (&n.value, k.as_str()) {
+                    (Value::Table(t), "materials" | "media") => (k.clone(), Ok(t.0.len())),
+                    _ => (k.clone(), Err(n.clone())),
+                })
+                .collect(),
+        )
+    }
+
+    /// What changed since the snapshot loses its line ([`forget_lines`]).
+    fn forget_since(&self, root: &mut Table) {
+        for (key, node) in &mut root.0 {
+            match (
+                self.0.iter().find(|(k, _)| k == key).map(|(_, s)| s),
+                &mut node.value,
+            ) {
+                (Some(Ok(len)), Value::Table(t)) => {
+                    t.0.iter_mut().skip(*len).for_each(|(_, n)| forget_line(n));
+                }
+                (Some(Err(old)), _) => {
+                    let mut before = Table::default();
+                    before.0.push((key.clone(), old.clone()));
+                    let mut after = Table(vec![(key.clone(), node.clone())]);
+                    forget_lines(&before, &mut after);
+                    *node = after.0.remove(0).1;
+                }
+                _ => forget_line(node),
+            }
+        }
     }
 }
 

@@ -85,9 +85,11 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         objects: HashMap::new(),
         sensor: false,
         crop: None,
+        pending: Vec::new(),
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text)?;
+    r.make_objects()?;
     r.check_defines(path)?;
     if !r.sensor {
         r.default_sensor(path);
@@ -265,6 +267,8 @@ struct Reader {
     sensor: bool,
     /// The film's crop window, read with the film, applied to the sensor's camera.
     crop: Option<sensor::Crop>,
+    /// The top-level objects (and aliases) read, made once the whole file is read.
+    pending: Vec<Obj>,
 }
 
 impl Reader {

@@ -83,9 +83,11 @@ impl Reader {
         camera.insert("fov", at(Value::Float(fov), line));
         camera.insert("fov_axis", at(Value::Str(fov_axis), line));
         if let Some((Prop::Ref(id), l)) = o.take("medium") {
-            let name = self.media.get(&id).cloned().ok_or_else(|| {
-                o.error(format!("medium `{id}` is not defined (before line {l})"))
-            })?;
+            let name = self
+                .media
+                .get(&id)
+                .cloned()
+                .ok_or_else(|| o.error(format!("line {l}: no medium with id `{id}`")))?;
             self.sensor_medium = Some((name, l));
         }
         let nested: Vec<Obj> = o

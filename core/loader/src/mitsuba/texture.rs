@@ -26,9 +26,7 @@ impl Reader {
             }
             Some((Prop::Ref(id), l)) => match self.textures.get(&id) {
                 Some(t) => Ok(Some(at(Value::Table(t.clone()), line))),
-                None => Err(o.error(format!(
-                    "`{name}`: line {l}: no texture with id `{id}` before it"
-                ))),
+                None => Err(o.error(format!("`{name}`: line {l}: no texture with id `{id}`"))),
             },
             Some((p, l)) => {
                 o.props.push((name.to_string(), p, l));
