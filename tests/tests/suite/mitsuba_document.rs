@@ -159,6 +159,24 @@ fn includes_resolve_from_the_including_file_and_report_their_lines() {
     // The scene file's own values keep their lines.
     assert_eq!(node(&doc.root, "film.width").line, 4);
 
+    // Mitsuba 3 includes a file of one object as that object.
+    write(
+        &dir.join("parts"),
+        "red.xml",
+        "<bsdf version=\"3.0.0\" type=\"diffuse\" id=\"red\">\n    <rgb name=\"reflectance\" value=\"0.8, 0.1, 0.1\"/>\n</bsdf>\n",
+    );
+    let with_red = main.replace(
+        "<include filename=\"parts/a.xml\"/>",
+        "<include filename=\"parts/red.xml\"/>\n<shape type=\"sphere\"><ref id=\"red\"/></shape>",
+    );
+    let red = write(&dir, "red.xml", &with_red);
+    let (doc, _) = read(&red, false).unwrap();
+    assert_eq!(text(&doc.root, "shapes.0.material"), "red");
+    assert_eq!(
+        vector(&doc.root, "materials.red.reflectance"),
+        Vec3::new(0.8, 0.1, 0.1)
+    );
+
     // A missing mesh in the nested file: that file and the element's line.
     write(
         &dir.join("parts/deeper"),

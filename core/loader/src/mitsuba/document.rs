@@ -64,19 +64,25 @@ impl Reader {
                 column: p.col,
             }
         };
-        if scene.tag_name().name() != "scene" {
-            return Err(syntax(
-                path,
-                line_of(scene),
-                "the root element must be <scene>",
-            ));
+        // Mitsuba 3 includes a file of one object (a `<bsdf>`, a `<shape>`...) as that object.
+        let root = scene.tag_name().name();
+        let fragment = path != self.file && OBJECT_TAGS.contains(&root);
+        if root != "scene" && !fragment {
+            let what = if path == self.file {
+                "the root element must be <scene>"
+            } else {
+                "the root element of an included file must be <scene> or an object (<bsdf>, <shape>...)"
+            };
+            return Err(syntax(path, line_of(scene), what));
         }
         // Each file is upgraded by its own version, as Mitsuba 3 does with included files.
         let version = scene.attribute("version").ok_or_else(|| {
             syntax(
                 path,
                 line_of(scene),
-                "<scene> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")",
+                &format!(
+                    "<{root}> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")"
+                ),
             )
         })?;
         let major = version
@@ -94,9 +100,14 @@ impl Reader {
                 )
             })?;
         let outer_v1 = std::mem::replace(&mut self.v1, major < 2);
-        self.read_scene_children(path, scene, &line_of)?;
+        let read = if fragment {
+            self.object(scene, path, &line_of)
+                .map(|o| self.pending.push(o))
+        } else {
+            self.read_scene_children(path, scene, &line_of)
+        };
         self.v1 = outer_v1;
-        Ok(())
+        read
     }
 
     fn read_scene_children(
