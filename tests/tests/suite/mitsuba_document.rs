@@ -298,6 +298,15 @@ fn no_sensor_is_mitsubas_default_camera() {
     let edge = camera.generate_ray(Vec2::new(0.0, 288.0)).dir;
     assert!((edge.angle_between(Vec3::Z).to_degrees() - 22.5).abs() < 1e-3);
 
+    // A sensor foton does not read: refused, or with --lenient Mitsuba's default camera.
+    let ortho = r#"<sensor type="orthographic"/>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", ortho));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("orthographic"), "{e}");
+    let loaded = foton_loader::load_with(&xml, &[], &[], true).unwrap();
+    assert_eq!(loaded.camera().resolution(), (768, 576));
+    assert!((loaded.camera().forward() - Vec3::Z).length() < 1e-6);
+
     let bare = r#"<sensor type="perspective"><float name="fov" value="30"/></sensor>"#;
     let xml = write(&dir, "scene.xml", &scene("3.0.0", bare));
     let loaded = foton_loader::load_with(&xml, &[], &[], false).unwrap();
@@ -445,6 +454,26 @@ fn bitmap_filter_and_wrap_modes() {
         assert_eq!(!report.warnings.is_empty(), warned, "{:?}", report.warnings);
         foton_loader::load_with(&xml, &[], &[], false).unwrap();
     }
+    // A texture left out (--lenient) leaves out what takes it by reference, which says so.
+    let dropped = format!(
+        r#"{SENSOR}
+<texture type="mesh_attribute" id="tex"><string name="name" value="vertex_color"/></texture>
+<shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="tex"/></bsdf></shape>"#
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &dropped));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("mesh_attribute"), "{e}");
+    let (doc, report) = read(&xml, true).unwrap();
+    assert!(doc.root.get("shapes").is_none());
+    assert!(
+        report
+            .left_out
+            .iter()
+            .any(|l| l.contains("texture `tex` was left out")),
+        "{:?}",
+        report.left_out
+    );
+
     for border in ["zero", "one"] {
         let params = format!("<string name=\"wrap_mode\" value=\"{border}\"/>");
         let xml = write(&dir, "scene.xml", &scene("3.0.0", &body(&params)));

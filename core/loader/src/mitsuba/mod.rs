@@ -86,13 +86,15 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         sensor: false,
         crop: None,
         pending: Vec::new(),
+        left_out_ids: HashSet::new(),
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text)?;
     r.make_objects()?;
     r.check_defines(path)?;
-    if !r.sensor {
-        r.default_sensor(path);
+    // No sensor, or (lenient) none foton reads.
+    if r.root.get("camera").is_none() {
+        r.default_sensor(path, r.sensor);
     }
     r.place_sensor_medium();
     if let Some(o) = r.integrator.take() {
@@ -263,12 +265,15 @@ struct Reader {
     /// Top-level objects with an `id` that others take by `<ref>` and that are not made
     /// where they stand: samplers, films, reconstruction filters, area emitters.
     objects: HashMap<String, Obj>,
-    /// Whether the file has a `<sensor>` (without one, Mitsuba places its own).
+    /// Whether the file has a `<sensor>` (without one, Mitsuba places its own; with one
+    /// foton does not read, `lenient` places Mitsuba's default).
     sensor: bool,
     /// The film's crop window, read with the film, applied to the sensor's camera.
     crop: Option<sensor::Crop>,
     /// The top-level objects (and aliases) read, made once the whole file is read.
     pending: Vec<Obj>,
+    /// Ids of top-level objects left out (lenient).
+    left_out_ids: HashSet<String>,
 }
 
 impl Reader {
@@ -423,6 +428,8 @@ impl Reader {
             "texture" => {
                 let id = obj.id.clone();
                 let Some(t) = self.texture_table(obj)? else {
+                    // Left out (lenient): what takes it by reference is left out with it.
+                    self.left_out_ids.extend(id);
                     return Ok(());
                 };
                 if let Some(id) = id {

@@ -152,7 +152,7 @@ impl Reader {
     /// across the image's width, looking down +z at the scene's bounds from in front of them,
     /// on a 768 x 576 hdrfilm with 4 independent samples per pixel. Where it stands depends
     /// on the scene's bounds: the loader places it ([`Report::default_camera`]).
-    pub(super) fn default_sensor(&mut self, path: &std::path::Path) {
+    pub(super) fn default_sensor(&mut self, path: &std::path::Path, left_out: bool) {
         let camera = table_mut(&mut self.root, "camera");
         camera.insert("position", vec3(DVec3::new(0.0, 0.0, -1.0), 0));
         camera.insert("look_at", vec3(DVec3::ZERO, 0));
@@ -168,8 +168,13 @@ impl Reader {
         film.insert("filter", at(Value::Table(filter), 0));
         table_mut(&mut self.root, "render").insert("spp", at(Value::Int(4), 0));
         self.report.default_camera = Some(DEFAULT_FOV);
+        let why = if left_out {
+            "no <sensor> foton reads"
+        } else {
+            "no <sensor>"
+        };
         self.report.notes.push(format!(
-            "{}: no <sensor>: rendered by Mitsuba's default, a perspective camera (fov 45 across the width) looking down +z at the whole scene, 768 x 576 pixels, 4 samples per pixel",
+            "{}: {why}: rendered by Mitsuba's default, a perspective camera (fov 45 across the width) looking down +z at the whole scene, 768 x 576 pixels, 4 samples per pixel",
             path.display()
         ));
     }

@@ -26,6 +26,11 @@ impl Reader {
             }
             Some((Prop::Ref(id), l)) => match self.textures.get(&id) {
                 Some(t) => Ok(Some(at(Value::Table(t.clone()), line))),
+                None if self.left_out_ids.contains(&id) => {
+                    o.props.clear();
+                    self.unsupported(o, &format!("`{name}`: texture `{id}` was left out"))?;
+                    Ok(None)
+                }
                 None => Err(o.error(format!("`{name}`: line {l}: no texture with id `{id}`"))),
             },
             Some((p, l)) => {
