@@ -1,13 +1,14 @@
-//! Triangle meshes: OBJ and PLY files, and whether a triangle set is closed (needed for a
-//! medium inside it).
+//! Triangle meshes: OBJ, PLY and Mitsuba serialized files, and whether a triangle set is closed
+//! (needed for a medium inside it).
 //!
-//! Each file format reads into a [`RawMesh`] (`raw`): `obj` (through tobj) and [`ply`]. A new
-//! format is a file here and one arm in `load_mesh`'s match on the extension; what follows
-//! (transform, normals, texture coordinates, closedness) is shared.
+//! Each file format reads into a [`RawMesh`] (`raw`): `obj` (through tobj), [`ply`] and
+//! [`serialized`]. A new format is a file here and one arm in `load_mesh`'s match on the
+//! extension; what follows (transform, normals, texture coordinates, closedness) is shared.
 
 mod obj;
 pub mod ply;
 mod raw;
+pub mod serialized;
 
 use foton_core::error::Result;
 use foton_core::geometry::{Shape, TriangleAttrs};
@@ -37,7 +38,8 @@ pub struct Mesh {
     pub closed: bool,
 }
 
-/// The mesh file `path` (OBJ or PLY, by extension) of shape `s` in the scene.
+/// The mesh file `path` of shape `s` in the scene: OBJ or PLY by its extension, Mitsuba
+/// serialized by its extension or its first bytes (mesh number `shape_index` of `s`, default 0).
 pub(super) fn load_mesh(
     s: &Properties<'_>,
     path: &Path,
@@ -59,24 +61,31 @@ pub(super) fn load_mesh(
             }
             raw
         }
-        Some("ply") => {
-            let mut file = open(s, path)?;
-            let mut bytes = Vec::new();
-            file.read_to_end(&mut bytes)
-                .map_err(|e| fail(format!("cannot read: {e}")))?;
-            ply::parse(&bytes).map_err(fail)?
-        }
+        Some("ply") => ply::parse(&read_all(s, path)?).map_err(fail)?,
         _ => {
-            return Err(s.error(
-                "file",
-                format!(
-                    "mesh {}: unknown mesh format; expected a file ending in .obj or .ply",
-                    path.display()
-                ),
-            ));
+            let bytes = read_all(s, path)?;
+            // Mitsuba reads a `serialized` shape's file whatever its name.
+            if extension.as_deref() != Some("serialized") && !serialized::is_serialized(&bytes) {
+                return Err(s.error(
+                    "file",
+                    format!(
+                        "mesh {}: unknown mesh format; expected a file ending in .obj, .ply or .serialized",
+                        path.display()
+                    ),
+                ));
+            }
+            serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
     triangles(raw, transform, options).map_err(fail)
+}
+
+fn read_all(s: &Properties<'_>, path: &Path) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    open(s, path)?
+        .read_to_end(&mut bytes)
+        .map_err(|e| s.error("file", format!("{}: cannot read: {e}", path.display())))?;
+    Ok(bytes)
 }
 
 fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {

@@ -2,7 +2,7 @@
 //! each with its material (a nested or referenced BSDF, or Mitsuba's default), its area
 //! emitter and the media on its two sides.
 
-use super::object::{Obj, Prop};
+use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::{Reader, at, matrix_table, table_mut, vec3};
 use foton_core::error::Result;
@@ -108,7 +108,7 @@ impl Reader {
             t
         };
         match o.ty.as_str() {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let file = self.filename(&mut o)?;
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("mesh".into()), line));
@@ -120,6 +120,27 @@ impl Reader {
                 }
                 if flip_normals {
                     t.insert("flip_normals", at(Value::Bool(true), line));
+                }
+                if o.ty == "serialized" {
+                    let index = o.int("shape_index", 0)?;
+                    if index < 0 {
+                        return Err(o.error(format!(
+                            "`shape_index` = {index}: expected a mesh number, 0 or more"
+                        )));
+                    }
+                    if index > 0 {
+                        t.insert("shape_index", at(Value::Int(index), line));
+                    }
+                }
+                if let Some((p, l)) = o.take("max_smooth_angle") {
+                    self.warn(
+                        &o,
+                        l,
+                        &format!(
+                            "`max_smooth_angle` = {}: not honoured; the mesh is shaded with its own vertex normals, or smooth ones computed over every angle",
+                            show(&p)
+                        ),
+                    );
                 }
                 t.insert("file", file);
                 if m != DMat4::IDENTITY {
