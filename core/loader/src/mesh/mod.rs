@@ -36,6 +36,9 @@ pub struct Mesh {
     pub triangles: Vec<Shape>,
     pub attrs: Vec<TriangleAttrs>,
     pub closed: bool,
+    /// How many of the file's triangles had zero area and were left out (Mitsuba keeps them,
+    /// but nothing can hit them; 0.6 warns about them), for a note.
+    pub dropped: usize,
 }
 
 /// The mesh file `path` of shape `s` in the scene: OBJ or PLY by its extension, Mitsuba
@@ -69,7 +72,7 @@ pub(super) fn load_mesh(
                 return Err(s.error(
                     "file",
                     format!(
-                        "mesh {}: unknown mesh format; expected a file ending in .obj, .ply or .serialized",
+                        "mesh {}: unknown mesh format; expected a file ending in .obj or .ply, or a Mitsuba serialized mesh (.serialized)",
                         path.display()
                     ),
                 ));
@@ -77,7 +80,16 @@ pub(super) fn load_mesh(
             serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
-    triangles(raw, transform, options).map_err(fail)
+    let mesh = triangles(raw, transform, options).map_err(fail)?;
+    // A mesh of zero-area triangles only is invisible, and Mitsuba opens it; as an emitter it
+    // would be a light of no area.
+    if mesh.triangles.is_empty() && s.has("emission") {
+        return Err(fail(format!(
+            "an emitting mesh with no triangle of non-zero area ({} of zero area)",
+            mesh.dropped
+        )));
+    }
+    Ok(mesh)
 }
 
 fn read_all(s: &Properties<'_>, path: &Path) -> Result<Vec<u8>> {
@@ -99,7 +111,7 @@ fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {
         .map_err(|e| s.error("file", format!("cannot open mesh {}: {e}", path.display())))
 }
 
-/// The mesh's triangles in the scene (degenerate ones dropped), their shading attributes and
+/// The mesh's triangles in the scene (zero-area ones dropped), their shading attributes and
 /// whether it is closed. Vertex normals: the file's, else (unless `face_normals`) computed as
 /// Mitsuba 3 computes them: per vertex, the sum of its faces' unit normals weighted by the
 /// face's angle at that vertex (Thuermer and Wuethrich 1998).
@@ -108,6 +120,11 @@ fn triangles(
     transform: Mat4,
     options: MeshOptions,
 ) -> std::result::Result<Mesh, String> {
+    // A file without faces is most likely a broken export; one whose faces all have zero area
+    // is invisible, and Mitsuba opens it.
+    if raw.triangles.is_empty() {
+        return Err("the mesh has no triangles".into());
+    }
     let face_normals = options.face_normals;
     // A mirroring transform reverses the winding (undone below, so that outward stays
     // outward); flip_normals reverses it on purpose.
@@ -206,11 +223,9 @@ fn triangles(
             }
         }
     }
-    if tris.is_empty() {
-        return Err("the mesh has no triangles".into());
-    }
     let closed = is_closed(&corners);
     Ok(Mesh {
+        dropped: raw.triangles.len() - tris.len(),
         triangles: tris,
         attrs,
         closed,
@@ -362,6 +377,39 @@ mod tests {
             && directed
                 .iter()
                 .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+    }
+
+    #[test]
+    fn zero_area_triangles_are_counted_and_left_out() {
+        let options = MeshOptions {
+            face_normals: false,
+            flip_tex_coords: false,
+            flip_normals: false,
+        };
+        let raw = |triangles: Vec<[u32; 3]>| RawMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, 2.0 * Vec3::X],
+            triangles,
+            ..RawMesh::default()
+        };
+        // Collinear corners, a repeated corner, and one real triangle.
+        let mesh = triangles(
+            raw(vec![[0, 1, 3], [0, 0, 2], [0, 1, 2]]),
+            Mat4::IDENTITY,
+            options,
+        )
+        .unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (1, 2));
+        let mesh = triangles(raw(vec![[0, 1, 3], [2, 2, 2]]), Mat4::IDENTITY, options).unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 2));
+        assert!(!mesh.closed);
+        // A zero scale flattens every triangle.
+        let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
+        let mesh = triangles(raw(vec![[0, 1, 2]]), flat, options).unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 1));
+        let e = triangles(raw(Vec::new()), Mat4::IDENTITY, options)
+            .err()
+            .unwrap();
+        assert!(e.contains("no triangles"), "{e}");
     }
 
     #[test]
