@@ -132,7 +132,7 @@ fn triangles(
     let swap = mirrored != options.flip_normals;
     let positions: Vec<Vec3> = raw
         .positions
-        .iter()
+        .par_iter()
         .map(|&p| transform.transform_point3(p))
         .collect();
     // `what`: the index's name and the plural of what it counts.
@@ -156,7 +156,7 @@ fn triangles(
     } else if !raw.normal_triangles.is_empty() {
         let n = raw
             .normals
-            .iter()
+            .par_iter()
             .map(|&n| (normal_matrix * n).normalize_or_zero())
             .collect();
         (n, &raw.normal_triangles[..])
@@ -173,14 +173,13 @@ fn triangles(
     } else {
         normals
     };
-    let mut tris = Vec::with_capacity(raw.triangles.len());
-    let mut attrs = Vec::new();
-    let mut corners = Vec::with_capacity(raw.triangles.len());
     let smooth = !normals.is_empty();
     let textured = !raw.uv_triangles.is_empty();
-    for (f, face) in raw.triangles.iter().enumerate() {
+    // Face f in the scene: None if it has zero area.
+    type Face = Option<(Shape, [Vec3; 3], TriangleAttrs)>;
+    let face = |f: usize| -> std::result::Result<Face, String> {
         let mut v = [Vec3::ZERO; 3];
-        for (slot, &i) in v.iter_mut().zip(face) {
+        for (slot, &i) in v.iter_mut().zip(&raw.triangles[f]) {
             *slot = positions[range(i, positions.len(), ("", "vertices"))?];
         }
         let mut a = TriangleAttrs::default();
@@ -215,8 +214,30 @@ fn triangles(
             return Err("non-finite vertex".into());
         }
         let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-        if e1.cross(e2).length_squared() > 0.0 {
-            tris.push(Shape::Triangle { p0: v[0], e1, e2 });
+        Ok((e1.cross(e2).length_squared() > 0.0).then_some((
+            Shape::Triangle { p0: v[0], e1, e2 },
+            v,
+            a,
+        )))
+    };
+    // In chunks on every thread, kept in order; the first bad face (in file order) is the
+    // one reported.
+    const CHUNK: usize = 1 << 14;
+    let chunks: Vec<std::result::Result<Vec<Face>, String>> = (0..raw.triangles.len())
+        .into_par_iter()
+        .step_by(CHUNK)
+        .map(|start| {
+            (start..(start + CHUNK).min(raw.triangles.len()))
+                .map(face)
+                .collect()
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(raw.triangles.len());
+    let mut attrs = Vec::new();
+    let mut corners = Vec::with_capacity(raw.triangles.len());
+    for chunk in chunks {
+        for (shape, v, a) in chunk?.into_iter().flatten() {
+            tris.push(shape);
             corners.push(v);
             if smooth || textured {
                 attrs.push(a);
