@@ -485,7 +485,7 @@ impl Reader {
                 self.warn(
                     &o,
                     o.line,
-                    "`to_world` scales a sphere of the group non-uniformly: rendered, as by Mitsuba 3, as the sphere of radius |to_world x|",
+                    "`to_world` scales a sphere of the group non-uniformly, into an ellipsoid in Mitsuba 3: foton has none and renders the sphere of radius |to_world x|",
                 );
             }
             self.shapes.push(at(Value::Table(t), o.line));
@@ -522,7 +522,8 @@ fn node_vec3(n: &Node) -> Option<DVec3> {
 }
 
 /// The shape table `t` (as [`Reader::shape`] writes it) moved by `m`, applied after its own
-/// placement; false if `m` turned a sphere into an ellipsoid (rendered as a sphere).
+/// placement, as Mitsuba 3's instance moves a shape; false if `m` turned a sphere into an
+/// ellipsoid (rendered as a sphere).
 fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
     let point = |t: &mut Table, key: &str| {
         if let Some(p) = t.get(key).and_then(node_vec3) {
@@ -534,8 +535,8 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
             t.insert(key, vec3(m.transform_vector3(v), line));
         }
     };
-    // A mirroring reverses u x v (quads, disks) and turns a sphere inside out, as it does
-    // when written in the shape's own to_world.
+    // A mirroring reverses u x v (quads, disks), which Mitsuba's instance does not: its
+    // normals are the shape's, transformed as normals.
     let toggle_flip = |t: &mut Table| {
         if m.determinant() < 0.0 {
             let flipped = matches!(
@@ -565,13 +566,14 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
             true
         }
         "sphere" => {
+            // Mitsuba 3 transforms the sphere's own normals by the instance's: a mirroring
+            // keeps them outward (unlike a mirroring in the sphere's own to_world).
             let uniform = is_similarity(m);
             if let Some(Value::Float(r)) = t.get("radius").map(|n| n.value.clone()) {
                 let r = r * m.transform_vector3(DVec3::X).length();
                 t.insert("radius", at(Value::Float(r), line));
             }
             point(t, "center");
-            toggle_flip(t);
             uniform
         }
         "quad" => {
