@@ -1,6 +1,6 @@
 //! Mitsuba's shapes as Mitsuba reads them (issue 32): `serialized` meshes (`shape_index`,
 //! `to_world`, `flip_normals`, the file's normals and texture coordinates), every parameter
-//! of `sphere` and `cylinder`, `shapegroup` with `instance`, meshes with zero-area triangles,
+//! of `sphere` and `cylinder`, `shapegroup` with `instance`, `merge`, meshes with zero-area triangles,
 //! and what a `<ref>` or a nested object inside a shape names. Checked on the loaded scene by
 //! tracing rays at it.
 
@@ -297,7 +297,9 @@ fn instances_are_transformed_copies_of_their_shapegroup() {
     <shape type="ply"><string name="filename" value="tri.ply"/>
         <transform name="to_world"><translate y="-3"/></transform></shape>
 </shape>
-<shape type="instance"><ref id="group"/><transform name="to_world"><translate x="10"/></transform></shape>
+<shape type="merge">
+    <shape type="instance"><ref id="group"/><transform name="to_world"><translate x="10"/></transform></shape>
+</shape>
 <shape type="instance"><ref id="group"/><transform name="to_world"><scale x="-2" y="2" z="2"/><translate x="-10"/></transform></shape>"#,
     );
     let scene = load(&path);
@@ -447,4 +449,51 @@ fn a_ref_or_object_in_a_shape_is_taken_for_what_it_names() {
     );
     let scene = foton_loader::load_with(&path, &[], &[], true).unwrap();
     assert!(trace(&scene, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).is_some());
+}
+
+#[test]
+fn mitsuba_06_mesh_parameters_are_read() {
+    let dir = temp_dir("mesh-06");
+    write(
+        &dir,
+        "tri.obj",
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib tri.mtl\nusemtl red\nf 1 2 3\n",
+    );
+    std::fs::write(
+        dir.join("m.serialized"),
+        serialized(
+            &[square(0.0, None, false), square(0.0, None, false)],
+            3,
+            false,
+        ),
+    )
+    .unwrap();
+    let path = write(
+        &dir,
+        "scene.xml",
+        r#"<scene version="0.6.0">
+<sensor type="perspective"><transform name="toWorld"><lookat origin="0, 0, 20" target="0, 0, 0" up="0, 1, 0"/></transform></sensor>
+<shape type="obj"><string name="filename" value="tri.obj"/>
+    <boolean name="collapse" value="true"/><boolean name="loadMaterials" value="true"/>
+    <boolean name="faceNormals" value="true"/><boolean name="flipNormals" value="true"/>
+    <transform name="toWorld"><translate x="5"/></transform></shape>
+<shape type="serialized"><string name="filename" value="m.serialized"/>
+    <integer name="shapeIndex" value="1"/><float name="maxSmoothAngle" value="30"/></shape>
+</scene>
+"#,
+    );
+    let scene = load(&path);
+    let (t, ng, ns, _) = trace(&scene, Vec3::new(5.2, 0.2, 5.0), -Vec3::Z).unwrap();
+    assert!((t - 5.0).abs() < 1e-4 && close(ng, -Vec3::Z, 1e-5) && close(ns, -Vec3::Z, 1e-5));
+    assert!(trace(&scene, Vec3::new(0.5, 0.5, 5.0), -Vec3::Z).is_some());
+    let ignored = scene.ignored().join("\n");
+    assert!(
+        ignored.contains("scene.xml:4") && ignored.contains("MTL materials"),
+        "{ignored}"
+    );
+    assert!(
+        ignored.contains("scene.xml:8") && ignored.contains("max_smooth_angle"),
+        "{ignored}"
+    );
+    assert!(!ignored.contains("collapse"), "{ignored}");
 }

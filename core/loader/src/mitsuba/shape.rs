@@ -1,7 +1,7 @@
 //! `<shape>`: meshes (obj, ply, serialized), spheres, disks, rectangles, cubes and cylinders as
 //! `[[shapes]]` entries, each with its material (a nested or referenced BSDF, or Mitsuba's
 //! default), its area emitter and the media on its two sides; `shapegroup` and `instance`
-//! flattened into transformed copies of the group's shapes.
+//! flattened into transformed copies of the group's shapes, `merge` into its shapes.
 //!
 //! A nested object or a `<ref>` is taken for what it is, as Mitsuba 3 does (a BSDF, an area
 //! emitter, a medium named `interior` or `exterior`), whatever the property's name. foton has
@@ -69,6 +69,7 @@ impl Reader {
         match o.ty.as_str() {
             "shapegroup" => return self.shapegroup(o),
             "instance" => return self.instance(o),
+            "merge" => return self.merge(o),
             _ => {}
         }
         let line = o.line;
@@ -251,6 +252,16 @@ impl Reader {
                         t.insert("shape_index", at(Value::Int(index), line));
                     }
                 }
+                // Mitsuba 0.6's: an OBJ's groups as separate shapes (the same surfaces), its
+                // MTL materials for a shape without a BSDF, a PLY's vertex colours as sRGB.
+                self.ignored(&mut o, "collapse", &|_| true, "");
+                self.ignored(
+                    &mut o,
+                    "load_materials",
+                    &|p| matches!(p, Prop::Bool(false)),
+                    "the OBJ's MTL materials are not read: the shape's BSDF (or Mitsuba's default) is used",
+                );
+                self.ignored(&mut o, "srgb", &|_| true, "");
                 if let Some((p, l)) = o.take("max_smooth_angle") {
                     self.warn(
                         &o,
@@ -401,6 +412,18 @@ impl Reader {
 }
 
 impl Reader {
+    /// `<shape type="merge">`: Mitsuba 3 merges its meshes of the same material into one
+    /// for speed; read one by one they are the same surfaces.
+    fn merge(&mut self, mut o: Obj) -> Result<()> {
+        for (name, p, l) in std::mem::take(&mut o.props) {
+            match p {
+                Prop::Object(member) if member.tag == "shape" => self.shape(member)?,
+                other => o.props.push((name, other, l)),
+            }
+        }
+        self.leftovers(&o)
+    }
+
     /// `<shape type="shapegroup" id="...">`: its shapes are read (materials and media bound
     /// there, as in Mitsuba) and kept for the `instance`s that place them; alone it renders
     /// nothing.
