@@ -459,41 +459,71 @@ fn mitsuba_06_mesh_parameters_are_read() {
         "tri.obj",
         "v 0 0 0\nv 1 0 0\nv 0 1 0\nmtllib tri.mtl\nusemtl red\nf 1 2 3\n",
     );
+    // A floor square (normal +z) and a wall square (normal -y) meeting at a right angle
+    // along y = 1.
+    let fold = Mesh {
+        positions: vec![
+            [0., 0., 0.],
+            [1., 0., 0.],
+            [1., 1., 0.],
+            [0., 1., 0.],
+            [1., 1., 1.],
+            [0., 1., 1.],
+        ],
+        normals: None,
+        uvs: None,
+        triangles: vec![[0, 1, 2], [0, 2, 3], [3, 2, 4], [3, 4, 5]],
+    };
     std::fs::write(
         dir.join("m.serialized"),
-        serialized(
-            &[square(0.0, None, false), square(0.0, None, false)],
-            3,
-            false,
-        ),
+        serialized(&[square(0.0, None, false), fold], 3, false),
     )
     .unwrap();
-    let path = write(
-        &dir,
-        "scene.xml",
-        r#"<scene version="0.6.0">
+    let scene_with = |angle: &str| {
+        format!(
+            r#"<scene version="0.6.0">
 <sensor type="perspective"><transform name="toWorld"><lookat origin="0, 0, 20" target="0, 0, 0" up="0, 1, 0"/></transform></sensor>
 <shape type="obj"><string name="filename" value="tri.obj"/>
     <boolean name="collapse" value="true"/><boolean name="loadMaterials" value="true"/>
     <boolean name="faceNormals" value="true"/><boolean name="flipNormals" value="true"/>
     <transform name="toWorld"><translate x="5"/></transform></shape>
 <shape type="serialized"><string name="filename" value="m.serialized"/>
-    <integer name="shapeIndex" value="1"/><float name="maxSmoothAngle" value="30"/></shape>
+    <integer name="shapeIndex" value="1"/>{angle}</shape>
 </scene>
-"#,
+"#
+        )
+    };
+    let path = write(
+        &dir,
+        "scene.xml",
+        &scene_with(r#"<float name="maxSmoothAngle" value="30"/>"#),
     );
     let scene = load(&path);
     let (t, ng, ns, _) = trace(&scene, Vec3::new(5.2, 0.2, 5.0), -Vec3::Z).unwrap();
     assert!((t - 5.0).abs() < 1e-4 && close(ng, -Vec3::Z, 1e-5) && close(ns, -Vec3::Z, 1e-5));
-    assert!(trace(&scene, Vec3::new(0.5, 0.5, 5.0), -Vec3::Z).is_some());
+    // Next to the fold the floor is shaded flat: 90 degrees is beyond 30.
+    let near_fold = Vec3::new(0.5, 0.95, 5.0);
+    let (_, _, ns, _) = trace(&scene, near_fold, -Vec3::Z).unwrap();
+    assert!(close(ns, Vec3::Z, 1e-5), "{ns}");
     let ignored = scene.ignored().join("\n");
     assert!(
         ignored.contains("scene.xml:4") && ignored.contains("MTL materials"),
         "{ignored}"
     );
-    assert!(
-        ignored.contains("scene.xml:8") && ignored.contains("max_smooth_angle"),
-        "{ignored}"
-    );
     assert!(!ignored.contains("collapse"), "{ignored}");
+    // Without it, the normals are smoothed across the fold (Mitsuba's computed normals),
+    // towards the wall's, -y.
+    let path = write(&dir, "scene.xml", &scene_with(""));
+    let (_, _, ns, _) = trace(&load(&path), near_fold, -Vec3::Z).unwrap();
+    assert!(ns.y < -0.3, "{ns}");
+    // With face normals, Mitsuba 0.6 refuses it.
+    let path = write(
+        &dir,
+        "scene.xml",
+        &scene_with(
+            r#"<float name="maxSmoothAngle" value="30"/><boolean name="faceNormals" value="true"/>"#,
+        ),
+    );
+    let e = load_err(&path, false);
+    assert!(e.contains("`max_smooth_angle` and `face_normals`"), "{e}");
 }

@@ -80,7 +80,14 @@ pub(super) fn load_mesh(
             serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
-    let mesh = triangles(raw, transform, options).map_err(fail)?;
+    let crease = s.f32_opt("max_smooth_angle")?;
+    if crease.is_some() && options.face_normals {
+        return Err(s.error(
+            "max_smooth_angle",
+            "`max_smooth_angle` and `face_normals` both: Mitsuba refuses the pair (smooth normals within an angle, or none)",
+        ));
+    }
+    let mesh = triangles(raw, transform, options, crease).map_err(fail)?;
     // A mesh of zero-area triangles only is invisible, and Mitsuba opens it; as an emitter it
     // would be a light of no area.
     if mesh.triangles.is_empty() && s.has("emission") {
@@ -114,11 +121,14 @@ fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {
 /// The mesh's triangles in the scene (zero-area ones dropped), their shading attributes and
 /// whether it is closed. Vertex normals: the file's, else (unless `face_normals`) computed as
 /// Mitsuba 3 computes them: per vertex, the sum of its faces' unit normals weighted by the
-/// face's angle at that vertex (Thuermer and Wuethrich 1998).
+/// face's angle at that vertex (Thuermer and Wuethrich 1998). With `crease` (Mitsuba 0.6's
+/// `maxSmoothAngle`, degrees) the file's normals are replaced by normals smoothed only across
+/// faces within that angle ([`crease_normals`]).
 fn triangles(
     raw: RawMesh,
     transform: Mat4,
     options: MeshOptions,
+    crease: Option<f32>,
 ) -> std::result::Result<Mesh, String> {
     // A file without faces is most likely a broken export; one whose faces all have zero area
     // is invisible, and Mitsuba opens it.
@@ -151,8 +161,17 @@ fn triangles(
     // Normals transform with the inverse transpose (outward stays outward, a mirroring
     // included).
     let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+    let creased: Vec<[u32; 3]>;
     let (normals, normal_triangles) = if face_normals {
         (Vec::new(), &[][..])
+    } else if let Some(angle) = crease {
+        let uvs = (!raw.uv_triangles.is_empty()).then_some((&raw.uvs[..], &raw.uv_triangles[..]));
+        let (mut n, t) = crease_normals(&positions, &raw.triangles, uvs, angle);
+        if mirrored {
+            n.iter_mut().for_each(|n| *n = -*n);
+        }
+        creased = t;
+        (n, &creased[..])
     } else if !raw.normal_triangles.is_empty() {
         let n = raw
             .normals
@@ -251,6 +270,85 @@ fn triangles(
         attrs,
         closed,
     })
+}
+
+/// Mitsuba 0.6's normals for `maxSmoothAngle` (its `TriMesh::rebuildTopology`): the corners
+/// at one point (one position and, with texture coordinates, one uv) are clustered greedily in
+/// face order, each unclustered corner starting a cluster that takes every later unclustered
+/// one whose face normal is within `max_angle` degrees of its own; each cluster gets the
+/// angle-weighted normal of its faces (as [`vertex_normals`]). Returns the normals and, per
+/// triangle, its corners' indices into them.
+fn crease_normals(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    uvs: Option<(&[Vec2], &[[u32; 3]])>,
+    max_angle: f32,
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let corner = |f: usize, k: usize| positions.get(triangles[f][k] as usize).copied();
+    let face_normal: Vec<Vec3> = (0..triangles.len())
+        .into_par_iter()
+        .map(|f| match (corner(f, 0), corner(f, 1), corner(f, 2)) {
+            (Some(a), Some(b), Some(c)) => (b - a).cross(c - a).normalize_or_zero(),
+            _ => Vec3::ZERO,
+        })
+        .collect();
+    // The key of a corner: its point's bits (+0 and -0 alike); corners whose position is out
+    // of range (reported by the caller) all share one.
+    let key = |c: usize| -> [u32; 5] {
+        let (f, k) = (c / 3, c % 3);
+        let p = corner(f, k).map_or(Vec3::NAN, |p| p + Vec3::ZERO);
+        let uv = uvs
+            .and_then(|(uvs, tris)| uvs.get(tris[f][k] as usize).copied())
+            .map_or(Vec2::ZERO, |t| t + Vec2::ZERO);
+        [p.x, p.y, p.z, uv.x, uv.y].map(f32::to_bits)
+    };
+    let mut order: Vec<u32> = (0..3 * triangles.len() as u32).collect();
+    // Stable: within a point, corners stay in face order, as Mitsuba's multimap keeps them.
+    order.par_sort_by_key(|&c| key(c as usize));
+    let threshold = max_angle.to_radians().cos();
+    let mut cluster = vec![u32::MAX; order.len()];
+    let mut clusters = 0u32;
+    let mut start = 0;
+    while start < order.len() {
+        let k0 = key(order[start] as usize);
+        let mut end = start + 1;
+        while end < order.len() && key(order[end] as usize) == k0 {
+            end += 1;
+        }
+        let group = &order[start..end];
+        for (i, &seed) in group.iter().enumerate() {
+            if cluster[seed as usize] != u32::MAX {
+                continue;
+            }
+            let n1 = face_normal[seed as usize / 3];
+            for &other in &group[i..] {
+                let n2 = face_normal[other as usize / 3];
+                if cluster[other as usize] == u32::MAX && (n1 == n2 || n1.dot(n2) > threshold) {
+                    cluster[other as usize] = clusters;
+                }
+            }
+            clusters += 1;
+        }
+        start = end;
+    }
+    let mut sum = vec![Vec3::ZERO; clusters as usize];
+    for (f, n) in face_normal.iter().enumerate() {
+        if *n == Vec3::ZERO {
+            continue;
+        }
+        let p = [0, 1, 2].map(|k| corner(f, k).unwrap_or(Vec3::ZERO));
+        for k in 0..3 {
+            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            sum[cluster[3 * f + k] as usize] += *n * a.dot(b).clamp(-1.0, 1.0).acos();
+        }
+    }
+    let normals = sum.into_iter().map(Vec3::normalize_or_zero).collect();
+    let corners = cluster
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    (normals, corners)
 }
 
 /// Angle-weighted vertex normals (see [`triangles`]); a vertex no face gives a normal keeps
@@ -417,20 +515,61 @@ mod tests {
             raw(vec![[0, 1, 3], [0, 0, 2], [0, 1, 2]]),
             Mat4::IDENTITY,
             options,
+            None,
         )
         .unwrap();
         assert_eq!((mesh.triangles.len(), mesh.dropped), (1, 2));
-        let mesh = triangles(raw(vec![[0, 1, 3], [2, 2, 2]]), Mat4::IDENTITY, options).unwrap();
+        let mesh = triangles(
+            raw(vec![[0, 1, 3], [2, 2, 2]]),
+            Mat4::IDENTITY,
+            options,
+            None,
+        )
+        .unwrap();
         assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 2));
         assert!(!mesh.closed);
         // A zero scale flattens every triangle.
         let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
-        let mesh = triangles(raw(vec![[0, 1, 2]]), flat, options).unwrap();
+        let mesh = triangles(raw(vec![[0, 1, 2]]), flat, options, None).unwrap();
         assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 1));
-        let e = triangles(raw(Vec::new()), Mat4::IDENTITY, options)
+        let e = triangles(raw(Vec::new()), Mat4::IDENTITY, options, None)
             .err()
             .unwrap();
         assert!(e.contains("no triangles"), "{e}");
+    }
+
+    #[test]
+    fn crease_normals_smooth_only_within_the_angle() {
+        // Two triangles folded 45 degrees along their shared edge (the x axis).
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, -s, s)];
+        let triangles = [[0, 1, 2], [1, 0, 3]];
+        let up = Vec3::Z;
+        let folded = Vec3::new(0.0, s, s);
+        let (n, t) = crease_normals(&positions, &triangles, None, 30.0);
+        // Each corner keeps its own face's normal: 45 degrees apart is beyond 30.
+        for (f, normal) in [(0, up), (1, folded)] {
+            for k in 0..3 {
+                assert!((n[t[f][k] as usize] - normal).length() < 1e-6, "{f} {k}");
+            }
+        }
+        let (n, t) = crease_normals(&positions, &triangles, None, 60.0);
+        // The shared edge's corners are one cluster each: both faces' normals, weighted by
+        // their angles at the corner (45 degrees in both faces at each of them).
+        let shared = (up + folded).normalize();
+        assert_eq!(t[0][0], t[1][1]);
+        assert_eq!(t[0][1], t[1][0]);
+        assert!((n[t[0][0] as usize] - shared).length() < 1e-6);
+        assert!((n[t[0][1] as usize] - shared).length() < 1e-6);
+        // The corners only one face has keep its normal.
+        assert!((n[t[0][2] as usize] - up).length() < 1e-6);
+        assert!((n[t[1][2] as usize] - folded).length() < 1e-6);
+        // Different texture coordinates at one position split the point, as in Mitsuba.
+        let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+        let uv_triangles = [[0, 1, 2], [1, 3, 3]];
+        let (_, t) = crease_normals(&positions, &triangles, Some((&uvs, &uv_triangles)), 60.0);
+        assert_ne!(t[0][0], t[1][1]);
+        assert_eq!(t[0][1], t[1][0]);
     }
 
     #[test]

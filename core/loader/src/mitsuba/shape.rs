@@ -262,15 +262,19 @@ impl Reader {
                     "the OBJ's MTL materials are not read: the shape's BSDF (or Mitsuba's default) is used",
                 );
                 self.ignored(&mut o, "srgb", &|_| true, "");
+                // Mitsuba 0.6's (Mitsuba 3 refuses it): normals smoothed within an angle.
                 if let Some((p, l)) = o.take("max_smooth_angle") {
-                    self.warn(
-                        &o,
-                        l,
-                        &format!(
-                            "`max_smooth_angle` = {}: not honoured; the mesh is shaded with its own vertex normals, or smooth ones computed over every angle",
-                            show(&p)
-                        ),
-                    );
+                    let angle = match p {
+                        Prop::Float(x) => x,
+                        Prop::Int(i) => i as f64,
+                        other => {
+                            return Err(o.error(format!(
+                                "line {l}: `max_smooth_angle`: expected an angle in degrees, found {}",
+                                show(&other)
+                            )));
+                        }
+                    };
+                    t.insert("max_smooth_angle", at(Value::Float(angle), l));
                 }
                 t.insert("file", file);
                 if m != DMat4::IDENTITY {
