@@ -80,6 +80,14 @@ pub(super) fn load_mesh(
             serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
+    let options = MeshOptions {
+        face_normals: if s.has("face_normals") {
+            options.face_normals
+        } else {
+            options.face_normals || raw.face_normals
+        },
+        ..options
+    };
     let crease = s.f32_opt("max_smooth_angle")?;
     if crease.is_some() && options.face_normals {
         return Err(s.error(

@@ -431,6 +431,7 @@ pub fn parse(data: &[u8]) -> Result<RawMesh, String> {
         normal_triangles,
         uvs: b.uvs,
         uv_triangles,
+        face_normals: false,
     })
 }
 

@@ -1,6 +1,7 @@
 //! Mitsuba's `serialized` meshes (versions 3 and 4 of the format, which Mitsuba 0.4 to 0.6
-//! write and Mitsuba 3 reads): indexed triangle meshes, each a zlib stream behind a short
-//! uncompressed header, several to a file, with a dictionary of where each starts at the end.
+//! write and Mitsuba 3 reads, and version 5, which Mitsuba 3 writes since 2026): indexed
+//! triangle meshes, each a zlib stream behind a short uncompressed header, several to a file,
+//! with a dictionary of where each starts at the end.
 //!
 //! The layout, all little-endian, as Mitsuba's documentation of the `serialized` plugin gives it:
 //!
@@ -15,13 +16,22 @@
 //! | 3V floats          | positions; then 3V normals, 2V texture coordinates, 3V colours as the flags say (f32, or f64 with 0x2000) |
 //! | 3F u32             | vertex indices of the triangles                                  |
 //!
+//! Version 5 stores Mitsuba 3's packed records instead: after the flags (low four bits the
+//! record layout: 0x1 normals, 0x2 tangents, 0x4 texture coordinates; 0x10 face normals;
+//! 0x1000 always set) the name (u32 length, bytes), the vertex, triangle, surface point and
+//! normal group counts (u64 each), 8 f32 per vertex (position, normal, or with tangents an
+//! encoded frame, uv), 4 u32 per triangle (three indices and a BSDF index), then index maps
+//! and attributes, which foton does not need.
+//!
 //! Further meshes follow, each with its own header and zlib stream; the file ends with the
-//! offset of each mesh (u64 in version 4, u32 in version 3) and their count (u32). Mesh 0 is
-//! read from the start of the file, any other through the dictionary, as Mitsuba does.
+//! offset of each mesh (u64 from version 4, u32 in version 3) and their count (u32). Mesh 0
+//! is read from the start of the file, any other through the dictionary, as Mitsuba does.
 //!
 //! Vertex colours are read past: Mitsuba 3 does the same, and foton has no texture that reads
-//! them. The face-normals flag is not honoured: Mitsuba 0.6's and 3's `serialized` plugins take
-//! `face_normals` from the scene only. Errors are plain text; the caller adds the file and the
+//! them. The face-normals flag of versions 3 and 4 is not honoured: Mitsuba 0.6's and 3's
+//! `serialized` plugins take `face_normals` from the scene only; version 5's is, when the
+//! scene does not say. A version 5 frame encoded with tangents is not decoded: the normals are
+//! then computed. Errors are plain text; the caller adds the file and the
 //! scene key.
 
 use super::raw::RawMesh;
@@ -64,7 +74,12 @@ pub fn parse(data: &[u8], shape_index: u32) -> Result<RawMesh, String> {
     flate2::read::ZlibDecoder::new(&data[start + 4..])
         .read_to_end(&mut bytes)
         .map_err(|e| format!("mesh {shape_index}: corrupt compressed data: {e}"))?;
-    mesh(&bytes, version).map_err(|e| format!("mesh {shape_index}: {e}"))
+    if version == 5 {
+        mesh_v5(&bytes)
+    } else {
+        mesh(&bytes, version)
+    }
+    .map_err(|e| format!("mesh {shape_index}: {e}"))
 }
 
 /// The version of the mesh whose header starts at byte `at`.
@@ -83,9 +98,9 @@ fn header(data: &[u8], at: usize) -> Result<u16, String> {
         ));
     }
     match version {
-        3 | 4 => Ok(version),
+        3..=5 => Ok(version),
         _ => Err(format!(
-            "serialized mesh version {version}; foton reads versions 3 and 4 (those of Mitsuba 0.4 to 0.6 and 3)"
+            "serialized mesh version {version}; foton reads versions 3 to 5 (those of Mitsuba 0.4 to 0.6 and 3)"
         )),
     }
 }
@@ -251,6 +266,81 @@ fn mesh(data: &[u8], version: u16) -> Result<RawMesh, String> {
     Ok(raw)
 }
 
+/// Version 5's vertex records: 8 f32 lanes, and its face records: 4 u32.
+const V5_VERTEX: usize = 32;
+const V5_FACE: usize = 16;
+
+fn mesh_v5(data: &[u8]) -> Result<RawMesh, String> {
+    let mut c = Cursor { data, pos: 0 };
+    let flags = c.u32("flag words")?;
+    if flags & 0x1000 == 0 {
+        return Err(
+            "a version 5 mesh without the single-precision flag (Mitsuba writes it always)".into(),
+        );
+    }
+    let name = c.u32("name lengths")?;
+    c.take(name as u64, 1, "bytes of the name")?;
+    let vertices = c.u64("vertex counts")?;
+    let faces = c.u64("triangle counts")?;
+    let points = c.u64("surface point counts")?;
+    let groups = c.u64("normal group counts")?;
+    let (normals, tangents, uvs) = (flags & 1 != 0, flags & 2 != 0, flags & 4 != 0);
+    if points > vertices || groups > vertices || (tangents && !normals) {
+        return Err(format!(
+            "invalid header: {vertices} vertices, {points} surface points, {groups} normal groups, layout 0x{:x}",
+            flags & 0xF
+        ));
+    }
+    let records = c.take(vertices, V5_VERTEX, "vertex records")?;
+    let face_records = c.take(faces, V5_FACE, "triangles")?;
+    let lanes = |r: &[u8], from: usize| {
+        let lane = |k: usize| f32::from_le_bytes(r[4 * k..4 * k + 4].try_into().unwrap());
+        [lane(from), lane(from + 1), lane(from + 2)]
+    };
+    let parallel = vertices as usize > PARALLEL;
+    let map_records = |f: &(dyn Fn(&[u8]) -> [f32; 3] + Sync)| -> Vec<[f32; 3]> {
+        if parallel {
+            records.par_chunks_exact(V5_VERTEX).map(f).collect()
+        } else {
+            records.chunks_exact(V5_VERTEX).map(f).collect()
+        }
+    };
+    let triangles: Vec<[u32; 3]> = {
+        let item = |t: &[u8]| {
+            [0, 1, 2].map(|k| u32::from_le_bytes(t[4 * k..4 * k + 4].try_into().unwrap()))
+        };
+        if faces as usize > PARALLEL {
+            face_records.par_chunks_exact(V5_FACE).map(item).collect()
+        } else {
+            face_records.chunks_exact(V5_FACE).map(item).collect()
+        }
+    };
+    let mut raw = RawMesh {
+        positions: map_records(&|r| lanes(r, 0))
+            .into_iter()
+            .map(Vec3::from_array)
+            .collect(),
+        face_normals: flags & 0x10 != 0,
+        ..RawMesh::default()
+    };
+    if normals && !tangents {
+        raw.normals = map_records(&|r| lanes(r, 3))
+            .into_iter()
+            .map(Vec3::from_array)
+            .collect();
+        raw.normal_triangles = triangles.clone();
+    }
+    if uvs {
+        raw.uvs = map_records(&|r| lanes(r, 5))
+            .into_iter()
+            .map(|l| Vec2::new(l[1], l[2]))
+            .collect();
+        raw.uv_triangles = triangles.clone();
+    }
+    raw.triangles = triangles;
+    Ok(raw)
+}
+
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
@@ -278,6 +368,10 @@ pub(crate) mod tests {
             offsets.push(file.len() as u64);
             file.extend(MAGIC.to_le_bytes());
             file.extend(version.to_le_bytes());
+            if version == 5 {
+                file.extend(zlib(&v5_stream(m, i, 0)));
+                continue;
+            }
             let mut s = Vec::new();
             let mut flags = if double { 0x2000u32 } else { 0x1000 };
             flags |= if m.normals.is_some() { 1 } else { 0 };
@@ -314,12 +408,10 @@ pub(crate) mod tests {
                     s.extend(i.to_le_bytes());
                 }
             }
-            let mut z = ZlibEncoder::new(Vec::new(), Compression::default());
-            z.write_all(&s).unwrap();
-            file.extend(z.finish().unwrap());
+            file.extend(zlib(&s));
         }
         for o in &offsets {
-            if version == 4 {
+            if version >= 4 {
                 file.extend(o.to_le_bytes());
             } else {
                 file.extend((*o as u32).to_le_bytes());
@@ -327,6 +419,41 @@ pub(crate) mod tests {
         }
         file.extend((meshes.len() as u32).to_le_bytes());
         file
+    }
+
+    fn zlib(data: &[u8]) -> Vec<u8> {
+        let mut z = ZlibEncoder::new(Vec::new(), Compression::default());
+        z.write_all(data).unwrap();
+        z.finish().unwrap()
+    }
+
+    /// The zlib-compressed part of a version 5 mesh (Mitsuba 3's `Mesh::write_serialized`),
+    /// with `extra` flag bits (0x10 face normals, 0x2 tangents).
+    fn v5_stream(m: &Mesh, i: usize, extra: u32) -> Vec<u8> {
+        let mut s = Vec::new();
+        let layout = u32::from(m.normals.is_some()) | (4 * u32::from(m.uvs.is_some()));
+        s.extend((0x1000 | layout | extra).to_le_bytes());
+        let name = format!("mesh{i}");
+        s.extend((name.len() as u32).to_le_bytes());
+        s.extend(name.bytes());
+        for n in [m.positions.len(), m.triangles.len(), 0, 0] {
+            s.extend((n as u64).to_le_bytes());
+        }
+        for (v, p) in m.positions.iter().enumerate() {
+            let n = m.normals.as_ref().map_or([0.0; 3], |n| n[v]);
+            let t = m.uvs.as_ref().map_or([0.0; 2], |t| t[v]);
+            for x in p.iter().chain(&n).chain(&t) {
+                s.extend((*x as f32).to_le_bytes());
+            }
+        }
+        for t in &m.triangles {
+            for i in t.iter().chain(&[0]) {
+                s.extend(i.to_le_bytes());
+            }
+        }
+        // No attributes.
+        s.extend(0u32.to_le_bytes());
+        s
     }
 
     /// A square of two triangles, z = `z`, with or without normals and texture coordinates.
@@ -389,7 +516,7 @@ pub(crate) mod tests {
     }
 
     #[test]
-    fn every_mesh_of_a_file_decodes_in_both_versions_and_precisions() {
+    fn every_mesh_of_a_file_decodes_in_every_version_and_precision() {
         let meshes = vec![
             square(0.0, false, false),
             square(1.0, true, false),
@@ -398,20 +525,18 @@ pub(crate) mod tests {
             square(-3.0, true, true),
             fan(40_000), // above PARALLEL: the parallel conversion
         ];
-        for version in [3, 4] {
-            for double in [false, true] {
-                let file = encode(&meshes, version, double);
-                for (i, m) in meshes.iter().enumerate() {
-                    let raw = parse(&file, i as u32)
-                        .unwrap_or_else(|e| panic!("v{version} double {double} mesh {i}: {e}"));
-                    check(&raw, m);
-                }
-                let e = parse(&file, 6).unwrap_err();
-                assert!(
-                    e.contains("shape_index 6 is out of range") && e.contains("6 meshes (0 to 5)"),
-                    "{e}"
-                );
+        for (version, double) in [(3, false), (3, true), (4, false), (4, true), (5, false)] {
+            let file = encode(&meshes, version, double);
+            for (i, m) in meshes.iter().enumerate() {
+                let raw = parse(&file, i as u32)
+                    .unwrap_or_else(|e| panic!("v{version} double {double} mesh {i}: {e}"));
+                check(&raw, m);
             }
+            let e = parse(&file, 6).unwrap_err();
+            assert!(
+                e.contains("shape_index 6 is out of range") && e.contains("6 meshes (0 to 5)"),
+                "{e}"
+            );
         }
     }
 
@@ -426,11 +551,11 @@ pub(crate) mod tests {
     #[test]
     fn a_truncated_or_corrupt_file_is_an_error_never_a_panic() {
         let meshes = vec![square(0.0, true, true), fan(9)];
-        for version in [3, 4] {
+        for version in [3, 4, 5] {
             let file = encode(&meshes, version, false);
             // Mesh 1 starts where mesh 0's stream ends.
             let end0 =
-                encode(&meshes[..1], version, false).len() - if version == 4 { 12 } else { 8 };
+                encode(&meshes[..1], version, false).len() - if version >= 4 { 12 } else { 8 };
             // Every prefix of the file: mesh 0 decodes whole once its stream is complete, and
             // is an error before; mesh 1 is an error or (by a chance of the cut) some mesh.
             for len in 0..file.len() {
@@ -481,12 +606,42 @@ pub(crate) mod tests {
     }
 
     #[test]
+    fn version_5_flags_face_normals_tangents_and_bad_headers() {
+        let m = square(0.0, true, true);
+        let one = |stream: Vec<u8>| {
+            let mut file = vec![0x1C, 0x04, 5, 0];
+            file.extend(zlib(&stream));
+            parse(&file, 0)
+        };
+        let raw = one(v5_stream(&m, 0, 0)).unwrap();
+        assert!(!raw.face_normals && raw.normals.len() == 4 && raw.uvs.len() == 4);
+        assert!(one(v5_stream(&m, 0, 0x10)).unwrap().face_normals);
+        // An encoded tangent frame is not a normal: the normals are left to be computed.
+        let raw = one(v5_stream(&m, 0, 0x2)).unwrap();
+        assert!(raw.normals.is_empty() && raw.normal_triangles.is_empty());
+        assert_eq!(raw.uvs[2], Vec2::ONE);
+        // Tangents without normals, and more surface points than vertices.
+        let e = one(v5_stream(&square(0.0, false, false), 0, 0x2)).unwrap_err();
+        assert!(e.contains("invalid header"), "{e}");
+        let mut s = v5_stream(&m, 0, 0);
+        // flags, name length, "mesh0", vertex and triangle counts: then the point count.
+        let points = 4 + 4 + 5 + 16;
+        s[points..points + 8].copy_from_slice(&5u64.to_le_bytes());
+        let e = one(s).unwrap_err();
+        assert!(e.contains("5 surface points"), "{e}");
+        let mut s = v5_stream(&m, 0, 0);
+        s[1] = 0;
+        let e = one(s).unwrap_err();
+        assert!(e.contains("single-precision"), "{e}");
+    }
+
+    #[test]
     fn other_versions_and_formats_are_named() {
         let mut file = encode(&[square(0.0, false, false)], 4, false);
-        file[2] = 5;
+        file[2] = 6;
         let e = parse(&file, 0).unwrap_err();
         assert!(
-            e.contains("version 5") && e.contains("versions 3 and 4"),
+            e.contains("version 6") && e.contains("versions 3 to 5"),
             "{e}"
         );
         assert!(is_serialized(&file) && !is_serialized(b"ply") && !is_serialized(b""));
