@@ -247,29 +247,37 @@ fn triangles(
             a,
         )))
     };
-    // In chunks on every thread, kept in order; the first bad face (in file order) is the
-    // one reported.
+    // In chunks on every thread, each into its own arrays, kept in order; the first bad face
+    // (in file order) is the one reported.
     const CHUNK: usize = 1 << 14;
-    let chunks: Vec<std::result::Result<Vec<Face>, String>> = (0..raw.triangles.len())
+    type Part = (Vec<Shape>, Vec<[Vec3; 3]>, Vec<TriangleAttrs>);
+    let parts: Vec<std::result::Result<Part, String>> = (0..raw.triangles.len())
         .into_par_iter()
         .step_by(CHUNK)
         .map(|start| {
-            (start..(start + CHUNK).min(raw.triangles.len()))
-                .map(face)
-                .collect()
+            let end = (start + CHUNK).min(raw.triangles.len());
+            let mut part: Part = (Vec::with_capacity(end - start), Vec::new(), Vec::new());
+            part.1.reserve(end - start);
+            for f in start..end {
+                if let Some((shape, v, a)) = face(f)? {
+                    part.0.push(shape);
+                    part.1.push(v);
+                    if smooth || textured {
+                        part.2.push(a);
+                    }
+                }
+            }
+            Ok(part)
         })
         .collect();
     let mut tris = Vec::with_capacity(raw.triangles.len());
     let mut attrs = Vec::new();
     let mut corners = Vec::with_capacity(raw.triangles.len());
-    for chunk in chunks {
-        for (shape, v, a) in chunk?.into_iter().flatten() {
-            tris.push(shape);
-            corners.push(v);
-            if smooth || textured {
-                attrs.push(a);
-            }
-        }
+    for part in parts {
+        let (t, c, a) = part?;
+        tris.extend(t);
+        corners.extend(c);
+        attrs.extend(a);
     }
     let closed = is_closed(&corners);
     Ok(Mesh {
