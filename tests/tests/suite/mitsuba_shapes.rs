@@ -527,3 +527,26 @@ fn mitsuba_06_mesh_parameters_are_read() {
     let e = load_err(&path, false);
     assert!(e.contains("`max_smooth_angle` and `face_normals`"), "{e}");
 }
+
+#[test]
+fn ply_texture_coordinates_are_flipped_only_when_asked() {
+    let dir = temp_dir("ply-uv");
+    write(
+        &dir,
+        "tri.ply",
+        "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n0 1 0 0 1\n3 0 1 2\n",
+    );
+    for (flip, v) in [
+        ("", 0.25),
+        (r#"<boolean name="flip_tex_coords" value="true"/>"#, 0.75),
+    ] {
+        let path = xml(
+            &dir,
+            &format!(
+                r#"<shape type="ply"><string name="filename" value="tri.ply"/>{flip}</shape>"#
+            ),
+        );
+        let (_, _, _, uv) = trace(&load(&path), Vec3::new(0.25, 0.25, 5.0), -Vec3::Z).unwrap();
+        assert!((uv - Vec2::new(0.25, v)).length() < 1e-5, "{flip}: {uv}");
+    }
+}

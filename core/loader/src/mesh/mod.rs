@@ -24,7 +24,8 @@ use std::path::Path;
 pub struct MeshOptions {
     /// Shade with the triangles' own normals, ignoring vertex normals.
     pub face_normals: bool,
-    /// OBJ texture coordinates count v from the top: v = 1 - v (Mitsuba's default).
+    /// Texture coordinates count v from the top: v = 1 - v (Mitsuba's default for OBJ; for
+    /// PLY only when the scene gives it).
     pub flip_tex_coords: bool,
     /// Turn the mesh inside out: reversed triangles, negated vertex normals.
     pub flip_normals: bool,
@@ -64,7 +65,17 @@ pub(super) fn load_mesh(
             }
             raw
         }
-        Some("ply") => ply::parse(&read_all(s, path)?).map_err(fail)?,
+        Some("ply") => {
+            let mut raw = ply::parse(&read_all(s, path)?).map_err(fail)?;
+            // A PLY's texture coordinates are flipped only when the scene says so (Mitsuba 3's
+            // default for PLY, unlike OBJ).
+            if options.flip_tex_coords && s.has("flip_tex_coords") {
+                for uv in &mut raw.uvs {
+                    uv.y = 1.0 - uv.y;
+                }
+            }
+            raw
+        }
         _ => {
             let bytes = read_all(s, path)?;
             // Mitsuba reads a `serialized` shape's file whatever its name.

@@ -235,8 +235,12 @@ impl Reader {
                 if o.boolean("face_normals", false)? {
                     t.insert("face_normals", at(Value::Bool(true), line));
                 }
+                // Mitsuba flips an OBJ's v unless told not to, a PLY's only when told.
                 if o.ty == "obj" && !o.boolean("flip_tex_coords", true)? {
                     t.insert("flip_tex_coords", at(Value::Bool(false), line));
+                }
+                if o.ty == "ply" && o.boolean("flip_tex_coords", false)? {
+                    t.insert("flip_tex_coords", at(Value::Bool(true), line));
                 }
                 if flip_normals {
                     t.insert("flip_normals", at(Value::Bool(true), line));
