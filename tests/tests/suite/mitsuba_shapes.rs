@@ -449,6 +449,18 @@ fn a_ref_or_object_in_a_shape_is_taken_for_what_it_names() {
     );
     let scene = foton_loader::load_with(&path, &[], &[], true).unwrap();
     assert!(trace(&scene, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).is_some());
+    // ... and the sphere without the <ref> it cannot resolve, saying so.
+    let path = xml(
+        &dir,
+        &format!("{defs}\n<shape type=\"sphere\">\n<ref id=\"nothing\"/></shape>"),
+    );
+    let scene = foton_loader::load_with(&path, &[], &[], true).unwrap();
+    assert!(trace(&scene, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).is_some());
+    let said = scene.warnings().join("\n");
+    assert!(
+        said.contains("left out: ") && said.contains("scene.xml:7") && said.contains("`nothing`"),
+        "{said}"
+    );
 }
 
 #[test]

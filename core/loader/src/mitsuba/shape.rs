@@ -164,13 +164,15 @@ impl Reader {
                         return Err(here.error(format!(
                             "<ref id=\"{id}\">: `{id}` is {kind}; a shape takes a BSDF, an area emitter or a medium (`interior`, `exterior`)"
                         )));
-                    } else if self.lenient {
-                        // Most likely an element left out before (lenient): the shape goes too.
-                        material = Some(None);
                     } else {
-                        return Err(here.error(format!(
-                            "<ref id=\"{id}\">: no BSDF, area emitter or medium with id `{id}` before it"
-                        )));
+                        // Most likely an element left out before (lenient): the shape is
+                        // rendered without it, with Mitsuba's default BSDF if it was its BSDF.
+                        self.unsupported(
+                            &here,
+                            &format!(
+                                "<ref id=\"{id}\">: no BSDF, area emitter or medium with id `{id}` before it"
+                            ),
+                        )?;
                     }
                 }
                 other => o.props.push((name, other, l)),
