@@ -8,7 +8,7 @@
 //! | bytes              | content                                                          |
 //! |--------------------|------------------------------------------------------------------|
 //! | u16                | format identifier 0x041C                                         |
-//! | u16                | version: 3 or 4                                                  |
+//! | u16                | version: 3 or 4 (5 below)                                        |
 //! | zlib stream:       |                                                                  |
 //! | u32                | flags: 0x1 vertex normals, 0x2 texture coordinates, 0x8 vertex colours, 0x10 face normals, 0x1000 single, 0x2000 double precision |
 //! | bytes, NUL         | the shape's name (version 4 only)                                |
@@ -31,8 +31,7 @@
 //! them. The face-normals flag of versions 3 and 4 is not honoured: Mitsuba 0.6's and 3's
 //! `serialized` plugins take `face_normals` from the scene only; version 5's is, when the
 //! scene does not say. A version 5 frame encoded with tangents is not decoded: the normals are
-//! then computed. Errors are plain text; the caller adds the file and the
-//! scene key.
+//! then computed. Errors are plain text; the caller adds the file and the scene key.
 
 use super::raw::RawMesh;
 use glam::{Vec2, Vec3};
