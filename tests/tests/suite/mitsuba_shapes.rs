@@ -577,3 +577,23 @@ fn an_area_emitter_given_by_ref_makes_its_shape_emit() {
     let expected = std::f32::consts::PI * 3.0 * 4.0;
     assert!((scene.total_power().x / expected - 1.0).abs() < 1e-4);
 }
+
+#[test]
+fn another_emitter_inside_a_shape_is_a_light_of_its_own() {
+    let dir = temp_dir("spot-in-shape");
+    // Mitsuba 3 reads the spot as a scene light at its own to_world, not the rectangle's
+    // (checked with Mitsuba 3.9.1).
+    let path = xml(
+        &dir,
+        r#"<shape type="rectangle"><transform name="to_world"><translate z="5"/></transform>
+    <emitter type="spot"><rgb name="intensity" value="2"/></emitter></shape>"#,
+    );
+    let scene = load(&path);
+    assert_eq!(scene.lights().len(), 1);
+    assert!(trace(&scene, Vec3::new(0.0, 0.0, 10.0), -Vec3::Z).is_some());
+    let said = scene.warnings().join("\n");
+    assert!(
+        said.contains("scene.xml:4") && said.contains("light of its own"),
+        "{said}"
+    );
+}

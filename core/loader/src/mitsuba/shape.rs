@@ -100,11 +100,17 @@ impl Reader {
                     once(material.is_some(), "BSDF")?;
                     material = Some(self.bsdf(b)?);
                 }
+                // Mitsuba 3 takes another kind of emitter in a shape for a light of its own,
+                // placed by its own to_world (the shape's plays no part).
+                Prop::Object(e) if e.tag == "emitter" && e.ty != "area" => {
+                    self.note(
+                        &e,
+                        "an emitter other than `area` inside a shape is a light of its own, placed by its own to_world, as Mitsuba 3 reads it",
+                    );
+                    self.emitter(e)?;
+                }
                 Prop::Object(mut e) if e.tag == "emitter" => {
                     once(emission.is_some(), "emitter")?;
-                    if e.ty != "area" {
-                        return Err(e.error("a shape's emitter must be `area`"));
-                    }
                     emission = Some(e.color("radiance", DVec3::ONE)?);
                     self.leftovers(&e)?;
                 }
