@@ -36,6 +36,7 @@ mod mitsuba;
 mod mitsuba05;
 mod mitsuba_document;
 mod mitsuba_materials;
+mod mitsuba_shapes;
 mod one_sided;
 mod parts;
 mod photon;
