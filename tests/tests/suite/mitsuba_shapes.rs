@@ -564,7 +564,6 @@ fn ply_texture_coordinates_are_flipped_only_when_asked() {
 }
 
 #[test]
-#[ignore = "needs the emitter reader to hand a top-level area emitter to Reader::declare_area_emitter (merge note of h4-serialized)"]
 fn an_area_emitter_given_by_ref_makes_its_shape_emit() {
     let dir = temp_dir("area-ref");
     let path = xml(

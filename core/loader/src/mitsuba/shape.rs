@@ -25,24 +25,6 @@ const GROUP_KEY: &str = "\0shapegroup:";
 const AREA_KEY: &str = "\0area_emitter:";
 
 impl Reader {
-    /// A top-level `<emitter type="area" id="...">`, kept for the shapes that `<ref>` it.
-    // Called by `emitter` for a top-level area emitter (to be wired there: its file is
-    // another reader's).
-    #[allow(dead_code)]
-    pub(super) fn declare_area_emitter(&mut self, mut e: Obj) -> Result<()> {
-        let Some(id) = e.id.clone() else {
-            return Err(e.error(
-                "an area emitter outside a shape needs an id, for the shapes that <ref> it",
-            ));
-        };
-        let radiance = e.color("radiance", DVec3::ONE)?;
-        self.leftovers(&e)?;
-        let mut t = Table::default();
-        t.insert("radiance", vec3(radiance, e.line));
-        self.textures.insert(format!("{AREA_KEY}{id}"), t);
-        Ok(())
-    }
-
     fn area_emitter(&self, id: &str) -> Option<DVec3> {
         let t = self.textures.get(&format!("{AREA_KEY}{id}"))?;
         node_vec3(t.get("radiance")?)
