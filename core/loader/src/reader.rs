@@ -42,6 +42,10 @@ pub struct Report {
     /// the integrator, the factor and its line; the loader sets `max_radius` once it knows the
     /// scene's bounds ([`crate::set_relative_radius`]).
     pub relative_radius: Option<(String, f64, u32)>,
+    /// The file has no camera and takes its format's default (Mitsuba's, with this field of
+    /// view in degrees across the image's width), which stands in front of the whole scene:
+    /// the loader places it once it knows the scene's bounds ([`crate::load_with`]).
+    pub default_camera: Option<f64>,
 }
 
 /// A format's reader: a scene file into the document and the report.

@@ -1,13 +1,14 @@
-//! Triangle meshes: OBJ and PLY files, and whether a triangle set is closed (needed for a
-//! medium inside it).
+//! Triangle meshes: OBJ, PLY and Mitsuba serialized files, and whether a triangle set is closed
+//! (needed for a medium inside it).
 //!
-//! Each file format reads into a [`RawMesh`] (`raw`): `obj` (through tobj) and [`ply`]. A new
-//! format is a file here and one arm in `load_mesh`'s match on the extension; what follows
-//! (transform, normals, texture coordinates, closedness) is shared.
+//! Each file format reads into a [`RawMesh`] (`raw`): `obj` (through tobj), [`ply`] and
+//! [`serialized`]. A new format is a file here and one arm in `load_mesh`'s match on the
+//! extension; what follows (transform, normals, texture coordinates, closedness) is shared.
 
 mod obj;
 pub mod ply;
 mod raw;
+pub mod serialized;
 
 use foton_core::error::Result;
 use foton_core::geometry::{Shape, TriangleAttrs};
@@ -23,7 +24,8 @@ use std::path::Path;
 pub struct MeshOptions {
     /// Shade with the triangles' own normals, ignoring vertex normals.
     pub face_normals: bool,
-    /// OBJ texture coordinates count v from the top: v = 1 - v (Mitsuba's default).
+    /// Texture coordinates count v from the top: v = 1 - v (Mitsuba's default for OBJ; for
+    /// PLY only when the scene gives it).
     pub flip_tex_coords: bool,
     /// Turn the mesh inside out: reversed triangles, negated vertex normals.
     pub flip_normals: bool,
@@ -35,9 +37,13 @@ pub struct Mesh {
     pub triangles: Vec<Shape>,
     pub attrs: Vec<TriangleAttrs>,
     pub closed: bool,
+    /// How many of the file's triangles had zero area and were left out (Mitsuba keeps them,
+    /// but nothing can hit them; 0.6 warns about them), for a note.
+    pub dropped: usize,
 }
 
-/// The mesh file `path` (OBJ or PLY, by extension) of shape `s` in the scene.
+/// The mesh file `path` of shape `s` in the scene: OBJ or PLY by its extension, Mitsuba
+/// serialized by its extension or its first bytes (mesh number `shape_index` of `s`, default 0).
 pub(super) fn load_mesh(
     s: &Properties<'_>,
     path: &Path,
@@ -60,23 +66,64 @@ pub(super) fn load_mesh(
             raw
         }
         Some("ply") => {
-            let mut file = open(s, path)?;
-            let mut bytes = Vec::new();
-            file.read_to_end(&mut bytes)
-                .map_err(|e| fail(format!("cannot read: {e}")))?;
-            ply::parse(&bytes).map_err(fail)?
+            let mut raw = ply::parse(&read_all(s, path)?).map_err(fail)?;
+            // A PLY's texture coordinates are flipped only when the scene says so (Mitsuba 3's
+            // default for PLY, unlike OBJ).
+            if options.flip_tex_coords && s.has("flip_tex_coords") {
+                for uv in &mut raw.uvs {
+                    uv.y = 1.0 - uv.y;
+                }
+            }
+            raw
         }
         _ => {
-            return Err(s.error(
-                "file",
-                format!(
-                    "mesh {}: unknown mesh format; expected a file ending in .obj or .ply",
-                    path.display()
-                ),
-            ));
+            let bytes = read_all(s, path)?;
+            // Mitsuba reads a `serialized` shape's file whatever its name.
+            if extension.as_deref() != Some("serialized") && !serialized::is_serialized(&bytes) {
+                return Err(s.error(
+                    "file",
+                    format!(
+                        "mesh {}: unknown mesh format; expected a file ending in .obj or .ply, or a Mitsuba serialized mesh (.serialized)",
+                        path.display()
+                    ),
+                ));
+            }
+            serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
-    triangles(raw, transform, options).map_err(fail)
+    let options = MeshOptions {
+        face_normals: if s.has("face_normals") {
+            options.face_normals
+        } else {
+            options.face_normals || raw.face_normals
+        },
+        ..options
+    };
+    let crease = s.f32_opt("max_smooth_angle")?;
+    if crease.is_some() && options.face_normals {
+        return Err(s.error(
+            "max_smooth_angle",
+            "`max_smooth_angle` and `face_normals` both: Mitsuba refuses the pair (smooth normals within an angle, or none)",
+        ));
+    }
+    let mesh = triangles(raw, transform, options, crease).map_err(fail)?;
+    // A mesh of zero-area triangles only is invisible, and Mitsuba opens it; as an emitter it
+    // would be a light of no area.
+    if mesh.triangles.is_empty() && s.has("emission") {
+        return Err(fail(format!(
+            "an emitting mesh with no triangle of non-zero area ({} of zero area)",
+            mesh.dropped
+        )));
+    }
+    Ok(mesh)
+}
+
+fn read_all(s: &Properties<'_>, path: &Path) -> Result<Vec<u8>> {
+    let mut bytes = Vec::new();
+    open(s, path)?
+        .read_to_end(&mut bytes)
+        .map_err(|e| s.error("file", format!("{}: cannot read: {e}", path.display())))?;
+    Ok(bytes)
 }
 
 fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {
@@ -90,15 +137,23 @@ fn open(s: &Properties<'_>, path: &Path) -> Result<std::fs::File> {
         .map_err(|e| s.error("file", format!("cannot open mesh {}: {e}", path.display())))
 }
 
-/// The mesh's triangles in the scene (degenerate ones dropped), their shading attributes and
+/// The mesh's triangles in the scene (zero-area ones dropped), their shading attributes and
 /// whether it is closed. Vertex normals: the file's, else (unless `face_normals`) computed as
 /// Mitsuba 3 computes them: per vertex, the sum of its faces' unit normals weighted by the
-/// face's angle at that vertex (Thuermer and Wuethrich 1998).
+/// face's angle at that vertex (Thuermer and Wuethrich 1998). With `crease` (Mitsuba 0.6's
+/// `maxSmoothAngle`, degrees) the file's normals are replaced by normals smoothed only across
+/// faces within that angle ([`crease_normals`]).
 fn triangles(
     raw: RawMesh,
     transform: Mat4,
     options: MeshOptions,
+    crease: Option<f32>,
 ) -> std::result::Result<Mesh, String> {
+    // A file without faces is most likely a broken export; one whose faces all have zero area
+    // is invisible, and Mitsuba opens it.
+    if raw.triangles.is_empty() {
+        return Err("the mesh has no triangles".into());
+    }
     let face_normals = options.face_normals;
     // A mirroring transform reverses the winding (undone below, so that outward stays
     // outward); flip_normals reverses it on purpose.
@@ -106,7 +161,7 @@ fn triangles(
     let swap = mirrored != options.flip_normals;
     let positions: Vec<Vec3> = raw
         .positions
-        .iter()
+        .par_iter()
         .map(|&p| transform.transform_point3(p))
         .collect();
     // `what`: the index's name and the plural of what it counts.
@@ -125,12 +180,21 @@ fn triangles(
     // Normals transform with the inverse transpose (outward stays outward, a mirroring
     // included).
     let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+    let creased: Vec<[u32; 3]>;
     let (normals, normal_triangles) = if face_normals {
         (Vec::new(), &[][..])
+    } else if let Some(angle) = crease {
+        let uvs = (!raw.uv_triangles.is_empty()).then_some((&raw.uvs[..], &raw.uv_triangles[..]));
+        let (mut n, t) = crease_normals(&positions, &raw.triangles, uvs, angle);
+        if mirrored {
+            n.iter_mut().for_each(|n| *n = -*n);
+        }
+        creased = t;
+        (n, &creased[..])
     } else if !raw.normal_triangles.is_empty() {
         let n = raw
             .normals
-            .iter()
+            .par_iter()
             .map(|&n| (normal_matrix * n).normalize_or_zero())
             .collect();
         (n, &raw.normal_triangles[..])
@@ -147,14 +211,13 @@ fn triangles(
     } else {
         normals
     };
-    let mut tris = Vec::with_capacity(raw.triangles.len());
-    let mut attrs = Vec::new();
-    let mut corners = Vec::with_capacity(raw.triangles.len());
     let smooth = !normals.is_empty();
     let textured = !raw.uv_triangles.is_empty();
-    for (f, face) in raw.triangles.iter().enumerate() {
+    // Face f in the scene: None if it has zero area.
+    type Face = Option<(Shape, [Vec3; 3], TriangleAttrs)>;
+    let face = |f: usize| -> std::result::Result<Face, String> {
         let mut v = [Vec3::ZERO; 3];
-        for (slot, &i) in v.iter_mut().zip(face) {
+        for (slot, &i) in v.iter_mut().zip(&raw.triangles[f]) {
             *slot = positions[range(i, positions.len(), ("", "vertices"))?];
         }
         let mut a = TriangleAttrs::default();
@@ -189,23 +252,130 @@ fn triangles(
             return Err("non-finite vertex".into());
         }
         let (e1, e2) = (v[1] - v[0], v[2] - v[0]);
-        if e1.cross(e2).length_squared() > 0.0 {
-            tris.push(Shape::Triangle { p0: v[0], e1, e2 });
-            corners.push(v);
-            if smooth || textured {
-                attrs.push(a);
+        Ok((e1.cross(e2).length_squared() > 0.0).then_some((
+            Shape::Triangle { p0: v[0], e1, e2 },
+            v,
+            a,
+        )))
+    };
+    // In chunks on every thread, each into its own arrays, kept in order; the first bad face
+    // (in file order) is the one reported.
+    const CHUNK: usize = 1 << 14;
+    type Part = (Vec<Shape>, Vec<[Vec3; 3]>, Vec<TriangleAttrs>);
+    let parts: Vec<std::result::Result<Part, String>> = (0..raw.triangles.len())
+        .into_par_iter()
+        .step_by(CHUNK)
+        .map(|start| {
+            let end = (start + CHUNK).min(raw.triangles.len());
+            let mut part: Part = (Vec::with_capacity(end - start), Vec::new(), Vec::new());
+            part.1.reserve(end - start);
+            for f in start..end {
+                if let Some((shape, v, a)) = face(f)? {
+                    part.0.push(shape);
+                    part.1.push(v);
+                    if smooth || textured {
+                        part.2.push(a);
+                    }
+                }
             }
-        }
-    }
-    if tris.is_empty() {
-        return Err("the mesh has no triangles".into());
+            Ok(part)
+        })
+        .collect();
+    let mut tris = Vec::with_capacity(raw.triangles.len());
+    let mut attrs = Vec::new();
+    let mut corners = Vec::with_capacity(raw.triangles.len());
+    for part in parts {
+        let (t, c, a) = part?;
+        tris.extend(t);
+        corners.extend(c);
+        attrs.extend(a);
     }
     let closed = is_closed(&corners);
     Ok(Mesh {
+        dropped: raw.triangles.len() - tris.len(),
         triangles: tris,
         attrs,
         closed,
     })
+}
+
+/// Mitsuba 0.6's normals for `maxSmoothAngle` (its `TriMesh::rebuildTopology`): the corners
+/// at one point (one position and, with texture coordinates, one uv) are clustered greedily in
+/// face order, each unclustered corner starting a cluster that takes every later unclustered
+/// one whose face normal is within `max_angle` degrees of its own; each cluster gets the
+/// angle-weighted normal of its faces (as [`vertex_normals`]). Returns the normals and, per
+/// triangle, its corners' indices into them.
+fn crease_normals(
+    positions: &[Vec3],
+    triangles: &[[u32; 3]],
+    uvs: Option<(&[Vec2], &[[u32; 3]])>,
+    max_angle: f32,
+) -> (Vec<Vec3>, Vec<[u32; 3]>) {
+    let corner = |f: usize, k: usize| positions.get(triangles[f][k] as usize).copied();
+    let face_normal: Vec<Vec3> = (0..triangles.len())
+        .into_par_iter()
+        .map(|f| match (corner(f, 0), corner(f, 1), corner(f, 2)) {
+            (Some(a), Some(b), Some(c)) => (b - a).cross(c - a).normalize_or_zero(),
+            _ => Vec3::ZERO,
+        })
+        .collect();
+    // The key of a corner: its point's bits (+0 and -0 alike); corners whose position is out
+    // of range (reported by the caller) all share one.
+    let key = |c: usize| -> [u32; 5] {
+        let (f, k) = (c / 3, c % 3);
+        let p = corner(f, k).map_or(Vec3::NAN, |p| p + Vec3::ZERO);
+        let uv = uvs
+            .and_then(|(uvs, tris)| uvs.get(tris[f][k] as usize).copied())
+            .map_or(Vec2::ZERO, |t| t + Vec2::ZERO);
+        [p.x, p.y, p.z, uv.x, uv.y].map(f32::to_bits)
+    };
+    let mut order: Vec<u32> = (0..3 * triangles.len() as u32).collect();
+    // Stable: within a point, corners stay in face order, as Mitsuba's multimap keeps them.
+    order.par_sort_by_key(|&c| key(c as usize));
+    let threshold = max_angle.to_radians().cos();
+    let mut cluster = vec![u32::MAX; order.len()];
+    let mut clusters = 0u32;
+    let mut start = 0;
+    while start < order.len() {
+        let k0 = key(order[start] as usize);
+        let mut end = start + 1;
+        while end < order.len() && key(order[end] as usize) == k0 {
+            end += 1;
+        }
+        let group = &order[start..end];
+        for (i, &seed) in group.iter().enumerate() {
+            if cluster[seed as usize] != u32::MAX {
+                continue;
+            }
+            let n1 = face_normal[seed as usize / 3];
+            for &other in &group[i..] {
+                let n2 = face_normal[other as usize / 3];
+                if cluster[other as usize] == u32::MAX && (n1 == n2 || n1.dot(n2) > threshold) {
+                    cluster[other as usize] = clusters;
+                }
+            }
+            clusters += 1;
+        }
+        start = end;
+    }
+    let mut sum = vec![Vec3::ZERO; clusters as usize];
+    for (f, n) in face_normal.iter().enumerate() {
+        if *n == Vec3::ZERO {
+            continue;
+        }
+        let p = [0, 1, 2].map(|k| corner(f, k).unwrap_or(Vec3::ZERO));
+        for k in 0..3 {
+            let a = (p[(k + 1) % 3] - p[k]).normalize_or_zero();
+            let b = (p[(k + 2) % 3] - p[k]).normalize_or_zero();
+            sum[cluster[3 * f + k] as usize] += *n * a.dot(b).clamp(-1.0, 1.0).acos();
+        }
+    }
+    let normals = sum.into_iter().map(Vec3::normalize_or_zero).collect();
+    let corners = cluster
+        .chunks_exact(3)
+        .map(|c| [c[0], c[1], c[2]])
+        .collect();
+    (normals, corners)
 }
 
 /// Angle-weighted vertex normals (see [`triangles`]); a vertex no face gives a normal keeps
@@ -353,6 +523,80 @@ mod tests {
             && directed
                 .iter()
                 .all(|(&(a, b), &n)| n == 1 && directed.get(&(b, a)) == Some(&1))
+    }
+
+    #[test]
+    fn zero_area_triangles_are_counted_and_left_out() {
+        let options = MeshOptions {
+            face_normals: false,
+            flip_tex_coords: false,
+            flip_normals: false,
+        };
+        let raw = |triangles: Vec<[u32; 3]>| RawMesh {
+            positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, 2.0 * Vec3::X],
+            triangles,
+            ..RawMesh::default()
+        };
+        // Collinear corners, a repeated corner, and one real triangle.
+        let mesh = triangles(
+            raw(vec![[0, 1, 3], [0, 0, 2], [0, 1, 2]]),
+            Mat4::IDENTITY,
+            options,
+            None,
+        )
+        .unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (1, 2));
+        let mesh = triangles(
+            raw(vec![[0, 1, 3], [2, 2, 2]]),
+            Mat4::IDENTITY,
+            options,
+            None,
+        )
+        .unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 2));
+        assert!(!mesh.closed);
+        // A zero scale flattens every triangle.
+        let flat = Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0));
+        let mesh = triangles(raw(vec![[0, 1, 2]]), flat, options, None).unwrap();
+        assert_eq!((mesh.triangles.len(), mesh.dropped), (0, 1));
+        let e = triangles(raw(Vec::new()), Mat4::IDENTITY, options, None)
+            .err()
+            .unwrap();
+        assert!(e.contains("no triangles"), "{e}");
+    }
+
+    #[test]
+    fn crease_normals_smooth_only_within_the_angle() {
+        // Two triangles folded 45 degrees along their shared edge (the x axis).
+        let s = std::f32::consts::FRAC_1_SQRT_2;
+        let positions = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::new(0.0, -s, s)];
+        let triangles = [[0, 1, 2], [1, 0, 3]];
+        let up = Vec3::Z;
+        let folded = Vec3::new(0.0, s, s);
+        let (n, t) = crease_normals(&positions, &triangles, None, 30.0);
+        // Each corner keeps its own face's normal: 45 degrees apart is beyond 30.
+        for (f, normal) in [(0, up), (1, folded)] {
+            for k in 0..3 {
+                assert!((n[t[f][k] as usize] - normal).length() < 1e-6, "{f} {k}");
+            }
+        }
+        let (n, t) = crease_normals(&positions, &triangles, None, 60.0);
+        // The shared edge's corners are one cluster each: both faces' normals, weighted by
+        // their angles at the corner (45 degrees in both faces at each of them).
+        let shared = (up + folded).normalize();
+        assert_eq!(t[0][0], t[1][1]);
+        assert_eq!(t[0][1], t[1][0]);
+        assert!((n[t[0][0] as usize] - shared).length() < 1e-6);
+        assert!((n[t[0][1] as usize] - shared).length() < 1e-6);
+        // The corners only one face has keep its normal.
+        assert!((n[t[0][2] as usize] - up).length() < 1e-6);
+        assert!((n[t[1][2] as usize] - folded).length() < 1e-6);
+        // Different texture coordinates at one position split the point, as in Mitsuba.
+        let uvs = [Vec2::ZERO, Vec2::X, Vec2::Y, Vec2::ONE];
+        let uv_triangles = [[0, 1, 2], [1, 3, 3]];
+        let (_, t) = crease_normals(&positions, &triangles, Some((&uvs, &uv_triangles)), 60.0);
+        assert_ne!(t[0][0], t[1][1]);
+        assert_eq!(t[0][1], t[1][0]);
     }
 
     #[test]

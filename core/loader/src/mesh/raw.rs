@@ -18,4 +18,7 @@ pub struct RawMesh {
     /// Texture coordinates, likewise.
     pub uvs: Vec<Vec2>,
     pub uv_triangles: Vec<[u32; 3]>,
+    /// The file asks for face normals (a version 5 serialized mesh's flag), which a scene's
+    /// own `face_normals` overrides.
+    pub face_normals: bool,
 }

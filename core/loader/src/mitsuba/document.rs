@@ -1,12 +1,16 @@
 //! The XML document: the file parsed, `<include>`d files read in place (each upgraded by its
-//! own version), `<default>`s and `$name` substituted (`-D` overrides a default), `<alias>`
-//! ids, each element into an `Obj` with its properties, and `<transform>` operations composed
-//! in document order. What the document's elements mean is the element-family files' work.
+//! own version, found from the folder of the file that includes it), `<path>` folders added
+//! to the file resolver, `<default>`s and `$name` substituted (`-D` overrides a default),
+//! `<alias>` ids, each element into an `Obj` with its properties (a `<ref>` to a top-level
+//! sampler, film, filter or area emitter as that object), and `<transform>` operations
+//! composed in document order. Errors name the file, line and column of the element. What
+//! the document's elements mean is the element-family files' work.
 
-use super::Reader;
 use super::object::{Obj, Prop};
 use super::upgrade::upgrade_v1;
+use super::{Reader, forget_line, forget_lines, shown};
 use foton_core::error::{Error, Location, Result};
+use foton_core::value::{Node, Table, Value};
 use glam::{DMat4, DVec3};
 use std::path::Path;
 
@@ -53,28 +57,32 @@ impl Reader {
             }
         })?;
         let scene = doc.root_element();
-        let is_main = path == self.file;
         let line_of = |n: roxmltree::Node<'_, '_>| {
-            // Lines of an included file do not belong to the scene file's document.
-            if is_main {
-                doc.text_pos_at(n.range().start).row
-            } else {
-                0
+            let p = doc.text_pos_at(n.range().start);
+            Pos {
+                line: p.row,
+                column: p.col,
             }
         };
-        if scene.tag_name().name() != "scene" {
-            return Err(syntax(
-                path,
-                line_of(scene),
-                "the root element must be <scene>",
-            ));
+        // Mitsuba 3 includes a file of one object (a `<bsdf>`, a `<shape>`...) as that object.
+        let root = scene.tag_name().name();
+        let fragment = path != self.file && OBJECT_TAGS.contains(&root);
+        if root != "scene" && !fragment {
+            let what = if path == self.file {
+                "the root element must be <scene>"
+            } else {
+                "the root element of an included file must be <scene> or an object (<bsdf>, <shape>...)"
+            };
+            return Err(syntax(path, line_of(scene), what));
         }
         // Each file is upgraded by its own version, as Mitsuba 3 does with included files.
         let version = scene.attribute("version").ok_or_else(|| {
             syntax(
                 path,
                 line_of(scene),
-                "<scene> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")",
+                &format!(
+                    "<{root}> without `version` (Mitsuba requires it, e.g. version=\"3.0.0\")"
+                ),
             )
         })?;
         let major = version
@@ -92,77 +100,209 @@ impl Reader {
                 )
             })?;
         let outer_v1 = std::mem::replace(&mut self.v1, major < 2);
-        self.read_scene_children(path, scene, &line_of)?;
+        let read = if fragment {
+            self.object(scene, path, &line_of)
+                .map(|o| self.pending.push(o))
+        } else {
+            self.read_scene_children(path, scene, &line_of)
+        };
         self.v1 = outer_v1;
-        Ok(())
+        read
     }
 
     fn read_scene_children(
         &mut self,
         path: &Path,
         scene: roxmltree::Node<'_, '_>,
-        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> Pos,
     ) -> Result<()> {
         for child in scene.children().filter(|n| n.is_element()) {
-            let line = line_of(child);
+            let pos = line_of(child);
             match child.tag_name().name() {
                 "default" => {
-                    let name = attr(child, "name", path, line)?;
-                    let value = attr(child, "value", path, line)?;
+                    let name = attr(child, "name", path, pos)?;
+                    let value = attr(child, "value", path, pos)?;
                     self.declared.insert(name.clone());
                     if !self.defined.contains(&name) {
                         self.defaults.entry(name).or_insert(value);
                     }
                 }
                 "include" => {
-                    let file = self.subst(&attr(child, "filename", path, line)?, path, line)?;
-                    let inc = path.parent().unwrap_or(Path::new("")).join(file);
+                    let file = self.subst(&attr(child, "filename", path, pos)?, path, pos)?;
+                    let inc = self.resolve(path, &file).map_err(|looked| {
+                        syntax(
+                            path,
+                            pos,
+                            &format!(
+                                "<include filename=\"{file}\">: no such file in {}",
+                                shown(&looked)
+                            ),
+                        )
+                    })?;
                     let text = std::fs::read_to_string(&inc).map_err(|e| Error::io(&inc, e))?;
                     self.report.included.push(inc.clone());
-                    self.read_file(&inc, &text)?;
+                    // Mitsuba resolves the included file's own includes from the folder of
+                    // the file that includes it, and forgets the included file's <path>s.
+                    let mark = self.search.len();
+                    self.search
+                        .push(path.parent().unwrap_or(Path::new("")).to_path_buf());
+                    let read = self.read_file(&inc, &text);
+                    self.search.truncate(mark);
+                    read?;
                 }
+                // Resolved with the references, once every id is known.
                 "alias" => {
-                    let id = self.subst(&attr(child, "id", path, line)?, path, line)?;
-                    let alias = self.subst(&attr(child, "as", path, line)?, path, line)?;
-                    let mut found = false;
-                    for map in [&mut self.bsdfs, &mut self.media] {
-                        if let Some(name) = map.get(&id).cloned() {
-                            map.insert(alias.clone(), name);
-                            found = true;
-                        }
-                    }
-                    if let Some(t) = self.textures.get(&id).cloned() {
-                        self.textures.insert(alias.clone(), t);
-                        found = true;
-                    }
-                    if !found {
-                        return Err(syntax(
-                            path,
-                            line,
-                            &format!(
-                                "<alias id=\"{id}\">: no BSDF, medium or texture with that id before it"
-                            ),
-                        ));
-                    }
+                    let id = self.subst(&attr(child, "id", path, pos)?, path, pos)?;
+                    let alias = self.subst(&attr(child, "as", path, pos)?, path, pos)?;
+                    self.pending.push(Obj {
+                        tag: "alias".into(),
+                        ty: alias,
+                        id: Some(id),
+                        line: pos.line,
+                        file: path.to_path_buf(),
+                        props: Vec::new(),
+                        v1: self.v1,
+                    });
                 }
-                "path" => {
-                    return Err(syntax(
-                        path,
-                        line,
-                        "<path> (a folder searched for files) is not supported: give file names relative to the scene",
-                    ));
-                }
+                "path" => self.path(child, path, pos)?,
                 _ => {
                     let obj = self.object(child, path, line_of)?;
-                    self.top_level(obj)?;
+                    self.pending.push(obj);
                 }
             }
         }
         Ok(())
     }
 
+    /// The top-level objects read, made once every id is known (Mitsuba resolves references
+    /// after reading the whole file, so a `<ref>` may come before its object): textures,
+    /// media and the objects taken by reference first, then BSDFs, aliases, and the rest,
+    /// each kind in document order. What an included file's objects add to the document
+    /// keeps no line: the document's lines are the scene file's.
+    pub(super) fn make_objects(&mut self) -> Result<()> {
+        let mut pending = std::mem::take(&mut self.pending);
+        let rank = |o: &Obj| match o.tag.as_str() {
+            "texture" | "medium" | "sampler" | "film" | "rfilter" => 0,
+            "emitter" if o.ty == "area" => 0,
+            "bsdf" => 1,
+            "alias" => 2,
+            _ => 3,
+        };
+        pending.sort_by_key(rank);
+        for mut obj in pending {
+            self.expand_refs(&mut obj, 0);
+            self.v1 = obj.v1;
+            if obj.tag == "alias" {
+                self.alias(&obj)?;
+                continue;
+            }
+            if obj.file == self.file {
+                self.top_level(obj)?;
+                continue;
+            }
+            let before = Snapshot::of(&self.root);
+            let (shapes, lights) = (self.shapes.len(), self.lights.len());
+            let textures = self.textures.clone();
+            self.top_level(obj)?;
+            before.forget_since(&mut self.root);
+            for node in self.shapes[shapes..]
+                .iter_mut()
+                .chain(&mut self.lights[lights..])
+            {
+                forget_line(node);
+            }
+            for (id, t) in &mut self.textures {
+                if textures.get(id) != Some(&*t) {
+                    forget_lines(&Table::default(), t);
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// A `<ref>` to a sampler, film, filter or area emitter is that object, made where it is
+    /// taken; an unnamed one to a medium is its parent's `medium` (a sensor's, an emitter's;
+    /// a shape's says interior or exterior), not a BSDF.
+    fn expand_refs(&self, o: &mut Obj, depth: u32) {
+        for (name, p, _) in &mut o.props {
+            match p {
+                Prop::Ref(id) if depth < 16 => {
+                    if let Some(obj) = self.objects.get(id.as_str()) {
+                        let mut obj = obj.clone();
+                        self.expand_refs(&mut obj, depth + 1);
+                        if ONE_OF_A_KIND.contains(&obj.tag.as_str()) {
+                            name.clear();
+                        }
+                        *p = Prop::Object(obj);
+                    } else if name.is_empty() && self.media.contains_key(id.as_str()) {
+                        *name = "medium".into();
+                    }
+                }
+                Prop::Object(child) if depth < 16 => self.expand_refs(child, depth + 1),
+                _ => {}
+            }
+        }
+    }
+
+    /// `<alias id="a" as="b">`: `b` names what `a` does.
+    fn alias(&mut self, o: &Obj) -> Result<()> {
+        let (id, alias) = (o.id.clone().unwrap_or_default(), o.ty.clone());
+        let mut found = false;
+        for map in [&mut self.bsdfs, &mut self.media] {
+            if let Some(name) = map.get(&id).cloned() {
+                map.insert(alias.clone(), name);
+                found = true;
+            }
+        }
+        if let Some(t) = self.textures.get(&id).cloned() {
+            self.textures.insert(alias.clone(), t);
+            found = true;
+        }
+        if !found {
+            return Err(syntax(
+                &o.file,
+                Pos {
+                    line: o.line,
+                    column: 1,
+                },
+                &format!("<alias id=\"{id}\">: no BSDF, medium or texture with that id"),
+            ));
+        }
+        Ok(())
+    }
+
+    /// `<path value="...">`: a folder the files named after it are looked for in (Mitsuba 3's
+    /// file resolver), relative to the file's own folder or found by the resolver.
+    fn path(&mut self, n: roxmltree::Node<'_, '_>, file: &Path, pos: Pos) -> Result<()> {
+        let value = self.subst(&attr(n, "value", file, pos)?, file, pos)?;
+        let own = file.parent().unwrap_or(Path::new("")).join(&value);
+        let folder = if own.is_dir() {
+            Some(own)
+        } else {
+            self.resolve(file, &value).ok().filter(|p| p.is_dir())
+        };
+        match folder {
+            Some(folder) => self.search.push(folder),
+            None if self.lenient => self.report.left_out.push(format!(
+                "{}:{}: <path value=\"{value}\">: no such folder",
+                file.display(),
+                pos.line
+            )),
+            None => {
+                return Err(syntax(
+                    file,
+                    pos,
+                    &format!(
+                        "<path value=\"{value}\">: no such folder (--lenient reads on without it)"
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
     /// `$name` replaced by the default's value.
-    fn subst(&self, s: &str, file: &Path, line: u32) -> Result<String> {
+    fn subst(&self, s: &str, file: &Path, pos: Pos) -> Result<String> {
         let mut out = String::new();
         let mut rest = s;
         while let Some(i) = rest.find('$') {
@@ -176,7 +316,7 @@ impl Reader {
             let value = self.defaults.get(name).ok_or_else(|| {
                 syntax(
                     file,
-                    line,
+                    pos,
                     &format!("`${name}`: no <default name=\"{name}\"> and no -D {name}=..."),
                 )
             })?;
@@ -191,12 +331,13 @@ impl Reader {
         &self,
         n: roxmltree::Node<'_, '_>,
         file: &Path,
-        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> Pos,
     ) -> Result<Obj> {
-        let line = line_of(n);
+        let pos = line_of(n);
+        let line = pos.line;
         let get = |name: &str| -> Result<Option<String>> {
             n.attribute(name)
-                .map(|v| self.subst(v, file, line))
+                .map(|v| self.subst(v, file, pos))
                 .transpose()
         };
         let mut obj = Obj {
@@ -206,18 +347,20 @@ impl Reader {
             line,
             file: file.to_path_buf(),
             props: Vec::new(),
+            v1: self.v1,
         };
         for c in n.children().filter(|c| c.is_element()) {
-            let cl = line_of(c);
+            let cpos = line_of(c);
+            let cl = cpos.line;
             let cget = |name: &str| -> Result<Option<String>> {
                 c.attribute(name)
-                    .map(|v| self.subst(v, file, cl))
+                    .map(|v| self.subst(v, file, cpos))
                     .transpose()
             };
             let name = cget("name")?.unwrap_or_default();
             let value =
-                || cget("value")?.ok_or_else(|| syntax(file, cl, "missing attribute `value`"));
-            let bad = |what: &str, v: &str| syntax(file, cl, &format!("`{name}`: {what} `{v}`"));
+                || cget("value")?.ok_or_else(|| syntax(file, cpos, "missing attribute `value`"));
+            let bad = |what: &str, v: &str| syntax(file, cpos, &format!("`{name}`: {what} `{v}`"));
             let tag = c.tag_name().name();
             let prop = match tag {
                 "float" => {
@@ -273,7 +416,7 @@ impl Reader {
                 }
                 "transform" => Prop::Transform(self.transform(c, file, line_of)?),
                 "ref" => {
-                    let id = cget("id")?.ok_or_else(|| syntax(file, cl, "<ref> without id"))?;
+                    let id = cget("id")?.ok_or_else(|| syntax(file, cpos, "<ref> without id"))?;
                     Prop::Ref(id)
                 }
                 // Mitsuba 0.6's sRGB colour: "#rrggbb" or numbers, both sRGB-encoded.
@@ -303,7 +446,7 @@ impl Reader {
                 other if KNOWN_UNREAD.contains(&other) => {
                     return Err(syntax(
                         file,
-                        cl,
+                        cpos,
                         &format!("<{other}> in <{}> is not supported", obj.tag),
                     ));
                 }
@@ -311,7 +454,7 @@ impl Reader {
                     let known = PROPERTY_TAGS.iter().chain(OBJECT_TAGS).copied();
                     return Err(syntax(
                         file,
-                        cl,
+                        cpos,
                         &format!(
                             "unknown element <{other}> in <{}>{}",
                             obj.tag,
@@ -319,6 +462,12 @@ impl Reader {
                         ),
                     ));
                 }
+            };
+            // These are one of a kind in their parent, which takes them whatever their name
+            // (Mitsuba names every nested object; files write `name="rfilter"`...).
+            let name = match &prop {
+                Prop::Object(o) if ONE_OF_A_KIND.contains(&o.tag.as_str()) => String::new(),
+                _ => name,
             };
             obj.props.push((name, prop, cl));
         }
@@ -333,20 +482,20 @@ impl Reader {
         &self,
         n: roxmltree::Node<'_, '_>,
         file: &Path,
-        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> u32,
+        line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> Pos,
     ) -> Result<DMat4> {
         let mut m = DMat4::IDENTITY;
         for op in n.children().filter(|c| c.is_element()) {
-            let l = line_of(op);
+            let lpos = line_of(op);
             let get = |name: &str| -> Result<Option<String>> {
                 op.attribute(name)
-                    .map(|v| self.subst(v, file, l))
+                    .map(|v| self.subst(v, file, lpos))
                     .transpose()
             };
             let bad = |v: &str| {
                 syntax(
                     file,
-                    l,
+                    lpos,
                     &format!("<{}>: bad value `{v}`", op.tag_name().name()),
                 )
             };
@@ -372,19 +521,27 @@ impl Reader {
             };
             let vec = |name: &str| -> Result<DVec3> {
                 let v = get(name)?
-                    .ok_or_else(|| syntax(file, l, &format!("<lookat> without `{name}`")))?;
+                    .ok_or_else(|| syntax(file, lpos, &format!("<lookat> without `{name}`")))?;
                 let xs = numbers(&v)
                     .filter(|x| x.len() == 3)
                     .ok_or_else(|| bad(&v))?;
                 Ok(DVec3::new(xs[0], xs[1], xs[2]))
             };
-            let step = match op.tag_name().name() {
+            // Mitsuba 0.6 and the upgrade of older files accept `lookAt`; exporters write
+            // other cases too.
+            let tag = op.tag_name().name();
+            let tag = if tag.eq_ignore_ascii_case("lookat") {
+                "lookat"
+            } else {
+                tag
+            };
+            let step = match tag {
                 "translate" => DMat4::from_translation(xyz(0.0)?),
                 "scale" => DMat4::from_scale(xyz(1.0)?),
                 "rotate" => {
                     let axis = xyz(0.0)?;
                     if axis.length_squared() == 0.0 {
-                        return Err(syntax(file, l, "<rotate> about the zero vector"));
+                        return Err(syntax(file, lpos, "<rotate> about the zero vector"));
                     }
                     DMat4::from_axis_angle(axis.normalize(), num("angle", 0.0)?.to_radians())
                 }
@@ -415,7 +572,7 @@ impl Reader {
                     if !dir.is_finite() || !left.is_finite() {
                         return Err(syntax(
                             file,
-                            l,
+                            lpos,
                             "<lookat>: degenerate origin, target and up",
                         ));
                     }
@@ -431,7 +588,7 @@ impl Reader {
                     let ops = ["translate", "scale", "rotate", "matrix", "lookat"];
                     return Err(syntax(
                         file,
-                        l,
+                        lpos,
                         &format!(
                             "unknown transform operation <{other}>{}",
                             foton_core::error::suggestion(other, ops)
@@ -445,22 +602,69 @@ impl Reader {
     }
 }
 
-fn syntax(file: &Path, line: u32, message: &str) -> Error {
+/// The document's sections as they were, to tell what one object added: the tables of
+/// named entries (materials, media) by their length, the others whole.
+struct Snapshot(Vec<(String, Result<usize, Node>)>);
+
+impl Snapshot {
+    fn of(root: &Table) -> Snapshot {
+        Snapshot(
+            root.0
+                .iter()
+                .map(|(k, n)| match (&n.value, k.as_str()) {
+                    (Value::Table(t), "materials" | "media") => (k.clone(), Ok(t.0.len())),
+                    _ => (k.clone(), Err(n.clone())),
+                })
+                .collect(),
+        )
+    }
+
+    /// What changed since the snapshot loses its line ([`forget_lines`]).
+    fn forget_since(&self, root: &mut Table) {
+        for (key, node) in &mut root.0 {
+            match (
+                self.0.iter().find(|(k, _)| k == key).map(|(_, s)| s),
+                &mut node.value,
+            ) {
+                (Some(Ok(len)), Value::Table(t)) => {
+                    t.0.iter_mut().skip(*len).for_each(|(_, n)| forget_line(n));
+                }
+                (Some(Err(old)), _) => {
+                    let mut before = Table::default();
+                    before.0.push((key.clone(), old.clone()));
+                    let mut after = Table(vec![(key.clone(), node.clone())]);
+                    forget_lines(&before, &mut after);
+                    *node = after.0.remove(0).1;
+                }
+                _ => forget_line(node),
+            }
+        }
+    }
+}
+
+/// Where an element starts in its file.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Pos {
+    line: u32,
+    column: u32,
+}
+
+fn syntax(file: &Path, pos: Pos, message: &str) -> Error {
     Error::XmlSyntax {
         location: Location {
             file: file.to_path_buf(),
-            line,
-            column: if line > 0 { 1 } else { 0 },
+            line: pos.line,
+            column: pos.column,
         },
         message: message.to_string(),
     }
 }
 
-fn attr(n: roxmltree::Node<'_, '_>, name: &str, file: &Path, line: u32) -> Result<String> {
+fn attr(n: roxmltree::Node<'_, '_>, name: &str, file: &Path, pos: Pos) -> Result<String> {
     n.attribute(name).map(str::to_string).ok_or_else(|| {
         syntax(
             file,
-            line,
+            pos,
             &format!("<{}> without `{name}`", n.tag_name().name()),
         )
     })
@@ -488,6 +692,9 @@ const PROPERTY_TAGS: &[&str] = &[
     "transform",
     "ref",
 ];
+
+/// Nested objects a parent has at most one of and finds by kind, not by name.
+const ONE_OF_A_KIND: &[&str] = &["rfilter", "sampler", "film", "phase"];
 
 /// The object elements of Mitsuba's parser.
 const OBJECT_TAGS: &[&str] = &[

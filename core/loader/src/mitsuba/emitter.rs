@@ -1,7 +1,7 @@
 //! `<emitter>` outside a shape: point, spot, directional, constant and envmap lights as
 //! `[[lights]]` entries (a point or spot light with the medium it sits in).
 
-use super::object::{Obj, Prop};
+use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::{Reader, at, matrix_table, vec3};
 use foton_core::error::Result;
@@ -17,12 +17,17 @@ impl Reader {
         // The medium a point or spot light sits in (Mitsuba's emitter `medium`).
         if let Some((p, l)) = o.take("medium") {
             let name = match p {
-                Prop::Ref(id) => self.media.get(&id).cloned().ok_or_else(|| {
-                    o.error(format!("line {l}: no medium with id `{id}` before it"))
-                })?,
+                Prop::Ref(id) => self
+                    .media
+                    .get(&id)
+                    .cloned()
+                    .ok_or_else(|| o.error(format!("line {l}: no medium with id `{id}`")))?,
                 Prop::Object(med) if med.tag == "medium" => self.medium(med)?,
                 other => {
-                    return Err(o.error(format!("`medium`: expected a medium, found {other:?}")));
+                    return Err(o.error(format!(
+                        "`medium`: expected a medium, found {}",
+                        show(&other)
+                    )));
                 }
             };
             if !matches!(o.ty.as_str(), "point" | "spot") {
@@ -52,7 +57,10 @@ impl Reader {
                 let d = match o.take("direction") {
                     Some((Prop::Point(d), _)) => d,
                     Some((p, _)) => {
-                        return Err(o.error(format!("`direction`: expected a vector, found {p:?}")));
+                        return Err(o.error(format!(
+                            "`direction`: expected a vector, found {}",
+                            show(&p)
+                        )));
                     }
                     None => m.transform_vector3(DVec3::Z),
                 };

@@ -98,6 +98,17 @@ impl Reader {
             "ignored (foton does not end paths whose shading and geometric normals disagree)",
         );
         let noise = "ignored (it changes the noise, not the image: foton takes one sample per camera sample; raise spp)";
+        // How Mitsuba 2 and 3 schedule the samples (passes, a time limit): not the image
+        // foton renders with all of them.
+        if !matches!(o.ty.as_str(), "sppm" | "ppm") {
+            o.take("samples_per_pass");
+        }
+        self.ignored(
+            &mut o,
+            "timeout",
+            &|p| matches!(p, Prop::Float(t) if *t < 0.0),
+            "ignored (foton renders every sample; a time limit would stop Mitsuba with fewer)",
+        );
         match o.ty.as_str() {
             "direct" => {
                 for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {

@@ -6,14 +6,16 @@
 //! with `--strict`.
 //!
 //! Mitsuba's conventions, as its documentation states them: `<default>` and `$name`
-//! substitution (`-D name=value` overrides a default), `ref`/`id`, `include`; transforms
+//! substitution (`-D name=value` overrides a default), `ref`/`id`, `include`, file names
+//! looked for as Mitsuba's file resolver does (the file's folder, `<path>` folders, the
+//! including files' folders, the scene's), no `<sensor>` as Mitsuba's default one; transforms
 //! composed in document order; `max_depth` counts path segments (-1: unbounded), so foton's
 //! count of scattering events is one less; area emitters emit on their normal's side; the
 //! sensor looks down its local +z with +y up. What foton cannot render yet is an error naming
 //! the element, its type and file:line, or with `lenient` is left out and listed.
 //!
 //! The reader is laid out as Mitsuba 3's parser and plugin folders are. `document` reads the
-//! XML: `<include>`, `<default>` and `$name`, `<alias>`, each element into an `Obj` (its
+//! XML: `<include>`, `<path>`, `<default>` and `$name`, `<alias>`, each element into an `Obj` (its
 //! property list, `object`), `<transform>` composed; `upgrade` holds the version upgrade
 //! rules for files older than 2.0. Then one file per element family turns an element into the
 //! tables of the TOML document: `shape`, `bsdf`, `emitter`, `medium`, `texture`, `sensor`
@@ -79,13 +81,32 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         used: RefCell::default(),
         declared: HashSet::new(),
         integrator: None,
+        search: vec![path.parent().map(Path::to_path_buf).unwrap_or_default()],
+        objects: HashMap::new(),
+        sensor: false,
+        crop: None,
+        pending: Vec::new(),
+        left_out_ids: HashSet::new(),
     };
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text)?;
+    r.make_objects()?;
     r.check_defines(path)?;
+    // No sensor, or (lenient) none foton reads.
+    if r.root.get("camera").is_none() {
+        r.default_sensor(path, r.sensor);
+    }
     r.place_sensor_medium();
     if let Some(o) = r.integrator.take() {
+        let included = o.file != r.file;
+        let before = r.root.clone();
         r.integrator(o)?;
+        if included {
+            forget_lines(&before, &mut r.root);
+            if let Some((_, _, line)) = &mut r.report.relative_radius {
+                *line = 0;
+            }
+        }
     }
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
@@ -114,6 +135,54 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         },
         r.report,
     ))
+}
+
+/// The values `after` holds that `before` did not (or held otherwise) lose their line: they
+/// were written in an included file, and a line of the document is one of the scene file's.
+/// (Errors while reading the included file name it and its lines; the builder's cannot.)
+fn forget_lines(before: &Table, after: &mut Table) {
+    for (key, node) in &mut after.0 {
+        let old = before.get(key);
+        if old == Some(&*node) {
+            continue;
+        }
+        match (old, &mut node.value) {
+            (
+                Some(Node {
+                    value: Value::Table(old),
+                    ..
+                }),
+                Value::Table(new),
+            ) => forget_lines(old, new),
+            _ => forget_line(node),
+        }
+    }
+}
+
+/// A value, and all it holds, without a line of the scene file (see [`forget_lines`]).
+fn forget_line(node: &mut Node) {
+    node.line = 0;
+    node.column = 0;
+    match &mut node.value {
+        Value::Array(items) => items.iter_mut().for_each(forget_line),
+        Value::Table(t) => t.0.iter_mut().for_each(|(_, n)| forget_line(n)),
+        _ => {}
+    }
+}
+
+/// The folders a file was looked for in, for a message ("." for the working folder).
+fn shown(folders: &[PathBuf]) -> String {
+    if folders.is_empty() {
+        return "no folder (the path is absolute)".into();
+    }
+    folders
+        .iter()
+        .map(|d| match d.to_string_lossy() {
+            s if s.is_empty() => "\".\"".to_string(),
+            s => format!("{s:?}"),
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn at(value: Value, line: u32) -> Node {
@@ -189,6 +258,22 @@ struct Reader {
     /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
     /// the scene has media.
     integrator: Option<Obj>,
+    /// Mitsuba's file resolver: the folders a relative file name is looked for in, the last
+    /// first (the scene's folder, then each `<path>` and each including file's folder, in
+    /// the order read; an `<include>`d file's own are forgotten at its end).
+    search: Vec<PathBuf>,
+    /// Top-level objects with an `id` that others take by `<ref>` and that are not made
+    /// where they stand: samplers, films, reconstruction filters, area emitters.
+    objects: HashMap<String, Obj>,
+    /// Whether the file has a `<sensor>` (without one, Mitsuba places its own; with one
+    /// foton does not read, `lenient` places Mitsuba's default).
+    sensor: bool,
+    /// The film's crop window, read with the film, applied to the sensor's camera.
+    crop: Option<sensor::Crop>,
+    /// The top-level objects (and aliases) read, made once the whole file is read.
+    pending: Vec<Obj>,
+    /// Ids of top-level objects left out (lenient).
+    left_out_ids: HashSet<String>,
 }
 
 impl Reader {
@@ -253,17 +338,71 @@ impl Reader {
         })
     }
 
-    /// The element's required `filename`, relative to the XML file, as the TOML document's
-    /// path (relative to the main scene's folder, or absolute).
+    /// The element's required `filename`, found as Mitsuba's file resolver finds it
+    /// ([`Reader::resolve`]), as the TOML document's path (relative to the main scene's
+    /// folder, or absolute). A file found nowhere is an error at the element.
     fn filename(&self, o: &mut Obj) -> Result<Node> {
         let file = o
             .string("filename")?
             .ok_or_else(|| o.error("missing `filename`"))?;
-        let path = o.file.parent().unwrap_or(Path::new("")).join(&file);
+        let path = self.resolve(&o.file, &file).map_err(|looked| {
+            o.error(format!(
+                "`filename` = {file:?}: no such file in {}",
+                shown(&looked)
+            ))
+        })?;
         let rel = path
             .strip_prefix(&self.dir)
             .map_or(path.clone(), Path::to_path_buf);
         Ok(at(Value::Str(rel.to_string_lossy().into_owned()), o.line))
+    }
+
+    /// A relative file name written in `from`, looked for in `from`'s folder, then in the
+    /// resolver's folders, the last added first (Mitsuba's `<path>` and `<include>` prepend
+    /// theirs; the scene's folder is the last resort). Mitsuba 3 resolves the files of an
+    /// included scene from the main scene's folder and Mitsuba 0.6 from the included file's:
+    /// both are searched. Err: the folders looked in.
+    fn resolve(&self, from: &Path, name: &str) -> std::result::Result<PathBuf, Vec<PathBuf>> {
+        let name = Path::new(name);
+        if name.is_absolute() {
+            return if name.exists() {
+                Ok(name.to_path_buf())
+            } else {
+                Err(Vec::new())
+            };
+        }
+        let own = from.parent().unwrap_or(Path::new("")).to_path_buf();
+        let mut looked: Vec<PathBuf> = Vec::new();
+        for dir in std::iter::once(&own).chain(self.search.iter().rev()) {
+            if looked.contains(dir) {
+                continue;
+            }
+            let candidate = dir.join(name);
+            if candidate.exists() {
+                return Ok(candidate);
+            }
+            looked.push(dir.clone());
+        }
+        Err(looked)
+    }
+
+    /// A top-level object others take by `<ref>`. Without an `id` nothing can: Mitsuba makes
+    /// it and uses it nowhere.
+    fn keep(&mut self, obj: Obj) -> Result<()> {
+        match obj.id.clone() {
+            Some(id) => {
+                self.objects.insert(id, obj);
+                Ok(())
+            }
+            None => {
+                self.warn(
+                    &obj,
+                    obj.line,
+                    "ignored: at the top level without an `id`, nothing uses it",
+                );
+                Ok(())
+            }
+        }
     }
 
     fn top_level(&mut self, obj: Obj) -> Result<()> {
@@ -275,7 +414,13 @@ impl Reader {
                 self.integrator = Some(obj);
                 Ok(())
             }
-            "sensor" => self.sensor(obj),
+            "sensor" => {
+                self.sensor = true;
+                self.sensor(obj)
+            }
+            // Made where a sensor, a film or a shape takes them by `<ref>`.
+            "sampler" | "film" | "rfilter" => self.keep(obj),
+            "emitter" if obj.ty == "area" => self.keep(obj),
             "bsdf" => self.bsdf(obj).map(|_| ()),
             "medium" => self.medium(obj).map(|_| ()),
             "shape" => self.shape(obj),
@@ -283,6 +428,8 @@ impl Reader {
             "texture" => {
                 let id = obj.id.clone();
                 let Some(t) = self.texture_table(obj)? else {
+                    // Left out (lenient): what takes it by reference is left out with it.
+                    self.left_out_ids.extend(id);
                     return Ok(());
                 };
                 if let Some(id) = id {

@@ -30,6 +30,8 @@ pub(super) struct Obj {
     /// The file it was written in (an `include`d one is not the scene's).
     pub(super) file: PathBuf,
     pub(super) props: Vec<(String, Prop, u32)>,
+    /// Written in a file older than Mitsuba 2.0: read with 0.6's defaults where they differ.
+    pub(super) v1: bool,
 }
 
 impl Obj {
@@ -64,7 +66,9 @@ impl Obj {
             None => Ok(default),
             Some((Prop::Float(x), _)) => Ok(x),
             Some((Prop::Int(i), _)) => Ok(i as f64),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a number, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected a number, found {}", show(&p))))
+            }
         }
     }
 
@@ -72,7 +76,9 @@ impl Obj {
         match self.take(name) {
             None => Ok(default),
             Some((Prop::Int(i), _)) => Ok(i),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected an integer, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected an integer, found {}", show(&p))))
+            }
         }
     }
 
@@ -80,7 +86,9 @@ impl Obj {
         match self.take(name) {
             None => Ok(default),
             Some((Prop::Bool(b), _)) => Ok(b),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a boolean, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected a boolean, found {}", show(&p))))
+            }
         }
     }
 
@@ -88,7 +96,9 @@ impl Obj {
         match self.take(name) {
             None => Ok(None),
             Some((Prop::Str(s), _)) => Ok(Some(s)),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a string, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected a string, found {}", show(&p))))
+            }
         }
     }
 
@@ -103,7 +113,9 @@ impl Obj {
                 "`{name}`: textures ({}) are not supported yet",
                 o.what()
             ))),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a colour, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected a colour, found {}", show(&p))))
+            }
         }
     }
 
@@ -111,7 +123,9 @@ impl Obj {
         match self.take(name) {
             None => Ok(None),
             Some((Prop::Point(p), _)) => Ok(Some(p)),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a point, found {p:?}"))),
+            Some((p, _)) => {
+                Err(self.error(format!("`{name}`: expected a point, found {}", show(&p))))
+            }
         }
     }
 
@@ -119,7 +133,10 @@ impl Obj {
         match self.take(name) {
             None => Ok(DMat4::IDENTITY),
             Some((Prop::Transform(m), _)) => Ok(m),
-            Some((p, _)) => Err(self.error(format!("`{name}`: expected a transform, found {p:?}"))),
+            Some((p, _)) => Err(self.error(format!(
+                "`{name}`: expected a transform, found {}",
+                show(&p)
+            ))),
         }
     }
 }

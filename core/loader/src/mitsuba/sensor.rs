@@ -1,9 +1,12 @@
 //! `<sensor>` and what it holds: the camera (a perspective sensor's to_world, fov or focal
-//! length, medium), `<film>` (size, format, `ldrfilm`'s tone curve) with its `<rfilter>`, and
-//! `<sampler>` (which foton sampler renders Mitsuba's, sample count, seed).
+//! length, medium), `<film>` (size, format, `ldrfilm`'s tone curve, a crop window) with its
+//! `<rfilter>`, and `<sampler>` (which foton sampler renders Mitsuba's, sample count, seed);
+//! Mitsuba's defaults for a sensor without a film or a sampler, and for a file without a
+//! sensor.
 
 use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
+use super::upgrade::camel_to_snake;
 use super::{Reader, at, table_mut, vec3};
 use foton_core::error::Result;
 use foton_core::value::{Table, Value};
@@ -80,9 +83,11 @@ impl Reader {
         camera.insert("fov", at(Value::Float(fov), line));
         camera.insert("fov_axis", at(Value::Str(fov_axis), line));
         if let Some((Prop::Ref(id), l)) = o.take("medium") {
-            let name = self.media.get(&id).cloned().ok_or_else(|| {
-                o.error(format!("medium `{id}` is not defined (before line {l})"))
-            })?;
+            let name = self
+                .media
+                .get(&id)
+                .cloned()
+                .ok_or_else(|| o.error(format!("line {l}: no medium with id `{id}`")))?;
             self.sensor_medium = Some((name, l));
         }
         let nested: Vec<Obj> = o
@@ -94,10 +99,17 @@ impl Reader {
             })
             .collect();
         o.props.retain(|(_, p, _)| !matches!(p, Prop::Object(_)));
+        let (mut film, mut sampler) = (false, false);
         for child in nested {
             match child.tag.as_str() {
-                "film" => self.film(child)?,
-                "sampler" => self.sampler(child)?,
+                "film" => {
+                    film = true;
+                    self.film(child)?;
+                }
+                "sampler" => {
+                    sampler = true;
+                    self.sampler(child)?;
+                }
                 "medium" => {
                     let l = child.line;
                     let name = self.medium(child)?;
@@ -110,7 +122,115 @@ impl Reader {
                 }
             }
         }
+        // Mitsuba's sensor without them: an hdrfilm of its defaults, 4 independent samples.
+        if !film {
+            self.film(Obj {
+                tag: "film".into(),
+                ty: "hdrfilm".into(),
+                id: None,
+                props: Vec::new(),
+                ..o.clone()
+            })?;
+        }
+        if !sampler {
+            table_mut(&mut self.root, "render").insert("spp", at(Value::Int(4), line));
+        }
+        if let Some(crop) = self.crop.take() {
+            self.crop_camera(&o, crop)?;
+        }
+        // A line of an included file is not one of the document's.
+        if o.file != self.file
+            && let Some((_, l)) = &mut self.sensor_medium
+        {
+            *l = 0;
+        }
         self.leftovers(&o)
+    }
+
+    /// Mitsuba's sensor when a file has none (Mitsuba 0.6's `Scene::configure`; Mitsuba 3
+    /// renders nothing without one): a perspective camera with a 45-degree field of view
+    /// across the image's width, looking down +z at the scene's bounds from in front of them,
+    /// on a 768 x 576 hdrfilm with 4 independent samples per pixel. Where it stands depends
+    /// on the scene's bounds: the loader places it ([`Report::default_camera`]).
+    pub(super) fn default_sensor(&mut self, path: &std::path::Path, left_out: bool) {
+        let camera = table_mut(&mut self.root, "camera");
+        camera.insert("position", vec3(DVec3::new(0.0, 0.0, -1.0), 0));
+        camera.insert("look_at", vec3(DVec3::ZERO, 0));
+        camera.insert("up", vec3(DVec3::Y, 0));
+        camera.insert("fov", at(Value::Float(DEFAULT_FOV), 0));
+        camera.insert("fov_axis", at(Value::Str("x".into()), 0));
+        let film = table_mut(&mut self.root, "film");
+        film.insert("width", at(Value::Int(768), 0));
+        film.insert("height", at(Value::Int(576), 0));
+        let mut filter = Table::default();
+        filter.insert("type", at(Value::Str("gaussian".into()), 0));
+        filter.insert("stddev", at(Value::Float(0.5), 0));
+        film.insert("filter", at(Value::Table(filter), 0));
+        table_mut(&mut self.root, "render").insert("spp", at(Value::Int(4), 0));
+        self.report.default_camera = Some(DEFAULT_FOV);
+        let why = if left_out {
+            "no <sensor> foton reads"
+        } else {
+            "no <sensor>"
+        };
+        self.report.notes.push(format!(
+            "{}: {why}: rendered by Mitsuba's default, a perspective camera (fov 45 across the width) looking down +z at the whole scene, 768 x 576 pixels, 4 samples per pixel",
+            path.display()
+        ));
+    }
+
+    /// A crop window (`crop_offset_x`, `crop_offset_y`, `crop_width`, `crop_height`, with
+    /// the film's full size), in the middle of the film: the camera of the window alone, a
+    /// narrower field of view on a smaller film; the same pixels. A window off the middle
+    /// needs an off-axis camera, which foton does not have: with `lenient` the whole film.
+    fn crop_camera(&mut self, sensor: &Obj, crop: Crop) -> Result<()> {
+        let Crop {
+            x,
+            y,
+            width,
+            height,
+            full,
+            line,
+        } = crop;
+        let centred = 2 * x + width == full.0 && 2 * y + height == full.1;
+        if !centred {
+            let o = Obj {
+                line,
+                ..sensor.clone()
+            };
+            return self.unsupported(
+                &o,
+                &format!(
+                    "a crop window off the middle of the film ({width} x {height} at {x}, {y} of {} x {}) is not supported; the whole film is rendered",
+                    full.0, full.1
+                ),
+            );
+        }
+        if (width, height) == full {
+            return Ok(());
+        }
+        let camera = table_mut(&mut self.root, "camera");
+        let fov = camera
+            .get("fov")
+            .and_then(|n| n.value.as_f64())
+            .unwrap_or(DEFAULT_FOV);
+        let axis = match camera.get("fov_axis").map(|n| &n.value) {
+            Some(Value::Str(a)) => a.clone(),
+            _ => "x".into(),
+        };
+        let tan_v = vertical_tan(fov, &axis, full.0, full.1).ok_or_else(|| {
+            sensor.error(format!(
+                "`fov_axis` = {axis:?}: expected x, y, diagonal, smaller or larger"
+            ))
+        })?;
+        let tan_crop = tan_v * height as f64 / full.1 as f64;
+        let fov = 2.0 * tan_crop.atan().to_degrees();
+        camera.insert("fov", at(Value::Float(fov), line));
+        camera.insert("fov_axis", at(Value::Str("y".into()), line));
+        let film = table_mut(&mut self.root, "film");
+        film.insert("width", at(Value::Int(width), line));
+        film.insert("height", at(Value::Int(height), line));
+        Ok(())
     }
 
     fn film(&mut self, mut o: Obj) -> Result<()> {
@@ -130,8 +250,13 @@ impl Reader {
                 );
             }
         };
+        // Exporters write Mitsuba 0.6's names into newer files too.
+        for (name, _, _) in &mut o.props {
+            *name = camel_to_snake(name);
+        }
         let width = o.int("width", 768)?;
         let height = o.int("height", 576)?;
+        self.crop_window(&mut o, width, height)?;
         if ldr {
             self.ldr_film(&mut o)?;
         } else {
@@ -142,11 +267,39 @@ impl Reader {
                 &mut o,
                 "component_format",
                 &f32,
-                "foton writes 32-bit floats",
+                "ignored (foton writes 32-bit floats: the same linear values)",
+            );
+            // An hdrfilm stores linear values: a gamma would only change an 8-bit copy.
+            if let Some((p, l)) = o.take("gamma") {
+                self.note(
+                    &Obj {
+                        line: l,
+                        ..o.clone()
+                    },
+                    &format!(
+                        "`gamma` = {}: ignored (an hdrfilm stores linear values)",
+                        show(&p)
+                    ),
+                );
+            }
+        }
+        // Luminance, alpha and the other channels Mitsuba can add are outside the RGB foton
+        // writes; the RGB is the same.
+        let rgb = |p: &Prop| matches!(p, Prop::Str(s) if s == "rgb");
+        self.ignored(
+            &mut o,
+            "pixel_format",
+            &rgb,
+            "ignored (foton writes the RGB channels only)",
+        );
+        if ldr {
+            self.ignored(
+                &mut o,
+                "component_format",
+                &|_| false,
+                "ignored (foton writes an 8-bit PNG)",
             );
         }
-        let rgb = |p: &Prop| matches!(p, Prop::Str(s) if s == "rgb");
-        self.ignored(&mut o, "pixel_format", &rgb, "foton writes RGB");
         let no = |p: &Prop| matches!(p, Prop::Bool(false));
         self.ignored(&mut o, "banner", &no, "foton draws no banner");
         self.ignored(
@@ -177,6 +330,18 @@ impl Reader {
                         let s = rf.float("stddev", 0.5)?;
                         filter.insert("stddev", at(Value::Float(s), l));
                     }
+                    // Filters with negative lobes foton does not have: the Gaussian of
+                    // Mitsuba's default, whose main lobe is about as wide, stands in.
+                    "mitchell" | "catmullrom" | "lanczos" => {
+                        rf.props.clear();
+                        self.unsupported(
+                            &rf,
+                            "foton has no such filter; it filters with a gaussian (stddev 0.5) instead",
+                        )?;
+                        filter = Table::default();
+                        filter.insert("type", at(Value::Str("gaussian".into()), l));
+                        filter.insert("stddev", at(Value::Float(0.5), l));
+                    }
                     _ => {
                         rf.props.clear();
                         let m = not_read(
@@ -202,6 +367,40 @@ impl Reader {
             table_mut(&mut self.root, "film").insert("filter", at(Value::Table(filter), rf_line));
         }
         self.leftovers(&o)
+    }
+
+    /// A film's crop window, kept for the sensor ([`Reader::crop_camera`]) once it is whole.
+    fn crop_window(&mut self, o: &mut Obj, width: i64, height: i64) -> Result<()> {
+        let keys = [
+            "crop_offset_x",
+            "crop_offset_y",
+            "crop_width",
+            "crop_height",
+        ];
+        let line = keys
+            .iter()
+            .find_map(|k| o.props.iter().find(|(n, _, _)| n == k).map(|(_, _, l)| *l));
+        let Some(line) = line else {
+            return Ok(());
+        };
+        let x = o.int("crop_offset_x", 0)?;
+        let y = o.int("crop_offset_y", 0)?;
+        let w = o.int("crop_width", width)?;
+        let h = o.int("crop_height", height)?;
+        if x < 0 || y < 0 || w < 1 || h < 1 || x + w > width || y + h > height {
+            return Err(o.error(format!(
+                "the crop window {w} x {h} at {x}, {y} is not inside the {width} x {height} film"
+            )));
+        }
+        self.crop = Some(Crop {
+            x,
+            y,
+            width: w,
+            height: h,
+            full: (width, height),
+            line,
+        });
+        Ok(())
     }
 
     /// Mitsuba 0.6's `ldrfilm`: a PNG through foton's exposure and tone curve (the sRGB
@@ -307,6 +506,37 @@ impl Reader {
         }
         self.leftovers(&o)
     }
+}
+
+/// Mitsuba's field of view when a file gives none.
+const DEFAULT_FOV: f64 = 45.0;
+
+/// A film's crop window and the film's full size (pixels), with the line that gives it.
+pub(super) struct Crop {
+    x: i64,
+    y: i64,
+    width: i64,
+    height: i64,
+    full: (i64, i64),
+    line: u32,
+}
+
+/// tan of half the vertical field of view of a film `width` x `height` whose `fov` (degrees)
+/// spans `axis` (Mitsuba's `fov_axis`, as foton's camera reads it). None: an unknown axis.
+fn vertical_tan(fov: f64, axis: &str, width: i64, height: i64) -> Option<f64> {
+    let aspect = width as f64 / height as f64;
+    let t = (fov.to_radians() * 0.5).tan();
+    let wide = width >= height;
+    Some(match axis {
+        "x" => t / aspect,
+        "y" => t,
+        "diagonal" => t / (1.0 + aspect * aspect).sqrt(),
+        "smaller" if wide => t,
+        "smaller" => t / aspect,
+        "larger" if wide => t / aspect,
+        "larger" => t,
+        _ => return None,
+    })
 }
 
 /// Mitsuba's samplers and what foton samples with: the one place that decides it. Every

@@ -1,16 +1,59 @@
-//! `<shape>`: meshes (obj, ply), spheres, disks, rectangles and cubes as `[[shapes]]` entries,
-//! each with its material (a nested or referenced BSDF, or Mitsuba's default), its area
-//! emitter and the media on its two sides.
+//! `<shape>`: meshes (obj, ply, serialized), spheres, disks, rectangles, cubes and cylinders as
+//! `[[shapes]]` entries, each with its material (a nested or referenced BSDF, or Mitsuba's
+//! default), its area emitter and the media on its two sides; `shapegroup` and `instance`
+//! flattened into transformed copies of the group's shapes, `merge` into its shapes.
+//!
+//! A nested object or a `<ref>` is taken for what it is, as Mitsuba 3 does (a BSDF, an area
+//! emitter, a medium named `interior` or `exterior`), whatever the property's name. foton has
+//! no analytic cylinder: a `cylinder` is its polygonal prism of [`CYLINDER_FACETS`] flat
+//! quads (with a note).
 
-use super::object::{Obj, Prop};
+use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::{Reader, at, matrix_table, table_mut, vec3};
 use foton_core::error::Result;
-use foton_core::value::{Table, Value};
+use foton_core::value::{Node, Table, Value};
 use glam::{DMat4, DVec3};
 
+/// Quads of a cylinder: the largest angle between neighbouring facets' normals is 360/64 =
+/// 5.6 degrees.
+pub(super) const CYLINDER_FACETS: usize = 64;
+
+/// Keys of the reader's side tables in `Reader::textures`, whose ids come from XML attribute
+/// values and so never hold a NUL: shape groups and top-level area emitters by id.
+const GROUP_KEY: &str = "\0shapegroup:";
+const AREA_KEY: &str = "\0area_emitter:";
+
 impl Reader {
+    fn area_emitter(&self, id: &str) -> Option<DVec3> {
+        let t = self.textures.get(&format!("{AREA_KEY}{id}"))?;
+        node_vec3(t.get("radiance")?)
+    }
+
+    /// What a `<ref id>` names, for messages about a reference of the wrong kind.
+    fn named(&self, id: &str) -> Option<&'static str> {
+        if self.bsdfs.contains_key(id) {
+            Some("a BSDF")
+        } else if self.media.contains_key(id) {
+            Some("a medium")
+        } else if self.area_emitter(id).is_some() {
+            Some("an area emitter")
+        } else if self.textures.contains_key(&format!("{GROUP_KEY}{id}")) {
+            Some("a shapegroup")
+        } else if self.textures.contains_key(id) {
+            Some("a texture")
+        } else {
+            None
+        }
+    }
+
     pub(super) fn shape(&mut self, mut o: Obj) -> Result<()> {
+        match o.ty.as_str() {
+            "shapegroup" => return self.shapegroup(o),
+            "instance" => return self.instance(o),
+            "merge" => return self.merge(o),
+            _ => {}
+        }
         let line = o.line;
         let m = o.transform("to_world")?;
         // The material: a nested BSDF, a reference, or Mitsuba's default (diffuse 0.5).
@@ -21,37 +64,104 @@ impl Reader {
         let mut exterior = None;
         let props = std::mem::take(&mut o.props);
         for (name, p, l) in props {
+            // Errors at the property's own line.
+            let here = Obj {
+                line: l,
+                props: Vec::new(),
+                ..o.clone()
+            };
+            let once = |slot: bool, what: &str| {
+                if slot {
+                    Err(here.error(format!("a second {what}: a shape has one (as in Mitsuba)")))
+                } else {
+                    Ok(())
+                }
+            };
             match p {
-                Prop::Object(b) if b.tag == "bsdf" => material = Some(self.bsdf(b)?),
-                Prop::Ref(id) if name.is_empty() || name == "bsdf" => {
-                    let found = self.bsdfs.get(&id).cloned();
-                    if found.is_none() && !self.lenient {
-                        return Err(o.error(format!("line {l}: no BSDF with id `{id}` before it")));
-                    }
-                    material = Some(found);
+                Prop::Object(b) if b.tag == "bsdf" => {
+                    once(material.is_some(), "BSDF")?;
+                    material = Some(self.bsdf(b)?);
+                }
+                // Mitsuba 3 takes another kind of emitter in a shape for a light of its own,
+                // placed by its own to_world (the shape's plays no part).
+                Prop::Object(e) if e.tag == "emitter" && e.ty != "area" => {
+                    self.note(
+                        &e,
+                        "an emitter other than `area` inside a shape is a light of its own, placed by its own to_world, as Mitsuba 3 reads it",
+                    );
+                    self.emitter(e)?;
                 }
                 Prop::Object(mut e) if e.tag == "emitter" => {
-                    if e.ty != "area" {
-                        return Err(e.error("a shape's emitter must be `area`"));
-                    }
+                    once(emission.is_some(), "emitter")?;
                     emission = Some(e.color("radiance", DVec3::ONE)?);
                     self.leftovers(&e)?;
                 }
-                Prop::Object(med) if med.tag == "medium" && name == "interior" => {
-                    interior = Some(self.medium(med)?)
+                Prop::Object(med) if med.tag == "medium" => match name.as_str() {
+                    "interior" => interior = Some(self.medium(med)?),
+                    "exterior" => exterior = Some(self.medium(med)?),
+                    // Mitsuba 3 attaches a medium to a shape by these two names only.
+                    _ => self.warn(
+                        &o,
+                        l,
+                        &format!(
+                            "{} named `{name}` is ignored, as Mitsuba 3 ignores it (a shape's media are named `interior` and `exterior`)",
+                            med.what()
+                        ),
+                    ),
+                },
+                Prop::Object(sensor) if sensor.tag == "sensor" => {
+                    self.unsupported(
+                        &Obj {
+                            props: Vec::new(),
+                            ..sensor.clone()
+                        },
+                        "a sensor attached to a shape is not supported (foton renders through the scene's one <sensor>)",
+                    )?;
                 }
-                Prop::Ref(id) if name == "interior" => {
-                    interior = Some(self.media.get(&id).cloned().ok_or_else(|| {
-                        o.error(format!("line {l}: no medium with id `{id}` before it"))
-                    })?)
+                Prop::Ref(id) if name == "interior" || name == "exterior" => {
+                    let Some(found) = self.media.get(&id).cloned() else {
+                        let what = self
+                            .named(&id)
+                            .map_or(String::new(), |k| format!(" (`{id}` is {k})"));
+                        return Err(here.error(format!(
+                            "<ref name=\"{name}\" id=\"{id}\">: no medium with id `{id}` before it{what}"
+                        )));
+                    };
+                    if name == "interior" {
+                        interior = Some(found);
+                    } else {
+                        exterior = Some(found);
+                    }
                 }
-                Prop::Object(med) if med.tag == "medium" && name == "exterior" => {
-                    exterior = Some(self.medium(med)?)
-                }
-                Prop::Ref(id) if name == "exterior" => {
-                    exterior = Some(self.media.get(&id).cloned().ok_or_else(|| {
-                        o.error(format!("line {l}: no medium with id `{id}` before it"))
-                    })?)
+                Prop::Ref(id) => {
+                    if let Some(found) = self.bsdfs.get(&id).cloned() {
+                        once(material.is_some(), "BSDF")?;
+                        material = Some(Some(found));
+                    } else if let Some(radiance) = self.area_emitter(&id) {
+                        once(emission.is_some(), "emitter")?;
+                        emission = Some(radiance);
+                    } else if self.media.contains_key(&id) {
+                        self.warn(
+                            &o,
+                            l,
+                            &format!(
+                                "<ref id=\"{id}\"> names a medium without saying which side: ignored, as Mitsuba 3 ignores it (name it `interior` or `exterior`)"
+                            ),
+                        );
+                    } else if let Some(kind) = self.named(&id) {
+                        return Err(here.error(format!(
+                            "<ref id=\"{id}\">: `{id}` is {kind}; a shape takes a BSDF, an area emitter or a medium (`interior`, `exterior`)"
+                        )));
+                    } else {
+                        // Most likely an element left out before (lenient): the shape is
+                        // rendered without it, with Mitsuba's default BSDF if it was its BSDF.
+                        self.unsupported(
+                            &here,
+                            &format!(
+                                "<ref id=\"{id}\">: no BSDF, area emitter or medium with id `{id}` before it"
+                            ),
+                        )?;
+                    }
                 }
                 other => o.props.push((name, other, l)),
             }
@@ -108,18 +218,57 @@ impl Reader {
             t
         };
         match o.ty.as_str() {
-            "obj" | "ply" => {
+            "obj" | "ply" | "serialized" => {
                 let file = self.filename(&mut o)?;
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("mesh".into()), line));
                 if o.boolean("face_normals", false)? {
                     t.insert("face_normals", at(Value::Bool(true), line));
                 }
+                // Mitsuba flips an OBJ's v unless told not to, a PLY's only when told.
                 if o.ty == "obj" && !o.boolean("flip_tex_coords", true)? {
                     t.insert("flip_tex_coords", at(Value::Bool(false), line));
                 }
+                if o.ty == "ply" && o.boolean("flip_tex_coords", false)? {
+                    t.insert("flip_tex_coords", at(Value::Bool(true), line));
+                }
                 if flip_normals {
                     t.insert("flip_normals", at(Value::Bool(true), line));
+                }
+                if o.ty == "serialized" {
+                    let index = o.int("shape_index", 0)?;
+                    if index < 0 {
+                        return Err(o.error(format!(
+                            "`shape_index` = {index}: expected a mesh number, 0 or more"
+                        )));
+                    }
+                    if index > 0 {
+                        t.insert("shape_index", at(Value::Int(index), line));
+                    }
+                }
+                // Mitsuba 0.6's: an OBJ's groups as separate shapes (the same surfaces), its
+                // MTL materials for a shape without a BSDF, a PLY's vertex colours as sRGB.
+                self.ignored(&mut o, "collapse", &|_| true, "");
+                self.ignored(
+                    &mut o,
+                    "load_materials",
+                    &|p| matches!(p, Prop::Bool(false)),
+                    "the OBJ's MTL materials are not read: the shape's BSDF (or Mitsuba's default) is used",
+                );
+                self.ignored(&mut o, "srgb", &|_| true, "");
+                // Mitsuba 0.6's (Mitsuba 3 refuses it): normals smoothed within an angle.
+                if let Some((p, l)) = o.take("max_smooth_angle") {
+                    let angle = match p {
+                        Prop::Float(x) => x,
+                        Prop::Int(i) => i as f64,
+                        other => {
+                            return Err(o.error(format!(
+                                "line {l}: `max_smooth_angle`: expected an angle in degrees, found {}",
+                                show(&other)
+                            )));
+                        }
+                    };
+                    t.insert("max_smooth_angle", at(Value::Float(angle), l));
                 }
                 t.insert("file", file);
                 if m != DMat4::IDENTITY {
@@ -139,34 +288,81 @@ impl Reader {
                 shapes.push(t);
             }
             "sphere" => {
+                // Mitsuba 3: to_world * translate(center) * scale(radius), whose x axis gives
+                // the radius; a non-uniform scale is warned about and rendered so too.
                 let center = o.point("center")?.unwrap_or(DVec3::ZERO);
                 let radius = o.float("radius", 1.0)?;
-                let (x, y, z) = (
-                    m.transform_vector3(DVec3::X),
-                    m.transform_vector3(DVec3::Y),
-                    m.transform_vector3(DVec3::Z),
-                );
-                let s = x.length();
-                let tol = 1e-6 * s.max(1e-30);
-                if (y.length() - s).abs() > tol
-                    || (z.length() - s).abs() > tol
-                    || x.dot(y).abs() > tol * s
-                    || y.dot(z).abs() > tol * s
-                {
-                    self.unsupported(
+                let full =
+                    m * DMat4::from_translation(center) * DMat4::from_scale(DVec3::splat(radius));
+                if !is_similarity(full) {
+                    self.warn(
                         &o,
-                        "a sphere with a non-uniform scale (an ellipsoid) is not supported",
-                    )?;
-                    return Ok(());
+                        line,
+                        "`to_world` scales non-uniformly or shears: rendered, as by Mitsuba 3, as the sphere of radius |to_world x|",
+                    );
                 }
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("sphere".into()), line));
-                t.insert("center", vec3(m.transform_point3(center), line));
-                t.insert("radius", at(Value::Float(radius * s), line));
-                if flip_normals {
+                t.insert("center", vec3(full.transform_point3(DVec3::ZERO), line));
+                t.insert(
+                    "radius",
+                    at(
+                        Value::Float(full.transform_vector3(DVec3::X).length()),
+                        line,
+                    ),
+                );
+                // A mirroring turns the sphere inside out in Mitsuba 3 (its scale factor is
+                // then negative).
+                if flip_normals != (full.determinant() < 0.0) {
                     t.insert("flip_normals", at(Value::Bool(true), line));
                 }
                 shapes.push(t);
+            }
+            "cylinder" => {
+                let p0 = o.point("p0")?.unwrap_or(DVec3::ZERO);
+                let p1 = o.point("p1")?.unwrap_or(DVec3::Z);
+                let radius = o.float("radius", 1.0)?;
+                let axis = p1 - p0;
+                if axis.length_squared() == 0.0 || radius == 0.0 {
+                    return Err(o.error(
+                        "a cylinder of zero length or radius: `p0` = `p1` or `radius` = 0",
+                    ));
+                }
+                let n = axis.normalize();
+                let s = n.any_orthonormal_vector();
+                let frame = DMat4::from_cols(
+                    s.extend(0.0),
+                    n.cross(s).extend(0.0),
+                    n.extend(0.0),
+                    p0.extend(1.0),
+                );
+                // The prism's facets at the radius that keeps Mitsuba's area 2 pi r l (and so
+                // an emitter's power): r (pi/N) / sin(pi/N).
+                let k = std::f64::consts::PI / CYLINDER_FACETS as f64;
+                let r = radius * k / k.sin();
+                let full = m * frame * DMat4::from_scale(DVec3::new(r, r, axis.length()));
+                let flip = flip_normals != (full.determinant() < 0.0);
+                for i in 0..CYLINDER_FACETS {
+                    let angle = |i: usize| 2.0 * k * i as f64;
+                    let a = DVec3::new(angle(i).cos(), angle(i).sin(), 0.0);
+                    let b = DVec3::new(angle(i + 1).cos(), angle(i + 1).sin(), 0.0);
+                    // (b - a) x z points outward.
+                    let mut t = quad(
+                        full.transform_point3(a),
+                        full.transform_vector3(b - a),
+                        full.transform_vector3(DVec3::Z),
+                    );
+                    if flip {
+                        t.insert("flip_normals", at(Value::Bool(true), line));
+                    }
+                    shapes.push(t);
+                }
+                self.note(
+                    &o,
+                    &format!(
+                        "a cylinder is rendered as {CYLINDER_FACETS} flat facets of the same area (foton has no analytic cylinder); its texture coordinates are each facet's"
+                    ),
+                );
             }
             "rectangle" => shapes.push(rectangle(
                 DVec3::new(-1.0, -1.0, 0.0),
@@ -191,6 +387,8 @@ impl Reader {
                 return self.unsupported(&o, &m);
             }
         }
+        // Only for differentiable rendering.
+        self.ignored(&mut o, "silhouette_sampling_weight", &|_| true, "");
         self.leftovers(&o)?;
         for mut t in shapes {
             t.insert("material", at(Value::Str(material.clone()), line));
@@ -208,5 +406,211 @@ impl Reader {
             self.shapes.push(at(Value::Table(t), line));
         }
         Ok(())
+    }
+}
+
+impl Reader {
+    /// `<shape type="merge">`: Mitsuba 3 merges its meshes of the same material into one
+    /// for speed; read one by one they are the same surfaces.
+    fn merge(&mut self, mut o: Obj) -> Result<()> {
+        for (name, p, l) in std::mem::take(&mut o.props) {
+            match p {
+                Prop::Object(member) if member.tag == "shape" => self.shape(member)?,
+                other => o.props.push((name, other, l)),
+            }
+        }
+        self.leftovers(&o)
+    }
+
+    /// `<shape type="shapegroup" id="...">`: its shapes are read (materials and media bound
+    /// there, as in Mitsuba) and kept for the `instance`s that place them; alone it renders
+    /// nothing.
+    fn shapegroup(&mut self, mut o: Obj) -> Result<()> {
+        let Some(id) = o.id.clone() else {
+            return Err(o.error("a shapegroup needs an id, for the instances that <ref> it"));
+        };
+        let before = self.shapes.len();
+        for (name, p, l) in std::mem::take(&mut o.props) {
+            match p {
+                Prop::Object(member) if member.tag == "shape" => {
+                    if matches!(member.ty.as_str(), "shapegroup" | "instance") {
+                        return Err(member.error(
+                            "a shapegroup inside a shapegroup: Mitsuba does not nest instancing",
+                        ));
+                    }
+                    let emits = member
+                        .props
+                        .iter()
+                        .any(|(_, p, _)| matches!(p, Prop::Object(e) if e.tag == "emitter"));
+                    if emits {
+                        return Err(member.error(
+                            "an emitting shape inside a shapegroup: Mitsuba does not instance emitters",
+                        ));
+                    }
+                    self.shape(member)?;
+                }
+                other => o.props.push((name, other, l)),
+            }
+        }
+        let members: Vec<Node> = self.shapes.drain(before..).collect();
+        self.leftovers(&o)?;
+        let mut t = Table::default();
+        t.insert("shapes", at(Value::Array(members), o.line));
+        self.textures.insert(format!("{GROUP_KEY}{id}"), t);
+        Ok(())
+    }
+
+    /// `<shape type="instance">`: the referenced group's shapes, each placed by the
+    /// instance's `to_world` after its own.
+    fn instance(&mut self, mut o: Obj) -> Result<()> {
+        let m = o.transform("to_world")?;
+        let mut group = None;
+        for (name, p, l) in std::mem::take(&mut o.props) {
+            match p {
+                Prop::Ref(id) => {
+                    let here = Obj {
+                        line: l,
+                        props: Vec::new(),
+                        ..o.clone()
+                    };
+                    if group.is_some() {
+                        return Err(here.error("a second shapegroup: an instance places one"));
+                    }
+                    let key = format!("{GROUP_KEY}{id}");
+                    let Some(t) = self.textures.get(&key) else {
+                        let what = self
+                            .named(&id)
+                            .map_or(String::new(), |k| format!(" (`{id}` is {k})"));
+                        return Err(here.error(format!(
+                            "<ref id=\"{id}\">: no shapegroup with id `{id}` before it{what}"
+                        )));
+                    };
+                    group = Some(t.clone());
+                }
+                other => o.props.push((name, other, l)),
+            }
+        }
+        let Some(group) = group else {
+            return Err(o.error("an instance without a <ref> to its shapegroup"));
+        };
+        self.leftovers(&o)?;
+        let Some(Value::Array(members)) = group.get("shapes").map(|n| &n.value) else {
+            return Ok(());
+        };
+        for member in members {
+            let Value::Table(t) = &member.value else {
+                continue;
+            };
+            let mut t = t.clone();
+            if !place(&mut t, m, o.line) {
+                self.warn(
+                    &o,
+                    o.line,
+                    "`to_world` scales a sphere of the group non-uniformly, into an ellipsoid in Mitsuba 3: foton has none and renders the sphere of radius |to_world x|",
+                );
+            }
+            self.shapes.push(at(Value::Table(t), o.line));
+        }
+        Ok(())
+    }
+}
+
+/// Whether `m` (its linear part) is a rotation, a uniform scale and perhaps a mirroring.
+fn is_similarity(m: DMat4) -> bool {
+    let (x, y, z) = (
+        m.transform_vector3(DVec3::X),
+        m.transform_vector3(DVec3::Y),
+        m.transform_vector3(DVec3::Z),
+    );
+    let s = x.length();
+    let tol = 1e-6 * s.max(1e-30);
+    (y.length() - s).abs() <= tol
+        && (z.length() - s).abs() <= tol
+        && x.dot(y).abs() <= tol * s
+        && y.dot(z).abs() <= tol * s
+        && x.dot(z).abs() <= tol * s
+}
+
+fn node_vec3(n: &Node) -> Option<DVec3> {
+    match &n.value {
+        Value::Array(xs) if xs.len() == 3 => Some(DVec3::new(
+            xs[0].value.as_f64()?,
+            xs[1].value.as_f64()?,
+            xs[2].value.as_f64()?,
+        )),
+        _ => None,
+    }
+}
+
+/// The shape table `t` (as [`Reader::shape`] writes it) moved by `m`, applied after its own
+/// placement, as Mitsuba 3's instance moves a shape; false if `m` turned a sphere into an
+/// ellipsoid (rendered as a sphere).
+fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
+    let point = |t: &mut Table, key: &str| {
+        if let Some(p) = t.get(key).and_then(node_vec3) {
+            t.insert(key, vec3(m.transform_point3(p), line));
+        }
+    };
+    let vector = |t: &mut Table, key: &str| {
+        if let Some(v) = t.get(key).and_then(node_vec3) {
+            t.insert(key, vec3(m.transform_vector3(v), line));
+        }
+    };
+    // A mirroring reverses u x v (quads, disks), which Mitsuba's instance does not: its
+    // normals are the shape's, transformed as normals.
+    let toggle_flip = |t: &mut Table| {
+        if m.determinant() < 0.0 {
+            let flipped = matches!(
+                t.get("flip_normals").map(|n| &n.value),
+                Some(Value::Bool(true))
+            );
+            t.insert("flip_normals", at(Value::Bool(!flipped), line));
+        }
+    };
+    let ty = match t.get("type").map(|n| &n.value) {
+        Some(Value::Str(s)) => s.clone(),
+        _ => return true,
+    };
+    match ty.as_str() {
+        "mesh" => {
+            let own = match t.get("transform").map(|n| &n.value) {
+                Some(Value::Table(tt)) => match tt.get("matrix").map(|n| &n.value) {
+                    Some(Value::Array(xs)) if xs.len() == 16 => {
+                        let xs: Vec<f64> = xs.iter().filter_map(|x| x.value.as_f64()).collect();
+                        DMat4::from_cols_slice(&xs).transpose()
+                    }
+                    _ => DMat4::IDENTITY,
+                },
+                _ => DMat4::IDENTITY,
+            };
+            t.insert("transform", matrix_table(m * own, line));
+            true
+        }
+        "sphere" => {
+            // Mitsuba 3 transforms the sphere's own normals by the instance's: a mirroring
+            // keeps them outward (unlike a mirroring in the sphere's own to_world).
+            let uniform = is_similarity(m);
+            if let Some(Value::Float(r)) = t.get("radius").map(|n| n.value.clone()) {
+                let r = r * m.transform_vector3(DVec3::X).length();
+                t.insert("radius", at(Value::Float(r), line));
+            }
+            point(t, "center");
+            uniform
+        }
+        "quad" => {
+            point(t, "origin");
+            vector(t, "u");
+            vector(t, "v");
+            toggle_flip(t);
+            true
+        }
+        "disk" => {
+            point(t, "center");
+            vector(t, "u");
+            vector(t, "v");
+            toggle_flip(t);
+            true
+        }
+        _ => true,
     }
 }

@@ -1,8 +1,9 @@
 //! `<texture>`: Mitsuba's `bitmap` and `checkerboard` as the inline texture tables foton's
 //! materials take, and a colour parameter that may be a texture (nested or a `<ref>`).
 
-use super::object::{Obj, Prop};
+use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
+use super::upgrade::camel_to_snake;
 use super::{Reader, at, matrix_table, vec3};
 use foton_core::error::Result;
 use foton_core::value::{Node, Table, Value};
@@ -25,9 +26,12 @@ impl Reader {
             }
             Some((Prop::Ref(id), l)) => match self.textures.get(&id) {
                 Some(t) => Ok(Some(at(Value::Table(t.clone()), line))),
-                None => Err(o.error(format!(
-                    "`{name}`: line {l}: no texture with id `{id}` before it"
-                ))),
+                None if self.left_out_ids.contains(&id) => {
+                    o.props.clear();
+                    self.unsupported(o, &format!("`{name}`: texture `{id}` was left out"))?;
+                    Ok(None)
+                }
+                None => Err(o.error(format!("`{name}`: line {l}: no texture with id `{id}`"))),
             },
             Some((p, l)) => {
                 o.props.push((name.to_string(), p, l));
@@ -44,17 +48,17 @@ impl Reader {
         let line = o.line;
         let mut t = Table::default();
         t.insert("type", at(Value::Str(o.ty.clone()), line));
+        // Exporters write Mitsuba 0.6's names (`filterType`, `wrapMode`) into newer files.
+        for (name, _, _) in &mut o.props {
+            *name = camel_to_snake(name);
+        }
         match o.ty.as_str() {
             "bitmap" => {
                 t.insert("filename", self.filename(&mut o)?);
                 if o.boolean("raw", false)? {
                     t.insert("raw", at(Value::Bool(true), line));
                 }
-                for key in ["filter_type", "wrap_mode"] {
-                    if let Some(v) = o.string(key)? {
-                        t.insert(key, at(Value::Str(v), line));
-                    }
-                }
+                self.bitmap_lookup(&mut o, &mut t)?;
                 // Storage format and value clamping change nothing foton renders.
                 o.take("format");
                 o.take("accel");
@@ -78,5 +82,94 @@ impl Reader {
         }
         self.leftovers(&o)?;
         Ok(Some(t))
+    }
+
+    /// A bitmap's lookup: `filter_type` (Mitsuba 3: bilinear, nearest; 0.6: ewa, trilinear,
+    /// nearest) and `wrap_mode` (repeat, mirror, clamp; 0.6 also zero and one, and a mode per
+    /// axis, `wrap_mode_u` and `wrap_mode_v`), as foton's bitmap textures have them: bilinear
+    /// or nearest, repeat, mirror or clamp. Mipmapped filters are bilinear without the
+    /// mipmap (the same where a texel covers at least a pixel: a warning); a constant border
+    /// is clamped (the same inside the texture: a warning, an error without `lenient`).
+    fn bitmap_lookup(&mut self, o: &mut Obj, t: &mut Table) -> Result<()> {
+        if let Some((p, l)) = o.take("filter_type") {
+            let Prop::Str(f) = &p else {
+                return Err(o.error(format!(
+                    "`filter_type`: expected a string, found {}",
+                    show(&p)
+                )));
+            };
+            let foton = match f.to_lowercase().as_str() {
+                "bilinear" => "bilinear",
+                "nearest" => "nearest",
+                "trilinear" | "ewa" => {
+                    self.warn(
+                        o,
+                        l,
+                        &format!("`filter_type` = {f:?}: foton filters bilinearly without a mipmap (the same where a texel covers at least a pixel; aliasing where the texture is minified)"),
+                    );
+                    "bilinear"
+                }
+                other => {
+                    return Err(o.error(format!(
+                        "`filter_type` = {other:?}: expected bilinear, nearest, trilinear or ewa"
+                    )));
+                }
+            };
+            t.insert("filter_type", at(Value::Str(foton.into()), l));
+        }
+        let mode = |o: &mut Obj, key: &str| -> Result<Option<(String, u32)>> {
+            match o.take(key) {
+                None => Ok(None),
+                Some((Prop::Str(m), l)) => Ok(Some((m.to_lowercase(), l))),
+                Some((p, _)) => {
+                    Err(o.error(format!("`{key}`: expected a string, found {}", show(&p))))
+                }
+            }
+        };
+        let both = mode(o, "wrap_mode")?;
+        let u = mode(o, "wrap_mode_u")?;
+        let v = mode(o, "wrap_mode_v")?;
+        let (wrap, l) = match (both, u, v) {
+            (Some(w), None, None) => w,
+            (None, None, None) => return Ok(()),
+            (_, u, v) => {
+                let (u, v) = (
+                    u.unwrap_or(("repeat".into(), o.line)),
+                    v.unwrap_or(("repeat".into(), o.line)),
+                );
+                if u.0 != v.0 {
+                    let w = Obj {
+                        line: v.1,
+                        ..o.clone()
+                    };
+                    self.unsupported(
+                        &w,
+                        &format!("`wrap_mode_v` = {:?} other than `wrap_mode_u` = {:?} is not supported; both wrap as {:?}", v.0, u.0, u.0),
+                    )?;
+                }
+                u
+            }
+        };
+        let foton = match wrap.as_str() {
+            "repeat" | "mirror" | "clamp" => wrap.clone(),
+            "zero" | "one" => {
+                let w = Obj {
+                    line: l,
+                    ..o.clone()
+                };
+                self.unsupported(
+                    &w,
+                    &format!("`wrap_mode` = {wrap:?} (a constant outside the texture) is not supported; it is clamped"),
+                )?;
+                "clamp".into()
+            }
+            other => {
+                return Err(o.error(format!(
+                    "`wrap_mode` = {other:?}: expected repeat, mirror, clamp, zero or one"
+                )));
+            }
+        };
+        t.insert("wrap_mode", at(Value::Str(foton), l));
+        Ok(())
     }
 }

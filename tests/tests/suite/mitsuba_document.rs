@@ -1,0 +1,559 @@
+//! The Mitsuba XML document as Mitsuba reads it (issue 32): `<path>` folders and the file
+//! resolver, `<include>` from the including file's folder with errors at the included file's
+//! lines, named nested objects, top-level samplers taken by `<ref>`, `<lookAt>` in any case,
+//! the default sensor, film parameters and crop windows, reconstruction filters foton lacks,
+//! 2.x files, bitmap filter and wrap modes, XML syntax errors with their column.
+
+use foton_core::value::{Document, Node, Table, Value};
+use foton_loader::mitsuba::read_xml;
+use foton_loader::reader::Report;
+use foton_tests::{temp_dir, write};
+use glam::{Vec2, Vec3};
+use std::path::Path;
+
+const OBJ: &str = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+
+/// A scene of `body` (elements inside `<scene>`), with a light and a sphere when `body`
+/// names none.
+fn scene(version: &str, body: &str) -> String {
+    let light = if body.contains("<emitter") {
+        ""
+    } else {
+        "<emitter type=\"constant\"/>"
+    };
+    let shape = if body.contains("<shape") {
+        ""
+    } else {
+        "<shape type=\"sphere\"/>"
+    };
+    format!("<scene version=\"{version}\">\n{body}\n{light}{shape}\n</scene>\n")
+}
+
+const SENSOR: &str = r#"<sensor type="perspective">
+    <transform name="to_world"><lookat origin="0, 0, -5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="16"/></film>
+</sensor>"#;
+
+fn read(path: &Path, lenient: bool) -> Result<(Document, Report), String> {
+    read_xml(path, &[], lenient).map_err(|e| e.to_string())
+}
+
+fn node<'d>(t: &'d Table, path: &str) -> &'d Node {
+    let mut keys = path.split('.');
+    let mut n = t
+        .get(keys.next().unwrap())
+        .unwrap_or_else(|| panic!("{path}"));
+    for k in keys {
+        n = match &n.value {
+            Value::Table(t) => t.get(k).unwrap_or_else(|| panic!("{path}: {k}")),
+            Value::Array(a) => &a[k.parse::<usize>().unwrap()],
+            other => panic!("{path}: {k} in {other:?}"),
+        };
+    }
+    n
+}
+
+fn text(t: &Table, path: &str) -> String {
+    match &node(t, path).value {
+        Value::Str(s) => s.clone(),
+        other => panic!("{path}: {other:?}"),
+    }
+}
+
+fn number(t: &Table, path: &str) -> f64 {
+    node(t, path)
+        .value
+        .as_f64()
+        .unwrap_or_else(|| panic!("{path}"))
+}
+
+fn vector(t: &Table, path: &str) -> Vec3 {
+    let Value::Array(a) = &node(t, path).value else {
+        panic!("{path}")
+    };
+    let x: Vec<f32> = a.iter().map(|n| n.value.as_f64().unwrap() as f32).collect();
+    Vec3::new(x[0], x[1], x[2])
+}
+
+/// `<path>` adds a folder in which every later file name is looked for after the file's own
+/// folder: meshes and textures by their bare names. Without it the file is not found, and
+/// the error names the element's file and line and the folders searched.
+#[test]
+fn path_folders_are_searched_for_files() {
+    let dir = temp_dir("mitsuba-path");
+    std::fs::create_dir_all(dir.join("assets/meshes")).unwrap();
+    write(&dir.join("assets/meshes"), "tri.obj", OBJ);
+    image::RgbImage::from_pixel(2, 2, image::Rgb([200, 100, 50]))
+        .save(dir.join("assets/meshes/wood.png"))
+        .unwrap();
+    let body = format!(
+        r#"{SENSOR}
+<path value="assets/meshes"/>
+<shape type="obj">
+    <string name="filename" value="tri.obj"/>
+    <bsdf type="diffuse">
+        <texture type="bitmap" name="reflectance"><string name="filename" value="wood.png"/></texture>
+    </bsdf>
+</shape>"#
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "shapes.0.file"), "assets/meshes/tri.obj");
+    let material = text(&doc.root, "shapes.0.material");
+    assert_eq!(
+        text(
+            &doc.root,
+            &format!("materials.{material}.reflectance.filename")
+        ),
+        "assets/meshes/wood.png"
+    );
+    // The scene loads: the builder finds the files where the reader says they are.
+    let loaded = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    assert_eq!(loaded.film().width, 32);
+
+    let without = scene("3.0.0", &body).replace("<path value=\"assets/meshes\"/>", "");
+    let xml = write(&dir, "scene.xml", &without);
+    let e = read(&xml, false).unwrap_err();
+    for needle in ["scene.xml:10:", "wood.png", "no such file"] {
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+
+    // A folder that does not exist is an error at its line; --lenient reads on without it.
+    let missing = scene("3.0.0", &body).replace("assets/meshes\"/>", "nowhere\"/>");
+    let xml = write(&dir, "scene.xml", &missing);
+    let e = read(&xml, false).unwrap_err();
+    for needle in ["scene.xml:6:", "nowhere", "no such folder"] {
+        assert!(e.contains(needle), "{needle}: {e}");
+    }
+    let e = read(&xml, true).unwrap_err();
+    assert!(e.contains("wood.png"), "{e}");
+}
+
+/// An include is found from the folder of the file that includes it, a nested one from
+/// its own includer's; what fails in an included file is reported at that file's line; and
+/// the document keeps no line of an included file (its lines are the scene file's).
+#[test]
+fn includes_resolve_from_the_including_file_and_report_their_lines() {
+    let dir = temp_dir("mitsuba-include");
+    std::fs::create_dir_all(dir.join("parts/deeper")).unwrap();
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    write(&dir.join("meshes"), "tri.obj", OBJ);
+    let main = scene(
+        "3.0.0",
+        &format!("{SENSOR}\n<include filename=\"parts/a.xml\"/>"),
+    );
+    let xml = write(&dir, "scene.xml", &main);
+    write(
+        &dir.join("parts"),
+        "a.xml",
+        "<scene version=\"2.1.0\">\n\n    <include filename=\"deeper/b.xml\"/>\n</scene>\n",
+    );
+    let b = "<scene version=\"3.0.0\">\n    <shape type=\"obj\">\n        <string name=\"filename\" value=\"../../meshes/tri.obj\"/>\n    </shape>\n</scene>\n";
+    write(&dir.join("parts/deeper"), "b.xml", b);
+    let (doc, report) = read(&xml, false).unwrap();
+    assert_eq!(report.included.len(), 2, "{:?}", report.included);
+    let shape = node(&doc.root, "shapes.0");
+    assert_eq!(shape.line, 0);
+    assert_eq!(node(&doc.root, "shapes.0.file").line, 0);
+    assert!(text(&doc.root, "shapes.0.file").ends_with("tri.obj"));
+    // The scene file's own values keep their lines.
+    assert_eq!(node(&doc.root, "film.width").line, 4);
+
+    // Mitsuba 3 includes a file of one object as that object.
+    write(
+        &dir.join("parts"),
+        "red.xml",
+        "<bsdf version=\"3.0.0\" type=\"diffuse\" id=\"red\">\n    <rgb name=\"reflectance\" value=\"0.8, 0.1, 0.1\"/>\n</bsdf>\n",
+    );
+    let with_red = main.replace(
+        "<include filename=\"parts/a.xml\"/>",
+        "<include filename=\"parts/red.xml\"/>\n<shape type=\"sphere\"><ref id=\"red\"/></shape>",
+    );
+    let red = write(&dir, "red.xml", &with_red);
+    let (doc, _) = read(&red, false).unwrap();
+    assert_eq!(text(&doc.root, "shapes.0.material"), "red");
+    assert_eq!(
+        vector(&doc.root, "materials.red.reflectance"),
+        Vec3::new(0.8, 0.1, 0.1)
+    );
+
+    // A missing mesh in the nested file: that file and the element's line.
+    write(
+        &dir.join("parts/deeper"),
+        "b.xml",
+        &b.replace("tri.obj", "gone.obj"),
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("b.xml:2:"), "{e}");
+    assert!(e.contains("gone.obj"), "{e}");
+
+    // A missing nested include: the including file and its line.
+    write(&dir.join("parts/deeper"), "b.xml", b);
+    write(
+        &dir.join("parts"),
+        "a.xml",
+        "<scene version=\"3.0.0\">\n\n    <include filename=\"deeper/c.xml\"/>\n</scene>\n",
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("a.xml:3:5"), "{e}");
+    assert!(e.contains("deeper/c.xml"), "{e}");
+
+    // An error inside an included file names its line there, not line 0.
+    write(
+        &dir.join("parts"),
+        "a.xml",
+        "<scene version=\"3.0.0\">\n\n    <bsdf type=\"dielectric\">\n        <string name=\"int_ior\" value=\"unobtainium\"/>\n    </bsdf>\n</scene>\n",
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("a.xml:3:"), "{e}");
+}
+
+/// Nested objects with a `name` (as Mitsuba names every child) are taken by kind; a
+/// top-level sampler, film and filter with an `id` are taken where a `<ref>` names them.
+#[test]
+fn named_nested_objects_and_referenced_samplers() {
+    let dir = temp_dir("mitsuba-named");
+    let body = r#"<sampler type="independent" id="spp7"><integer name="sample_count" value="7"/></sampler>
+<rfilter type="tent" id="wide"><float name="radius" value="2"/></rfilter>
+<sensor type="perspective" name="sensor">
+    <ref name="sampler" id="spp7"/>
+    <film type="hdrfilm" name="film">
+        <integer name="width" value="8"/><integer name="height" value="8"/>
+        <ref id="wide"/>
+    </film>
+</sensor>
+<medium type="homogeneous" id="fog">
+    <phase type="hg" name="phase_function"><float name="g" value="0.3"/></phase>
+</medium>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(number(&doc.root, "render.spp"), 7.0);
+    assert_eq!(text(&doc.root, "film.filter.type"), "tent");
+    assert_eq!(number(&doc.root, "film.filter.radius"), 2.0);
+    assert_eq!(number(&doc.root, "media.fog.phase.g"), 0.3);
+
+    let named = body
+        .replace("<ref id=\"wide\"/>", "<rfilter name=\"rfilter\" type=\"box\"/>")
+        .replace(
+            "<ref name=\"sampler\" id=\"spp7\"/>",
+            "<sampler name=\"sampler\" type=\"independent\"><integer name=\"sample_count\" value=\"3\"/></sampler>",
+        );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &named));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(number(&doc.root, "render.spp"), 3.0);
+    assert_eq!(text(&doc.root, "film.filter.type"), "box");
+}
+
+/// `<lookAt>` in any case is `<lookat>`; without `up`, Mitsuba's (0.6 and 3) is the first
+/// vector of the orthonormal basis it builds around the viewing direction: +x for +z.
+#[test]
+fn lookat_in_any_case_and_without_up() {
+    let dir = temp_dir("mitsuba-lookat");
+    let mut cameras = Vec::new();
+    for tag in ["lookat", "lookAt", "LookAt", "LOOKAT"] {
+        let body = SENSOR.replace("lookat", tag);
+        let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+        let (doc, _) = read(&xml, false).unwrap();
+        cameras.push((
+            vector(&doc.root, "camera.position"),
+            vector(&doc.root, "camera.look_at"),
+            vector(&doc.root, "camera.up"),
+        ));
+    }
+    assert!(cameras.iter().all(|c| *c == cameras[0]), "{cameras:?}");
+    assert_eq!(cameras[0].0, Vec3::new(0.0, 0.0, -5.0));
+    assert!((cameras[0].2 - Vec3::Y).length() < 1e-6);
+
+    let body = SENSOR.replace(" up=\"0, 1, 0\"", "");
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    let up = vector(&doc.root, "camera.up");
+    assert!((up - Vec3::X).length() < 1e-6, "{up}");
+}
+
+/// Without a `<sensor>`, Mitsuba 0.6's: fov 45 across the width, looking down +z from in
+/// front of the scene's bounds at the distance where the fov spans their larger extent in x
+/// and y; a 768 x 576 film, 4 samples per pixel. A sensor without a film or a sampler takes
+/// Mitsuba's film and sample count.
+#[test]
+fn no_sensor_is_mitsubas_default_camera() {
+    let dir = temp_dir("mitsuba-nosensor");
+    let body = r#"<shape type="sphere"><point name="center" x="2" y="3" z="5"/><float name="radius" value="1"/></shape>"#;
+    let xml = write(&dir, "scene.xml", &scene("0.6.0", body));
+    let loaded = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    let (lo, hi) = loaded.bounds();
+    let distance = (hi - lo).x.max((hi - lo).y) / (2.0 * 22.5f32.to_radians().tan());
+    let expected = Vec3::new(2.0, 3.0, lo.z - distance);
+    let camera = loaded.camera();
+    assert!(
+        (camera.position - expected).length() < 1e-4,
+        "{:?}",
+        camera.position
+    );
+    assert!((camera.forward() - Vec3::Z).length() < 1e-6);
+    assert_eq!(camera.resolution(), (768, 576));
+    assert_eq!(loaded.render().spp, 4);
+    // The fov spans the width: the ray through the middle of the left edge is 22.5 degrees
+    // off the axis.
+    let edge = camera.generate_ray(Vec2::new(0.0, 288.0)).dir;
+    assert!((edge.angle_between(Vec3::Z).to_degrees() - 22.5).abs() < 1e-3);
+
+    // A sensor foton does not read: refused, or with --lenient Mitsuba's default camera.
+    let ortho = r#"<sensor type="orthographic"/>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", ortho));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("orthographic"), "{e}");
+    let loaded = foton_loader::load_with(&xml, &[], &[], true).unwrap();
+    assert_eq!(loaded.camera().resolution(), (768, 576));
+    assert!((loaded.camera().forward() - Vec3::Z).length() < 1e-6);
+
+    let bare = r#"<sensor type="perspective"><float name="fov" value="30"/></sensor>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", bare));
+    let loaded = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    assert_eq!(loaded.camera().resolution(), (768, 576));
+    assert_eq!(loaded.render().spp, 4);
+}
+
+/// A crop window in the middle of the film renders the same pixels as the whole film
+/// would there: each crop pixel's ray is the whole film's ray through the same pixel. One
+/// off the middle is refused (foton's camera has no lens shift); `--lenient` renders the
+/// whole film and says so. Film parameters that do not change the linear image are read.
+#[test]
+fn crop_windows_and_film_parameters() {
+    let dir = temp_dir("mitsuba-crop");
+    let film = |extra: &str| {
+        format!(
+            r#"<sensor type="perspective">
+    <float name="fov" value="50"/>
+    <transform name="to_world"><lookat origin="1, 2, -5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <film type="hdrfilm">
+        <integer name="width" value="40"/><integer name="height" value="30"/>
+        <string name="pixel_format" value="rgba"/>
+        <string name="component_format" value="float16"/>
+        <boolean name="banner" value="false"/>
+        <boolean name="highQualityEdges" value="true"/>
+        <float name="gamma" value="2.2"/>
+        {extra}
+    </film>
+</sensor>"#
+        )
+    };
+    let xml = write(&dir, "full.xml", &scene("3.0.0", &film("")));
+    let full = foton_loader::load_with(&xml, &[], &[], true).unwrap();
+    let crop = r#"<integer name="crop_offset_x" value="10"/><integer name="crop_offset_y" value="9"/>
+        <integer name="crop_width" value="20"/><integer name="crop_height" value="12"/>"#;
+    let xml = write(&dir, "crop.xml", &scene("3.0.0", &film(crop)));
+    let (_, report) = read(&xml, false).unwrap();
+    assert!(report.left_out.is_empty(), "{:?}", report.left_out);
+    let cropped = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    assert_eq!(cropped.camera().resolution(), (20, 12));
+    for (x, y) in [(0.5, 0.5), (19.5, 0.5), (7.25, 11.0), (20.0, 12.0)] {
+        let a = cropped.camera().generate_ray(Vec2::new(x, y)).dir;
+        let b = full.camera().generate_ray(Vec2::new(x + 10.0, y + 9.0)).dir;
+        assert!((a - b).length() < 1e-5, "({x}, {y}): {a} against {b}");
+    }
+
+    let off = crop.replace("value=\"9\"", "value=\"2\"");
+    let xml = write(&dir, "crop.xml", &scene("3.0.0", &film(&off)));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("crop window"), "{e}");
+    assert!(e.contains("--lenient"), "{e}");
+    let (doc, report) = read(&xml, true).unwrap();
+    assert_eq!(number(&doc.root, "film.width"), 40.0);
+    assert!(
+        report.left_out.iter().any(|l| l.contains("crop window")),
+        "{:?}",
+        report.left_out
+    );
+}
+
+/// Mitsuba's mitchell, catmullrom and lanczos filters: foton has none, so the file is
+/// refused, or with `--lenient` filtered by Mitsuba's default gaussian, which it says.
+#[test]
+fn filters_foton_lacks_are_replaced_with_a_note() {
+    let dir = temp_dir("mitsuba-filters");
+    for ty in ["mitchell", "catmullrom", "lanczos"] {
+        let body = SENSOR.replace(
+            "</film>",
+            &format!("<rfilter type=\"{ty}\"><float name=\"B\" value=\"0.3\"/></rfilter></film>"),
+        );
+        let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+        let e = read(&xml, false).unwrap_err();
+        assert!(e.contains(ty) && e.contains("gaussian"), "{e}");
+        let (doc, report) = read(&xml, true).unwrap();
+        assert_eq!(text(&doc.root, "film.filter.type"), "gaussian");
+        assert_eq!(number(&doc.root, "film.filter.stddev"), 0.5);
+        assert!(report.left_out.iter().any(|l| l.contains(ty)), "{ty}");
+    }
+}
+
+/// Mitsuba 2.0 to 2.2 files are read as 3.x files are (the same names), and their sample
+/// scheduling parameters are not refused.
+#[test]
+fn mitsuba_2_files_are_read() {
+    let dir = temp_dir("mitsuba-2");
+    for version in ["2.0", "2.0.0", "2.1.0", "2.2.1"] {
+        let body = format!(
+            "<integrator type=\"path\"><integer name=\"max_depth\" value=\"3\"/><integer name=\"samples_per_pass\" value=\"4\"/></integrator>\n{SENSOR}"
+        );
+        let xml = write(&dir, "scene.xml", &scene(version, &body));
+        let (doc, _) = read(&xml, false).unwrap_or_else(|e| panic!("{version}: {e}"));
+        assert_eq!(number(&doc.root, "render.max_depth"), 2.0);
+    }
+}
+
+/// Bitmap filter and wrap modes as foton's textures have them: Mitsuba 3's names kept,
+/// 0.6's camelCase and its mipmapped filters read (bilinear, a warning), a constant border
+/// clamped with `--lenient` (an error without).
+#[test]
+fn bitmap_filter_and_wrap_modes() {
+    let dir = temp_dir("mitsuba-bitmap");
+    image::RgbImage::from_pixel(2, 2, image::Rgb([10, 20, 30]))
+        .save(dir.join("t.png"))
+        .unwrap();
+    let body = |params: &str| {
+        format!(
+            r#"{SENSOR}
+<shape type="sphere"><bsdf type="diffuse">
+    <texture type="bitmap" name="reflectance"><string name="filename" value="t.png"/>{params}</texture>
+</bsdf></shape>"#
+        )
+    };
+    let cases = [
+        (
+            r#"<string name="filter_type" value="nearest"/><string name="wrap_mode" value="mirror"/>"#,
+            "nearest",
+            "mirror",
+            false,
+        ),
+        (
+            r#"<string name="filterType" value="trilinear"/><string name="wrapMode" value="clamp"/>"#,
+            "bilinear",
+            "clamp",
+            true,
+        ),
+        (
+            r#"<string name="filter_type" value="ewa"/><string name="wrap_mode_u" value="repeat"/><string name="wrap_mode_v" value="repeat"/>"#,
+            "bilinear",
+            "repeat",
+            true,
+        ),
+    ];
+    for (params, filter, wrap, warned) in cases {
+        let xml = write(&dir, "scene.xml", &scene("3.0.0", &body(params)));
+        let (doc, report) = read(&xml, false).unwrap_or_else(|e| panic!("{params}: {e}"));
+        let m = text(&doc.root, "shapes.0.material");
+        assert_eq!(
+            text(&doc.root, &format!("materials.{m}.reflectance.filter_type")),
+            filter
+        );
+        assert_eq!(
+            text(&doc.root, &format!("materials.{m}.reflectance.wrap_mode")),
+            wrap
+        );
+        assert_eq!(!report.warnings.is_empty(), warned, "{:?}", report.warnings);
+        foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    }
+    // A texture left out (--lenient) leaves out what takes it by reference, which says so.
+    let dropped = format!(
+        r#"{SENSOR}
+<texture type="mesh_attribute" id="tex"><string name="name" value="vertex_color"/></texture>
+<shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="tex"/></bsdf></shape>"#
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &dropped));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("mesh_attribute"), "{e}");
+    let (doc, report) = read(&xml, true).unwrap();
+    assert!(doc.root.get("shapes").is_none());
+    assert!(
+        report
+            .left_out
+            .iter()
+            .any(|l| l.contains("texture `tex` was left out")),
+        "{:?}",
+        report.left_out
+    );
+
+    for border in ["zero", "one"] {
+        let params = format!("<string name=\"wrap_mode\" value=\"{border}\"/>");
+        let xml = write(&dir, "scene.xml", &scene("3.0.0", &body(&params)));
+        let e = read(&xml, false).unwrap_err();
+        assert!(e.contains(border) && e.contains("--lenient"), "{e}");
+        let (doc, report) = read(&xml, true).unwrap();
+        let m = text(&doc.root, "shapes.0.material");
+        assert_eq!(
+            text(&doc.root, &format!("materials.{m}.reflectance.wrap_mode")),
+            "clamp"
+        );
+        assert_eq!(report.left_out.len(), 1, "{:?}", report.left_out);
+    }
+}
+
+/// An area emitter defined at the top level and given to a shape by `<ref>` (before or after
+/// it) is the shape's emitter, a medium given by an unnamed `<ref>` the sensor's or the light's; XML that does
+/// not parse is reported at its line and column.
+#[test]
+fn referenced_area_emitters_and_syntax_error_columns() {
+    let dir = temp_dir("mitsuba-refs");
+    let body = format!(
+        r#"{SENSOR}
+<emitter type="area" id="glow"><rgb name="radiance" value="3, 2, 1"/></emitter>
+<shape type="sphere"><ref id="glow"/></shape>"#
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(
+        vector(&doc.root, "shapes.0.emission"),
+        Vec3::new(3.0, 2.0, 1.0)
+    );
+
+    // Mitsuba resolves references once the file is read: the official Cornell box gives its
+    // light by a <ref> before the emitter, in an included file.
+    let body = format!(
+        r#"{SENSOR}
+<include filename="shapes.xml"/>
+<bsdf type="diffuse" id="white"/>
+<emitter type="area" id="glow"><rgb name="radiance" value="5, 5, 5"/></emitter>"#
+    );
+    write(
+        &dir,
+        "shapes.xml",
+        "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n        <ref id=\"white\"/>\n        <ref id=\"glow\"/>\n    </shape>\n</scene>\n",
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(
+        vector(&doc.root, "shapes.0.emission"),
+        Vec3::new(5.0, 5.0, 5.0)
+    );
+    assert_eq!(text(&doc.root, "shapes.0.material"), "white");
+    assert_eq!(node(&doc.root, "shapes.0").line, 0);
+
+    // An unnamed reference to a medium is a sensor's or a light's medium, not a BSDF.
+    let body = r#"<medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.1"/></medium>
+<sensor type="perspective"><ref id="fog"/></sensor>
+<emitter type="point"><ref id="fog"/></emitter>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "camera.medium"), "fog");
+    assert_eq!(text(&doc.root, "lights.0.medium"), "fog");
+
+    // A property of the wrong kind is named as the file writes it, not as a debug dump.
+    let body = r#"<sensor type="perspective"><texture type="checkerboard" name="fov"/></sensor>"#;
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("`fov`: expected a number, found <texture type=\"checkerboard\">"),
+        "{e}"
+    );
+    assert!(!e.contains("Obj {"), "{e}");
+
+    let broken = "<scene version=\"3.0.0\">\n    <shape type=\"sphere\">\n        <float name=\"radius\" value=\"1\"/ >\n    </shape>\n</scene>\n";
+    let xml = write(&dir, "scene.xml", broken);
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("scene.xml:3:40"), "{e}");
+    let bad_value = "<scene version=\"3.0.0\">\n  <shape type=\"sphere\">\n      <float name=\"radius\"/>\n  </shape>\n</scene>\n";
+    let xml = write(&dir, "scene.xml", bad_value);
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("scene.xml:3:7"), "{e}");
+}
