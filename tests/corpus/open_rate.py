@@ -88,6 +88,23 @@ def referenced_files(root):
             yield "file", el.get("filename")
 
 
+def resolve_folder(value, here, search):
+    """A <path> folder as Mitsuba 3's parser finds it: relative to the XML file's folder
+    first, else through the folders the resolver already has."""
+    if os.path.isabs(value):
+        return value
+    first = os.path.join(here, value)
+    if os.path.isdir(first):
+        return first
+    return next((os.path.join(d, value) for d in reversed(search) if os.path.isdir(os.path.join(d, value))), first)
+
+
+def find_file(value, search):
+    if os.path.isabs(value):
+        return value if os.path.isfile(value) else None
+    return next((os.path.join(d, value) for d in reversed(search) if os.path.isfile(os.path.join(d, value))), None)
+
+
 def missing_assets(path, defaults=None, seen=None, search=None):
     """The files `path` (and its includes) name that exist nowhere Mitsuba would look."""
     seen = seen if seen is not None else set()
@@ -104,19 +121,18 @@ def missing_assets(path, defaults=None, seen=None, search=None):
         if name and value is not None:
             defaults.setdefault(name, value)
     here = os.path.dirname(os.path.abspath(path))
-    search = list(search or []) + [here]
+    search = search if search is not None else []  # shared: Mitsuba's resolver is global
+    search.append(here)
     for el in root.iter("path"):
         value = el.get("value")
         if value:
-            value = substitute(value, defaults)
-            search.append(value if os.path.isabs(value) else os.path.join(here, value))
+            search.append(resolve_folder(substitute(value, defaults), here, search))
     missing = []
     for kind, value in referenced_files(root):
         value = substitute(value, defaults)
         if "$" in value:
             continue  # a default nobody set: the scene cannot name its file, foton says so
-        candidates = [value] if os.path.isabs(value) else [os.path.join(d, value) for d in reversed(search)]
-        found = next((c for c in candidates if os.path.isfile(c)), None)
+        found = find_file(value, search)
         if found is None:
             missing.append(value)
         elif kind == "include":
@@ -147,6 +163,7 @@ def run_check(foton, scene, lenient, timeout, cwd):
 LOCATION = re.compile(r"^(?:error:\s*)?(?:\S+?\.(?:xml|toml|obj|ply|serialized|exr|png|jpg|hdr)(?::\d+)*:\s*)+", re.I)
 BACKQUOTED = re.compile(r"`([^`]*)`")
 KEY_PATH = re.compile(r"[A-Za-z_][\w-]*(\[\d+\])?(\.[\w-]+(\[\d+\])?)+")
+NUMBER = re.compile(r"[-+\d.eE]+")
 FILE_NAME = re.compile(r"\.(obj|ply|serialized|exr|png|jpe?g|hdr|pfm|tga|bmp|xml|spd|vol|toml)$", re.I)
 PATHLIKE = re.compile(r"(?:[\w.+-]*/)+[\w.+-]+")
 
@@ -161,6 +178,10 @@ def categorise(line):
         v = m.group(1)
         if v.startswith("<") and len(v) <= 80:
             return m.group(0)  # an element: `<bsdf type="ward">` says what refused
+        if re.fullmatch(r"\s*[-+\d.eE]+\s*:\s*[-+\d.eE]+(\s*[,;]?\s*[-+\d.eE]+\s*:\s*[-+\d.eE]+)*\s*,?\s*", v):
+            return "`<wavelength:value list>`"
+        if re.fullmatch(r"\s*[-+\d.eE]+(\s*[,\s]\s*[-+\d.eE]+)+\s*", v):
+            return "`<%d numbers>`" % len(NUMBER.findall(v))
         if FILE_NAME.search(v):
             return "`…`"
         if KEY_PATH.fullmatch(v):
@@ -247,12 +268,64 @@ def constructs(path, seen=None):
     return found - {"(sensor)"} if top else found
 
 
+PEEL_PREFIX = ".open-rate-peel."
+
+
+def peeled_copy(path):
+    """A copy of `path` beside it with the constructs that refuse most files today rewritten
+    the way Mitsuba reads them, so that the check shows what refuses the file next; None when
+    Python cannot parse the file. Rewritten: <path> elements (file names made absolute through
+    the search path, includes too), transform operations spelled in any case (`lookAt`),
+    wavelength:value spectra (their mean, a grey), three-value spectra (as <rgb>), booleans spelled True/False. The copy is
+    a survey aid: remove it after use."""
+    try:
+        tree = ET.parse(path)
+    except (ET.ParseError, OSError, ValueError):
+        return None
+    root = tree.getroot()
+    here = os.path.dirname(os.path.abspath(path))
+    defaults = {el.get("name"): el.get("value") for el in root.iter("default") if el.get("name")}
+    search = [here]
+    for el in list(root):
+        if el.tag == "path" and el.get("value"):
+            search.append(resolve_folder(substitute(el.get("value"), defaults), here, search))
+            root.remove(el)
+    for el in root.iter():
+        if not isinstance(el.tag, str):
+            continue
+        if el.tag.lower() in ("lookat", "translate", "rotate", "scale", "matrix") and el.tag != el.tag.lower():
+            el.tag = el.tag.lower()
+        attr = "filename" if (el.tag == "include" or el.get("filename")) else (
+            "value" if el.tag == "string" and (el.get("name") or "").lower() == "filename" else None)
+        if attr and el.get(attr) and "$" not in el.get(attr):
+            found = find_file(el.get(attr), search)
+            if found:
+                el.set(attr, os.path.abspath(found))
+        value = el.get("value") or ""
+        if el.tag in ("spectrum", "rgb") and ":" in value:
+            try:
+                pairs = [float(p.split(":")[1]) for p in value.replace(";", ",").split(",") if ":" in p]
+                el.set("value", f"{sum(pairs) / len(pairs):.6g}")
+            except (ValueError, IndexError, ZeroDivisionError):
+                pass
+        elif el.tag == "spectrum" and len(NUMBER.findall(value)) == 3 and ":" not in value:
+            el.tag = "rgb"
+        if el.tag == "boolean" and value in ("True", "False", "TRUE", "FALSE"):
+            el.set("value", value.lower())
+    copy = os.path.join(here, PEEL_PREFIX + os.path.basename(path))
+    tree.write(copy, encoding="utf-8", xml_declaration=True)
+    return copy
+
+
 # Coarse groups of the categories, for prioritising: the first pattern that matches wins.
 GROUPS = [
     (r"^panic", "panic"),
     (r"^timeout", "timeout"),
     (r"<path> \(a folder searched", "<path> element (adds a folder to the file resolver)"),
+    (r"expected one value or three.*`<3 numbers>`", "three-value <spectrum> refused (the message says wavelength:value)"),
     (r"wavelength:value|not a list of numbers", "spectrum given as wavelength:value list"),
+    (r"found Object\(Obj", "texture where foton takes a number (the message is a debug dump)"),
+    (r"textures \(<texture[^)]*\) are not supported", "texture where foton takes a constant"),
     (r'type="serialized"', "serialized shape"),
     (r"<lookAt>|lookat", "<lookAt> spelling / attributes"),
     (r"missing section \[camera\]", "no usable <sensor> (refused with a TOML [camera] message)"),
@@ -270,13 +343,14 @@ GROUPS = [
     (r"<shape [^>]*>`: this shape is not supported", "shape plugin not supported yet"),
     (r"<texture [^>]*>`: this texture is not supported", "texture plugin not supported yet"),
     (r"<sensor [^>]*>`: only the perspective", "sensor plugin other than perspective"),
-    (r"parameter `` is not supported", "nested object refused as parameter `` (empty name)"),
+    (r"parameter `` is not supported", "nested object or <ref> without a name refused as parameter `` (a sensor in a shape, a medium <ref> in a sensor)"),
     (r"parameter `[^`]*` is not supported", "plugin parameter not supported"),
     (r"is not a top-level element", "top-level object foton does not take (<phase>, <film>, ...)"),
     (r"no BSDF with id", "<ref> / id resolution"),
     (r"a shape's emitter must be", "emitter type nested in a shape"),
     (r"no <default name=", "$name without <default>"),
-    (r"cannot open|No such file|not found", "file not found by foton's resolver"),
+    (r"cannot open|No such file|not found", "file not found by foton's resolver (Mitsuba finds it)"),
+    (r"`material` \(Mitsuba", "named medium material"),
     (r"`distribution`", "microfacet distribution name"),
     (r"no integrator plugin", "integrator plugin library missing (build the plugins)"),
 ]
@@ -293,6 +367,10 @@ def main():
     ap.add_argument("--timeout", type=float, default=60.0, help="seconds per check (60)")
     ap.add_argument("--jobs", type=int, default=2, help="checks run at once (2)")
     ap.add_argument("--census-min", type=int, default=3, help="list census items used by at least this many judged files (3)")
+    ap.add_argument("--peel", action="store_true",
+                    help="for each judged file refused as written, also check a copy (written beside it, then removed) with "
+                         "<path>, lookAt spelling, wavelength:value and three-value spectra and True/False rewritten as Mitsuba reads them, "
+                         "and report what refuses it next")
     ap.add_argument("--tsv", help="also write one line per file: path, version, assets, as written, lenient, first errors")
     args = ap.parse_args()
     foton = os.path.abspath(args.foton)
@@ -302,7 +380,7 @@ def main():
     for folder, dirs, files in os.walk(corpus):
         dirs.sort()
         for name in sorted(files):
-            if name.lower().endswith(".xml"):
+            if name.lower().endswith(".xml") and not name.startswith(PEEL_PREFIX):
                 path = os.path.join(folder, name)
                 version = scene_root(path)
                 if version is not None:
@@ -327,7 +405,15 @@ def main():
         used = constructs(path)
         strict = run_check(foton, path, False, args.timeout, workdir)
         lenient = run_check(foton, path, True, args.timeout, workdir)
-        return path, version, missing, strict, lenient, used
+        after_peel = None
+        if args.peel and not missing and strict[0] != "ok":
+            copy = peeled_copy(path)
+            if copy:
+                try:
+                    after_peel = run_check(foton, copy, False, args.timeout, workdir)
+                finally:
+                    os.remove(copy)
+        return path, version, missing, strict, lenient, used, after_peel
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         results = list(pool.map(one, scenes))
@@ -338,7 +424,7 @@ def main():
     hist = {"as written": collections.Counter(), "--lenient": collections.Counter()}
     example = {"as written": {}, "--lenient": {}}
     per_repo = collections.defaultdict(collections.Counter)
-    for path, version, missing, strict, lenient, used in results:
+    for path, version, missing, strict, lenient, used, after_peel in results:
         r = rows[bucket(version)]
         repo = per_repo[os.path.relpath(path, corpus).split(os.sep)[0]]
         r["files"] += 1
@@ -395,7 +481,7 @@ def main():
     usage = collections.Counter()
     usage_open = collections.Counter()
     usage_example = {}
-    for path, version, missing, strict, lenient, used in results:
+    for path, version, missing, strict, lenient, used, after_peel in results:
         if missing:
             continue
         for c in used:
@@ -432,13 +518,39 @@ def main():
             shown = cat.replace("|", "\\|")
             print(f"| {count} | {shown} | {os.path.relpath(example[mode][cat], corpus)} |")
 
+    if args.peel:
+        peel_hist = collections.Counter()
+        peel_example = {}
+        opened = 0
+        tried = 0
+        for path, version, missing, strict, lenient, used, after_peel in results:
+            if after_peel is None:
+                continue
+            tried += 1
+            if after_peel[0] == "ok":
+                opened += 1
+                continue
+            cat = {"timeout": f"timeout (> {args.timeout:g} s)", "panic": "panic: " + categorise(after_peel[1])}.get(
+                after_peel[0]) or categorise(after_peel[1])
+            peel_hist[cat] += 1
+            peel_example.setdefault(cat, path)
+        print(f"\nAfter peeling (<path>, lookAt spelling, wavelength:value and three-value spectra, True/False rewritten in a copy): "
+              f"{tried} judged files refused as written, {opened} of them open; what refuses the others next")
+        print("| count | category | group | example |")
+        print("|---|---|---|---|")
+        for cat, count in sorted(peel_hist.items(), key=lambda kv: (-kv[1], kv[0])):
+            shown = cat.replace("|", "\\|")
+            print(f"| {count} | {shown} | {group_of(cat)} | {os.path.relpath(peel_example[cat], corpus)} |")
+
     if args.tsv:
         with open(args.tsv, "w", encoding="utf-8") as out:
-            out.write("file\tversion\tassets\tas written\tlenient\terror as written\terror --lenient\n")
-            for path, version, missing, strict, lenient, used in results:
+            out.write("file\tversion\tassets\tas written\tlenient\tpeeled\terror as written\terror --lenient\terror peeled\n")
+            for path, version, missing, strict, lenient, used, after_peel in results:
                 assets = "missing: " + ", ".join(missing[:3]) if missing else "ok"
+                peel = after_peel or ("-", "")
                 out.write("\t".join([os.path.relpath(path, corpus), version or "-", assets, strict[0], lenient[0],
-                                     strict[1].replace("\t", " "), lenient[1].replace("\t", " ")]) + "\n")
+                                     peel[0], strict[1].replace("\t", " "), lenient[1].replace("\t", " "),
+                                     peel[1].replace("\t", " ")]) + "\n")
 
 
 if __name__ == "__main__":
