@@ -27,6 +27,7 @@ import collections
 import concurrent.futures
 import os
 import re
+import shutil
 import subprocess
 import sys
 import tempfile
@@ -376,6 +377,10 @@ def main():
     foton = os.path.abspath(args.foton)
     corpus = os.path.abspath(args.corpus)
 
+    if not (os.path.isfile(foton) and os.access(foton, os.X_OK)):
+        sys.exit(f"{foton}: not an executable (build it: cargo build --release -p foton)")
+    if not os.path.isdir(corpus):
+        sys.exit(f"{corpus}: not a folder")
     scenes = []
     for folder, dirs, files in os.walk(corpus):
         dirs.sort()
@@ -417,7 +422,7 @@ def main():
 
     with concurrent.futures.ThreadPoolExecutor(max_workers=max(1, args.jobs)) as pool:
         results = list(pool.map(one, scenes))
-    os.rmdir(workdir)
+    shutil.rmtree(workdir, ignore_errors=True)
 
     buckets = ["0.x", "2.x", "3.x", "none", "other"]
     rows = collections.OrderedDict((b, collections.Counter()) for b in buckets)
