@@ -19,25 +19,18 @@ use glam::{DMat4, DVec3};
 /// 5.6 degrees.
 pub(super) const CYLINDER_FACETS: usize = 64;
 
-/// Keys of the reader's side tables in `Reader::textures`, whose ids come from XML attribute
-/// values and so never hold a NUL: shape groups and top-level area emitters by id.
+/// The key of a shape group in the reader's side table `Reader::textures`: ids come from XML
+/// attribute values and so never hold a NUL. (A `<ref>` to a top-level area emitter reaches a
+/// shape as the emitter itself: the document reader resolves it.)
 const GROUP_KEY: &str = "\0shapegroup:";
-const AREA_KEY: &str = "\0area_emitter:";
 
 impl Reader {
-    fn area_emitter(&self, id: &str) -> Option<DVec3> {
-        let t = self.textures.get(&format!("{AREA_KEY}{id}"))?;
-        node_vec3(t.get("radiance")?)
-    }
-
     /// What a `<ref id>` names, for messages about a reference of the wrong kind.
     fn named(&self, id: &str) -> Option<&'static str> {
         if self.bsdfs.contains_key(id) {
             Some("a BSDF")
         } else if self.media.contains_key(id) {
             Some("a medium")
-        } else if self.area_emitter(id).is_some() {
-            Some("an area emitter")
         } else if self.textures.contains_key(&format!("{GROUP_KEY}{id}")) {
             Some("a shapegroup")
         } else if self.textures.contains_key(id) {
@@ -137,9 +130,6 @@ impl Reader {
                     if let Some(found) = self.bsdfs.get(&id).cloned() {
                         once(material.is_some(), "BSDF")?;
                         material = Some(Some(found));
-                    } else if let Some(radiance) = self.area_emitter(&id) {
-                        once(emission.is_some(), "emitter")?;
-                        emission = Some(radiance);
                     } else if self.media.contains_key(&id) {
                         self.warn(
                             &o,
