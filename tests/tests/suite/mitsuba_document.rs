@@ -557,3 +557,95 @@ fn referenced_area_emitters_and_syntax_error_columns() {
     let e = read(&xml, false).unwrap_err();
     assert!(e.contains("scene.xml:3:7"), "{e}");
 }
+
+/// A parameter no Mitsuba plugin reads: Mitsuba 0.6 warns of an unqueried attribute and
+/// renders, so a 0.x file opens with a warning naming it; Mitsuba 2 and 3 refuse the file, and
+/// so does foton for theirs. A parameter 0.6 reads and foton does not honour is still refused.
+/// Booleans in any case (Mitsuba 2 and 3), comments with `--` (their pugixml).
+#[test]
+fn unread_parameters_of_0x_files_warn_as_mitsuba_0_6_does() {
+    let dir = temp_dir("mitsuba-unqueried");
+    let body = |version: &str| {
+        scene(
+            version,
+            &format!(
+                "<!-- made by a tool -- version 2 -->\n<integrator type=\"path\"><integer name=\"stepSnapshot\" value=\"3\"/><boolean name=\"hideEmitters\" value=\"True\"/></integrator>\n{SENSOR}"
+            ),
+        )
+    };
+    let xml = write(&dir, "old.xml", &body("0.6.0"));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("old.xml:3") && w.contains("`step_snapshot` ignored")),
+        "{:?}",
+        report.warnings
+    );
+    assert_eq!(
+        node(&doc.root, "render.hide_emitters").value,
+        Value::Bool(true)
+    );
+    for version in ["2.1.0", "3.0.0"] {
+        let xml = write(&dir, "new.xml", &body(version));
+        let e = read(&xml, false).unwrap_err();
+        assert!(
+            e.contains("new.xml:3") && e.contains("step_snapshot"),
+            "{version}: {e}"
+        );
+    }
+    // Mitsuba 0.6's sensors read `shutterOpenTime` (motion blur), which foton does not
+    // render: refused, not ignored.
+    let xml = write(
+        &dir,
+        "honoured.xml",
+        &scene(
+            "0.5.0",
+            &SENSOR.replace(
+                "<film",
+                "<float name=\"shutterOpenTime\" value=\"1\"/><film",
+            ),
+        ),
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("shutter_open_time"), "{e}");
+}
+
+/// `moment` renders the integrator it wraps, with a warning that the moment layer is not
+/// written; an emitter's `sampling_weight` (noise, not the image) is read without a word.
+#[test]
+fn moment_renders_the_wrapped_integrator() {
+    let dir = temp_dir("mitsuba-moment");
+    let body = format!(
+        "<integrator type=\"moment\"><integrator type=\"bdpt\"><integer name=\"max_depth\" value=\"4\"/></integrator></integrator>\n{SENSOR}\n<shape type=\"sphere\"><emitter type=\"area\"><float name=\"sampling_weight\" value=\"2\"/></emitter></shape>"
+    );
+    let xml = write(&dir, "moment.xml", &scene("3.0.0", &body));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "render.integrator"), "bdpt");
+    assert_eq!(number(&doc.root, "render.max_depth"), 3.0);
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("moment.xml:2") && w.contains("second-moment layer")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(
+        !report
+            .warnings
+            .iter()
+            .any(|w| w.contains("sampling_weight"))
+    );
+    let xml = write(
+        &dir,
+        "empty.xml",
+        &scene("3.0.0", &format!("<integrator type=\"moment\"/>\n{SENSOR}")),
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("empty.xml:2") && e.contains("without the integrator it wraps"),
+        "{e}"
+    );
+}

@@ -45,7 +45,8 @@ impl Reader {
     }
 
     pub(super) fn read_file(&mut self, path: &Path, text: &str) -> Result<()> {
-        let doc = roxmltree::Document::parse(text).map_err(|e| {
+        let text = comments_as_pugixml_reads_them(text);
+        let doc = roxmltree::Document::parse(&text).map_err(|e| {
             let pos = e.pos();
             Error::XmlSyntax {
                 location: Location {
@@ -373,10 +374,14 @@ impl Reader {
                 }
                 "boolean" => {
                     let v = value()?;
-                    Prop::Bool(match v.trim() {
-                        "true" => true,
-                        "false" => false,
-                        _ => return Err(bad("not true or false", &v)),
+                    // Mitsuba 2 and 3 compare without case (`True`, as Python writes it).
+                    let v = v.trim();
+                    Prop::Bool(if v.eq_ignore_ascii_case("true") {
+                        true
+                    } else if v.eq_ignore_ascii_case("false") {
+                        false
+                    } else {
+                        return Err(bad("not true or false", v));
                     })
                 }
                 "string" => Prop::Str(value()?),
@@ -747,6 +752,36 @@ fn srgb_to_linear(v: f64) -> f64 {
     }
 }
 
+/// The text with `--` inside comments made ` -` (and a `-` that ends a comment made a space):
+/// XML forbids them there, but Mitsuba 2 and 3 read files with pugixml, which takes a comment
+/// as everything up to the first `-->`, so that published files have them. Same length, so
+/// that lines and columns stay those of the file.
+fn comments_as_pugixml_reads_them(text: &str) -> std::borrow::Cow<'_, str> {
+    let mut out: Option<Vec<u8>> = None;
+    let bytes = text.as_bytes();
+    let mut at = 0;
+    while let Some(start) = text[at..].find("<!--").map(|i| at + i + 4) {
+        let Some(end) = text[start..].find("-->").map(|i| start + i) else {
+            break;
+        };
+        let body = &bytes[start..end];
+        if body.windows(2).any(|w| w == b"--") || body.last() == Some(&b'-') {
+            let o = out.get_or_insert_with(|| bytes.to_vec());
+            for i in start..end {
+                if o[i] == b'-' && (i + 1 == end || o[i + 1] == b'-') {
+                    o[i] = b' ';
+                }
+            }
+        }
+        at = end + 3;
+    }
+    match out {
+        // Only ASCII '-' became ASCII ' ': still UTF-8, so the lossy path never replaces.
+        Some(o) => std::borrow::Cow::Owned(String::from_utf8_lossy(&o).into_owned()),
+        None => std::borrow::Cow::Borrowed(text),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -764,5 +799,26 @@ mod tests {
             assert!(s.dot(n).abs() < 1e-12 && t.dot(n).abs() < 1e-12 && s.dot(t).abs() < 1e-12);
             assert!((s.cross(t) - n).length() < 1e-12, "right-handed for {n}");
         }
+    }
+
+    #[test]
+    fn double_hyphens_in_comments_are_blanked_keeping_positions() {
+        let text = "<scene>\n<!-- a -- b --->\n<!-- fine -->\n<!-- c--d -->\n</scene>";
+        let read = comments_as_pugixml_reads_them(text);
+        assert_eq!(read.len(), text.len());
+        assert_eq!(
+            read,
+            "<scene>\n<!-- a  - b  -->\n<!-- fine -->\n<!-- c -d -->\n</scene>"
+        );
+        assert!(roxmltree::Document::parse(&read).is_ok());
+        assert!(
+            roxmltree::Document::parse(text).is_err(),
+            "the case the function exists for"
+        );
+        let clean = "<scene><!-- fine --></scene>";
+        assert!(matches!(
+            comments_as_pugixml_reads_them(clean),
+            std::borrow::Cow::Borrowed(_)
+        ));
     }
 }

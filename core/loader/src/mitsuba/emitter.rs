@@ -87,6 +87,9 @@ impl Reader {
                 return self.unsupported(&o, &m);
             }
         }
+        // How often next-event estimation picks this emitter: noise, not the image (foton
+        // picks by power).
+        o.take("sampling_weight");
         self.leftovers(&o)?;
         self.lights.push(at(Value::Table(t), line));
         Ok(())

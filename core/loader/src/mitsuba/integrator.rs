@@ -18,6 +18,9 @@ impl Reader {
         for (name, _, _) in &mut o.props {
             *name = camel_to_snake(name);
         }
+        if o.ty == "moment" {
+            return self.moment(o);
+        }
         let has_media = !self.media.is_empty();
         let Some(name) = foton_integrator(&o.ty, has_media) else {
             o.props.clear();
@@ -231,6 +234,46 @@ impl Reader {
 }
 
 /// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
+impl Reader {
+    /// Mitsuba's `moment`: the integrators it wraps render the image, and it adds their
+    /// second moments as layers of the film. foton renders the first it wraps; the moment
+    /// layers are not written (a warning says so).
+    fn moment(&mut self, mut o: Obj) -> Result<()> {
+        let nested = o
+            .props
+            .iter()
+            .position(|(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "integrator"));
+        let Some(i) = nested else {
+            return Err(o.error("a moment integrator without the integrator it wraps"));
+        };
+        let (_, Prop::Object(inner), _) = o.props.remove(i) else {
+            unreachable!("the position of an object")
+        };
+        let more = o
+            .props
+            .iter()
+            .filter(|(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "integrator"))
+            .count();
+        o.props
+            .retain(|(_, p, _)| !matches!(p, Prop::Object(n) if n.tag == "integrator"));
+        self.leftovers(&o)?;
+        let line = o.line;
+        let what = if more > 0 {
+            format!(
+                "renders the image of the first integrator it wraps (<integrator type=\"{}\">); the other {more} and the second-moment layers are not written",
+                inner.ty
+            )
+        } else {
+            format!(
+                "renders the image of the integrator it wraps (<integrator type=\"{}\">); its second-moment layer is not written",
+                inner.ty
+            )
+        };
+        self.warn(&o, line, &what);
+        self.integrator(inner)
+    }
+}
+
 const MITSUBA_INTEGRATORS: &[&str] = &[
     "path",
     "volpath",

@@ -289,13 +289,24 @@ impl Reader {
         }
     }
 
-    /// Properties nobody read: Mitsuba parameters foton does not know.
+    /// Properties nobody read: Mitsuba parameters foton does not know. In a 0.x file, one
+    /// that Mitsuba 0.6 does not read either is a warning, as 0.6 makes it.
     fn leftovers(&mut self, obj: &Obj) -> Result<()> {
         for (name, _, line) in obj.props.clone() {
             let o = Obj {
                 line,
                 ..obj.clone()
             };
+            if obj.v1 && !plugins::mitsuba06_reads(&obj.tag, &obj.ty, &name) {
+                self.warn(
+                    obj,
+                    line,
+                    &format!(
+                        "parameter `{name}` ignored: Mitsuba 0.6 does not read it either (it warns of an unqueried attribute and renders on)"
+                    ),
+                );
+                continue;
+            }
             self.unsupported(&o, &format!("parameter `{name}` is not supported"))?;
         }
         Ok(())

@@ -87,6 +87,8 @@ impl Reader {
                 Prop::Object(mut e) if e.tag == "emitter" => {
                     once(emission.is_some(), "emitter")?;
                     emission = Some(e.color("radiance", DVec3::ONE)?);
+                    // Noise, not the image: see `Reader::emitter`.
+                    e.take("sampling_weight");
                     self.leftovers(&e)?;
                 }
                 Prop::Object(med) if med.tag == "medium" => match name.as_str() {
