@@ -35,6 +35,7 @@ mod medium_kind;
 mod mitsuba;
 mod mitsuba05;
 mod mitsuba_document;
+mod mitsuba_fixtures;
 mod mitsuba_materials;
 mod mitsuba_shapes;
 mod one_sided;

@@ -649,3 +649,53 @@ fn moment_renders_the_wrapped_integrator() {
         "{e}"
     );
 }
+
+/// What `--lenient` gets past that Mitsuba refuses or foton lacks, each said in the report:
+/// a `$name` with no value (the property left out, its default standing), Mitsuba 0.6's
+/// `phong` microfacet distribution (Beckmann's instead). Read as written: a top-level
+/// `<phase>` taken by `<ref>` from a medium, a filter beside the film in the sensor.
+#[test]
+fn lenient_gets_past_unresolved_names_and_0_6_distributions() {
+    let dir = temp_dir("mitsuba-lenient-more");
+    let body = format!(
+        "<sampler type=\"independent\" id=\"s\"><integer name=\"sample_count\" value=\"$spp\"/></sampler>\n<bsdf type=\"roughconductor\" id=\"b\"><string name=\"distribution\" value=\"phong\"/></bsdf>\n{SENSOR}"
+    );
+    let xml = write(&dir, "lenient.xml", &scene("0.6.0", &body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("lenient.xml:2") && e.contains("$spp"), "{e}");
+    let (doc, report) = read(&xml, true).unwrap();
+    let said = |needle: &str| report.left_out.iter().any(|w| w.contains(needle));
+    assert!(
+        said("lenient.xml:2") && said("`$spp`"),
+        "{:?}",
+        report.left_out
+    );
+    assert!(
+        said("lenient.xml:3") && said("\"phong\""),
+        "{:?}",
+        report.left_out
+    );
+    assert_eq!(text(&doc.root, "materials.b.distribution"), "beckmann");
+    let e = read(
+        &write(&dir, "typo.xml", &body.replace("phong", "phnog")),
+        true,
+    );
+    assert!(
+        e.is_err(),
+        "a misspelt distribution is not Mitsuba's: refused"
+    );
+
+    let body = "<phase type=\"hg\" id=\"fwd\"><float name=\"g\" value=\"0.7\"/></phase>\n<medium type=\"homogeneous\" id=\"fog\"><ref id=\"fwd\"/></medium>\n<sensor type=\"perspective\"><rfilter type=\"tent\"/><ref id=\"fog\"/></sensor>";
+    let xml = write(&dir, "phase.xml", &scene("3.0.0", body));
+    let (doc, report) = read(&xml, false).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(number(&doc.root, "media.fog.phase.g"), 0.7);
+    assert_eq!(text(&doc.root, "film.filter.type"), "tent");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("phase.xml:4") && w.contains("the film's filter")),
+        "{:?}",
+        report.warnings
+    );
+}

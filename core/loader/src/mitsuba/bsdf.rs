@@ -184,11 +184,22 @@ impl Reader {
         let distribution = o
             .string("distribution")?
             .unwrap_or_else(|| "beckmann".into());
-        if distribution != "beckmann" && distribution != "ggx" {
-            return Err(o.error(format!(
-                "`distribution`: unknown {distribution:?}; expected beckmann or ggx"
-            )));
-        }
+        let distribution = match distribution.as_str() {
+            "beckmann" | "ggx" => distribution,
+            // Mitsuba 0.6's other two, shaped much like Beckmann's at the same alpha.
+            "phong" | "as" => {
+                let what = format!(
+                    "`distribution` {distribution:?} is not supported; rendered with \"beckmann\" of the same roughness"
+                );
+                self.unsupported(o, &what)?;
+                "beckmann".to_string()
+            }
+            _ => {
+                return Err(o.error(format!(
+                    "`distribution`: unknown {distribution:?}; expected beckmann or ggx (or, in Mitsuba 0.6, phong or as)"
+                )));
+            }
+        };
         t.insert("distribution", at(Value::Str(distribution), line));
         o.take("sample_visible");
         let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);

@@ -176,18 +176,20 @@ impl Reader {
     }
 
     /// The top-level objects read, made once every id is known (Mitsuba resolves references
-    /// after reading the whole file, so a `<ref>` may come before its object): textures,
-    /// media and the objects taken by reference first, then BSDFs, aliases, and the rest,
+    /// after reading the whole file, so a `<ref>` may come before its object): the objects
+    /// taken by reference first, then textures and media, then BSDFs, aliases, and the rest,
     /// each kind in document order. What an included file's objects add to the document
     /// keeps no line: the document's lines are the scene file's.
     pub(super) fn make_objects(&mut self) -> Result<()> {
         let mut pending = std::mem::take(&mut self.pending);
         let rank = |o: &Obj| match o.tag.as_str() {
-            "texture" | "medium" | "sampler" | "film" | "rfilter" => 0,
+            // Kept to be made where they are taken (a medium takes a phase function).
+            "sampler" | "film" | "rfilter" | "phase" => 0,
             "emitter" if o.ty == "area" => 0,
-            "bsdf" => 1,
-            "alias" => 2,
-            _ => 3,
+            "texture" | "medium" => 1,
+            "bsdf" => 2,
+            "alias" => 3,
+            _ => 4,
         };
         pending.sort_by_key(rank);
         for mut obj in pending {
@@ -328,6 +330,39 @@ impl Reader {
         Ok(out)
     }
 
+    /// The first `$name` in `s` that has no value (no `<default>`, no `-D`).
+    fn unresolved(&self, s: &str) -> Option<String> {
+        s.split('$').skip(1).find_map(|after| {
+            let end = after
+                .find(|c: char| !(c.is_alphanumeric() || c == '_'))
+                .unwrap_or(after.len());
+            let name = &after[..end];
+            (!self.defaults.contains_key(name)).then(|| name.to_string())
+        })
+    }
+
+    /// With `lenient`, an element whose attributes name a `$name` without a value is left
+    /// out (its plugin's default stands), and the report says so: true if `n` is left out.
+    fn leave_out_unresolved(&self, n: roxmltree::Node<'_, '_>, file: &Path, pos: Pos) -> bool {
+        if !self.lenient {
+            return false;
+        }
+        let Some(name) = n.attributes().find_map(|a| self.unresolved(a.value())) else {
+            return false;
+        };
+        self.used.borrow_mut().insert(name.clone());
+        let what = match n.attribute("name") {
+            Some(p) => format!("<{} name=\"{p}\">", n.tag_name().name()),
+            None => format!("<{}>", n.tag_name().name()),
+        };
+        self.unresolved.borrow_mut().push(format!(
+            "{}:{}: {what}: `${name}` has no <default> and no -D {name}=... (its plugin's default stands)",
+            file.display(),
+            pos.line
+        ));
+        true
+    }
+
     fn object(
         &self,
         n: roxmltree::Node<'_, '_>,
@@ -341,9 +376,14 @@ impl Reader {
                 .map(|v| self.subst(v, file, pos))
                 .transpose()
         };
+        // A type without a value (lenient): an unknown plugin, left out where it is read.
+        let ty = match n.attribute("type") {
+            Some(t) if self.lenient && self.unresolved(t).is_some() => t.to_string(),
+            _ => get("type")?.unwrap_or_default(),
+        };
         let mut obj = Obj {
             tag: n.tag_name().name().to_string(),
-            ty: get("type")?.unwrap_or_default(),
+            ty,
             id: get("id")?,
             line,
             file: file.to_path_buf(),
@@ -353,6 +393,11 @@ impl Reader {
         for c in n.children().filter(|c| c.is_element()) {
             let cpos = line_of(c);
             let cl = cpos.line;
+            if !OBJECT_TAGS.contains(&c.tag_name().name())
+                && self.leave_out_unresolved(c, file, cpos)
+            {
+                continue;
+            }
             let cget = |name: &str| -> Result<Option<String>> {
                 c.attribute(name)
                     .map(|v| self.subst(v, file, cpos))

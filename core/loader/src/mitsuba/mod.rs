@@ -79,6 +79,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         anonymous: 0,
         v1: false,
         used: RefCell::default(),
+        unresolved: RefCell::default(),
         declared: HashSet::new(),
         integrator: None,
         search: vec![path.parent().map(Path::to_path_buf).unwrap_or_default()],
@@ -91,6 +92,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
     let text = std::fs::read_to_string(path).map_err(|e| Error::io(path, e))?;
     r.read_file(path, &text)?;
     r.make_objects()?;
+    r.report.left_out.append(&mut r.unresolved.borrow_mut());
     r.check_defines(path)?;
     // No sensor, or (lenient) none foton reads.
     if r.root.get("camera").is_none() {
@@ -253,6 +255,9 @@ struct Reader {
     v1: bool,
     /// The `$name`s substituted so far (a `-D` nobody uses is a typo).
     used: RefCell<HashSet<String>>,
+    /// With `lenient`, the properties left out for a `$name` with no value (what the report
+    /// says of each), gathered while reading elements and added to the report at the end.
+    unresolved: RefCell<Vec<String>>,
     /// The `<default>`s declared.
     declared: HashSet<String>,
     /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
@@ -429,8 +434,8 @@ impl Reader {
                 self.sensor = true;
                 self.sensor(obj)
             }
-            // Made where a sensor, a film or a shape takes them by `<ref>`.
-            "sampler" | "film" | "rfilter" => self.keep(obj),
+            // Made where a sensor, a film, a shape or a medium takes them by `<ref>`.
+            "sampler" | "film" | "rfilter" | "phase" => self.keep(obj),
             "emitter" if obj.ty == "area" => self.keep(obj),
             "bsdf" => self.bsdf(obj).map(|_| ()),
             "medium" => self.medium(obj).map(|_| ()),

@@ -99,11 +99,44 @@ impl Reader {
             })
             .collect();
         o.props.retain(|(_, p, _)| !matches!(p, Prop::Object(_)));
+        // A reconstruction filter beside the film instead of in it (as exporters write):
+        // Mitsuba 2 and 3 refuse the file, its intent is plain; the film takes it.
+        let mut loose_filter = None;
+        for child in &nested {
+            if child.tag == "rfilter" {
+                if loose_filter.is_some() {
+                    return Err(child.error("a second reconstruction filter in the sensor"));
+                }
+                self.warn(
+                    child,
+                    child.line,
+                    "a filter directly in the sensor (Mitsuba 2 and 3 take it only in the <film>): the film's filter",
+                );
+                loose_filter = Some(child.clone());
+            }
+        }
+        let give_filter = |film: &mut Obj, filter: &mut Option<Obj>| -> Result<()> {
+            if let Some(f) = filter.take() {
+                if film
+                    .props
+                    .iter()
+                    .any(|(_, p, _)| matches!(p, Prop::Object(c) if c.tag == "rfilter"))
+                {
+                    return Err(f.error("a reconstruction filter in both the sensor and its film"));
+                }
+                let line = f.line;
+                film.props.push((String::new(), Prop::Object(f), line));
+            }
+            Ok(())
+        };
         let (mut film, mut sampler) = (false, false);
         for child in nested {
             match child.tag.as_str() {
+                "rfilter" => {}
                 "film" => {
                     film = true;
+                    let mut child = child;
+                    give_filter(&mut child, &mut loose_filter)?;
                     self.film(child)?;
                 }
                 "sampler" => {
@@ -124,13 +157,15 @@ impl Reader {
         }
         // Mitsuba's sensor without them: an hdrfilm of its defaults, 4 independent samples.
         if !film {
-            self.film(Obj {
+            let mut default = Obj {
                 tag: "film".into(),
                 ty: "hdrfilm".into(),
                 id: None,
                 props: Vec::new(),
                 ..o.clone()
-            })?;
+            };
+            give_filter(&mut default, &mut loose_filter)?;
+            self.film(default)?;
         }
         if !sampler {
             table_mut(&mut self.root, "render").insert("spp", at(Value::Int(4), line));
