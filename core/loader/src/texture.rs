@@ -14,8 +14,8 @@ use std::sync::Arc;
 
 pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard"];
 
-/// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR; the format is recognised by its
-/// content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
+/// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR, BMP, TGA, PPM/PGM: Mitsuba's formats but
+/// PFM; the format is recognised by its content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
 /// images are taken as linear. The error names the file; a texel that is not finite is
 /// an error.
 pub fn load_bitmap(path: &Path, raw: bool) -> Result<Bitmap> {

@@ -699,3 +699,84 @@ fn lenient_gets_past_unresolved_names_and_0_6_distributions() {
         report.warnings
     );
 }
+
+/// A heterogeneous medium (Mitsuba 0.6's `density` grid and `albedo` constant) is refused as
+/// written and, with `--lenient`, rendered as the homogeneous medium of the grid's mean
+/// density, scaled, and of the albedo; a phase function foton lacks is the isotropic one.
+#[test]
+fn lenient_heterogeneous_media_take_the_grids_mean() {
+    let dir = temp_dir("mitsuba-heterogeneous");
+    // A 2 x 1 x 1 grid of one channel: cells 1 and 3, mean 2.
+    let mut vol = b"VOL\x03".to_vec();
+    for i in [1i32, 2, 1, 1, 1] {
+        vol.extend(i.to_le_bytes());
+    }
+    for f in [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0, 1.0, 3.0] {
+        vol.extend(f.to_le_bytes());
+    }
+    std::fs::write(dir.join("smoke.vol"), &vol).unwrap();
+    let body = format!(
+        "<medium type=\"heterogeneous\" id=\"smoke\">\n<volume name=\"density\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume>\n<volume name=\"albedo\" type=\"constvolume\"><spectrum name=\"value\" value=\"0.9\"/></volume>\n<float name=\"scale\" value=\"10\"/><string name=\"method\" value=\"woodcock\"/>\n<phase type=\"rayleigh\"/>\n</medium>\n{SENSOR}"
+    );
+    let xml = write(&dir, "smoke.xml", &scene("0.6.0", &body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("smoke.xml:2") && e.contains("heterogeneous"),
+        "{e}"
+    );
+    let (doc, report) = read(&xml, true).unwrap();
+    let s = vector(&doc.root, "media.smoke.sigma_s");
+    let a = vector(&doc.root, "media.smoke.sigma_a");
+    assert!(
+        (s.x - 18.0).abs() < 1e-4 && (a.x - 2.0).abs() < 1e-4,
+        "{s} {a}"
+    );
+    assert_eq!(text(&doc.root, "media.smoke.phase"), "isotropic");
+    assert!(
+        report
+            .left_out
+            .iter()
+            .any(|w| w.contains("smoke.xml:6") && w.contains("rayleigh")),
+        "{:?}",
+        report.left_out
+    );
+    std::fs::write(dir.join("smoke.vol"), &vol[..30]).unwrap();
+    let e = read(&xml, true).unwrap_err();
+    assert!(
+        e.contains("smoke.vol") && e.contains("not a Mitsuba grid volume"),
+        "{e}"
+    );
+}
+
+/// A texture where foton takes a constant (an area emitter's radiance, a roughness) is
+/// refused as written and, with `--lenient`, rendered with its mean, said in the report.
+#[test]
+fn lenient_textures_where_foton_takes_constants_are_their_means() {
+    let dir = temp_dir("mitsuba-textured-constants");
+    let checker = |name: &str, a: f64, b: f64| {
+        format!(
+            "<texture type=\"checkerboard\" name=\"{name}\"><rgb name=\"color0\" value=\"{a}\"/><rgb name=\"color1\" value=\"{b}\"/></texture>"
+        )
+    };
+    let body = format!(
+        "<shape type=\"sphere\">\n<emitter type=\"area\">{}</emitter>\n<bsdf type=\"roughconductor\" id=\"metal\">{}</bsdf>\n</shape>\n{SENSOR}",
+        checker("radiance", 2.0, 4.0),
+        checker("alpha", 0.1, 0.3)
+    );
+    let xml = write(&dir, "textured.xml", &scene("3.0.0", &body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("textured.xml:3") && e.contains("`radiance`"),
+        "{e}"
+    );
+    let (doc, report) = read(&xml, true).unwrap();
+    let Value::Array(shapes) = &node(&doc.root, "shapes").value else {
+        panic!("shapes")
+    };
+    let Value::Table(sphere) = &shapes[0].value else {
+        panic!("a shape")
+    };
+    assert_eq!(vector(sphere, "emission"), Vec3::splat(3.0));
+    assert!((number(&doc.root, "materials.metal.alpha") - 0.2).abs() < 1e-12);
+    assert_eq!(report.left_out.len(), 2, "{:?}", report.left_out);
+}

@@ -203,6 +203,22 @@ impl Reader {
         t.insert("distribution", at(Value::Str(distribution), line));
         o.take("sample_visible");
         let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
+        // A textured roughness: its mean (lenient), as foton's roughness is a constant.
+        for k in ["alpha", "alpha_u", "alpha_v"] {
+            let textured = o.props.iter().any(|(n, p, _)| {
+                n == k
+                    && match p {
+                        Prop::Object(t) => t.tag == "texture",
+                        Prop::Ref(id) => self.textures.contains_key(id),
+                        _ => false,
+                    }
+            });
+            if textured {
+                let mean = self.constant(o, k, DVec3::splat(0.1))?;
+                let l = o.line;
+                o.props.push((k.to_string(), Prop::Float(mean.x), l));
+            }
+        }
         if anisotropic && (has(o, "alpha_u") || has(o, "alpha_v")) {
             let u = o.float("alpha_u", 0.1)?;
             let v = o.float("alpha_v", 0.1)?;

@@ -490,7 +490,7 @@ impl Reader {
                     Prop::Color(DVec3::from_array(c.to_array().map(srgb_to_linear)))
                 }
                 "bsdf" | "emitter" | "medium" | "phase" | "texture" | "rfilter" | "sampler"
-                | "film" | "shape" | "sensor" | "integrator" => {
+                | "film" | "shape" | "sensor" | "integrator" | "volume" => {
                     Prop::Object(self.object(c, file, line_of)?)
                 }
                 other if KNOWN_UNREAD.contains(&other) => {

@@ -69,7 +69,7 @@ impl Reader {
                 t.insert("irradiance", vec3(e, line));
             }
             "constant" => {
-                let l = o.color("radiance", DVec3::ONE)?;
+                let l = self.constant(&mut o, "radiance", DVec3::ONE)?;
                 t.insert("radiance", vec3(l, line));
             }
             "envmap" => {

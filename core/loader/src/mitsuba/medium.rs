@@ -4,13 +4,23 @@
 use super::object::{Obj, Prop};
 use super::plugins::not_read;
 use super::{Reader, at, table_mut, vec3};
-use foton_core::error::Result;
+use foton_core::error::{Error, Result};
 use foton_core::value::{Table, Value};
 use glam::DVec3;
 
 impl Reader {
     /// A medium into `[media]`; returns its name there.
     pub(super) fn medium(&mut self, mut o: Obj) -> Result<String> {
+        if o.ty == "heterogeneous" {
+            self.unsupported(
+                &o,
+                "heterogeneous media are not supported yet; rendered as a homogeneous medium of the grids' mean density and albedo",
+            )?;
+            self.mean_volumes(&mut o)?;
+            o.ty = "homogeneous".into();
+            o.take("method");
+            o.take("step_size");
+        }
         if o.ty != "homogeneous" {
             return Err(o.error(not_read(
                 "medium",
@@ -62,9 +72,11 @@ impl Reader {
                     let m = not_read(
                         "phase",
                         &phase.ty,
-                        "foton's phase functions are isotropic and hg",
+                        "foton's phase functions are isotropic and hg; rendered with the isotropic one",
                     );
-                    return Err(phase.error(m));
+                    phase.props.clear();
+                    self.unsupported(&phase, &m)?;
+                    t.insert("phase", at(Value::Str("isotropic".into()), l));
                 }
             }
             self.leftovers(&phase)?;
@@ -77,4 +89,73 @@ impl Reader {
         table_mut(&mut self.root, "media").insert(&name, at(Value::Table(t), line));
         Ok(name)
     }
+
+    /// A heterogeneous medium's `<volume>`s (`density` or `sigma_t`, `albedo`) replaced by
+    /// their means (lenient: see [`Reader::medium`]): a `constvolume`'s value, a `gridvolume`'s
+    /// mean over its cells (Mitsuba's binary `.vol` file), 1 for any other.
+    fn mean_volumes(&mut self, o: &mut Obj) -> Result<()> {
+        for (name, p, _) in &mut o.props {
+            let Prop::Object(v) = p else { continue };
+            if v.tag != "volume" {
+                continue;
+            }
+            let mean = match v.ty.as_str() {
+                "constvolume" => v.color("value", DVec3::ONE)?,
+                "gridvolume" => {
+                    let file = v
+                        .string("filename")?
+                        .ok_or_else(|| v.error("missing `filename`"))?;
+                    let path = self.resolve(&v.file, &file).map_err(|looked| {
+                        v.error(format!(
+                            "`filename` = {file:?}: no such file in {}",
+                            super::shown(&looked)
+                        ))
+                    })?;
+                    let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+                    grid_mean(&bytes).ok_or_else(|| {
+                        v.error(format!(
+                            "{}: not a Mitsuba grid volume (`VOL`, version 3, float32 cells)",
+                            path.display()
+                        ))
+                    })?
+                }
+                _ => DVec3::ONE,
+            };
+            // Mitsuba 0.6 names the extinction volume `density`, Mitsuba 3 `sigma_t`.
+            if name == "density" {
+                *name = "sigma_t".into();
+            }
+            *p = Prop::Color(mean);
+        }
+        Ok(())
+    }
+}
+
+/// The mean of a Mitsuba `.vol` grid's cells (version 3, float32; one channel is grey, three
+/// are RGB); None for anything else.
+fn grid_mean(bytes: &[u8]) -> Option<DVec3> {
+    let int = |at: usize| -> Option<i32> {
+        Some(i32::from_le_bytes(bytes.get(at..at + 4)?.try_into().ok()?))
+    };
+    if bytes.get(..4)? != b"VOL\x03" || int(4)? != 1 {
+        return None;
+    }
+    let (x, y, z, channels) = (int(8)?, int(12)?, int(16)?, int(20)?);
+    if x <= 0 || y <= 0 || z <= 0 || !(channels == 1 || channels == 3) {
+        return None;
+    }
+    let cells = (x as usize)
+        .checked_mul(y as usize)?
+        .checked_mul(z as usize)?;
+    let data = bytes.get(48..48 + cells.checked_mul(channels as usize * 4)?)?;
+    let mut sum = DVec3::ZERO;
+    for cell in data.chunks_exact(channels as usize * 4) {
+        let c = |i: usize| f32::from_le_bytes(cell[4 * i..4 * i + 4].try_into().unwrap_or([0; 4]));
+        sum += if channels == 1 {
+            DVec3::splat(c(0) as f64)
+        } else {
+            DVec3::new(c(0) as f64, c(1) as f64, c(2) as f64)
+        };
+    }
+    Some(sum / cells as f64)
 }

@@ -86,7 +86,7 @@ impl Reader {
                 }
                 Prop::Object(mut e) if e.tag == "emitter" => {
                     once(emission.is_some(), "emitter")?;
-                    emission = Some(e.color("radiance", DVec3::ONE)?);
+                    emission = Some(self.constant(&mut e, "radiance", DVec3::ONE)?);
                     // Noise, not the image: see `Reader::emitter`.
                     e.take("sampling_weight");
                     self.leftovers(&e)?;

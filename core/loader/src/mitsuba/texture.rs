@@ -41,6 +41,60 @@ impl Reader {
         }
     }
 
+    /// A parameter foton takes as a constant where Mitsuba also takes a texture (an area
+    /// emitter's radiance, a roughness): its colour, or for a texture (given inline or by
+    /// `<ref>`) its mean over the texture, with `lenient` and a line in the report.
+    pub(super) fn constant(&mut self, o: &mut Obj, name: &str, default: DVec3) -> Result<DVec3> {
+        let table = match o.take(name) {
+            Some((Prop::Object(t), l)) if t.tag == "texture" => {
+                o.props.push((name.to_string(), Prop::Object(t.clone()), l));
+                self.unsupported(o, &format!("`{name}`: a texture ({}) where foton takes a constant: rendered with the texture's mean", t.what()))?;
+                o.take(name);
+                self.texture_table(t)?
+            }
+            Some((Prop::Ref(id), l)) if self.textures.contains_key(&id) => {
+                o.props.push((name.to_string(), Prop::Ref(id.clone()), l));
+                self.unsupported(o, &format!("`{name}`: the texture `{id}` where foton takes a constant: rendered with the texture's mean"))?;
+                o.take(name);
+                self.textures.get(&id).cloned()
+            }
+            Some((p, l)) => {
+                o.props.push((name.to_string(), p, l));
+                return o.color(name, default);
+            }
+            None => return Ok(default),
+        };
+        let Some(t) = table else {
+            return Ok(default);
+        };
+        let colour = |key: &str| -> DVec3 {
+            match t.get(key).map(|n| &n.value) {
+                Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
+                    a[0].value.as_f64().unwrap_or(0.0),
+                    a[1].value.as_f64().unwrap_or(0.0),
+                    a[2].value.as_f64().unwrap_or(0.0),
+                ),
+                Some(v) => DVec3::splat(v.as_f64().unwrap_or(0.0)),
+                None => DVec3::ZERO,
+            }
+        };
+        match t.get("type").map(|n| &n.value) {
+            Some(Value::Str(ty)) if ty == "checkerboard" => {
+                Ok((colour("color0") + colour("color1")) * 0.5)
+            }
+            Some(Value::Str(ty)) if ty == "bitmap" => {
+                let Some(Value::Str(file)) = t.get("filename").map(|n| &n.value) else {
+                    return Ok(default);
+                };
+                let raw = matches!(t.get("raw").map(|n| &n.value), Some(Value::Bool(true)));
+                let bitmap = crate::texture::load_bitmap(&self.dir.join(file), raw)?;
+                let m = bitmap.mean();
+                Ok(DVec3::new(m.x as f64, m.y as f64, m.z as f64))
+            }
+            _ => Ok(default),
+        }
+    }
+
     /// A `<texture>` as the inline table foton's materials take (docs/scene-format.md):
     /// Mitsuba's `bitmap` (filename, raw, filter_type, wrap_mode, to_uv) and `checkerboard`
     /// (color0, color1, to_uv). None: left out (lenient).
