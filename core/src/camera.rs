@@ -40,6 +40,9 @@ pub struct Camera {
     up: Vec3,
     /// tan(fov/2): half the height of the image plane at distance 1.
     tan_half: f32,
+    /// The image's centre on the plane at distance 1, along `right` and `up`: zero unless
+    /// the window is off the optical axis ([`Camera::with_shift`]).
+    shift: Vec2,
     width: u32,
     height: u32,
 }
@@ -63,9 +66,26 @@ impl Camera {
             right,
             up,
             tan_half: (fov_degrees.to_radians() * 0.5).tan(),
+            shift: Vec2::ZERO,
             width,
             height,
         }
+    }
+
+    /// The camera with its image mirrored left to right (a camera transform whose
+    /// determinant is negative: Mitsuba's `<scale x="-1"/>`, pbrt's `Scale -1 1 1`).
+    pub fn mirrored(mut self) -> Camera {
+        self.right = -self.right;
+        self
+    }
+
+    /// The camera with its image's centre moved to `shift` on the plane at distance 1 (in
+    /// units of that plane, along the image's x to the right and y up): a window off the
+    /// optical axis, as a crop of a larger image is, or pbrt's `screenwindow`. The field of
+    /// view stays the image's height.
+    pub fn with_shift(mut self, shift: Vec2) -> Camera {
+        self.shift = shift;
+        self
     }
 
     pub fn resolution(&self) -> (u32, u32) {
@@ -75,8 +95,10 @@ impl Camera {
     /// The ray through a point on the film in pixel units: (0, 0) is the top-left corner.
     pub fn generate_ray(&self, film: Vec2) -> Ray {
         let aspect = self.width as f32 / self.height as f32;
-        let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect;
-        let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half;
+        // The shift is +0 for a centred window, and x + 0 is x (never -0 here): a centred
+        // camera's rays are those of the plain formula, bit for bit.
+        let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect + self.shift.x;
+        let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half + self.shift.y;
         Ray::new(
             self.position,
             (self.forward + sx * self.right + sy * self.up).normalize(),
@@ -160,8 +182,8 @@ impl Camera {
             return None;
         }
         let aspect = self.width as f32 / self.height as f32;
-        let sx = d.dot(self.right) / z / (self.tan_half * aspect);
-        let sy = d.dot(self.up) / z / self.tan_half;
+        let sx = (d.dot(self.right) / z - self.shift.x) / (self.tan_half * aspect);
+        let sy = (d.dot(self.up) / z - self.shift.y) / self.tan_half;
         let film = Vec2::new(
             (sx + 1.0) * 0.5 * self.width as f32,
             (1.0 - sy) * 0.5 * self.height as f32,
@@ -214,9 +236,22 @@ mod tests {
         assert!((ray.dir - expect).length() < 1e-4, "{p}");
     }
 
+    /// The oblique camera, and the same mirrored with its window off the axis.
+    fn cameras() -> [Camera; 2] {
+        [
+            oblique_camera(),
+            oblique_camera().mirrored().with_shift(Vec2::new(0.3, -0.2)),
+        ]
+    }
+
     #[test]
     fn a_point_on_a_camera_ray_projects_to_its_pixel() {
-        let cam = oblique_camera();
+        for cam in cameras() {
+            projects_to_its_pixel(cam);
+        }
+    }
+
+    fn projects_to_its_pixel(cam: Camera) {
         for film in [
             Vec2::new(0.5, 0.5),
             Vec2::new(13.25, 40.75),
@@ -240,7 +275,12 @@ mod tests {
     /// draws, and `sample_wi` lands where `generate_ray` started.
     #[test]
     fn importance_is_normalised_and_consistent_with_camera_rays() {
-        let cam = oblique_camera();
+        for cam in cameras() {
+            importance_is_normalised(cam);
+        }
+    }
+
+    fn importance_is_normalised(cam: Camera) {
         // Monte Carlo over the sphere of directions: the integral of pdf_dir is 1, and so is
         // the integral of We cos (the importance of the whole image).
         let mut rng = crate::sampling::Rng::new(&[7]);
@@ -286,5 +326,50 @@ mod tests {
         assert!(cam.sample_wi(outside, 0.0).is_none());
         let s = cam.sample_wi(outside, 1.0).unwrap();
         assert!((s.film - Vec2::new(-0.7, 10.0)).length() < 1e-3);
+    }
+
+    /// A crop of an image is the camera of the crop's size, its field of view the crop's
+    /// height, shifted to the crop's centre: each of its rays is the full camera's through the
+    /// same point. Mirrored, a film point's ray is the plain camera's through the point
+    /// mirrored about the image's middle column.
+    #[test]
+    fn crops_are_shifted_cameras_and_mirrors_mirror() {
+        let (w, h) = (64.0f32, 48.0f32);
+        let full = oblique_camera();
+        let (x0, y0, cw, ch) = (40.0f32, 6.0f32, 20.0f32, 10.0f32);
+        let tan_v = full.tan_half;
+        let tan_crop = tan_v * ch / h;
+        let shift = Vec2::new(
+            ((2.0 * x0 + cw) / w - 1.0) * tan_v * (w / h),
+            (1.0 - (2.0 * y0 + ch) / h) * tan_v,
+        );
+        let crop = Camera::new(
+            full.position,
+            full.position + full.forward,
+            full.up,
+            2.0 * tan_crop.atan().to_degrees(),
+            cw as u32,
+            ch as u32,
+        )
+        .with_shift(shift);
+        for film in [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(7.25, 3.5),
+            Vec2::new(20.0, 10.0),
+        ] {
+            let a = crop.generate_ray(film).dir;
+            let b = full.generate_ray(film + Vec2::new(x0, y0)).dir;
+            assert!((a - b).length() < 1e-5, "{film}: {a} vs {b}");
+        }
+        let mirror = oblique_camera().mirrored();
+        for film in [Vec2::new(3.0, 5.0), Vec2::new(50.5, 40.0)] {
+            let a = mirror.generate_ray(film).dir;
+            let b = full.generate_ray(Vec2::new(w - film.x, film.y)).dir;
+            assert!((a - b).length() < 1e-6, "{film}: {a} vs {b}");
+        }
+        // A centred camera's rays are those without a shift, bit for bit.
+        let centred = oblique_camera().with_shift(Vec2::ZERO);
+        let f = Vec2::new(11.3, 29.9);
+        assert_eq!(centred.generate_ray(f).dir, full.generate_ray(f).dir);
     }
 }

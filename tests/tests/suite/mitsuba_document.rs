@@ -315,9 +315,9 @@ fn no_sensor_is_mitsubas_default_camera() {
 }
 
 /// A crop window in the middle of the film renders the same pixels as the whole film
-/// would there: each crop pixel's ray is the whole film's ray through the same pixel. One
-/// off the middle is refused (foton's camera has no lens shift); `--lenient` renders the
-/// whole film and says so. Film parameters that do not change the linear image are read.
+/// would there: each crop pixel's ray is the whole film's ray through the same pixel, for a
+/// window off the middle too (a shifted camera), and for a mirrored sensor. Film parameters
+/// that do not change the linear image are read.
 #[test]
 fn crop_windows_and_film_parameters() {
     let dir = temp_dir("mitsuba-crop");
@@ -353,18 +353,38 @@ fn crop_windows_and_film_parameters() {
         assert!((a - b).length() < 1e-5, "({x}, {y}): {a} against {b}");
     }
 
-    let off = crop.replace("value=\"9\"", "value=\"2\"");
-    let xml = write(&dir, "crop.xml", &scene("3.0.0", &film(&off)));
-    let e = read(&xml, false).unwrap_err();
-    assert!(e.contains("crop window"), "{e}");
-    assert!(e.contains("--lenient"), "{e}");
-    let (doc, report) = read(&xml, true).unwrap();
-    assert_eq!(number(&doc.root, "film.width"), 40.0);
-    assert!(
-        report.left_out.iter().any(|l| l.contains("crop window")),
-        "{:?}",
-        report.left_out
-    );
+    // Off the middle, and with the sensor mirrored (`<scale x="-1"/>`): the crop's pixels
+    // of the whole (mirrored) image.
+    let off = crop
+        .replace("value=\"9\"", "value=\"2\"")
+        .replace("value=\"10\"", "value=\"17\"");
+    let mirrored = |f: String| {
+        f.replace(
+            "<transform name=\"to_world\">",
+            "<transform name=\"to_world\"><scale x=\"-1\"/>",
+        )
+    };
+    let xml = write(&dir, "full.xml", &scene("3.0.0", &mirrored(film(""))));
+    let full = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    let xml = write(&dir, "crop.xml", &scene("3.0.0", &mirrored(film(&off))));
+    let cropped = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    assert_eq!(cropped.camera().resolution(), (20, 12));
+    for (x, y) in [(0.5, 0.5), (19.5, 0.5), (7.25, 11.0), (20.0, 12.0)] {
+        let a = cropped.camera().generate_ray(Vec2::new(x, y)).dir;
+        let b = full.camera().generate_ray(Vec2::new(x + 17.0, y + 2.0)).dir;
+        assert!((a - b).length() < 1e-5, "({x}, {y}): {a} against {b}");
+    }
+    // Mirrored: the image's right is the scene's left seen from the camera.
+    let plain = foton_loader::load_with(
+        &write(&dir, "plain.xml", &scene("3.0.0", &film(""))),
+        &[],
+        &[],
+        false,
+    )
+    .unwrap();
+    let a = full.camera().generate_ray(Vec2::new(3.0, 4.0)).dir;
+    let b = plain.camera().generate_ray(Vec2::new(37.0, 4.0)).dir;
+    assert!((a - b).length() < 1e-5, "{a} against {b}");
 }
 
 /// Mitsuba's mitchell, catmullrom and lanczos filters: foton has none, so the file is

@@ -10,7 +10,7 @@ use foton_core::registry::{self, NoResources};
 use foton_core::sampling::{SAMPLERS, SamplerKind};
 use foton_core::scene::{FilmSettings, RenderSettings};
 use foton_core::value::{Node, Value};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 use std::path::PathBuf;
 
 pub(super) fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<RenderSettings> {
@@ -208,8 +208,18 @@ pub(super) fn read_camera(
     if forward.normalize().cross(up).length_squared() < 1e-12 {
         return Err(t.error("up", "is zero or parallel to the viewing direction"));
     }
+    let mirror = t.bool("mirror", false)?;
+    let shift = match t.floats_opt("shift", 2)? {
+        Some(s) if s.iter().all(|x| x.is_finite()) => Vec2::new(s[0], s[1]),
+        Some(s) => return Err(t.error("shift", format!("must be finite, found {s:?}"))),
+        None => Vec2::ZERO,
+    };
     let medium = medium_ref(&t, "medium", media)?;
     ld.done(&t);
-    let camera = Camera::new(position, look_at, up, fov, film.width, film.height);
+    let mut camera =
+        Camera::new(position, look_at, up, fov, film.width, film.height).with_shift(shift);
+    if mirror {
+        camera = camera.mirrored();
+    }
     Ok((camera, medium))
 }

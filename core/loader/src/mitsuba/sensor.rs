@@ -38,12 +38,14 @@ impl Reader {
         let dir = m.transform_vector3(DVec3::Z).normalize();
         let up = m.transform_vector3(DVec3::Y).normalize();
         let left = m.transform_vector3(DVec3::X);
-        if left.dot(up.cross(dir)) <= 0.0 {
-            self.unsupported(
-                &o,
-                "a sensor to_world that mirrors the image is not supported",
-            )?;
+        // A transform with a negative determinant (`<scale x="-1"/>`) mirrors the image.
+        let handedness = left.dot(up.cross(dir));
+        if !(handedness != 0.0 && handedness.is_finite()) {
+            return Err(
+                o.error("`to_world`: a degenerate sensor transform (its axes do not span space)")
+            );
         }
+        let mirror = handedness < 0.0;
         let has_fov = o.props.iter().any(|(n, _, _)| n == "fov");
         let (fov, fov_axis) = if has_fov {
             if o.props.iter().any(|(n, _, _)| n == "focal_length") {
@@ -77,6 +79,9 @@ impl Reader {
             o.take(ignored);
         }
         let camera = table_mut(&mut self.root, "camera");
+        if mirror {
+            camera.insert("mirror", at(Value::Bool(true), line));
+        }
         camera.insert("position", vec3(position, line));
         camera.insert("look_at", vec3(position + dir, line));
         camera.insert("up", vec3(up, line));
@@ -227,20 +232,6 @@ impl Reader {
             full,
             line,
         } = crop;
-        let centred = 2 * x + width == full.0 && 2 * y + height == full.1;
-        if !centred {
-            let o = Obj {
-                line,
-                ..sensor.clone()
-            };
-            return self.unsupported(
-                &o,
-                &format!(
-                    "a crop window off the middle of the film ({width} x {height} at {x}, {y} of {} x {}) is not supported; the whole film is rendered",
-                    full.0, full.1
-                ),
-            );
-        }
         if (width, height) == full {
             return Ok(());
         }
@@ -262,6 +253,17 @@ impl Reader {
         let fov = 2.0 * tan_crop.atan().to_degrees();
         camera.insert("fov", at(Value::Float(fov), line));
         camera.insert("fov_axis", at(Value::Str("y".into()), line));
+        // The crop's centre on the image plane at distance 1 (a window off the middle is a
+        // camera shifted there; a centred one needs no shift).
+        let (full_w, full_h) = (full.0 as f64, full.1 as f64);
+        let shift = [
+            ((2 * x + width) as f64 / full_w - 1.0) * tan_v * full_w / full_h,
+            (1.0 - (2 * y + height) as f64 / full_h) * tan_v,
+        ];
+        if shift != [0.0, 0.0] {
+            let s = shift.map(|c| at(Value::Float(c), line)).to_vec();
+            camera.insert("shift", at(Value::Array(s), line));
+        }
         let film = table_mut(&mut self.root, "film");
         film.insert("width", at(Value::Int(width), line));
         film.insert("height", at(Value::Int(height), line));
