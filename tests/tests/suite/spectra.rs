@@ -393,3 +393,15 @@ fn malformed_spectra_are_errors_at_their_line() {
         "{e}"
     );
 }
+
+/// Mitsuba 0.6's `<rgb value="#rrggbb">`: each channel over 255, not decoded from sRGB (its
+/// `<srgb>` decodes); Mitsuba 3 ("could not parse RGB value") and foton refuse it in files
+/// of 2.0 and later.
+#[test]
+fn hexadecimal_rgb_in_files_older_than_2() {
+    let hex = "<rgb name=\"reflectance\" value=\"#ff8000\"/>";
+    close(reflectance("0.6.0", hex), [1.0, 128.0 / 255.0, 0.0], 1e-12);
+    let body = format!("<shape type=\"sphere\"><bsdf type=\"diffuse\">{hex}</bsdf></shape>");
+    let e = read("hex-v3", "3.0.0", &body).unwrap_err();
+    assert!(e.contains("scene.xml:3") && e.contains("not a list of numbers"), "{e}");
+}

@@ -383,11 +383,20 @@ impl Reader {
                 "string" => Prop::Str(value()?),
                 "rgb" => {
                     let v = value()?;
-                    let xs = numbers(&v).ok_or_else(|| bad("not a list of numbers", &v))?;
-                    match xs[..] {
-                        [x] => Prop::Color(DVec3::splat(x)),
-                        [r, g, b] => Prop::Color(DVec3::new(r, g, b)),
-                        _ => return Err(bad("expected one value or three (r, g, b)", &v)),
+                    // Mitsuba 0.6 also reads "#rrggbb", as linear values (its <srgb> decodes
+                    // them); Mitsuba 3 does not.
+                    match v.trim().strip_prefix('#').filter(|_| self.v1) {
+                        Some(hex) => {
+                            Prop::Color(hex_color(hex).ok_or_else(|| bad("expected #rrggbb", &v))?)
+                        }
+                        None => {
+                            let xs = numbers(&v).ok_or_else(|| bad("not a list of numbers", &v))?;
+                            match xs[..] {
+                                [x] => Prop::Color(DVec3::splat(x)),
+                                [r, g, b] => Prop::Color(DVec3::new(r, g, b)),
+                                _ => return Err(bad("expected one value or three (r, g, b)", &v)),
+                            }
+                        }
                     }
                 }
                 // Mitsuba 3 reads a <spectrum type="..."> as a texture of that plugin.
@@ -800,6 +809,21 @@ impl Reader {
         }
         Ok(Prop::Color(color))
     }
+}
+
+/// `rrggbb` in hexadecimal, each channel over 255.
+fn hex_color(hex: &str) -> Option<DVec3> {
+    if hex.len() != 6 || !hex.is_ascii() {
+        return None;
+    }
+    let channel = |i: usize| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok();
+    Some(
+        DVec3::new(
+            f64::from(channel(0)?),
+            f64::from(channel(1)?),
+            f64::from(channel(2)?),
+        ) / 255.0,
+    )
 }
 
 /// What a Mitsuba 3 plugin reads its property `name` as: an emitter's radiance, irradiance
