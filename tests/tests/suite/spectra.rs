@@ -403,5 +403,38 @@ fn hexadecimal_rgb_in_files_older_than_2() {
     close(reflectance("0.6.0", hex), [1.0, 128.0 / 255.0, 0.0], 1e-12);
     let body = format!("<shape type=\"sphere\"><bsdf type=\"diffuse\">{hex}</bsdf></shape>");
     let e = read("hex-v3", "3.0.0", &body).unwrap_err();
-    assert!(e.contains("scene.xml:3") && e.contains("not a list of numbers"), "{e}");
+    assert!(
+        e.contains("scene.xml:3") && e.contains("not a list of numbers"),
+        "{e}"
+    );
+}
+
+/// Mitsuba 0.6's measured media (`<string name="material" value="Regular Milk"/>`): the
+/// table's coefficients times 100, sigma_s reduced by (1 - g), then `scale`; names in any
+/// case. Mitsuba 3 has none.
+#[test]
+fn measured_media_in_files_older_than_2() {
+    let medium = |version: &str, name: &str, material: &str| {
+        let body = format!(
+            "<medium type=\"homogeneous\" id=\"m\"><string name=\"material\" value=\"{material}\"/>\
+             <float name=\"scale\" value=\"0.5\"/></medium>\
+             <shape type=\"sphere\"><ref name=\"interior\" id=\"m\"/></shape>"
+        );
+        read(name, version, &body)
+    };
+    let doc = medium("0.6.0", "milk", "regular milk").unwrap();
+    let media = table(&doc.root, "media");
+    let Value::Table(m) = &media.0[0].1.value else {
+        panic!("{media:?}")
+    };
+    // Narasimhan et al. 2006: sigma_s (18.2052, 20.3826, 22.3698), sigma_a (0.00153, 0.00460,
+    // 0.01993) per mm, g (0.750, 0.714, 0.681).
+    let g = DVec3::new(0.75, 0.714, 0.681);
+    let s = DVec3::new(18.2052, 20.3826, 22.3698) * 100.0 * (DVec3::ONE - g) * 0.5;
+    close(rgb(m, "sigma_s"), s.to_array(), 1e-12);
+    close(rgb(m, "sigma_a"), [0.0765, 0.23, 0.9965], 1e-12);
+    let e = medium("0.6.0", "milk-typo", "Regular Milc").unwrap_err();
+    assert!(e.contains("Regular Milc") && e.contains("Skimmilk"), "{e}");
+    let e = medium("3.0.0", "milk-v3", "Skimmilk").unwrap_err();
+    assert!(e.contains("not Mitsuba 3's"), "{e}");
 }
