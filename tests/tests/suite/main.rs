@@ -54,6 +54,7 @@ mod sampling_materials;
 mod sampling_media;
 mod scenes;
 mod shapes;
+mod spectra;
 mod sphere_light;
 mod spot;
 mod sppm;

@@ -9,7 +9,7 @@ use foton_core::error::Result;
 use foton_core::value::{Table, Value};
 use glam::DVec3;
 
-/// Mitsuba's named indices of refraction (its documentation's table).
+/// Mitsuba's named indices of refraction (Mitsuba 3's and 0.6's `ior_data`, the same table).
 const IORS: &[(&str, f64)] = &[
     ("vacuum", 1.0),
     ("helium", 1.000036),
@@ -102,11 +102,27 @@ impl Reader {
                 let (eta, k) = (o.take("eta"), o.take("k"));
                 match (eta, k) {
                     (None, None) => {
-                        let name = material.unwrap_or_else(|| "none".into());
-                        if name != "none" && foton_core::material::conductor_ior(&name).is_none() {
+                        // Mitsuba 0.6's conductor is copper unless told otherwise, Mitsuba 3's
+                        // a perfect mirror.
+                        let default = if o.v1 { "Cu" } else { "none" };
+                        let name = material.unwrap_or_else(|| default.into());
+                        let spectra = foton_core::spectrum::conductor(&name);
+                        if name.eq_ignore_ascii_case("none") {
+                            t.insert("material", at(Value::Str("none".into()), line));
+                        } else if spectra.is_none() {
                             return Err(o.error(format!("`material`: unknown conductor `{name}`")));
+                        } else if let (Some((eta, k)), true) = (spectra, o.v1) {
+                            // Mitsuba 0.6 reduces the measured spectra its own way (a
+                            // negative component, out of gamut, clamped as Mitsuba 3 does).
+                            let ext = self.ior(&mut o, "ext_eta", 1.0)?;
+                            let rgb = |s: foton_core::spectrum::Spectrum| {
+                                s.to_srgb_v06().max(DVec3::ZERO) / ext
+                            };
+                            t.insert("eta", vec3(rgb(eta), line));
+                            t.insert("k", vec3(rgb(k), line));
+                        } else {
+                            t.insert("material", at(Value::Str(name), line));
                         }
-                        t.insert("material", at(Value::Str(name), line));
                     }
                     (Some((eta, l1)), Some((k, l2))) => {
                         o.props.push(("eta".into(), eta, l1));

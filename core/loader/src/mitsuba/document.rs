@@ -10,6 +10,7 @@ use super::object::{Obj, Prop};
 use super::upgrade::upgrade_v1;
 use super::{Reader, forget_line, forget_lines, shown};
 use foton_core::error::{Error, Location, Result};
+use foton_core::spectrum::{self, Quantity, Spectrum};
 use foton_core::value::{Node, Table, Value};
 use glam::{DMat4, DVec3};
 use std::path::Path;
@@ -430,19 +431,46 @@ impl Reader {
                     })
                 }
                 "string" => Prop::Str(value()?),
-                "rgb" | "spectrum" => {
+                "rgb" => {
                     let v = value()?;
-                    let xs = numbers(&v).ok_or_else(|| bad("not a list of numbers", &v))?;
-                    match (tag, xs.len()) {
-                        (_, 1) => Prop::Color(DVec3::splat(xs[0])),
-                        ("rgb", 3) => Prop::Color(DVec3::new(xs[0], xs[1], xs[2])),
-                        _ => {
-                            return Err(bad(
-                                "expected one value or three (r, g, b); wavelength:value spectra are not supported",
-                                &v,
-                            ));
+                    // Mitsuba 0.6 also reads "#rrggbb", as linear values (its <srgb> decodes
+                    // them); Mitsuba 3 does not.
+                    match v.trim().strip_prefix('#').filter(|_| self.v1) {
+                        Some(hex) => {
+                            Prop::Color(hex_color(hex).ok_or_else(|| bad("expected #rrggbb", &v))?)
+                        }
+                        None => {
+                            let xs = numbers(&v).ok_or_else(|| bad("not a list of numbers", &v))?;
+                            match xs[..] {
+                                [x] => Prop::Color(DVec3::splat(x)),
+                                [r, g, b] => Prop::Color(DVec3::new(r, g, b)),
+                                _ => return Err(bad("expected one value or three (r, g, b)", &v)),
+                            }
                         }
                     }
+                }
+                // Mitsuba 3 reads a <spectrum type="..."> as a texture of that plugin.
+                "spectrum" if c.has_attribute("type") => {
+                    let spectrum = self.object(c, file, line_of)?;
+                    self.spectrum_object(spectrum, quantity(&obj, &name))?
+                }
+                "spectrum" => {
+                    let (value, filename) = (cget("value")?, cget("filename")?);
+                    let at = Place {
+                        file,
+                        pos: cpos,
+                        name: &name,
+                    };
+                    Prop::Color(self.spectrum(value, filename, quantity(&obj, &name), at)?)
+                }
+                "blackbody" => {
+                    let (temperature, scale) = (cget("temperature")?, cget("scale")?);
+                    let at = Place {
+                        file,
+                        pos: cpos,
+                        name: &name,
+                    };
+                    Prop::Color(self.blackbody(temperature, scale, at)?)
                 }
                 "point" | "vector" => {
                     let p = match cget("value")? {
@@ -652,6 +680,213 @@ impl Reader {
     }
 }
 
+/// Where a spectrum is written, for its messages: the file, the element and its `name`.
+#[derive(Clone, Copy)]
+struct Place<'a> {
+    file: &'a Path,
+    pos: Pos,
+    name: &'a str,
+}
+
+impl Place<'_> {
+    fn error(&self, tag: &str, message: &str) -> Error {
+        syntax(
+            self.file,
+            self.pos,
+            &format!("<{tag} name=\"{}\">: {message}", self.name),
+        )
+    }
+}
+
+/// Spectra, reduced to linear sRGB as each version's RGB renderer reduces them: Mitsuba 3's
+/// reduction for files of 2.0 and later, Mitsuba 0.6's for older ones (see
+/// `foton_core::spectrum`).
+impl Reader {
+    /// `<spectrum value="..."/>` (one value, wavelength:value pairs, or in a file older than
+    /// 2.0 three values: Mitsuba 0.6's RGB builds have three spectral samples, r, g and b)
+    /// or `<spectrum filename="x.spd"/>`.
+    fn spectrum(
+        &self,
+        value: Option<String>,
+        filename: Option<String>,
+        quantity: Quantity,
+        at: Place<'_>,
+    ) -> Result<DVec3> {
+        let bad = |message: &str| at.error("spectrum", message);
+        let spectrum = match (value, filename) {
+            (Some(v), None) if !v.contains(':') => {
+                let xs = numbers(&v).ok_or_else(|| bad(&format!("`{v}` is not a number")))?;
+                return match (&xs[..], self.v1) {
+                    // Mitsuba 3 gives a flat emission the colour of a flat spectrum in
+                    // sRGB, as its spectral variants render it; Mitsuba 0.6 a grey.
+                    ([x], false) if quantity == Quantity::Emission => {
+                        Ok(spectrum::uniform_emission(*x))
+                    }
+                    ([x], _) => Ok(DVec3::splat(*x)),
+                    ([r, g, b], true) => Ok(DVec3::new(*r, *g, *b)),
+                    (_, true) => Err(bad(&format!(
+                        "`{v}`: expected one value, three (r, g, b) or wavelength:value pairs"
+                    ))),
+                    (_, false) => Err(bad(&format!(
+                        "`{v}`: expected one value or wavelength:value pairs (Mitsuba 3 reads \
+                         three values as r, g, b only in files older than version 2.0; \
+                         write <rgb> for a colour)"
+                    ))),
+                };
+            }
+            (Some(v), None) => Spectrum::parse_pairs(&v).map_err(|e: String| bad(&e))?,
+            (None, Some(name)) => {
+                let path = self.resolve(at.file, &name).map_err(|looked| {
+                    bad(&format!(
+                        "filename=\"{name}\": no such file in {}",
+                        shown(&looked)
+                    ))
+                })?;
+                let text = std::fs::read_to_string(&path).map_err(|e| Error::io(&path, e))?;
+                Spectrum::parse_spd(&text).map_err(|e| bad(&format!("{}: {e}", path.display())))?
+            }
+            _ => return Err(bad("expected either `value` or `filename`")),
+        };
+        Ok(if self.v1 {
+            // Mitsuba 0.6's scene parser ramps the spectrum to zero past its ends.
+            spectrum.zero_extended().to_srgb_v06().max(DVec3::ZERO)
+        } else {
+            spectrum.to_srgb(quantity)
+        })
+    }
+
+    /// Mitsuba 0.6's `<blackbody temperature="5000K" scale="1"/>`: Planck's law in
+    /// W m⁻² sr⁻¹ nm⁻¹, reduced to RGB, times `scale`.
+    fn blackbody(
+        &self,
+        temperature: Option<String>,
+        scale: Option<String>,
+        at: Place<'_>,
+    ) -> Result<DVec3> {
+        let bad = |message: &str| at.error("blackbody", message);
+        if !self.v1 {
+            return Err(bad(
+                "<blackbody> is Mitsuba 0.6's; Mitsuba 3 writes <spectrum type=\"blackbody\"> \
+                 with a <float name=\"temperature\">",
+            ));
+        }
+        let t = temperature.ok_or_else(|| bad("missing attribute `temperature`"))?;
+        let kelvin = t
+            .trim()
+            .trim_end_matches(['K', 'k'])
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|k| *k > 0.0)
+            .ok_or_else(|| bad(&format!("temperature `{t}`: expected kelvins, e.g. 5000K")))?;
+        let scale = match scale {
+            None => 1.0,
+            Some(s) => s
+                .trim()
+                .parse::<f64>()
+                .map_err(|_| bad(&format!("scale `{s}`: not a number")))?,
+        };
+        let rgb = spectrum::to_srgb_v06(|l| spectrum::blackbody_v06(l, kelvin), &[]);
+        Ok(rgb.max(DVec3::ZERO) * scale)
+    }
+
+    /// Mitsuba 3's spectrum plugins written as `<spectrum type="...">` with their parameters:
+    /// reduced to a colour as the RGB variants reduce `<spectrum value>`s (its RGB variants
+    /// cannot render `blackbody`, `regular` and `irregular`; this is what its spectral
+    /// variants render). Other types (`bitmap`...) are textures.
+    fn spectrum_object(&self, mut o: Obj, quantity: Quantity) -> Result<Prop> {
+        let text = |o: &mut Obj, key: &str| -> Result<Vec<f64>> {
+            let s = o
+                .string(key)?
+                .ok_or_else(|| o.error(format!("missing `{key}`")))?;
+            numbers(&s).ok_or_else(|| o.error(format!("`{key}`: `{s}` is not a list of numbers")))
+        };
+        let bad = |o: &Obj, e: String| o.error(e);
+        let color = match o.ty.as_str() {
+            "blackbody" => {
+                let kelvin = o.float("temperature", f64::NAN)?;
+                if kelvin.is_nan() || kelvin <= 0.0 {
+                    return Err(o.error("`temperature`: a positive number of kelvins is needed"));
+                }
+                let (lo, hi) = (
+                    o.float("wavelength_min", 360.0)?,
+                    o.float("wavelength_max", 830.0)?,
+                );
+                spectrum::to_srgb(
+                    |l| {
+                        (lo..=hi)
+                            .contains(&l)
+                            .then(|| spectrum::blackbody(l, kelvin))
+                    },
+                    quantity,
+                )
+            }
+            "regular" => {
+                let (lo, hi) = (
+                    o.float("wavelength_min", f64::NAN)?,
+                    o.float("wavelength_max", f64::NAN)?,
+                );
+                let values = text(&mut o, "values")?;
+                let n = values.len().max(2) - 1;
+                let wavelengths = (0..values.len())
+                    .map(|i| lo + (hi - lo) * i as f64 / n as f64)
+                    .collect();
+                Spectrum::new(wavelengths, values)
+                    .map_err(|e| bad(&o, e))?
+                    .to_srgb(quantity)
+            }
+            "irregular" => {
+                let wavelengths = text(&mut o, "wavelengths")?;
+                let values = text(&mut o, "values")?;
+                Spectrum::new(wavelengths, values)
+                    .map_err(|e| bad(&o, e))?
+                    .to_srgb(quantity)
+            }
+            "uniform" => DVec3::splat(o.float("value", f64::NAN)?),
+            // In RGB variants `d65` is its colour times its scale.
+            "d65" => o.color("color", DVec3::ONE)? * o.float("scale", 1.0)?,
+            "srgb" => o.color("color", DVec3::splat(f64::NAN))?,
+            _ => {
+                o.tag = "texture".into();
+                return Ok(Prop::Object(o));
+            }
+        };
+        if let Some((key, _, _)) = o.props.first() {
+            return Err(o.error(format!("unknown parameter `{key}`")));
+        }
+        if !color.is_finite() {
+            return Err(o.error("missing parameters (`value`, `color`, `wavelength_min`...)"));
+        }
+        Ok(Prop::Color(color))
+    }
+}
+
+/// `rrggbb` in hexadecimal, each channel over 255.
+fn hex_color(hex: &str) -> Option<DVec3> {
+    if hex.len() != 6 || !hex.is_ascii() {
+        return None;
+    }
+    let channel = |i: usize| u8::from_str_radix(&hex[2 * i..2 * i + 2], 16).ok();
+    Some(
+        DVec3::new(
+            f64::from(channel(0)?),
+            f64::from(channel(1)?),
+            f64::from(channel(2)?),
+        ) / 255.0,
+    )
+}
+
+/// What a Mitsuba 3 plugin reads its property `name` as: an emitter's radiance, irradiance
+/// and intensity emit; a BSDF's indices of refraction and roughnesses have no upper bound;
+/// everything else is a reflectance.
+fn quantity(parent: &Obj, name: &str) -> Quantity {
+    match (parent.tag.as_str(), name) {
+        ("emitter", "radiance" | "irradiance" | "intensity") => Quantity::Emission,
+        ("bsdf", "eta" | "k" | "alpha" | "alpha_u" | "alpha_v" | "sigma_a") => Quantity::Unbounded,
+        _ => Quantity::Reflectance,
+    }
+}
+
 /// The document's sections as they were, to tell what one object added: the tables of
 /// named entries (materials, media) by their length, the others whole.
 struct Snapshot(Vec<(String, Result<usize, Node>)>);
@@ -737,6 +972,7 @@ const PROPERTY_TAGS: &[&str] = &[
     "rgb",
     "srgb",
     "spectrum",
+    "blackbody",
     "point",
     "vector",
     "transform",
@@ -764,7 +1000,6 @@ const OBJECT_TAGS: &[&str] = &[
 /// Elements Mitsuba (3 or 0.6) reads that foton does not: "not supported", not "unknown".
 const KNOWN_UNREAD: &[&str] = &[
     "volume",
-    "blackbody",
     "animation",
     "alias",
     "path",

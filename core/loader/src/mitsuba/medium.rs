@@ -1,5 +1,5 @@
-//! `<medium>`: a homogeneous medium into `[media]` (sigma_s and sigma_a, or sigma_t and
-//! albedo; scale), with its `<phase>` function.
+//! `<medium>`: a homogeneous medium into `[media]` (sigma_s and sigma_a, sigma_t and albedo,
+//! or in files older than 2.0 a measured `material`; scale), with its `<phase>` function.
 
 use super::object::{Obj, Prop};
 use super::plugins::not_read;
@@ -30,12 +30,37 @@ impl Reader {
         }
         let line = o.line;
         let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
-        if has(&o, "material") {
-            return Err(o.error("`material` (Mitsuba 0.6's measured media) is not supported: give sigma_s and sigma_a"));
-        }
-        // Mitsuba 0.6 writes a medium as sigma_s and sigma_a or as sigma_t and albedo (Mitsuba
-        // 3 only the latter, and its upgrade drops the former: foton keeps them).
-        let (sigma_s, sigma_a) = if has(&o, "sigma_s") || has(&o, "sigma_a") {
+        let coefficients = ["sigma_s", "sigma_a", "sigma_t", "albedo"];
+        // Mitsuba 0.6 writes a medium as a named measured `material`, as sigma_s and sigma_a or
+        // as sigma_t and albedo (Mitsuba 3 only the last, and its upgrade drops sigma_s and
+        // sigma_a: foton keeps them).
+        let (sigma_s, sigma_a) = if has(&o, "material") {
+            if !self.v1 {
+                return Err(o.error(
+                    "`material` (Mitsuba 0.6's measured media) is not Mitsuba 3's: give sigma_t and albedo",
+                ));
+            }
+            if coefficients.iter().any(|k| has(&o, k)) {
+                return Err(
+                    o.error("give either a named `material` or scattering coefficients, not both")
+                );
+            }
+            let name = o.string("material")?.unwrap_or_default();
+            let found = MEASURED_MEDIA
+                .iter()
+                .find(|(n, ..)| n.eq_ignore_ascii_case(&name));
+            let Some((_, s, a, g)) = found else {
+                let names: Vec<&str> = MEASURED_MEDIA.iter().map(|(n, ..)| *n).collect();
+                return Err(o.error(format!(
+                    "`material`: no measured medium `{name}`; Mitsuba 0.6's are: {}",
+                    names.join(", ")
+                )));
+            };
+            // Mitsuba 0.6 scales the table by 100 and, ignoring the preset's anisotropy,
+            // scatters with the reduced coefficient sigma_s (1 - g).
+            let (s, a, g) = (DVec3::from(*s), DVec3::from(*a), DVec3::from(*g));
+            (s * 100.0 * (DVec3::ONE - g), a * 100.0)
+        } else if has(&o, "sigma_s") || has(&o, "sigma_a") {
             if has(&o, "sigma_t") || has(&o, "albedo") {
                 return Err(o.error("give sigma_s and sigma_a, or sigma_t and albedo, not both"));
             }
@@ -159,3 +184,295 @@ fn grid_mean(bytes: &[u8]) -> Option<DVec3> {
     }
     Some(sum / cells as f64)
 }
+
+/// Mitsuba 0.6's measured media (its `materialData`): name, sigma_s, sigma_a and the
+/// anisotropy g per channel (r, g, b). The first twelve are the fits of Jensen, Marschner,
+/// Levoy and Hanrahan, "A Practical Model for Subsurface Light Transport" (SIGGRAPH 2001),
+/// without anisotropy data; the others are from Narasimhan, Gupta, Donner, Ramamoorthi, Nayar
+/// and Jensen, "Acquiring Scattering Properties of Participating Media by Dilution"
+/// (SIGGRAPH 2006).
+#[allow(clippy::type_complexity)]
+const MEASURED_MEDIA: &[(&str, [f64; 3], [f64; 3], [f64; 3])] = &[
+    (
+        "Apple",
+        [2.29, 2.39, 1.97],
+        [0.0030, 0.0034, 0.046],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Chicken1",
+        [0.15, 0.21, 0.38],
+        [0.0015, 0.077, 0.19],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Chicken2",
+        [0.19, 0.25, 0.32],
+        [0.0018, 0.088, 0.20],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Cream",
+        [7.38, 5.47, 3.15],
+        [0.0002, 0.0028, 0.0163],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Ketchup",
+        [0.18, 0.07, 0.03],
+        [0.061, 0.97, 1.45],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Marble",
+        [2.19, 2.62, 3.00],
+        [0.0021, 0.0041, 0.0071],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Potato",
+        [0.68, 0.70, 0.55],
+        [0.0024, 0.0090, 0.12],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Skimmilk",
+        [0.70, 1.22, 1.90],
+        [0.0014, 0.0025, 0.0142],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Skin1",
+        [0.74, 0.88, 1.01],
+        [0.032, 0.17, 0.48],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Skin2",
+        [1.09, 1.59, 1.79],
+        [0.013, 0.070, 0.145],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Spectralon",
+        [11.6, 20.4, 14.9],
+        [0.00, 0.00, 0.00],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Wholemilk",
+        [2.55, 3.21, 3.77],
+        [0.0011, 0.0024, 0.014],
+        [0.0, 0.0, 0.0],
+    ),
+    (
+        "Lowfat Milk",
+        [13.1157, 15.4445, 17.9572],
+        [0.00287, 0.00575, 0.01150],
+        [0.93200, 0.90200, 0.85900],
+    ),
+    (
+        "Reduced Milk",
+        [13.7335, 15.6003, 17.8007],
+        [0.00256, 0.00511, 0.01278],
+        [0.81900, 0.79700, 0.74600],
+    ),
+    (
+        "Regular Milk",
+        [18.2052, 20.3826, 22.3698],
+        [0.00153, 0.00460, 0.01993],
+        [0.75000, 0.71400, 0.68100],
+    ),
+    (
+        "Espresso",
+        [7.78262, 8.13050, 8.53875],
+        [4.79838, 6.57512, 8.84925],
+        [0.90700, 0.89600, 0.88000],
+    ),
+    (
+        "Mint Mocha Coffee",
+        [3.51133, 4.14383, 5.59667],
+        [3.77200, 5.82283, 7.82000],
+        [0.91000, 0.90700, 0.91400],
+    ),
+    (
+        "Lowfat Soy Milk",
+        [2.03838, 2.32875, 3.90281],
+        [0.00144, 0.00719, 0.03594],
+        [0.85000, 0.85300, 0.84200],
+    ),
+    (
+        "Regular Soy Milk",
+        [4.66325, 5.20183, 8.74575],
+        [0.00192, 0.00958, 0.06517],
+        [0.87300, 0.85800, 0.83200],
+    ),
+    (
+        "Lowfat Chocolate Milk",
+        [9.83710, 11.4954, 13.1629],
+        [0.01150, 0.03680, 0.15640],
+        [0.93400, 0.92700, 0.91600],
+    ),
+    (
+        "Regular Chocolate Milk",
+        [10.5685, 13.1416, 15.2202],
+        [0.01006, 0.04313, 0.14375],
+        [0.86200, 0.83800, 0.80600],
+    ),
+    (
+        "Coke",
+        [0.00254, 0.00299, 0.00000],
+        [0.10014, 0.16503, 0.24680],
+        [0.96500, 0.97200, 0.00000],
+    ),
+    (
+        "Pepsi",
+        [0.00083, 0.00203, 0.00000],
+        [0.09164, 0.14158, 0.20729],
+        [0.92600, 0.97900, 0.00000],
+    ),
+    (
+        "Sprite",
+        [0.00011, 0.00014, 0.00014],
+        [0.00189, 0.00183, 0.00200],
+        [0.94300, 0.95300, 0.95200],
+    ),
+    (
+        "Gatorade",
+        [0.03668, 0.04488, 0.05742],
+        [0.02479, 0.01929, 0.00888],
+        [0.93300, 0.93300, 0.93500],
+    ),
+    (
+        "Chardonnay",
+        [0.00021, 0.00033, 0.00048],
+        [0.01078, 0.01186, 0.02400],
+        [0.91400, 0.95800, 0.97500],
+    ),
+    (
+        "White Zinfandel",
+        [0.00022, 0.00033, 0.00046],
+        [0.01207, 0.01618, 0.01984],
+        [0.91900, 0.94300, 0.97200],
+    ),
+    (
+        "Merlot",
+        [0.00081, 0.00000, 0.00000],
+        [0.11632, 0.25191, 0.29434],
+        [0.97400, 0.00000, 0.00000],
+    ),
+    (
+        "Budweiser Beder",
+        [0.00029, 0.00055, 0.00059],
+        [0.01149, 0.02491, 0.05779],
+        [0.91700, 0.95600, 0.98200],
+    ),
+    (
+        "Coors Light Beer",
+        [0.00062, 0.00127, 0.00000],
+        [0.00616, 0.01398, 0.03498],
+        [0.91800, 0.96600, 0.00000],
+    ),
+    (
+        "Clorox",
+        [0.02731, 0.03302, 0.03695],
+        [0.00335, 0.01489, 0.02630],
+        [0.91200, 0.90500, 0.89200],
+    ),
+    (
+        "Apple Juice",
+        [0.00257, 0.00311, 0.00413],
+        [0.01296, 0.02374, 0.05218],
+        [0.94700, 0.94900, 0.94500],
+    ),
+    (
+        "Cranberry Juice",
+        [0.00196, 0.00238, 0.00301],
+        [0.03944, 0.09422, 0.12426],
+        [0.94700, 0.95100, 0.97400],
+    ),
+    (
+        "Grape Juice",
+        [0.00138, 0.00000, 0.00000],
+        [0.10404, 0.23958, 0.29325],
+        [0.96100, 0.00000, 0.00000],
+    ),
+    (
+        "Ruby Grapefruit Juice",
+        [0.15496, 0.15391, 0.15995],
+        [0.08587, 0.18314, 0.25262],
+        [0.92900, 0.92900, 0.93100],
+    ),
+    (
+        "White Grapefruit Juice",
+        [0.50499, 0.52742, 0.75282],
+        [0.01380, 0.01883, 0.05678],
+        [0.54800, 0.54500, 0.56500],
+    ),
+    (
+        "Shampoo",
+        [0.00797, 0.00874, 0.01127],
+        [0.01411, 0.04569, 0.06172],
+        [0.91000, 0.90500, 0.92000],
+    ),
+    (
+        "Strawberry Shampoo",
+        [0.00215, 0.00245, 0.00253],
+        [0.01449, 0.05796, 0.07582],
+        [0.92700, 0.93500, 0.99400],
+    ),
+    (
+        "Head & Shoulders Shampoo",
+        [0.26747, 0.27696, 0.29574],
+        [0.08462, 0.15688, 0.20365],
+        [0.91100, 0.89600, 0.88400],
+    ),
+    (
+        "Lemon Tea Powder",
+        [0.74489, 0.83823, 1.00158],
+        [2.42881, 4.57573, 7.21270],
+        [0.94600, 0.94600, 0.94900],
+    ),
+    (
+        "Orange Juice Powder",
+        [0.00193, 0.00213, 0.00226],
+        [0.00145, 0.00344, 0.00786],
+        [0.91900, 0.91800, 0.92200],
+    ),
+    (
+        "Pink Lemonade Powder",
+        [0.00123, 0.00133, 0.00131],
+        [0.00116, 0.00237, 0.00320],
+        [0.90200, 0.90200, 0.90400],
+    ),
+    (
+        "Cappuccino Powder",
+        [12.2094, 16.4659, 29.2727],
+        [35.8441, 49.5470, 61.0844],
+        [0.84900, 0.84300, 0.92600],
+    ),
+    (
+        "Salt Powder",
+        [0.13805, 0.15677, 0.17865],
+        [0.28415, 0.32570, 0.34148],
+        [0.80200, 0.79300, 0.82100],
+    ),
+    (
+        "Sugar Powder",
+        [0.00282, 0.00315, 0.00393],
+        [0.01264, 0.03105, 0.05012],
+        [0.92100, 0.91900, 0.93100],
+    ),
+    (
+        "Suisse Mocha Powder",
+        [30.0848, 33.4452, 38.7191],
+        [17.5020, 27.0044, 35.4334],
+        [0.90700, 0.89400, 0.88800],
+    ),
+    (
+        "Pacific Ocean Surface Water",
+        [0.00180, 0.00183, 0.00228],
+        [0.03184, 0.03132, 0.03015],
+        [0.90200, 0.82500, 0.91400],
+    ),
+];
