@@ -42,6 +42,9 @@ materials! {
         RoughDielectric(roughdielectric::RoughDielectricMaterial, glossy::RoughDielectric),
         Plastic(plastic::PlasticMaterial, glossy::Plastic),
         RoughPlastic(roughplastic::RoughPlasticMaterial, glossy::RoughPlastic),
+        Phong(phong::PhongMaterial, phong::PhongBxdf),
+        Ward(ward::WardMaterial, ward::WardBxdf),
+        RoughDiffuse(roughdiffuse::RoughDiffuseMaterial, roughdiffuse::RoughDiffuseBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

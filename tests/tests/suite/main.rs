@@ -29,6 +29,7 @@ mod environment;
 mod filter;
 mod glossy;
 mod kernels;
+mod materials_classic;
 mod media;
 mod media_sides;
 mod medium_kind;

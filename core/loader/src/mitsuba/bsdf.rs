@@ -6,7 +6,7 @@ use super::object::{Obj, Prop};
 use super::plugins::not_read;
 use super::{Reader, at, table_mut, vec3};
 use foton_core::error::Result;
-use foton_core::value::{Table, Value};
+use foton_core::value::{Node, Table, Value};
 use glam::DVec3;
 
 /// Mitsuba's named indices of refraction (Mitsuba 3's and 0.6's `ior_data`, the same table).
@@ -175,6 +175,65 @@ impl Reader {
                 t.insert("nonlinear", at(Value::Bool(nonlinear), line));
                 t.insert("twosided", at(Value::Bool(false), line));
             }
+            "phong" | "ward" => {
+                put("type", Value::Str(o.ty.clone()));
+                if o.ty == "phong" {
+                    let Some(n) = self.scalar_texture(&mut o, "exponent", 30.0)? else {
+                        return Ok(None);
+                    };
+                    t.insert("exponent", n);
+                } else {
+                    // Mitsuba 0.6 reads the variant in any case.
+                    let variant = o
+                        .string("variant")?
+                        .unwrap_or_else(|| "balanced".into())
+                        .to_lowercase();
+                    t.insert("variant", at(Value::Str(variant), line));
+                    let alpha = o.float("alpha", 0.1)?;
+                    for k in ["alpha_u", "alpha_v"] {
+                        let Some(a) = self.scalar_texture(&mut o, k, alpha)? else {
+                            return Ok(None);
+                        };
+                        t.insert(k, a);
+                    }
+                }
+                for (k, default) in [("specular_reflectance", 0.2), ("diffuse_reflectance", 0.5)] {
+                    let Some(c) = self.texture(&mut o, k, DVec3::splat(default))? else {
+                        return Ok(None);
+                    };
+                    t.insert(k, c);
+                }
+                energy_conservation(&mut o, &mut t)?;
+                // Mitsuba's BSDFs are one-sided unless wrapped in `twosided`.
+                t.insert("twosided", at(Value::Bool(false), line));
+            }
+            "roughdiffuse" => {
+                put("type", Value::Str("roughdiffuse".into()));
+                // Mitsuba 0.6 reads `reflectance`, or else `diffuseReflectance`.
+                let key = if o.props.iter().any(|(n, _, _)| n == "reflectance") {
+                    "reflectance"
+                } else {
+                    "diffuse_reflectance"
+                };
+                let Some(c) = self.texture(&mut o, key, DVec3::splat(0.5))? else {
+                    return Ok(None);
+                };
+                t.insert("reflectance", c);
+                let Some(a) = self.scalar_texture(&mut o, "alpha", 0.2)? else {
+                    return Ok(None);
+                };
+                t.insert("alpha", a);
+                let fast = o.boolean("use_fast_approx", false)?;
+                t.insert("use_fast_approx", at(Value::Bool(fast), line));
+                self.ignored(
+                    &mut o,
+                    "distribution",
+                    &|_| false,
+                    "ignored, as by Mitsuba 0.6's roughdiffuse (its roughness is Oren-Nayar's)",
+                );
+                energy_conservation(&mut o, &mut t)?;
+                t.insert("twosided", at(Value::Bool(false), line));
+            }
             "null" => put("type", Value::Str("null".into())),
             _ => {
                 o.props.clear();
@@ -266,4 +325,30 @@ impl Reader {
             ))),
         }
     }
+}
+
+impl Reader {
+    /// A float parameter that may be a texture (Mitsuba's float textures, as `phong`'s
+    /// `exponent`): a number, or what [`Reader::texture`] makes of a colour or a texture.
+    /// None: a texture left out (lenient).
+    fn scalar_texture(&mut self, o: &mut Obj, name: &str, default: f64) -> Result<Option<Node>> {
+        let line = o.line;
+        match o.take(name) {
+            None => Ok(Some(at(Value::Float(default), line))),
+            Some((Prop::Float(x), _)) => Ok(Some(at(Value::Float(x), line))),
+            Some((Prop::Int(i), _)) => Ok(Some(at(Value::Float(i as f64), line))),
+            Some((p, l)) => {
+                o.props.push((name.to_string(), p, l));
+                self.texture(o, name, DVec3::splat(default))
+            }
+        }
+    }
+}
+
+/// Mitsuba 0.6's `ensureEnergyConservation` (default true), written only when off.
+fn energy_conservation(o: &mut Obj, t: &mut Table) -> Result<()> {
+    if !o.boolean("ensure_energy_conservation", true)? {
+        t.insert("ensure_energy_conservation", at(Value::Bool(false), o.line));
+    }
+    Ok(())
 }
