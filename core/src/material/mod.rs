@@ -12,6 +12,8 @@
 //! Mirror surfaces are two-sided, diffuse ones unless made one-sided (Mitsuba's BSDFs are
 //! one-sided: black seen from behind).
 
+mod principled_common;
+
 use crate::Rgb;
 use crate::error::Result;
 use crate::glossy;
@@ -42,6 +44,8 @@ materials! {
         RoughDielectric(roughdielectric::RoughDielectricMaterial, glossy::RoughDielectric),
         Plastic(plastic::PlasticMaterial, glossy::Plastic),
         RoughPlastic(roughplastic::RoughPlasticMaterial, glossy::RoughPlastic),
+        Principled(principled::PrincipledMaterial, principled::PrincipledBxdf),
+        PrincipledThin(principledthin::PrincipledThinMaterial, principledthin::PrincipledThinBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of
