@@ -28,6 +28,11 @@
 //! chosen with probabilities proportional to spec_trans / 2 for each specular lobe,
 //! (1 - spec_trans)(1 - diff_trans / 2) for the diffuse reflection and
 //! (1 - spec_trans) diff_trans / 2 for the diffuse transmission (times the sampling rates).
+//!
+//! As Mitsuba's, the specular transmission masks the transmitted direction itself against the
+//! half vector of its mirror image; where that direction sees the microfacet from behind the
+//! lobe is black, which makes it non-reciprocal over part of the sphere (the light's and the
+//! viewer's directions swapped give different values there).
 
 use super::principled_common::{
     Scalar, compatible, diffuse, distribution, fresnel, read_rate, read_scalar, schlick_fresnel,
