@@ -554,7 +554,9 @@ mod tests {
     /// a sample's cosine has the CDF that inverts to the sampling formula.
     #[test]
     fn gtr1_is_normalised() {
-        for alpha in [0.1f32, 0.03, 0.001] {
+        // Down to alpha 0.03: the midpoint rule in cos theta resolves the peak (a half-width
+        // of about alpha^2 in cos theta).
+        for alpha in [0.1f32, 0.03] {
             let cc = Gtr1 { alpha };
             // Integral of D cos over the hemisphere in cos theta (phi gives 2 pi).
             let n = 200_000;
