@@ -12,6 +12,8 @@
 //! Mirror surfaces are two-sided, diffuse ones unless made one-sided (Mitsuba's BSDFs are
 //! one-sided: black seen from behind).
 
+mod principled_common;
+
 use crate::Rgb;
 use crate::error::Result;
 use crate::glossy;
@@ -45,6 +47,8 @@ materials! {
         Phong(phong::PhongMaterial, phong::PhongBxdf),
         Ward(ward::WardMaterial, ward::WardBxdf),
         RoughDiffuse(roughdiffuse::RoughDiffuseMaterial, roughdiffuse::RoughDiffuseBxdf),
+        Principled(principled::PrincipledMaterial, principled::PrincipledBxdf),
+        PrincipledThin(principledthin::PrincipledThinMaterial, principledthin::PrincipledThinBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

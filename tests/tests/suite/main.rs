@@ -48,6 +48,7 @@ mod plugin_api;
 mod plugins;
 mod ply;
 mod ppb;
+mod principled;
 mod samplers;
 mod sampling;
 mod sampling_lights;

@@ -335,14 +335,14 @@ fn unsupported_and_bad_xml_is_a_clear_error() {
         .replace("<bsdf type=\"conductor\" id=\"mirror\"/>", "")
         .replace(
             "<ref id=\"mirror\"/>",
-            "<bsdf type=\"principled\"><float name=\"roughness\" value=\"0.1\"/></bsdf>",
+            "<bsdf type=\"hk\"><float name=\"thickness\" value=\"0.1\"/></bsdf>",
         );
     write(&dir, "scene.xml", &rough);
     let run = render(&xml, &out, &[]);
     assert_eq!(run.code, 1);
     for needle in [
         "scene.xml:",
-        "<bsdf type=\"principled\">",
+        "<bsdf type=\"hk\">",
         "not supported yet",
         "--lenient",
     ] {
@@ -352,7 +352,7 @@ fn unsupported_and_bad_xml_is_a_clear_error() {
     let run = render(&xml, &out, &["--lenient"]);
     ok(&run);
     assert!(run.stderr.contains("left out: "), "{}", run.stderr);
-    assert!(run.stderr.contains("principled"), "{}", run.stderr);
+    assert!(run.stderr.contains("hk"), "{}", run.stderr);
     std::fs::remove_file(&out).unwrap();
 
     let cases: Vec<(String, Vec<&str>)> = vec![

@@ -533,8 +533,8 @@ fn xml_errors_say_what_and_where() {
             "unknown element <flaot> in <shape> (did you mean `float`?)",
         ),
         (
-            r#"<blackbody name="x" temperature="5000"/>"#,
-            "<blackbody> in <shape> is not supported",
+            r#"<animation name="x"/>"#,
+            "<animation> in <shape> is not supported",
         ),
     ] {
         let text = scene_with(
@@ -627,7 +627,7 @@ fn unknown_plugin_types_suggest_the_close_one() {
             "unknown bsdf type `difuse` (did you mean `diffuse`?)",
         ),
         (
-            r#"<shape type="sphere"><bsdf type="ward"/></shape>"#,
+            r#"<shape type="sphere"><bsdf type="irawan"/></shape>"#,
             "this BSDF is not supported yet",
         ),
         (

@@ -63,13 +63,7 @@ const FIXTURES: &[(&str, Option<(u32, &str)>)] = &[
         "mitsuba-renderer+mitsuba-blender/scenes/sampler_stratified.xml",
         None,
     ),
-    (
-        "mitsuba-renderer+mitsuba-blender/scenes/test1.xml",
-        Some((
-            41,
-            "`<bsdf type=\"principled\">`: this BSDF is not supported yet",
-        )),
-    ),
+    ("mitsuba-renderer+mitsuba-blender/scenes/test1.xml", None),
 ];
 
 fn fixtures() -> PathBuf {

@@ -234,6 +234,12 @@ impl Reader {
                 energy_conservation(&mut o, &mut t)?;
                 t.insert("twosided", at(Value::Bool(false), line));
             }
+            "principled" | "principledthin" => {
+                put("type", Value::Str(o.ty.clone()));
+                if !self.principled(&mut o, &mut t)? {
+                    return Ok(None);
+                }
+            }
             "null" => put("type", Value::Str("null".into())),
             _ => {
                 o.props.clear();
@@ -351,4 +357,117 @@ fn energy_conservation(o: &mut Obj, t: &mut Table) -> Result<()> {
         t.insert("ensure_energy_conservation", at(Value::Bool(false), o.line));
     }
     Ok(())
+}
+
+/// The numeric parameters of `principled` and `principledthin` that may be textures (the
+/// thin sheet's `eta` among them), and their sampling rates.
+const PRINCIPLED_SCALARS: &[&str] = &[
+    "roughness",
+    "anisotropic",
+    "metallic",
+    "spec_trans",
+    "spec_tint",
+    "sheen",
+    "sheen_tint",
+    "flatness",
+    "clearcoat",
+    "clearcoat_gloss",
+];
+const PRINCIPLED_THIN_SCALARS: &[&str] = &[
+    "roughness",
+    "anisotropic",
+    "spec_trans",
+    "eta",
+    "spec_tint",
+    "sheen",
+    "sheen_tint",
+    "flatness",
+    "diff_trans",
+];
+const PRINCIPLED_RATES: &[&str] = &[
+    "diffuse_reflectance_sampling_rate",
+    "main_specular_sampling_rate",
+    "clearcoat_sampling_rate",
+];
+const PRINCIPLED_THIN_RATES: &[&str] = &[
+    "specular_reflectance_sampling_rate",
+    "specular_transmittance_sampling_rate",
+    "diffuse_reflectance_sampling_rate",
+    "diffuse_transmittance_sampling_rate",
+];
+
+impl Reader {
+    /// `principled` and `principledthin`: foton's parameters have Mitsuba's names and
+    /// defaults, so only those given are written. False: a texture was left out (lenient).
+    fn principled(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
+        let line = o.line;
+        let thin = o.ty == "principledthin";
+        let Some(c) = self.texture(o, "base_color", DVec3::splat(0.5))? else {
+            return Ok(false);
+        };
+        t.insert("base_color", c);
+        let (scalars, rates) = if thin {
+            (PRINCIPLED_THIN_SCALARS, PRINCIPLED_THIN_RATES)
+        } else {
+            (PRINCIPLED_SCALARS, PRINCIPLED_RATES)
+        };
+        for &k in scalars {
+            match self.principled_scalar(o, k)? {
+                Scalar::Absent => {}
+                Scalar::LeftOut => return Ok(false),
+                Scalar::Given(v) => t.insert(k, v),
+            }
+        }
+        let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
+        if !thin && has(o, "eta") && has(o, "specular") {
+            return Err(o.error("give either `eta` or `specular`, not both"));
+        }
+        let floats: &[&str] = if thin { &[] } else { &["eta", "specular"] };
+        for &k in floats.iter().chain(rates) {
+            if o.props.iter().any(|(n, _, _)| n == k) {
+                let x = o.float(k, 0.0)?;
+                t.insert(k, at(Value::Float(x), line));
+            }
+        }
+        if !thin {
+            // Mitsuba's BSDFs are one-sided unless wrapped in `twosided`.
+            t.insert("twosided", at(Value::Bool(false), line));
+        }
+        Ok(true)
+    }
+
+    /// A numeric parameter that may be a texture: a number (an RGB colour gives its mean, as
+    /// Mitsuba's `eval_1` of a colour), or the texture's table (whose luminance foton reads,
+    /// as Mitsuba's of a bitmap).
+    fn principled_scalar(&mut self, o: &mut Obj, name: &str) -> Result<Scalar> {
+        let line = o.line;
+        match o.take(name) {
+            None => Ok(Scalar::Absent),
+            Some((Prop::Float(x), _)) => Ok(Scalar::Given(at(Value::Float(x), line))),
+            Some((Prop::Int(i), _)) => Ok(Scalar::Given(at(Value::Float(i as f64), line))),
+            Some((Prop::Color(c), _)) => Ok(Scalar::Given(at(
+                Value::Float((c.x + c.y + c.z) / 3.0),
+                line,
+            ))),
+            Some((p @ (Prop::Object(_) | Prop::Ref(_)), l)) => {
+                o.props.push((name.to_string(), p, l));
+                Ok(match self.texture(o, name, DVec3::ZERO)? {
+                    Some(node) => Scalar::Given(node),
+                    None => Scalar::LeftOut,
+                })
+            }
+            Some((p, _)) => Err(o.error(format!(
+                "`{name}`: expected a number or a texture, found {}",
+                super::object::show(&p)
+            ))),
+        }
+    }
+}
+
+/// What [`Reader::principled_scalar`] found.
+enum Scalar {
+    Absent,
+    /// A texture left out (lenient).
+    LeftOut,
+    Given(foton_core::value::Node),
 }
