@@ -760,6 +760,29 @@ fn lenient_heterogeneous_media_take_the_grids_mean() {
         "{:?}",
         report.left_out
     );
+    // A grid in a homogeneous medium (Mitsuba 3's textured albedo): its mean, said.
+    let body = format!(
+        "<medium type=\"homogeneous\" id=\"milk\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume><rgb name=\"sigma_t\" value=\"1\"/></medium>\n{SENSOR}"
+    );
+    let xml = write(&dir, "milk.xml", &scene("3.0.0", &body));
+    assert!(read(&xml, false).is_err());
+    let (doc, report) = read(&xml, true).unwrap();
+    assert!((vector(&doc.root, "media.milk.sigma_s").x - 2.0).abs() < 1e-4);
+    assert!(
+        report.left_out.iter().any(|w| w.contains("milk.xml:2")),
+        "{:?}",
+        report.left_out
+    );
+    let xml = write(
+        &dir,
+        "smoke.xml",
+        &scene(
+            "0.6.0",
+            &format!(
+                "<medium type=\"heterogeneous\" id=\"smoke\">\n<volume name=\"density\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume>\n</medium>\n{SENSOR}"
+            ),
+        ),
+    );
     std::fs::write(dir.join("smoke.vol"), &vol[..30]).unwrap();
     let e = read(&xml, true).unwrap_err();
     assert!(

@@ -1,5 +1,6 @@
 //! `<bsdf>`: a Mitsuba BSDF as a material of `[materials]` (diffuse, dielectrics, conductors,
-//! plastics, their rough variants, twosided, null), with Mitsuba's defaults written out and
+//! plastics, their rough variants, phong, ward, roughdiffuse, principled, principledthin,
+//! twosided, null), with Mitsuba's defaults written out and
 //! its named indices of refraction.
 
 use super::object::{Obj, Prop};

@@ -21,6 +21,17 @@ impl Reader {
             o.take("method");
             o.take("step_size");
         }
+        let textured = o
+            .props
+            .iter()
+            .any(|(_, p, _)| matches!(p, Prop::Object(v) if v.tag == "volume"));
+        if o.ty == "homogeneous" && textured {
+            self.unsupported(
+                &o,
+                "a <volume> in a homogeneous medium is not supported yet; rendered with its mean",
+            )?;
+            self.mean_volumes(&mut o)?;
+        }
         if o.ty != "homogeneous" {
             return Err(o.error(not_read(
                 "medium",
