@@ -54,7 +54,7 @@ XML = """<scene version="3.0.0">
 """
 DIFFUSE = '<bsdf type="diffuse"><rgb name="reflectance" value="0.5, 0.2, 0.2"/></bsdf>'
 # A BSDF foton does not read (yet).
-UNREAD = '<bsdf type="principled"><float name="roughness" value="0.1"/></bsdf>'
+UNREAD = '<bsdf type="hk"><float name="thickness" value="0.1"/></bsdf>'
 
 
 def xml_scene(tmp_path, bsdf=DIFFUSE):
@@ -89,10 +89,10 @@ def test_xml_lenient(tmp_path):
         foton.load(xml)
     assert e.value.file == str(xml)
     assert XML.replace("SPHERE_BSDF", UNREAD).splitlines()[e.value.line - 1].strip().startswith(
-        '<bsdf type="principled">'
+        '<bsdf type="hk">'
     )
     assert "not supported yet" in e.value.reason and "--lenient" in e.value.reason
-    with pytest.warns(foton.FotonWarning, match="left out: .*principled"):
+    with pytest.warns(foton.FotonWarning, match="left out: .*hk"):
         scene = foton.load(xml, lenient=True, **{"render.spp": 1})
     assert scene.render(progress=False).any()
 
