@@ -55,7 +55,7 @@ fn above(v: Vec3) -> bool {
 /// of the transmitted side, eta_it, eta_ti), eta_it the relative index in the direction of
 /// travel and eta_ti its reciprocal.
 #[inline]
-fn fresnel(cos_i: f32, eta: f32) -> (f32, f32, f32, f32) {
+pub(crate) fn fresnel(cos_i: f32, eta: f32) -> (f32, f32, f32, f32) {
     let (eta_it, eta_ti) = if cos_i >= 0.0 {
         (eta, 1.0 / eta)
     } else {
@@ -71,7 +71,7 @@ fn fresnel(cos_i: f32, eta: f32) -> (f32, f32, f32, f32) {
 /// Refraction of `v` through the microfacet `m`, given the signed cos_theta_t and eta_ti of
 /// [`fresnel`].
 #[inline]
-fn refract(v: Vec3, m: Vec3, cos_t: f32, eta_ti: f32) -> Vec3 {
+pub(crate) fn refract(v: Vec3, m: Vec3, cos_t: f32, eta_ti: f32) -> Vec3 {
     m * (v.dot(m) * eta_ti + cos_t) - v * eta_ti
 }
 

@@ -9,7 +9,6 @@ use crate::error::Result;
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::registry::Resources;
-use crate::scattering::fresnel_dielectric;
 use crate::texture::{Texture, luminance};
 use crate::value::Value;
 use glam::{Vec2, Vec3};
@@ -144,29 +143,7 @@ pub fn tint(base_color: Rgb) -> Rgb {
     }
 }
 
-/// Mitsuba's dielectric Fresnel term for a signed cosine (negative: from inside) and the
-/// relative index `eta` (inside over outside): (F, cos theta_t signed as the transmitted
-/// side, eta_it, eta_ti), eta_it the relative index along the light's travel.
-#[inline]
-pub fn fresnel(cos_i: f32, eta: f32) -> (f32, f32, f32, f32) {
-    let (eta_it, eta_ti) = if cos_i >= 0.0 {
-        (eta, 1.0 / eta)
-    } else {
-        (1.0 / eta, eta)
-    };
-    let f = fresnel_dielectric(cos_i.abs(), eta_it);
-    let cos_t = (1.0 - (1.0 - cos_i * cos_i) * eta_ti * eta_ti)
-        .max(0.0)
-        .sqrt();
-    (f, if cos_i >= 0.0 { -cos_t } else { cos_t }, eta_it, eta_ti)
-}
-
-/// Refraction of `v` through the microfacet `m`, given the signed cos theta_t and eta_ti of
-/// [`fresnel`].
-#[inline]
-pub fn refract(v: Vec3, m: Vec3, cos_t: f32, eta_ti: f32) -> Vec3 {
-    m * (v.dot(m) * eta_ti + cos_t) - v * eta_ti
-}
+pub(crate) use crate::glossy::{fresnel, refract};
 
 /// The GGX distribution of Disney's `roughness` and `anisotropic` (Burley 2012):
 /// alpha = roughness^2, stretched by sqrt(1 - 0.9 anisotropic) along x and shrunk along y,

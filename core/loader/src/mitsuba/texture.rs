@@ -46,16 +46,13 @@ impl Reader {
     /// `<ref>`) its mean over the texture, with `lenient` and a line in the report.
     pub(super) fn constant(&mut self, o: &mut Obj, name: &str, default: DVec3) -> Result<DVec3> {
         let table = match o.take(name) {
-            Some((Prop::Object(t), l)) if t.tag == "texture" => {
-                o.props.push((name.to_string(), Prop::Object(t.clone()), l));
-                self.unsupported(o, &format!("`{name}`: a texture ({}) where foton takes a constant: rendered with the texture's mean", t.what()))?;
-                o.take(name);
+            Some((Prop::Object(t), _)) if t.tag == "texture" => {
+                let what = t.what();
+                self.unsupported(o, &format!("`{name}`: a texture ({what}) where foton takes a constant: rendered with the texture's mean"))?;
                 self.texture_table(t)?
             }
-            Some((Prop::Ref(id), l)) if self.textures.contains_key(&id) => {
-                o.props.push((name.to_string(), Prop::Ref(id.clone()), l));
+            Some((Prop::Ref(id), _)) if self.textures.contains_key(&id) => {
                 self.unsupported(o, &format!("`{name}`: the texture `{id}` where foton takes a constant: rendered with the texture's mean"))?;
-                o.take(name);
                 self.textures.get(&id).cloned()
             }
             Some((p, l)) => {
