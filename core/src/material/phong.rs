@@ -84,6 +84,7 @@ impl PhongBxdf {
 }
 
 impl Bxdf for PhongBxdf {
+    #[inline(never)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
@@ -97,6 +98,7 @@ impl Bxdf for PhongBxdf {
         f * wi.z
     }
 
+    #[inline(never)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return 0.0;
@@ -112,6 +114,7 @@ impl Bxdf for PhongBxdf {
         w * specular + (1.0 - w) * wi.z * FRAC_1_PI
     }
 
+    #[inline(never)]
     fn sample(&self, wo: Vec3, u: Vec2, uc: f32, _: TransportMode) -> Option<LocalSample> {
         if wo.z <= 0.0 {
             return None;

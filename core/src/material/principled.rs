@@ -457,17 +457,17 @@ impl PrincipledBxdf {
 }
 
 impl Bxdf for PrincipledBxdf {
-    #[inline]
+    #[inline(never)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         self.eval_mode(wo, wi, TransportMode::Radiance)
     }
 
-    #[inline]
+    #[inline(never)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         PrincipledBxdf::pdf(self, wo, wi)
     }
 
-    #[inline]
+    #[inline(never)]
     fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
         PrincipledBxdf::sample(self, wo, u, uc, mode)
     }

@@ -301,17 +301,17 @@ impl PrincipledThinBxdf {
 }
 
 impl Bxdf for PrincipledThinBxdf {
-    #[inline]
+    #[inline(never)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         PrincipledThinBxdf::eval(self, wo, wi)
     }
 
-    #[inline]
+    #[inline(never)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         PrincipledThinBxdf::pdf(self, wo, wi)
     }
 
-    #[inline]
+    #[inline(never)]
     fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
         PrincipledThinBxdf::sample(self, wo, u, uc, mode)
     }

@@ -83,6 +83,7 @@ fn angles(w: Vec3) -> (f32, f32, f32) {
 }
 
 impl Bxdf for RoughDiffuseBxdf {
+    #[inline(never)]
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             return Rgb::ZERO;
@@ -135,6 +136,7 @@ impl Bxdf for RoughDiffuseBxdf {
         (single + double) * (FRAC_1_PI * wi.z)
     }
 
+    #[inline(never)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         if wo.z <= 0.0 || wi.z <= 0.0 {
             0.0
@@ -143,6 +145,7 @@ impl Bxdf for RoughDiffuseBxdf {
         }
     }
 
+    #[inline(never)]
     fn sample(&self, wo: Vec3, u: Vec2, _: f32, _: TransportMode) -> Option<LocalSample> {
         if wo.z <= 0.0 {
             return None;
