@@ -242,7 +242,7 @@ impl Material {
                 Frame::from_normal_tangent(sp.ns, sp.dpdu)
             }
         };
-        self.bsdf_in(sp.uv, sp.ng, frame)
+        self.bsdf_in(sp.p, sp.uv, sp.ng, frame)
     }
 
     /// The BSDF at a point of a flat surface whose material needs no texture coordinates and
@@ -252,14 +252,15 @@ impl Material {
     /// built without testing a tangent that is known to be zero.)
     #[inline]
     pub fn flat_bsdf(&self, ng: Vec3) -> Option<Bsdf> {
-        self.bsdf_in(Vec2::ZERO, ng, || Frame::from_normal(ng))
+        self.bsdf_in(Vec3::ZERO, Vec2::ZERO, ng, || Frame::from_normal(ng))
     }
 
-    /// The BSDF with its textures looked up at `uv`, the geometric normal `ng`, and the
-    /// shading frame `frame` makes (not made for the null material).
+    /// The BSDF at point `p` (which only a blend reads) with its textures looked up at `uv`,
+    /// the geometric normal `ng`, and the shading frame `frame` makes (not made for the null
+    /// material).
     #[inline(always)]
-    fn bsdf_in(&self, uv: Vec2, ng: Vec3, frame: impl FnOnce() -> Frame) -> Option<Bsdf> {
-        let (lobe, twosided) = self.lobe_at(uv)?;
+    fn bsdf_in(&self, p: Vec3, uv: Vec2, ng: Vec3, frame: impl FnOnce() -> Frame) -> Option<Bsdf> {
+        let (lobe, twosided) = self.lobe_at(p, uv)?;
         Some(Bsdf {
             lobe,
             frame: frame(),

@@ -12,6 +12,7 @@
 //! Mirror surfaces are two-sided, diffuse ones unless made one-sided (Mitsuba's BSDFs are
 //! one-sided: black seen from behind).
 
+pub mod blend;
 mod principled_common;
 
 use crate::Rgb;
@@ -27,12 +28,14 @@ use glam::{Vec2, Vec3};
 pub use crate::scattering::{
     LocalSample, TransportMode, fresnel_conductor, fresnel_dielectric, reflect, refract,
 };
+pub use blend::BlendMaterial;
 pub use conductor::{CONDUCTORS, conductor_ior};
 
 materials! {
     /// A material of any kind: one variant per file of this folder, each line naming the
-    /// kind and its lobe, and `Null`, the invisible boundary of a medium (rays cross it
-    /// without scattering), which the macro adds.
+    /// kind and its lobe, and two the macro adds: `Null`, the invisible boundary of a medium
+    /// (rays cross it without scattering), and `Blend`, a weighted sum of materials of which
+    /// each hit takes one (so that it has no lobe of its own).
     #[derive(Clone, Debug)]
     pub enum Material {
         Diffuse(diffuse::DiffuseMaterial, diffuse::DiffuseBxdf),
@@ -106,6 +109,7 @@ macro_rules! materials {
         pub enum Material {
             $($variant($kind),)*
             Null,
+            Blend(Box<blend::BlendMaterial>),
         }
 
         $(#[$lobe_attr])*
@@ -121,7 +125,7 @@ macro_rules! materials {
                 let material = ($module::FACTORY.create)(bag, nested, resources)?;
                 Ok(Box::new(Material::$variant(*material)))
             },
-        },)* NULL];
+        },)* NULL, blend::FACTORY];
 
         $(impl From<$kind> for Material {
             fn from(material: $kind) -> Material {
@@ -136,6 +140,7 @@ macro_rules! materials {
                 match self {
                     $(Material::$variant(_) => <$bxdf as Bxdf>::DELTA,)*
                     Material::Null => false,
+                    Material::Blend(b) => b.is_delta(),
                 }
             }
 
@@ -145,6 +150,8 @@ macro_rules! materials {
                 match self {
                     $(Material::$variant(m) => m.needs_coordinates(),)*
                     Material::Null => false,
+                    // The choice of a component hashes the hit's position and coordinates.
+                    Material::Blend(_) => true,
                 }
             }
 
@@ -153,16 +160,19 @@ macro_rules! materials {
                 match self {
                     $(Material::$variant(m) => m.encloses_volume(),)*
                     Material::Null => false,
+                    Material::Blend(b) => b.encloses_volume(),
                 }
             }
 
-            /// The lobe at `uv` and whether the BSDF mirrors directions from below (see
-            /// [`SurfaceMaterial`]); None for the null material, which does not scatter.
+            /// The lobe at point `p` with coordinates `uv` and whether the BSDF mirrors
+            /// directions from below (see [`SurfaceMaterial`]); None for the null material,
+            /// which does not scatter. Only a blend reads `p` (to choose its component).
             #[inline(always)]
-            pub(crate) fn lobe_at(&self, uv: Vec2) -> Option<(Lobe, bool)> {
+            pub(crate) fn lobe_at(&self, p: Vec3, uv: Vec2) -> Option<(Lobe, bool)> {
                 match self {
                     $(Material::$variant(m) => Some((Lobe::$variant(m.bxdf(uv)), m.twosided())),)*
                     Material::Null => None,
+                    Material::Blend(b) => b.lobe_at(p, uv),
                 }
             }
         }

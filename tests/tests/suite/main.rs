@@ -15,6 +15,7 @@ mod bad_input_values;
 mod bdpt;
 mod beams;
 mod bitterli;
+mod blend;
 mod build_id;
 mod capabilities;
 mod conductor;

@@ -1,6 +1,6 @@
 //! `<bsdf>`: a Mitsuba BSDF as a material of `[materials]` (diffuse, dielectrics, conductors,
 //! plastics, their rough variants, phong, ward, roughdiffuse, principled, principledthin,
-//! twosided, null), with Mitsuba's defaults written out and
+//! twosided, null, blendbsdf and mixturebsdf as `blend`), with Mitsuba's defaults written out and
 //! its named indices of refraction.
 
 use super::object::{Obj, Prop};
@@ -61,14 +61,13 @@ impl Reader {
                 self.leftovers(&o)?;
                 let name = self.bsdf(inner)?;
                 // The same BSDF on both sides: diffuse's own switch (the others are two-sided
-                // or have no sides).
+                // or have no sides), a blend's components' switches.
                 if let Some(Value::Table(t)) = name
                     .as_deref()
                     .and_then(|n| table_mut(&mut self.root, "materials").get_mut(n))
                     .map(|n| &mut n.value)
-                    && t.get("twosided").is_some()
                 {
-                    t.insert("twosided", at(Value::Bool(true), line));
+                    make_twosided(t, line);
                 }
                 return Ok(name);
             }
@@ -242,6 +241,52 @@ impl Reader {
                 }
             }
             "null" => put("type", Value::Str("null".into())),
+            "blendbsdf" | "mixturebsdf" => {
+                put("type", Value::Str("blend".into()));
+                let Some(components) = self.blend_components(&mut o)? else {
+                    return Ok(None);
+                };
+                if o.ty == "blendbsdf" {
+                    if components.len() != 2 {
+                        return Err(o.error(format!(
+                            "a blendbsdf blends two BSDFs; found {}",
+                            components.len()
+                        )));
+                    }
+                    // Mitsuba 3 requires the weight; 0.6 takes 0.5.
+                    if !o.v1 && !o.props.iter().any(|(n, _, _)| n == "weight") {
+                        return Err(o.error("a blendbsdf needs its `weight` (Mitsuba 3)"));
+                    }
+                    let Some(w) = self.scalar_texture(&mut o, "weight", 0.5)? else {
+                        return Ok(None);
+                    };
+                    t.insert("weight", w);
+                    // Read by 0.6's base class, unused by its blendbsdf.
+                    o.take("ensure_energy_conservation");
+                } else {
+                    let weights = o.string("weights")?.unwrap_or_default();
+                    let mut ws = Vec::new();
+                    for token in weights.split([' ', ',', ';']).filter(|s| !s.is_empty()) {
+                        let w: f64 = token.parse().map_err(|_| {
+                            o.error(format!("`weights`: could not read {token:?} as a number"))
+                        })?;
+                        ws.push(at(Value::Float(w), line));
+                    }
+                    if ws.is_empty() {
+                        return Err(o.error("a mixturebsdf needs its `weights`"));
+                    }
+                    if ws.len() != components.len() {
+                        return Err(o.error(format!(
+                            "{} weights for {} BSDFs: a mixturebsdf takes one per BSDF",
+                            ws.len(),
+                            components.len()
+                        )));
+                    }
+                    put("weights", Value::Array(ws));
+                    energy_conservation(&mut o, &mut t)?;
+                }
+                t.insert("materials", at(Value::Array(components), line));
+            }
             _ => {
                 o.props.clear();
                 let m = not_read("bsdf", &o.ty, "this BSDF is not supported yet");
@@ -349,6 +394,77 @@ impl Reader {
                 self.texture(o, name, DVec3::splat(default))
             }
         }
+    }
+}
+
+/// Makes a material table two-sided (Mitsuba's `twosided` around it): its own switch, or
+/// those of a blend's components.
+fn make_twosided(t: &mut Table, line: u32) {
+    if t.get("twosided").is_some() {
+        t.insert("twosided", at(Value::Bool(true), line));
+    }
+    if let Some(Node {
+        value: Value::Array(components),
+        ..
+    }) = t.get_mut("materials")
+    {
+        for c in components {
+            if let Value::Table(inner) = &mut c.value {
+                make_twosided(inner, line);
+            }
+        }
+    }
+}
+
+impl Reader {
+    /// The BSDFs nested in (or referenced by) a blendbsdf or mixturebsdf, in the file's
+    /// order, as material tables (copies of those written to `[materials]`). None: one was
+    /// left out (lenient). A null BSDF among them is refused.
+    fn blend_components(&mut self, o: &mut Obj) -> Result<Option<Vec<Node>>> {
+        let mut names = Vec::new();
+        let mut i = 0;
+        while i < o.props.len() {
+            let take = match &o.props[i].1 {
+                Prop::Object(b) => b.tag == "bsdf",
+                Prop::Ref(id) => self.bsdfs.contains_key(id),
+                _ => false,
+            };
+            if !take {
+                i += 1;
+                continue;
+            }
+            let (_, p, l) = o.props.remove(i);
+            let name = match p {
+                Prop::Object(b) => self.bsdf(b)?,
+                Prop::Ref(id) => self.bsdfs.get(&id).cloned(),
+                _ => unreachable!(),
+            };
+            let Some(name) = name else {
+                return Ok(None);
+            };
+            names.push((name, l));
+        }
+        let mut out = Vec::new();
+        for (name, l) in names {
+            let node = table_mut(&mut self.root, "materials")
+                .get(&name)
+                .cloned()
+                .expect("a BSDF read is in [materials]");
+            if let Value::Table(t) = &node.value
+                && matches!(t.get("type").map(|n| &n.value), Some(Value::Str(s)) if s == "null")
+            {
+                let here = Obj {
+                    line: l,
+                    props: Vec::new(),
+                    ..o.clone()
+                };
+                return Err(here.error(
+                    "a null BSDF inside a blend is not supported (foton's null surfaces are holes everywhere, not at some points)",
+                ));
+            }
+            out.push(node);
+        }
+        Ok(Some(out))
     }
 }
 
