@@ -52,6 +52,7 @@ materials! {
         RoughDiffuse(roughdiffuse::RoughDiffuseMaterial, roughdiffuse::RoughDiffuseBxdf),
         Principled(principled::PrincipledMaterial, principled::PrincipledBxdf),
         PrincipledThin(principledthin::PrincipledThinMaterial, principledthin::PrincipledThinBxdf),
+        DiffTrans(difftrans::DiffTransMaterial, difftrans::DiffTransBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

@@ -32,7 +32,7 @@ use std::f64::consts::PI;
 // ---------------------------------------------------------------------------------------------
 
 /// The goodness-of-fit tests of this file, for the Sidak correction of their significance.
-const NUM_GOF_TESTS: usize = 9;
+const NUM_GOF_TESTS: usize = 11;
 
 fn alpha_each() -> f64 {
     1.0 - (1.0 - 0.01f64).powf(1.0 / NUM_GOF_TESTS as f64)
@@ -858,5 +858,294 @@ fn bad_classic_parameters_are_errors() {
             err.contains(words) && err.contains("bad.xml"),
             "{bsdf}: {err}"
         );
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Dielectrics' specular_reflectance and specular_transmittance
+// ---------------------------------------------------------------------------------------------
+
+/// Mitsuba's dielectrics multiply the reflected part by `specular_reflectance` and the
+/// transmitted one by `specular_transmittance`, with the probabilities of the plain lobe: each
+/// sample of the coloured lobe has the plain one's direction and pdf, its weight times r or t
+/// by the side wi is on; the rough lobe's eval likewise.
+#[test]
+fn dielectric_factors_scale_reflection_and_transmission_only() {
+    use foton_core::glossy::RoughDielectric;
+    use foton_core::material::dielectric::DielectricBxdf;
+    use foton_core::material::thindielectric::ThinDielectricBxdf;
+    use foton_core::microfacet::{Microfacet, MicrofacetKind};
+    let (r, t) = (Rgb::new(0.5, 0.25, 0.8), Rgb::new(0.3, 0.9, 0.6));
+    let close = |what: &str, got: Rgb, want: Rgb| {
+        assert!(rgb_close(got, want, 1e-6), "{what}: {got} against {want}");
+    };
+    fn check<B: Bxdf>(
+        name: &str,
+        plain: &B,
+        coloured: &B,
+        r: Rgb,
+        t: Rgb,
+        close: &dyn Fn(&str, Rgb, Rgb),
+    ) {
+        let mut rng = Rng::new(&[5]);
+        let (mut reflected, mut transmitted) = (0, 0);
+        for k in 0..4000 {
+            let w = uniform_sphere(rng.next_2d());
+            let wo = Vec3::new(w.x, w.y, if w.z.abs() < 1e-3 { 0.5 } else { w.z }).normalize();
+            let (u, uc) = (rng.next_2d(), rng.next_f32());
+            let mode = if k % 2 == 0 {
+                TransportMode::Radiance
+            } else {
+                TransportMode::Importance
+            };
+            let (a, b) = (
+                plain.sample(wo, u, uc, mode),
+                coloured.sample(wo, u, uc, mode),
+            );
+            let (Some(a), Some(b)) = (a, b) else {
+                assert_eq!(a.is_none(), b.is_none(), "{name}: one sample failed");
+                continue;
+            };
+            assert_eq!((a.wi, a.pdf, a.delta), (b.wi, b.pdf, b.delta), "{name}");
+            let factor = if a.wi.z * wo.z > 0.0 {
+                reflected += 1;
+                r
+            } else {
+                transmitted += 1;
+                t
+            };
+            close(
+                &format!("{name}: sample weight"),
+                b.weight,
+                a.weight * factor,
+            );
+            if !B::DELTA {
+                close(
+                    &format!("{name}: eval"),
+                    coloured.eval(wo, a.wi),
+                    plain.eval(wo, a.wi) * factor,
+                );
+                assert_eq!(coloured.pdf(wo, a.wi), plain.pdf(wo, a.wi), "{name}: pdf");
+            }
+        }
+        assert!(
+            reflected > 100 && transmitted > 100,
+            "{name}: {reflected} {transmitted}"
+        );
+    }
+    check(
+        "dielectric",
+        &DielectricBxdf {
+            ior: 1.5,
+            specular_reflectance: Rgb::ONE,
+            specular_transmittance: Rgb::ONE,
+        },
+        &DielectricBxdf {
+            ior: 1.5,
+            specular_reflectance: r,
+            specular_transmittance: t,
+        },
+        r,
+        t,
+        &close,
+    );
+    check(
+        "thindielectric",
+        &ThinDielectricBxdf {
+            ior: 1.5,
+            specular_reflectance: Rgb::ONE,
+            specular_transmittance: Rgb::ONE,
+        },
+        &ThinDielectricBxdf {
+            ior: 1.5,
+            specular_reflectance: r,
+            specular_transmittance: t,
+        },
+        r,
+        t,
+        &close,
+    );
+    let rough = RoughDielectric {
+        distribution: Microfacet::isotropic(MicrofacetKind::Ggx, 0.3),
+        eta: 1.5,
+        specular_reflectance: Rgb::ONE,
+        specular_transmittance: Rgb::ONE,
+    };
+    let coloured = RoughDielectric {
+        specular_reflectance: r,
+        specular_transmittance: t,
+        ..rough
+    };
+    check("roughdielectric", &rough, &coloured, r, t, &close);
+    // Through the scene's reader: the factors reach the lobe.
+    for kind in ["dielectric", "thindielectric"] {
+        let m = material(
+            kind,
+            &[
+                ("specular_reflectance", rgb([0.5, 0.25, 0.8])),
+                ("specular_transmittance", rgb([0.3, 0.9, 0.6])),
+            ],
+        );
+        let (got_r, got_t) = match m {
+            Material::Dielectric(m) => {
+                let b = m.bxdf(Vec2::ZERO);
+                (b.specular_reflectance, b.specular_transmittance)
+            }
+            Material::ThinDielectric(m) => {
+                let b = m.bxdf(Vec2::ZERO);
+                (b.specular_reflectance, b.specular_transmittance)
+            }
+            m => panic!("{m:?}"),
+        };
+        assert_eq!((got_r, got_t), (r, t), "{kind}");
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// difftrans
+// ---------------------------------------------------------------------------------------------
+
+fn difftrans(entries: &[(&str, Value)]) -> foton_core::material::difftrans::DiffTransBxdf {
+    match material("difftrans", entries) {
+        Material::DiffTrans(m) => m.bxdf(Vec2::ZERO),
+        m => panic!("{m:?}"),
+    }
+}
+
+/// A transmitting lobe seen as a reflecting one, for [`check_sampling`]: `wo` (above) is put
+/// on the lobe's side `from_below` or above, `wi` (above) on the other side.
+struct Unfolded<B> {
+    inner: B,
+    from_below: bool,
+}
+
+impl<B: Bxdf> Unfolded<B> {
+    fn flip(w: Vec3) -> Vec3 {
+        Vec3::new(w.x, w.y, -w.z)
+    }
+    fn dirs(&self, wo: Vec3, wi: Vec3) -> (Vec3, Vec3) {
+        if self.from_below {
+            (Self::flip(wo), wi)
+        } else {
+            (wo, Self::flip(wi))
+        }
+    }
+}
+
+impl<B: Bxdf> Bxdf for Unfolded<B> {
+    fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
+        let (o, i) = self.dirs(wo, wi);
+        self.inner.eval(o, i)
+    }
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (o, i) = self.dirs(wo, wi);
+        self.inner.pdf(o, i)
+    }
+    fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
+        let o = if self.from_below { Self::flip(wo) } else { wo };
+        let mut s = self.inner.sample(o, u, uc, mode)?;
+        if !self.from_below {
+            s.wi = Self::flip(s.wi);
+        }
+        Some(s)
+    }
+    fn roughness(&self) -> f32 {
+        self.inner.roughness()
+    }
+}
+
+use foton_core::scattering::LocalSample;
+
+/// Mitsuba 0.6's `difftrans` samples the other side by the cosine (chi-square), from either
+/// side, every sample's weight eval / pdf = transmittance.
+#[test]
+fn difftrans_samples_follow_its_pdf_from_both_sides() {
+    let t = [0.7, 0.4, 0.1];
+    let lobe = difftrans(&[("transmittance", rgb(t))]);
+    for (k, from_below) in [false, true].into_iter().enumerate() {
+        let name = format!(
+            "difftrans, wo {}",
+            if from_below { "below" } else { "above" }
+        );
+        let unfolded = Unfolded {
+            inner: lobe,
+            from_below,
+        };
+        let albedo = check_sampling(&name, &unfolded, dir(50.0, 30.0), 200_000, 30 + k as u64);
+        for c in 0..3 {
+            assert_close(&format!("{name}: weight"), albedo[c], t[c], 1e-6);
+        }
+    }
+}
+
+/// eval and pdf against Mitsuba 0.6's formulas (difftrans.cpp): f |cos theta_i| =
+/// transmittance / pi |cos theta_i| and pdf = |cos theta_i| / pi for wi on the other side of
+/// wo, both zero on the same side; the default transmittance is 0.5.
+#[test]
+fn difftrans_eval_and_pdf_match_mitsubas_formulas() {
+    let t = [0.7, 0.4, 0.1];
+    let lobe = difftrans(&[("transmittance", rgb(t))]);
+    assert_eq!(difftrans(&[]).transmittance, Rgb::splat(0.5));
+    for (wo, wi) in direction_pairs() {
+        let flip = |w: Vec3| Vec3::new(w.x, w.y, -w.z);
+        for (o, i) in [(wo, flip(wi)), (flip(wo), wi)] {
+            let cos_i = (i.z as f64).abs();
+            let want = t.map(|c| c * cos_i / PI);
+            assert_rgb("difftrans eval", lobe.eval(o, i), want);
+            assert_pdf("difftrans pdf", lobe.pdf(o, i), cos_i / PI);
+            // Reciprocal: f = eval / |cos theta_i| is symmetric.
+            let f_oi = lobe.eval(o, i) / i.z.abs();
+            let f_io = lobe.eval(i, o) / o.z.abs();
+            assert!(rgb_close(f_oi, f_io, 1e-5), "{f_oi} vs {f_io}");
+        }
+        for (o, i) in [(wo, wi), (flip(wo), flip(wi))] {
+            assert_eq!(lobe.eval(o, i), Rgb::ZERO);
+            assert_eq!(lobe.pdf(o, i), 0.0);
+        }
+    }
+}
+
+/// A white furnace of the transmitter: the integral of eval over the sphere (midpoint rule
+/// in theta and phi) is the transmittance, all of it on the other side, and the pdf integrates
+/// to one.
+#[test]
+fn difftrans_transmits_its_transmittance_and_reflects_nothing() {
+    let t = [0.7, 0.4, 0.1];
+    let lobe = difftrans(&[("transmittance", rgb(t))]);
+    let (n_theta, n_phi) = (600, 64);
+    for wo in [dir(0.0, 0.0), dir(40.0, 10.0), dir(85.0, 200.0)] {
+        for wo in [wo, -wo] {
+            let (mut other, mut same, mut pdf) = (DVec3::ZERO, DVec3::ZERO, 0.0);
+            for i in 0..n_theta {
+                let theta = (i as f64 + 0.5) * PI / n_theta as f64;
+                let dw = theta.sin() * (PI / n_theta as f64) * (2.0 * PI / n_phi as f64);
+                for j in 0..n_phi {
+                    let phi = (j as f64 + 0.5) * 2.0 * PI / n_phi as f64;
+                    let wi = DVec3::new(
+                        theta.sin() * phi.cos(),
+                        theta.sin() * phi.sin(),
+                        theta.cos(),
+                    )
+                    .as_vec3();
+                    let e = lobe.eval(wo, wi).as_dvec3() * dw;
+                    if wi.z * wo.z < 0.0 {
+                        other += e
+                    } else {
+                        same += e
+                    }
+                    pdf += lobe.pdf(wo, wi) as f64 * dw;
+                }
+            }
+            for c in 0..3 {
+                assert_close(
+                    &format!("difftrans transmittance, wo {wo}"),
+                    other[c],
+                    t[c],
+                    1e-4,
+                );
+            }
+            assert_eq!(same, DVec3::ZERO, "difftrans reflects, wo {wo}");
+            assert_close(&format!("difftrans pdf mass, wo {wo}"), pdf, 1.0, 1e-4);
+        }
     }
 }

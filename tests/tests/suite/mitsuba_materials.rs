@@ -269,3 +269,92 @@ fn an_emitter_without_a_bsdf_reflects_nothing() {
         assert!((c - 1.0).abs() < 1e-4, "the light reflects: {m:?}");
     }
 }
+
+/// Mitsuba's `specular_reflectance` and `specular_transmittance` of the smooth dielectrics
+/// (a colour or a texture) reach the material, and `difftrans` (Mitsuba 0.6's, with its
+/// default 0.5 and its older name `diffuseTransmittance`) is read.
+#[test]
+fn dielectric_factors_and_difftrans_read_as_mitsuba_means_them() {
+    use foton_core::Rgb;
+    use foton_core::material::{Material, SurfaceMaterial};
+    let dir = scene_folder("mitsuba-dielectric-factors");
+    let shapes = |bsdfs: &str, n: usize| {
+        let mut s = bsdfs.to_string();
+        for i in 0..n {
+            s += &format!(
+                "<shape type=\"sphere\"><point name=\"center\" x=\"{}\" y=\"0\" z=\"0\"/><ref id=\"b{i}\"/></shape>\n",
+                3 * i
+            );
+        }
+        s
+    };
+    let text = format!(
+        r#"<scene version="3.0.0">
+    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+    {}
+    <emitter type="constant"/>
+</scene>
+"#,
+        shapes(
+            r#"<bsdf type="dielectric" id="b0"><rgb name="specular_reflectance" value="0.5"/></bsdf>
+    <bsdf type="thindielectric" id="b1">
+        <texture type="checkerboard" name="specular_transmittance"><rgb name="color0" value="0.2"/><rgb name="color1" value="0.6"/></texture>
+    </bsdf>
+    <bsdf type="difftrans" id="b2"><rgb name="transmittance" value="0.1, 0.2, 0.3"/></bsdf>
+    <bsdf type="difftrans" id="b3"/>
+"#,
+            4
+        )
+    );
+    let xml = write(&dir, "factors.xml", &text);
+    let scene = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    let material = |i: usize| &scene.materials()[scene.objects()[i].material as usize].value;
+    let Material::Dielectric(m) = material(0) else {
+        panic!("{:?}", material(0))
+    };
+    let b = m.bxdf(glam::Vec2::ZERO);
+    assert_eq!(
+        (b.specular_reflectance, b.specular_transmittance),
+        (Rgb::splat(0.5), Rgb::ONE)
+    );
+    assert!((b.ior - 1.5046 / 1.000277).abs() < 1e-6);
+    let Material::ThinDielectric(m) = material(1) else {
+        panic!("{:?}", material(1))
+    };
+    assert!(m.needs_coordinates());
+    assert_eq!(m.bxdf(glam::Vec2::ZERO).specular_reflectance, Rgb::ONE);
+    let ts: Vec<Rgb> = [(0.25, 0.25), (0.75, 0.25)]
+        .map(|(u, v)| m.bxdf(glam::Vec2::new(u, v)).specular_transmittance)
+        .into();
+    assert!(
+        ts.contains(&Rgb::splat(0.2)) && ts.contains(&Rgb::splat(0.6)),
+        "{ts:?}"
+    );
+    let transmittance = |i: usize| match material(i) {
+        Material::DiffTrans(m) => m.bxdf(glam::Vec2::ZERO).transmittance,
+        m => panic!("{m:?}"),
+    };
+    assert_eq!(transmittance(2), Rgb::new(0.1, 0.2, 0.3));
+    assert_eq!(transmittance(3), Rgb::splat(0.5));
+    // Mitsuba 0.6's name of the parameter.
+    let old = format!(
+        r#"<scene version="0.6.0">
+    <sensor type="perspective"><film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+    {}
+    <emitter type="constant"/>
+</scene>
+"#,
+        shapes(
+            r#"<bsdf type="difftrans" id="b0"><spectrum name="diffuseTransmittance" value="0.25"/></bsdf>
+"#,
+            1
+        )
+    );
+    let xml = write(&dir, "old.xml", &old);
+    let scene = foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    let Material::DiffTrans(m) = &scene.materials()[scene.objects()[0].material as usize].value
+    else {
+        panic!()
+    };
+    assert_eq!(m.bxdf(glam::Vec2::ZERO).transmittance, Rgb::splat(0.25));
+}

@@ -130,7 +130,7 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
     const N: usize = 100_000;
     let ng = Vec3::new(-0.2, 0.5, 0.84).normalize();
     for (k, &(ior, inside, cos)) in DIELECTRIC_CASES.iter().enumerate() {
-        let mat = Material::from(DielectricMaterial { ior });
+        let mat = Material::from(DielectricMaterial::new(ior));
         let (wo, n) = dielectric_wo(ng, inside, cos);
         let (n_o, n_t) = if inside {
             (ior as f64, 1.0)
@@ -227,7 +227,7 @@ fn dielectric_reflects_with_fresnel_probability_and_refracts_by_snell() {
 fn dielectric_totally_reflects_beyond_the_critical_angle() {
     let ng = Vec3::new(-0.2, 0.5, 0.84).normalize();
     for (k, &(ior, inside, cos)) in TIR_CASES.iter().enumerate() {
-        let mat = Material::from(DielectricMaterial { ior });
+        let mat = Material::from(DielectricMaterial::new(ior));
         let (wo, n) = dielectric_wo(ng, inside, cos);
         let (n_o, n_t) = if inside {
             (ior as f64, 1.0)

@@ -146,6 +146,15 @@ fn every_colour_field_takes_a_texture() {
             vec!["specular_reflectance", "specular_transmittance"],
         ),
         (
+            "dielectric",
+            vec!["specular_reflectance", "specular_transmittance"],
+        ),
+        (
+            "thindielectric",
+            vec!["specular_reflectance", "specular_transmittance"],
+        ),
+        ("difftrans", vec!["transmittance"]),
+        (
             "plastic",
             vec!["diffuse_reflectance", "specular_reflectance"],
         ),

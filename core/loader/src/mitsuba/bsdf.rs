@@ -1,6 +1,7 @@
 //! `<bsdf>`: a Mitsuba BSDF as a material of `[materials]` (diffuse, dielectrics, conductors,
-//! plastics, their rough variants, phong, ward, roughdiffuse, principled, principledthin,
-//! twosided, null, blendbsdf and mixturebsdf as `blend`), with Mitsuba's defaults written out and
+//! plastics, their rough variants, difftrans, phong, ward, roughdiffuse, principled,
+//! principledthin, twosided, null, blendbsdf and mixturebsdf as `blend`), with Mitsuba's
+//! defaults written out and
 //! its named indices of refraction.
 
 use super::object::{Obj, Prop};
@@ -86,10 +87,26 @@ impl Reader {
                 let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
                 t.insert("ior", at(Value::Float(int / ext), line));
                 for k in ["specular_reflectance", "specular_transmittance"] {
-                    if o.color(k, DVec3::ONE)? != DVec3::ONE {
-                        self.unsupported(&o, &format!("`{k}` other than 1 is not supported yet"))?;
-                    }
+                    let Some(c) = self.texture(&mut o, k, DVec3::ONE)? else {
+                        return Ok(None);
+                    };
+                    t.insert(k, c);
                 }
+            }
+            "difftrans" => {
+                put("type", Value::Str("difftrans".into()));
+                // Mitsuba 0.6 also reads `diffuseTransmittance` when `transmittance` is absent
+                // (Mitsuba 3 has no `difftrans`; a newer file is read the same way).
+                let has = |k: &str| o.props.iter().any(|(n, _, _)| n == k);
+                let key = if o.v1 && !has("transmittance") && has("diffuse_transmittance") {
+                    "diffuse_transmittance"
+                } else {
+                    "transmittance"
+                };
+                let Some(c) = self.texture(&mut o, key, DVec3::splat(0.5))? else {
+                    return Ok(None);
+                };
+                t.insert("transmittance", c);
             }
             "conductor" | "roughconductor" => {
                 put("type", Value::Str(o.ty.clone()));

@@ -251,7 +251,11 @@ const MITSUBA06_PARAMETERS: &[(&str, &str, &[&str])] = &[
             "sample_visible",
         ],
     ),
-    ("bsdf", "difftrans", &["transmittance"]),
+    (
+        "bsdf",
+        "difftrans",
+        &["transmittance", "diffuse_transmittance"],
+    ),
     ("bsdf", "diffuse", &["reflectance"]),
     ("bsdf", "mask", &["opacity"]),
     ("bsdf", "mixturebsdf", &["weights"]),
