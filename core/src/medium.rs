@@ -19,6 +19,7 @@ use crate::Rgb;
 use crate::geometry::Ray;
 use glam::Vec3;
 
+pub mod grid;
 mod phase;
 pub use phase::Phase;
 
@@ -27,8 +28,10 @@ crate::registry::builtins! {
     /// `FACTORY`): what a `[media]` table's `type` names.
     pub const MEDIA: [dyn Medium] = [
         homogeneous,
+        heterogeneous,
     ];
 }
+pub use heterogeneous::Heterogeneous;
 pub use homogeneous::Homogeneous;
 
 /// A free-flight distance sample along a ray segment of length `tmax` (to the next surface, or

@@ -39,6 +39,11 @@ pub trait Resources {
     fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture>;
     /// A warning about parameter `key`, reported with the scene's others.
     fn warn(&mut self, bag: &Properties<'_>, key: &str, message: String);
+    /// The bytes of the file named by the string parameter `key` (a path relative to the
+    /// scene file's folder), which becomes one of the scene's sources.
+    fn file(&mut self, bag: &Properties<'_>, key: &str) -> Result<Vec<u8>> {
+        Err(bag.error(key, "files are read only in a scene file"))
+    }
 }
 
 /// The resources of a bag read outside a scene file (an integrator's `kernel`, a test): no
@@ -280,7 +285,7 @@ mod tests {
         assert_eq!(
             unknown("medium type", "homogenous", MEDIA),
             "unknown medium type \"homogenous\" (did you mean \"homogeneous\"?); \
-             expected one of: homogeneous"
+             expected one of: homogeneous, heterogeneous"
         );
     }
 

@@ -2,7 +2,7 @@
 
     pip install mitsuba          # 3.x
     python3 tests/corpus/vs_mitsuba3.py --foton target/release/foton [--size 128] \
-        [--spp 256] [--variant scalar_rgb] FILE.xml [FILE.xml ...]
+        [--spp 256] [--variant scalar_rgb] [--integrator NAME] [--set KEY=VALUE] FILE.xml [...]
 
 Each file is copied beside itself (so that its relative paths resolve), with the film's
 `width` and `height` scaled so that the larger is `--size` and any crop window dropped, then
@@ -80,8 +80,8 @@ def mitsuba_render(path, spp, seed):
     return np.array(img, dtype=np.float64)[:, :, :3]
 
 
-def foton_render(foton, path, spp, out):
-    cmd = [foton, "render", path, "--spp", str(spp), "-q", "-o", out]
+def foton_render(foton, path, spp, out, extra=()):
+    cmd = [foton, "render", path, "--spp", str(spp), "-q", "-o", out, *extra]
     r = subprocess.run(cmd, capture_output=True, text=True)
     if r.returncode != 0:
         raise RuntimeError(r.stderr.strip().splitlines()[-1] if r.stderr.strip() else "failed")
@@ -111,6 +111,8 @@ def main():
     ap.add_argument("--size", type=int, default=128)
     ap.add_argument("--spp", type=int, default=256)
     ap.add_argument("--variant", default="scalar_rgb")
+    ap.add_argument("--integrator", help="foton's integrator, instead of the file's")
+    ap.add_argument("--set", action="append", default=[], help="foton's --set (repeatable)")
     ap.add_argument("files", nargs="+")
     args = ap.parse_args()
     mi.set_variant(args.variant)
@@ -124,7 +126,10 @@ def main():
         try:
             ref = mitsuba_render(copy, args.spp, 1)
             ref2 = mitsuba_render(copy, args.spp, 2)
-            img = foton_render(foton, copy, args.spp, out)
+            extra = ["--integrator", args.integrator] if args.integrator else []
+            for kv in args.set:
+                extra += ["--set", kv]
+            img = foton_render(foton, copy, args.spp, out, extra)
             if img.shape != ref.shape:
                 raise RuntimeError(f"sizes differ: foton {img.shape}, mitsuba {ref.shape}")
             m, med, worst = stats(img, ref)

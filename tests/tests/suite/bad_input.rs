@@ -411,14 +411,14 @@ fn unknown_medium_type_lists_the_types() {
     let text = format!("{BASE}{FOG}");
     let scene = SceneFile::new(
         "unknown-medium",
-        &edit(&text, "type = \"homogeneous\"", "type = \"heterogeneous\""),
+        &edit(&text, "type = \"homogeneous\"", "type = \"volumetric\""),
     );
     scene.check_fails(
-        "type = \"heterogeneous\"",
+        "type = \"volumetric\"",
         "media.fog.type",
         &[
-            "unknown medium type \"heterogeneous\"",
-            "expected one of: homogeneous",
+            "unknown medium type \"volumetric\"",
+            "expected one of: homogeneous, heterogeneous",
         ],
     );
 }

@@ -29,6 +29,7 @@ mod docs;
 mod environment;
 mod filter;
 mod glossy;
+mod heterogeneous;
 mod kernels;
 mod materials_classic;
 mod media;

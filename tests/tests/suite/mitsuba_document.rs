@@ -720,13 +720,14 @@ fn lenient_gets_past_unresolved_names_and_0_6_distributions() {
     );
 }
 
-/// A heterogeneous medium (Mitsuba 0.6's `density` grid and `albedo` constant) is refused as
-/// written and, with `--lenient`, rendered as the homogeneous medium of the grid's mean
-/// density, scaled, and of the albedo; a phase function foton lacks is the isotropic one.
+/// A heterogeneous medium (Mitsuba 0.6's `density` grid and `albedo` constant) is foton's
+/// `heterogeneous`: the grid in the box its file gives, samples on the corners, zero beyond,
+/// `scale` into sigma_t; a phase function foton lacks is refused as written and the
+/// isotropic one with `--lenient`.
 #[test]
-fn lenient_heterogeneous_media_take_the_grids_mean() {
+fn heterogeneous_media_read_their_grids() {
     let dir = temp_dir("mitsuba-heterogeneous");
-    // A 2 x 1 x 1 grid of one channel: cells 1 and 3, mean 2.
+    // A 2 x 1 x 1 grid of one channel in the box (0, 0, 0)-(1, 1, 1): samples 1 and 3.
     let mut vol = b"VOL\x03".to_vec();
     for i in [1i32, 2, 1, 1, 1] {
         vol.extend(i.to_le_bytes());
@@ -740,17 +741,14 @@ fn lenient_heterogeneous_media_take_the_grids_mean() {
     );
     let xml = write(&dir, "smoke.xml", &scene("0.6.0", &body));
     let e = read(&xml, false).unwrap_err();
-    assert!(
-        e.contains("smoke.xml:2") && e.contains("heterogeneous"),
-        "{e}"
-    );
+    assert!(e.contains("smoke.xml:6") && e.contains("rayleigh"), "{e}");
     let (doc, report) = read(&xml, true).unwrap();
-    let s = vector(&doc.root, "media.smoke.sigma_s");
-    let a = vector(&doc.root, "media.smoke.sigma_a");
-    assert!(
-        (s.x - 18.0).abs() < 1e-4 && (a.x - 2.0).abs() < 1e-4,
-        "{s} {a}"
-    );
+    assert_eq!(text(&doc.root, "media.smoke.type"), "heterogeneous");
+    assert!((vector(&doc.root, "media.smoke.sigma_t") - Vec3::splat(10.0)).length() < 1e-4);
+    assert!((vector(&doc.root, "media.smoke.albedo") - Vec3::splat(0.9)).length() < 1e-4);
+    assert_eq!(text(&doc.root, "media.smoke.density.samples"), "corners");
+    assert_eq!(text(&doc.root, "media.smoke.density.outside"), "zero");
+    assert!(text(&doc.root, "media.smoke.density.file").ends_with("smoke.vol"));
     assert_eq!(text(&doc.root, "media.smoke.phase"), "isotropic");
     assert!(
         report
@@ -760,6 +758,19 @@ fn lenient_heterogeneous_media_take_the_grids_mean() {
         "{:?}",
         report.left_out
     );
+    // Mitsuba 3: the grid on its unit cube under `to_world`, and the medium only in that
+    // box (a constant extinction too: a one-sample grid in its box).
+    let body = format!(
+        "<medium type=\"heterogeneous\" id=\"smoke\">\n<volume name=\"sigma_t\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/><transform name=\"to_world\"><scale value=\"2\"/></transform></volume>\n<rgb name=\"albedo\" value=\"0.5, 0.6, 0.7\"/><float name=\"scale\" value=\"4\"/></medium>\n<medium type=\"heterogeneous\" id=\"fog\"><volume name=\"sigma_t\" type=\"constvolume\"><rgb name=\"value\" value=\"1, 2, 3\"/></volume></medium>\n{SENSOR}"
+    );
+    let xml = write(&dir, "smoke3.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "media.smoke.density.outside"), "box");
+    assert!((number(&doc.root, "media.smoke.density.transform.matrix.0") - 2.0).abs() < 1e-9);
+    assert!((vector(&doc.root, "media.smoke.sigma_t") - Vec3::splat(4.0)).length() < 1e-4);
+    assert!((vector(&doc.root, "media.fog.sigma_t") - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-4);
+    assert_eq!(text(&doc.root, "media.fog.density.outside"), "box");
+    assert!((vector(&doc.root, "media.fog.albedo") - Vec3::splat(0.75)).length() < 1e-4);
     // A grid in a homogeneous medium (Mitsuba 3's textured albedo): its mean, said.
     let body = format!(
         "<medium type=\"homogeneous\" id=\"milk\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume><rgb name=\"sigma_t\" value=\"1\"/></medium>\n{SENSOR}"
@@ -786,7 +797,7 @@ fn lenient_heterogeneous_media_take_the_grids_mean() {
     std::fs::write(dir.join("smoke.vol"), &vol[..30]).unwrap();
     let e = read(&xml, true).unwrap_err();
     assert!(
-        e.contains("smoke.vol") && e.contains("not a Mitsuba grid volume"),
+        e.contains("smoke.vol") && e.contains("ends inside its header"),
         "{e}"
     );
 }

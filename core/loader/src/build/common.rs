@@ -38,6 +38,15 @@ impl Resources for Loader {
         Ok(bitmap)
     }
 
+    fn file(&mut self, bag: &Properties<'_>, key: &str) -> Result<Vec<u8>> {
+        let name = bag.string_required(key)?;
+        let path = self.dir.join(name);
+        let bytes =
+            std::fs::read(&path).map_err(|e| bag.error(key, format!("{}: {e}", path.display())))?;
+        self.sources.push(path);
+        Ok(bytes)
+    }
+
     fn transform(&mut self, bag: &Properties<'_>, key: &str) -> Result<Mat4> {
         read_transform_at(bag, key, self)
     }

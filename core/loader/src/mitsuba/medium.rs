@@ -12,10 +12,15 @@ impl Reader {
     /// A medium into `[media]`; returns its name there.
     pub(super) fn medium(&mut self, mut o: Obj) -> Result<String> {
         if o.ty == "heterogeneous" {
-            self.unsupported(
-                &o,
-                "heterogeneous media are not supported yet; rendered as a homogeneous medium of the grids' mean density and albedo",
-            )?;
+            match self.grid_unsupported(&o) {
+                None => return self.heterogeneous(o),
+                Some(why) => self.unsupported(
+                    &o,
+                    &format!(
+                        "{why}; rendered as a homogeneous medium of the grids' mean density and albedo"
+                    ),
+                )?,
+            }
             self.mean_volumes(&mut o)?;
             o.ty = "homogeneous".into();
             o.take("method");
@@ -93,6 +98,24 @@ impl Reader {
         t.insert("type", at(Value::Str("homogeneous".into()), line));
         t.insert("sigma_s", vec3(sigma_s * scale, line));
         t.insert("sigma_a", vec3(sigma_a * scale, line));
+        self.finish_medium(o, t)
+    }
+
+    /// A medium's table `t` completed with its `<phase>`, checked for parameters nobody read
+    /// and added to `[media]`; returns its name there.
+    fn finish_medium(&mut self, mut o: Obj, mut t: Table) -> Result<String> {
+        self.phase(&mut o, &mut t)?;
+        self.leftovers(&o)?;
+        let name = self.new_name("medium", &o.id);
+        if let Some(id) = &o.id {
+            self.media.insert(id.clone(), name.clone());
+        }
+        table_mut(&mut self.root, "media").insert(&name, at(Value::Table(t), o.line));
+        Ok(name)
+    }
+
+    /// The `<phase>` nested in a medium, into its table `t`.
+    fn phase(&mut self, o: &mut Obj, t: &mut Table) -> Result<()> {
         if let Some((Prop::Object(mut phase), l)) = o.take("") {
             match phase.ty.as_str() {
                 "isotropic" => t.insert("phase", at(Value::Str("isotropic".into()), l)),
@@ -117,13 +140,164 @@ impl Reader {
             }
             self.leftovers(&phase)?;
         }
-        self.leftovers(&o)?;
-        let name = self.new_name("medium", &o.id);
-        if let Some(id) = &o.id {
-            self.media.insert(id.clone(), name.clone());
+        Ok(())
+    }
+
+    /// Why a heterogeneous medium cannot be read as foton's `heterogeneous` (None: it can):
+    /// its volumes must be `gridvolume`s or `constvolume`s, interpolated trilinearly and
+    /// clamped (Mitsuba 3) or zero (0.6) outside.
+    fn grid_unsupported(&self, o: &Obj) -> Option<String> {
+        for (name, p, _) in &o.props {
+            let Prop::Object(v) = p else { continue };
+            if v.tag != "volume" {
+                continue;
+            }
+            match v.ty.as_str() {
+                "constvolume" => continue,
+                "gridvolume" => {}
+                other => {
+                    return Some(format!(
+                        "`{name}`: volume type `{other}` is not supported yet"
+                    ));
+                }
+            }
+            let value = |k: &str| {
+                v.props.iter().find_map(|(n, p, _)| match p {
+                    Prop::Str(s) if n == k => Some(s.clone()),
+                    _ => None,
+                })
+            };
+            if value("filter_type").is_some_and(|f| f != "bilinear" && f != "trilinear") {
+                return Some(format!(
+                    "`{name}`: only trilinear grid lookups are supported"
+                ));
+            }
+            if value("wrap_mode").is_some_and(|w| w != "clamp") {
+                return Some(format!("`{name}`: only the `clamp` wrap mode is supported"));
+            }
         }
-        table_mut(&mut self.root, "media").insert(&name, at(Value::Table(t), line));
-        Ok(name)
+        None
+    }
+
+    /// A heterogeneous medium into `[media]` as foton's `heterogeneous`: the extinction
+    /// (`sigma_t`, 0.6's `density`) and `albedo` volumes or constants, `scale`, the phase.
+    fn heterogeneous(&mut self, mut o: Obj) -> Result<String> {
+        let line = o.line;
+        let mut t = Table::default();
+        t.insert("type", at(Value::Str("heterogeneous".into()), line));
+        let scale = o.float("scale", 1.0)?;
+        let key = if o.props.iter().any(|(n, _, _)| n == "density") {
+            "density"
+        } else {
+            "sigma_t"
+        };
+        let mut sigma_t = DVec3::splat(scale);
+        // Mitsuba's default extinction is a constant 1.
+        let extinction = self
+            .volume(&mut o, key)?
+            .unwrap_or(Volume::Constant(DVec3::ONE, glam::DMat4::IDENTITY));
+        match extinction {
+            Volume::Grid(mut g) => {
+                // Mitsuba 3's medium exists only in its extinction volume's bounding box.
+                if let Value::Table(g) = &mut g.value
+                    && !self.v1
+                {
+                    g.insert("outside", at(Value::Str("box".into()), line));
+                }
+                t.insert("density", g)
+            }
+            Volume::Constant(c, to_world) => {
+                sigma_t *= c;
+                if self.v1 {
+                    t.insert("density", at(Value::Float(1.0), line));
+                } else {
+                    // A constant volume too has a box: its unit cube under its to_world.
+                    let mut g = Table::default();
+                    let one = |x: f64| at(Value::Float(x), line);
+                    g.insert(
+                        "resolution",
+                        at(Value::Array(vec![one(1.0), one(1.0), one(1.0)]), line),
+                    );
+                    g.insert("values", at(Value::Array(vec![one(1.0)]), line));
+                    g.insert("transform", super::matrix_table(to_world, line));
+                    g.insert("outside", at(Value::Str("box".into()), line));
+                    t.insert("density", at(Value::Table(g), line));
+                }
+            }
+        }
+        t.insert("sigma_t", vec3(sigma_t, line));
+        match self.volume(&mut o, "albedo")? {
+            Some(Volume::Grid(g)) => t.insert("albedo", g),
+            Some(Volume::Constant(c, _)) => t.insert("albedo", vec3(c, line)),
+            None => t.insert("albedo", vec3(DVec3::splat(0.75), line)),
+        }
+        // How Mitsuba samples distances and estimates transmittance changes noise (0.6's
+        // Simpson quadrature also bias), not the medium: foton's tracking is exact.
+        for k in [
+            "method",
+            "step_size",
+            "sample_emitters",
+            "has_spectral_extinction",
+        ] {
+            o.take(k);
+        }
+        self.finish_medium(o, t)
+    }
+
+    /// A medium's volume `key`: a grid as foton's volume table, or a constant (a
+    /// `constvolume`, a `<float>`, an `<rgb>`).
+    fn volume(&mut self, o: &mut Obj, key: &str) -> Result<Option<Volume>> {
+        let v = match o.take(key) {
+            None => return Ok(None),
+            Some((Prop::Object(v), _)) if v.tag == "volume" => v,
+            Some((p, l)) => {
+                o.props.push((key.to_string(), p, l));
+                return Ok(Some(Volume::Constant(
+                    o.color(key, DVec3::ONE)?,
+                    glam::DMat4::IDENTITY,
+                )));
+            }
+        };
+        let mut v = v;
+        if v.ty == "constvolume" {
+            let c = v.color("value", DVec3::ONE)?;
+            let to_world = v.transform("to_world")?;
+            self.leftovers(&v)?;
+            return Ok(Some(Volume::Constant(c, to_world)));
+        }
+        let line = v.line;
+        let file = self.filename(&mut v)?;
+        let Value::Str(rel) = &file.value else {
+            unreachable!("filename is a string")
+        };
+        let mut to_world = v.transform("to_world")?;
+        v.take("filter_type");
+        v.take("wrap_mode");
+        v.take("raw");
+        v.take("send_data");
+        let use_bbox = v.boolean("use_grid_bbox", false)?;
+        let mut g = Table::default();
+        if self.v1 || use_bbox {
+            // Mitsuba 0.6 places the grid in the box its file gives (or `min` and `max`),
+            // samples on its corners, zero beyond; Mitsuba 3 only with `use_grid_bbox`.
+            let path = self.dir.join(rel);
+            let bytes = std::fs::read(&path).map_err(|e| Error::io(&path, e))?;
+            let f = foton_core::medium::grid::VolFile::parse(&bytes)
+                .map_err(|e| v.error(format!("{}: {e}", path.display())))?;
+            let (fmin, fmax) = (f.bbox.0.as_dvec3(), f.bbox.1.as_dvec3());
+            let min = v.point("min")?.unwrap_or(fmin);
+            let max = v.point("max")?.unwrap_or(fmax);
+            to_world =
+                to_world * glam::DMat4::from_translation(min) * glam::DMat4::from_scale(max - min);
+            if self.v1 {
+                g.insert("samples", at(Value::Str("corners".into()), line));
+                g.insert("outside", at(Value::Str("zero".into()), line));
+            }
+        }
+        g.insert("file", file.clone());
+        g.insert("transform", super::matrix_table(to_world, line));
+        self.leftovers(&v)?;
+        Ok(Some(Volume::Grid(at(Value::Table(g), line))))
     }
 
     /// A heterogeneous medium's `<volume>`s (`density` or `sigma_t`, `albedo`) replaced by
@@ -487,3 +661,12 @@ const MEASURED_MEDIA: &[(&str, [f64; 3], [f64; 3], [f64; 3])] = &[
         [0.90200, 0.82500, 0.91400],
     ),
 ];
+
+/// A heterogeneous medium's volume parameter as the reader writes it.
+enum Volume {
+    /// A volume table (`file`, `transform`, and where they are not the defaults `samples`
+    /// and `outside`).
+    Grid(foton_core::value::Node),
+    /// A value and the volume's `to_world` (Mitsuba 3's medium exists only in its box).
+    Constant(DVec3, glam::DMat4),
+}
