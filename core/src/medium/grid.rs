@@ -49,7 +49,14 @@ pub struct Grid {
     /// Where the grid is not zero (world space), with [`Outside::ClampInBox`].
     support: Option<(Vec3, Vec3)>,
     max: f32,
+    /// Blocks of BLOCK^3 cells per axis, and per block whether all its samples are zero
+    /// (empty space, which traversal crosses in one step).
+    blocks: [usize; 3],
+    empty: Vec<bool>,
 }
+
+/// The cells per axis of a block of empty space.
+const BLOCK: usize = 8;
 
 /// The contents of a Mitsuba `.vol` file.
 #[derive(Clone, Debug, PartialEq)]
@@ -191,6 +198,30 @@ impl Grid {
             Outside::ClampInBox => Outside::Clamp,
             o => o,
         };
+        let blocks = res.map(|n| (n - 1).div_ceil(BLOCK));
+        let mut empty = vec![true; blocks[0] * blocks[1] * blocks[2]];
+        for k in 0..res[2] {
+            for j in 0..res[1] {
+                for i in 0..res[0] {
+                    let at = ((k * res[1] + j) * res[0] + i) * channels;
+                    if values[at..at + channels].iter().all(|v| *v == 0.0) {
+                        continue;
+                    }
+                    // A sample is a corner of the cells on either side of it (cells x - 1
+                    // and x, of 0..=res - 2).
+                    let span = |x: usize, r: usize| {
+                        (x.saturating_sub(1) / BLOCK)..=(x.min(r.saturating_sub(2)) / BLOCK)
+                    };
+                    for bk in span(k, res[2]).filter(|b| *b < blocks[2]) {
+                        for bj in span(j, res[1]).filter(|b| *b < blocks[1]) {
+                            for bi in span(i, res[0]).filter(|b| *b < blocks[0]) {
+                                empty[(bk * blocks[1] + bj) * blocks[0] + bi] = false;
+                            }
+                        }
+                    }
+                }
+            }
+        }
         Ok(Grid {
             res,
             channels,
@@ -199,6 +230,8 @@ impl Grid {
             outside,
             support,
             max,
+            blocks,
+            empty,
         })
     }
 
@@ -316,23 +349,25 @@ impl Grid {
         let start = o + d * t;
         // Per axis, the lattice cell: -1 below the first sample, k between samples k and
         // k + 1, res - 1 beyond the last; the distance to the next cell and its step.
-        let mut cell = [0i64; 3];
-        let mut next = [f64::INFINITY; 3];
-        let mut delta = [f64::INFINITY; 3];
-        for a in 0..3 {
-            let last = self.res[a] as i64 - 1;
-            cell[a] = (start[a].floor() as i64).clamp(-1, last);
-            if d[a] > 0.0 && cell[a] < last {
-                next[a] = (cell[a] as f64 + 1.0 - o[a]) / d[a];
-                delta[a] = 1.0 / d[a];
-            } else if d[a] < 0.0 && cell[a] >= 0 {
-                next[a] = (cell[a] as f64 - o[a]) / d[a];
-                delta[a] = -1.0 / d[a];
-            }
-        }
+        let (mut cell, mut next, mut delta) = self.dda(o, d, start);
         let mut cubics = [Cubic::ZERO; 3];
         let cubics = &mut cubics[..self.channels];
         while t < tmax {
+            // Empty space: the whole block of cells at once.
+            if let Some(exit) = self.empty_block_exit(o, d, &cell)
+                && exit > t
+            {
+                let end = exit.min(tmax);
+                if !piece(t, end - t, &ZEROS[..self.channels]) {
+                    return;
+                }
+                t = end;
+                if end >= tmax {
+                    break;
+                }
+                (cell, next, delta) = self.dda(o, d, o + d * t);
+                continue;
+            }
             let a = if next[0] <= next[1] && next[0] <= next[2] {
                 0
             } else if next[1] <= next[2] {
@@ -370,6 +405,55 @@ impl Grid {
         if let Some((t1, tmax)) = after {
             piece(t1, tmax - t1, &ZEROS[..self.channels]);
         }
+    }
+
+    /// The 3-D DDA's state at lattice point `q` of the ray o + t d: per axis, the cell (-1
+    /// below the first sample, k between samples k and k + 1, res - 1 beyond the last), the
+    /// distance at which the ray enters the next one, and the distance between crossings.
+    #[allow(clippy::type_complexity)]
+    fn dda(&self, o: DVec3, d: DVec3, q: DVec3) -> ([i64; 3], [f64; 3], [f64; 3]) {
+        let mut cell = [0i64; 3];
+        let mut next = [f64::INFINITY; 3];
+        let mut delta = [f64::INFINITY; 3];
+        for a in 0..3 {
+            let last = self.res[a] as i64 - 1;
+            cell[a] = (q[a].floor() as i64).clamp(-1, last);
+            if d[a] > 0.0 && cell[a] < last {
+                next[a] = (cell[a] as f64 + 1.0 - o[a]) / d[a];
+                delta[a] = 1.0 / d[a];
+            } else if d[a] < 0.0 && cell[a] >= 0 {
+                next[a] = (cell[a] as f64 - o[a]) / d[a];
+                delta[a] = -1.0 / d[a];
+            }
+        }
+        (cell, next, delta)
+    }
+
+    /// If `cell` lies in a block of cells whose samples are all zero, the distance at which
+    /// the ray o + t d leaves the block.
+    #[inline]
+    fn empty_block_exit(&self, o: DVec3, d: DVec3, cell: &[i64; 3]) -> Option<f64> {
+        let mut b = [0usize; 3];
+        for a in 0..3 {
+            if cell[a] < 0 || cell[a] >= self.res[a] as i64 - 1 {
+                return None;
+            }
+            b[a] = cell[a] as usize / BLOCK;
+        }
+        if !self.empty[(b[2] * self.blocks[1] + b[1]) * self.blocks[0] + b[0]] {
+            return None;
+        }
+        let mut exit = f64::INFINITY;
+        for a in 0..3 {
+            let lo = (b[a] * BLOCK) as f64;
+            let hi = ((b[a] + 1) * BLOCK).min(self.res[a] - 1) as f64;
+            if d[a] > 0.0 {
+                exit = exit.min((hi - o[a]) / d[a]);
+            } else if d[a] < 0.0 {
+                exit = exit.min((lo - o[a]) / d[a]);
+            }
+        }
+        Some(exit)
     }
 
     /// Each channel along the ray from distance `t` on, within the lattice cell `cell`, as a
@@ -634,6 +718,76 @@ mod tests {
                 assert!(
                     (exact - q).abs().max_element() <= tolerance,
                     "{samples:?} {outside:?}: {exact} vs {q}"
+                );
+            }
+        }
+    }
+
+    /// A sparse grid, mostly empty blocks that traversal crosses in one step: the integrals
+    /// are still those of the lookups, and inversion still lands on its target.
+    #[test]
+    fn empty_blocks_are_crossed_without_changing_the_integral() {
+        let mut rng = Lcg(5);
+        let res = [19, 21, 17];
+        let mut values = vec![0.0f32; 19 * 21 * 17];
+        for _ in 0..12 {
+            let (i, j, k) = (
+                (rng.next() * 19.0) as usize,
+                (rng.next() * 21.0) as usize,
+                (rng.next() * 17.0) as usize,
+            );
+            values[(k * 21 + j) * 19 + i] = 1.0 + 4.0 * rng.next();
+        }
+        // The first and last samples of an axis too (the edges of the blocks' range).
+        values[0] = 2.0;
+        values[19 * 21 * 17 - 1] = 3.0;
+        // Samples on the faces between blocks, seen from the cells on their lower side.
+        let faces = [(8, 10, 8), (16, 8, 3), (3, 16, 16)];
+        for (i, j, k) in faces {
+            values[(k * 21 + j) * 19 + i] = 1.0;
+        }
+        let g = Grid::new(
+            res,
+            1,
+            values,
+            Mat4::IDENTITY,
+            Samples::Corners,
+            Outside::Zero,
+        )
+        .unwrap();
+        assert!(g.empty.iter().any(|e| *e) && g.empty.iter().any(|e| !*e));
+        let lattice = |x: f32, n: usize| x / (n - 1) as f32;
+        for (i, j, k) in faces {
+            for dir in [Vec3::X, Vec3::Y, Vec3::Z] {
+                let mut o = Vec3::new(
+                    lattice(i as f32 - 0.5, 19),
+                    lattice(j as f32 - 0.5, 21),
+                    lattice(k as f32 - 0.5, 17),
+                );
+                o -= dir * o.dot(dir) + dir * 0.1;
+                let ray = Ray::new(o, dir);
+                let (exact, q) = (g.integral(&ray, 1.2).x, quadrature(&g, &ray, 1.2).x);
+                assert!(q > 0.0 && (exact - q).abs() <= 2e-3 * q, "{exact} vs {q}");
+            }
+        }
+        for _ in 0..40 {
+            let o = Vec3::new(
+                rng.next() * 1.4 - 0.2,
+                rng.next() * 1.4 - 0.2,
+                rng.next() * 1.4 - 0.2,
+            );
+            let dir = Vec3::new(rng.next() - 0.5, rng.next() - 0.5, rng.next() - 0.5).normalize();
+            let ray = Ray::new(o, dir);
+            let exact = g.integral(&ray, 2.0).x;
+            let q = quadrature(&g, &ray, 2.0).x;
+            assert!((exact - q).abs() <= 2e-3 * q.max(0.05), "{exact} vs {q}");
+            if exact > 0.0 {
+                let target = exact * rng.next() as f64;
+                let (t, _) = g.invert(&ray, 2.0, 0, target);
+                let at = g.integral(&ray, t.unwrap() as f32).x;
+                assert!(
+                    (at - target).abs() <= 1e-4 * target.max(1e-3),
+                    "{at} vs {target}"
                 );
             }
         }
