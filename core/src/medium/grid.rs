@@ -308,12 +308,10 @@ impl Grid {
         }
     }
 
-    /// Walks the grid along `ray` over (0, `tmax`) in pieces within which each channel is a
-    /// cubic c0 + c1 s + c2 s^2 + c3 s^3 of the distance s from the piece's start: calls
-    /// `piece(start, length, cubics)` (one cubic per channel) for each, in order, until it
-    /// returns false. The last piece may be infinitely long when `tmax` is (its cubics are
-    /// then constants).
-    pub fn pieces(&self, ray: &Ray, tmax: f32, mut piece: impl FnMut(f64, f64, &[Cubic]) -> bool) {
+    /// Walks the grid along `ray` over (0, `tmax`) in pieces, each within one lattice cell:
+    /// calls `piece(start, length, cell)` for each, in order, until it returns false. The last
+    /// piece may be infinitely long when `tmax` is (the grid is then constant along it).
+    pub fn pieces(&self, ray: &Ray, tmax: f32, mut piece: impl FnMut(f64, f64, &Cell) -> bool) {
         let (mut t, mut tmax) = (0.0f64, tmax as f64);
         let mut after = None;
         if let Some((lo, hi)) = self.support {
@@ -333,10 +331,10 @@ impl Grid {
                 t1 = t1.min(a.max(b));
             }
             if t1 <= t0 {
-                piece(0.0, tmax, &ZEROS[..self.channels]);
+                piece(0.0, tmax, &Cell::ZERO);
                 return;
             }
-            if t0 > 0.0 && !piece(0.0, t0, &ZEROS[..self.channels]) {
+            if t0 > 0.0 && !piece(0.0, t0, &Cell::ZERO) {
                 return;
             }
             if t1 < tmax {
@@ -350,15 +348,13 @@ impl Grid {
         // Per axis, the lattice cell: -1 below the first sample, k between samples k and
         // k + 1, res - 1 beyond the last; the distance to the next cell and its step.
         let (mut cell, mut next, mut delta) = self.dda(o, d, start);
-        let mut cubics = [Cubic::ZERO; 3];
-        let cubics = &mut cubics[..self.channels];
         while t < tmax {
             // Empty space: the whole block of cells at once.
             if let Some(exit) = self.empty_block_exit(o, d, &cell)
                 && exit > t
             {
                 let end = exit.min(tmax);
-                if !piece(t, end - t, &ZEROS[..self.channels]) {
+                if !piece(t, end - t, &Cell::ZERO) {
                     return;
                 }
                 t = end;
@@ -376,8 +372,7 @@ impl Grid {
                 2
             };
             let end = next[a].min(tmax).max(t);
-            self.cubics(o, d, t, &cell, cubics);
-            if !piece(t, end - t, cubics) {
+            if !piece(t, end - t, &self.cell(o, d, t, &cell)) {
                 return;
             }
             t = end;
@@ -403,7 +398,7 @@ impl Grid {
             }
         }
         if let Some((t1, tmax)) = after {
-            piece(t1, tmax - t1, &ZEROS[..self.channels]);
+            piece(t1, tmax - t1, &Cell::ZERO);
         }
     }
 
@@ -456,11 +451,17 @@ impl Grid {
         Some(exit)
     }
 
-    /// Each channel along the ray from distance `t` on, within the lattice cell `cell`, as a
-    /// cubic in the distance from `t`.
-    fn cubics(&self, o: DVec3, d: DVec3, t: f64, cell: &[i64; 3], out: &mut [Cubic]) {
+    /// The piece of the ray o + t d from distance `t` on within the lattice cell `cell`.
+    fn cell(&self, o: DVec3, d: DVec3, t: f64, cell: &[i64; 3]) -> Cell {
         // Per axis: the samples on either side and the weight of the second, linear in s.
-        let mut axes = [(0usize, 0usize, 0.0f64, 0.0f64); 3];
+        let mut at = [(0usize, 0usize); 3];
+        let mut piece = Cell {
+            channels: self.channels,
+            zero: false,
+            v: [[0.0; 8]; 3],
+            w0: [0.0; 3],
+            dw: [0.0; 3],
+        };
         for a in 0..3 {
             let last = self.res[a] as i64 - 1;
             let c = cell[a];
@@ -469,25 +470,27 @@ impl Grid {
                 // the ray does not move along (a grid one sample thick).
                 let on_last = c == last && d[a] == 0.0 && o[a] == last as f64;
                 if self.outside == Outside::Zero && !on_last {
-                    out.fill(Cubic::ZERO);
-                    return;
+                    return Cell::ZERO;
                 }
                 let i = c.clamp(0, last) as usize;
-                axes[a] = (i, i, 0.0, 0.0);
+                at[a] = (i, i);
             } else {
                 let i = c as usize;
-                let w = (o[a] + d[a] * t - c as f64).clamp(0.0, 1.0);
-                axes[a] = (i, i + 1, w, d[a]);
+                at[a] = (i, i + 1);
+                piece.w0[a] = (o[a] + d[a] * t - c as f64).clamp(0.0, 1.0);
+                piece.dw[a] = d[a];
             }
         }
-        let [x, y, z] = axes;
-        let lerp = |a: Cubic, b: Cubic, w0: f64, dw: f64| a.add(&b.sub(&a).mul_linear(w0, dw));
-        for (ch, out) in out.iter_mut().enumerate() {
-            let v = |i, j, k| Cubic::constant(self.sample(i, j, k, ch) as f64);
-            let e = |j, k| lerp(v(x.0, j, k), v(x.1, j, k), x.2, x.3);
-            let g = |k| lerp(e(y.0, k), e(y.1, k), y.2, y.3);
-            *out = lerp(g(z.0), g(z.1), z.2, z.3);
+        let [x, y, z] = at;
+        for ch in 0..self.channels {
+            for (n, v) in piece.v[ch].iter_mut().enumerate() {
+                let i = if n & 1 == 0 { x.0 } else { x.1 };
+                let j = if n & 2 == 0 { y.0 } else { y.1 };
+                let k = if n & 4 == 0 { z.0 } else { z.1 };
+                *v = self.sample(i, j, k, ch);
+            }
         }
+        piece
     }
 
     /// The integral of each channel along `ray` over (0, `d`) (a grey grid's in each): the
@@ -495,7 +498,7 @@ impl Grid {
     pub fn integral(&self, ray: &Ray, d: f32) -> DVec3 {
         let mut sum = DVec3::ZERO;
         self.pieces(ray, d, |_, len, c| {
-            sum += integrals(c, len);
+            sum += c.integrals(len);
             sum.is_finite()
         });
         sum
@@ -511,15 +514,14 @@ impl Grid {
         channel: usize,
         target: f64,
     ) -> (Option<f64>, DVec3) {
-        let ch = if self.channels == 1 { 0 } else { channel };
         let mut sum = DVec3::ZERO;
         let mut found = None;
         self.pieces(ray, tmax, |start, len, c| {
-            let whole = integrals(c, len);
+            let whole = c.integrals(len);
             if sum[channel] + whole[channel] >= target && whole[channel] > 0.0 {
-                let s = c[ch].solve(target - sum[channel], len);
+                let s = c.cubic(channel).solve(target - sum[channel], len);
                 found = Some(start + s);
-                sum += integrals(c, s);
+                sum += c.integrals(s);
                 sum[channel] = target;
                 return false;
             }
@@ -530,14 +532,78 @@ impl Grid {
     }
 }
 
-const ZEROS: [Cubic; 3] = [Cubic::ZERO; 3];
+/// A piece of a ray within one lattice cell: each channel's corner samples and, per axis, the
+/// weight of the second sample, linear in the distance s from the piece's start. The
+/// interpolated value is a cubic in s.
+#[derive(Clone, Copy, Debug)]
+pub struct Cell {
+    channels: usize,
+    zero: bool,
+    /// Per channel, the corners, index x + 2 y + 4 z (0: the first sample, 1: the second).
+    v: [[f32; 8]; 3],
+    w0: [f64; 3],
+    dw: [f64; 3],
+}
 
-/// The integrals over (0, `s`) of one cubic per channel (one: the same in each).
-fn integrals(c: &[Cubic], s: f64) -> DVec3 {
-    if c.len() == 1 {
-        DVec3::splat(c[0].integral(s))
-    } else {
-        DVec3::new(c[0].integral(s), c[1].integral(s), c[2].integral(s))
+impl Cell {
+    const ZERO: Cell = Cell {
+        channels: 1,
+        zero: true,
+        v: [[0.0; 8]; 3],
+        w0: [0.0; 3],
+        dw: [0.0; 3],
+    };
+
+    /// Channel `ch`'s value at distance s into the piece.
+    #[inline]
+    fn value(&self, ch: usize, s: f64) -> f64 {
+        let w = |a: usize| self.w0[a] + self.dw[a] * s;
+        let lerp = |a: f64, b: f64, t: f64| a + (b - a) * t;
+        let v = self.v[ch].map(f64::from);
+        let wx = w(0);
+        let e = |n: usize| lerp(v[n], v[n + 1], wx);
+        let wy = w(1);
+        lerp(lerp(e(0), e(2), wy), lerp(e(4), e(6), wy), w(2))
+    }
+
+    /// Each channel's integral over (0, `len`) (one channel: the same in each). Simpson's
+    /// rule, exact for the cubic; an infinite piece, along which the value is constant,
+    /// integrates to infinity unless it is zero.
+    #[inline]
+    pub fn integrals(&self, len: f64) -> DVec3 {
+        if self.zero {
+            return DVec3::ZERO;
+        }
+        let one = |ch: usize| {
+            if len.is_infinite() {
+                if self.value(ch, 0.0) > 0.0 {
+                    f64::INFINITY
+                } else {
+                    0.0
+                }
+            } else {
+                len / 6.0
+                    * (self.value(ch, 0.0) + 4.0 * self.value(ch, 0.5 * len) + self.value(ch, len))
+            }
+        };
+        if self.channels == 1 {
+            DVec3::splat(one(0))
+        } else {
+            DVec3::new(one(0), one(1), one(2))
+        }
+    }
+
+    /// Channel `ch` as a cubic in the distance into the piece.
+    pub fn cubic(&self, ch: usize) -> Cubic {
+        if self.zero {
+            return Cubic::ZERO;
+        }
+        let ch = ch.min(self.channels - 1);
+        let lerp =
+            |a: Cubic, b: Cubic, a_: usize| a.add(&b.sub(&a).mul_linear(self.w0[a_], self.dw[a_]));
+        let v = |n: usize| Cubic::constant(self.v[ch][n] as f64);
+        let e = |n: usize| lerp(v(n), v(n + 1), 0);
+        lerp(lerp(e(0), e(2), 1), lerp(e(4), e(6), 1), 2)
     }
 }
 
