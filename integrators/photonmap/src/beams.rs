@@ -281,6 +281,8 @@ pub struct BeamMap {
     pub(crate) pieces: Vec<Piece>,
     pub(crate) bvh: Accel,
     radius: f32,
+    /// The box around every beam's segment (empty when there is none).
+    bounds: (Vec3, Vec3),
 }
 
 impl BeamMap {
@@ -289,10 +291,16 @@ impl BeamMap {
     pub fn build(beams: Vec<Beam>, radius: f32) -> BeamMap {
         let piece = PIECE_WIDTHS * radius;
         let mut pieces = Vec::with_capacity(beams.len());
+        let mut bounds = (Vec3::INFINITY, Vec3::NEG_INFINITY);
         for (i, b) in beams.iter().enumerate() {
             if !(b.length > 0.0 && b.length.is_finite()) {
                 continue;
             }
+            let end = b.origin + b.dir * b.length;
+            bounds = (
+                bounds.0.min(b.origin).min(end),
+                bounds.1.max(b.origin).max(end),
+            );
             let n = (b.length / piece).ceil().clamp(1.0, 1e6) as u32;
             let step = b.length / n as f32;
             for k in 0..n {
@@ -319,7 +327,14 @@ impl BeamMap {
             pieces,
             bvh,
             radius,
+            bounds,
         }
+    }
+
+    /// The box around every beam's segment (lo > hi when there is no beam): camera segments
+    /// that leave the scene in a medium gather up to where it ends, grown by the width.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        self.bounds
     }
 
     pub fn len(&self) -> usize {

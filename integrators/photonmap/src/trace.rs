@@ -152,8 +152,8 @@ pub fn trace_one_with_beams(
                     BeamKind::Short => flight.t,
                     BeamKind::Long => seg.length(),
                 };
-                // A photon leaving the scene inside a medium: its beam ends at the scene's box
-                // (no camera ray is marched beyond it either).
+                // A beam without end (a long beam, or a short one whose hero channel does
+                // not attenuate, leaving the scene in a medium) is cut at the scene's box.
                 let length = if end.is_finite() {
                     end
                 } else {

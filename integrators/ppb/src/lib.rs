@@ -239,8 +239,14 @@ impl Ppb {
         let film = scene.film().filter.film_position(x, y, sampler.next_2d());
         let ray = scene.camera().generate_ray(film);
         let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
+        // A segment that leaves the scene in a medium (unbounded fog, a camera in it) meets
+        // beams as far as photons went: the box around the scene and the pass's beams.
         let grow = Vec3::splat(pass.beams.radius());
-        let bounds = (scene.bounds().0 - grow, scene.bounds().1 + grow);
+        let (lo, hi) = pass.beams.bounds();
+        let bounds = (
+            scene.bounds().0.min(lo) - grow,
+            scene.bounds().1.max(hi) + grow,
+        );
         let path = walk_to_diffuse(
             scene,
             ray,
