@@ -116,6 +116,59 @@ impl Accel {
     }
 }
 
+impl Accel {
+    /// Whether a primitive accepted by `accept` has its box within distance `r` of `p`: the
+    /// float nodes walked with a ball in place of a ray.
+    pub(super) fn any_box_near(
+        &self,
+        p: Vec3,
+        r: f32,
+        accept: &impl Fn(&Primitive) -> bool,
+    ) -> bool {
+        let r2 = r * r;
+        let mut stack = [MaybeUninit::<u32>::uninit(); STACK];
+        let mut sp = 0usize;
+        let mut cur = 0u32;
+        loop {
+            let node = &self.nodes[cur as usize];
+            for i in 0..8 {
+                let mut d2 = 0.0f32;
+                for axis in 0..3 {
+                    let (lo, hi) = (node.bounds[axis][i], node.bounds[3 + axis][i]);
+                    let d = (lo - p[axis]).max(p[axis] - hi).max(0.0);
+                    d2 += d * d;
+                }
+                // An empty slot's box (min +inf, max -inf) is infinitely far.
+                if d2 > r2 {
+                    continue;
+                }
+                let count = node.count[i] as usize;
+                if count == 0 {
+                    stack[sp] = MaybeUninit::new(node.child[i]);
+                    sp += 1;
+                    continue;
+                }
+                let first = node.child[i] as usize;
+                for prim in &self.prims[first..first + count] {
+                    let b = prim.shape.aabb();
+                    let d = (Vec3::from(b.min) - p)
+                        .max(p - Vec3::from(b.max))
+                        .max(Vec3::ZERO);
+                    if d.length_squared() <= r2 && accept(prim) {
+                        return true;
+                    }
+                }
+            }
+            if sp == 0 {
+                return false;
+            }
+            sp -= 1;
+            // SAFETY: every entry below `sp` was written.
+            cur = unsafe { stack[sp].assume_init() };
+        }
+    }
+}
+
 /// Entries of the traversal stacks: a node's visit pops one entry and pushes at most eight,
 /// so a tree of depth d needs at most 7 d + 1. Room for depth 64 (obvhs' own stack holds 32
 /// groups); uninitialised, it costs nothing until used.

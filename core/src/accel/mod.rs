@@ -175,6 +175,16 @@ impl Accel {
         }
     }
 
+    /// Whether any primitive accepted by `accept` may lie within distance `r` of `p`: its
+    /// box does (false only when none can; a BVH of boxes answers true). A cheap test before
+    /// rays that look for surfaces near a point.
+    pub fn any_near(&self, p: Vec3, r: f32, accept: impl Fn(&Primitive) -> bool) -> bool {
+        if self.nodes.is_empty() {
+            return !self.prims.is_empty();
+        }
+        self.any_box_near(p, r, &accept)
+    }
+
     /// Calls `f(primitive index, t)` for every primitive the ray meets within (0, tmax), in no
     /// particular order (medium boundaries need every crossing, not only the closest).
     pub fn for_each_hit(&self, ray: &Ray, tmax: f32, mut f: impl FnMut(u32, f32)) {
@@ -400,6 +410,41 @@ mod tests {
             assert!(
                 hits > 100 && blocked > 100,
                 "{n}: {hits} hits, {blocked} blocked"
+            );
+        }
+    }
+
+    /// The ball query finds what testing every primitive's box finds: some accepted box
+    /// within r of the point, or none, for points near and far from the primitives.
+    #[test]
+    fn any_near_matches_testing_every_box() {
+        let mut rng = Rng::new(&[6]);
+        for n in [1, 7, 40, 3000] {
+            let mut prims = scene(&mut rng, n);
+            for (i, p) in prims.iter_mut().enumerate() {
+                p.object = i as u32;
+            }
+            let accel = Accel::build(prims.clone());
+            let (mut near, mut far) = (0, 0);
+            for _ in 0..4000 {
+                let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 12.0 - 1.0;
+                let r = 1.5 * rng.next_f32() * rng.next_f32();
+                let odd = |q: &Primitive| q.object % 2 == 1;
+                for accept in [&(|_: &Primitive| true) as &dyn Fn(&Primitive) -> bool, &odd] {
+                    let want = prims.iter().any(|q| {
+                        let b = q.shape.aabb();
+                        let d = (Vec3::from(b.min) - p)
+                            .max(p - Vec3::from(b.max))
+                            .max(Vec3::ZERO);
+                        d.length_squared() <= r * r && accept(q)
+                    });
+                    assert_eq!(accel.any_near(p, r, accept), want, "{n}: {p} within {r}");
+                    if want { near += 1 } else { far += 1 }
+                }
+            }
+            assert!(
+                n < 40 || (near > 100 && far > 100),
+                "{n}: {near} near, {far} far"
             );
         }
     }

@@ -372,7 +372,13 @@ impl Scene {
 
     #[inline]
     pub fn material(&self, hit: &Hit) -> &Material {
-        &self.materials[self.object(hit).material as usize].value
+        self.material_of(self.primitive(hit))
+    }
+
+    /// The material of the object `prim` belongs to.
+    #[inline]
+    pub fn material_of(&self, prim: &Primitive) -> &Material {
+        &self.materials[self.objects[prim.object as usize].material as usize].value
     }
 
     /// The surface at a hit: shading normal, texture coordinates, tangent.

@@ -9,7 +9,9 @@
 //! incrementally (Arya and Mount), which prunes more than the distance to the last plane.
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
-use foton_core::api::{Bsdf, Lobe, NormalizedKernel, Phase, Ray, Rgb, Scene, offset_origin};
+use foton_core::api::{
+    Bsdf, Lobe, NormalizedKernel, Phase, Primitive, Ray, Rgb, Scene, Shape, offset_origin,
+};
 use glam::{Vec2, Vec3};
 
 /// A photon: 32 bytes. The incoming direction is octahedron-encoded in 2 x 16 bits; the
@@ -194,6 +196,19 @@ impl DiscClip {
             ..DiscClip::NONE
         };
         let origin = offset_origin(p, n, n);
+        // No probe can find a wall where no surface that could be one comes within reach
+        // (most points, away from creases): skip the rays. A hit lies in its primitive's
+        // box, rounding aside (the margin).
+        let margin = 1e-3 * reach + 1e-5 * origin.abs().max_element();
+        let wall = |prim: &Primitive| {
+            // A plane's normal is the same everywhere on it: the one a probe hit would have.
+            let coplanar = !matches!(prim.shape, Shape::Sphere { .. })
+                && prim.shape.normal(Vec3::ZERO).dot(n).abs() > 0.9;
+            !coplanar && !scene.material_of(prim).is_null()
+        };
+        if !scene.accel().any_near(origin, reach + margin, wall) {
+            return clip;
+        }
         for j in 0..CLIP_PROBES {
             let theta = (j as f32 + 0.5) * std::f32::consts::TAU / CLIP_PROBES as f32;
             let (sin, cos) = theta.sin_cos();
