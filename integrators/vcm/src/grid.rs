@@ -17,42 +17,71 @@ pub struct HashGrid {
     starts: Vec<u32>,
     indices: Vec<u32>,
     positions: Vec<Vec3>,
+    /// The build's scratch: each vertex's bucket, then its slot.
+    keys: Vec<u32>,
 }
 
 impl HashGrid {
     /// A grid over `positions` for queries of radius `radius`.
     pub fn build(positions: Vec<Vec3>, radius: f32) -> HashGrid {
-        let min = positions
+        let mut grid = HashGrid::empty();
+        grid.rebuild(positions.into_iter(), radius);
+        grid
+    }
+
+    /// A grid over nothing, to be rebuilt.
+    pub fn empty() -> HashGrid {
+        HashGrid {
+            min: Vec3::ZERO,
+            inv_cell: 0.0,
+            radius: 0.0,
+            radius2: 0.0,
+            starts: Vec::new(),
+            indices: Vec::new(),
+            positions: Vec::new(),
+            keys: Vec::new(),
+        }
+    }
+
+    /// The grid over `positions` for queries of radius `radius`, in this grid's memory (an
+    /// iteration's grid reuses the last one's: no allocation once it is large enough).
+    pub fn rebuild(&mut self, positions: impl Iterator<Item = Vec3>, radius: f32) {
+        self.positions.clear();
+        self.positions.extend(positions);
+        self.min = self
+            .positions
             .iter()
             .fold(Vec3::splat(f32::INFINITY), |m, p| m.min(*p));
-        let buckets = positions.len().max(1);
-        let inv_cell = 1.0 / (2.0 * radius);
-        let mut grid = HashGrid {
-            min,
-            inv_cell,
-            radius,
-            radius2: radius * radius,
-            starts: vec![0; buckets + 1],
-            indices: vec![0; positions.len()],
-            positions: Vec::new(),
-        };
-        let keys: Vec<u32> = positions
-            .iter()
-            .map(|p| grid.bucket(grid.cell(*p)))
-            .collect();
+        let buckets = self.positions.len().max(1);
+        self.inv_cell = 1.0 / (2.0 * radius);
+        self.radius = radius;
+        self.radius2 = radius * radius;
+        self.starts.clear();
+        self.starts.resize(buckets + 1, 0);
+        let mut keys = std::mem::take(&mut self.keys);
+        keys.clear();
+        keys.extend(self.positions.iter().map(|p| self.bucket(self.cell(*p))));
         for &k in &keys {
-            grid.starts[k as usize + 1] += 1;
+            self.starts[k as usize + 1] += 1;
         }
         for b in 0..buckets {
-            grid.starts[b + 1] += grid.starts[b];
+            self.starts[b + 1] += self.starts[b];
         }
-        let mut next = grid.starts.clone();
-        for (i, &k) in keys.iter().enumerate() {
-            grid.indices[next[k as usize] as usize] = i as u32;
-            next[k as usize] += 1;
+        // Counting sort; each key then counts its bucket's next free slot.
+        self.indices.clear();
+        self.indices.resize(self.positions.len(), 0);
+        for (i, k) in keys.iter_mut().enumerate() {
+            let slot = &mut self.starts[*k as usize];
+            *k = *slot;
+            *slot += 1;
+            self.indices[*k as usize] = i as u32;
         }
-        grid.positions = positions;
-        grid
+        // The slots moved each start to its bucket's end, the next bucket's start: back.
+        for b in (1..=buckets).rev() {
+            self.starts[b] = self.starts[b - 1];
+        }
+        self.starts[0] = 0;
+        self.keys = keys;
     }
 
     /// The query radius the grid was built for.

@@ -150,6 +150,7 @@ pub fn radius_of(r1: f32, alpha: f32, iteration: u64) -> f32 {
 
 /// One iteration's light subpaths: their vertices in pixel order, where each pixel's end, and
 /// each pixel's origin on an area light.
+#[derive(Default)]
 struct LightPaths {
     vertices: Vec<Vertex>,
     ends: Vec<u32>,
@@ -157,6 +158,12 @@ struct LightPaths {
 }
 
 impl LightPaths {
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.ends.clear();
+        self.origins.clear();
+    }
+
     fn of(&self, pixel: usize) -> &[Vertex] {
         let start = if pixel == 0 { 0 } else { self.ends[pixel - 1] };
         &self.vertices[start as usize..self.ends[pixel] as usize]
@@ -188,6 +195,8 @@ struct Row {
     splats: RowSplats,
     rays: u64,
     bad: u64,
+    /// The camera subpath's vertices (scratch, kept for the next pixel and iteration).
+    camera: Vec<Vertex>,
 }
 
 impl Vcm {
@@ -226,25 +235,27 @@ impl Vcm {
         )
     }
 
-    /// Traces one light subpath per pixel.
+    /// Traces one light subpath per pixel into `paths`, each row first into its own of
+    /// `rows` (both kept from one iteration to the next: no allocation once they are large
+    /// enough); returns the rays cast.
     fn light_pass(
         &self,
         scene: &Scene,
         bidir: &Bidir,
         media: &[Option<u32>],
         iteration: u64,
-    ) -> (LightPaths, u64) {
+        rows: &mut Vec<LightPaths>,
+        paths: &mut LightPaths,
+    ) -> u64 {
         let (width, height) = (scene.film().width, scene.film().height);
+        rows.resize_with(height as usize, LightPaths::default);
         // Each row's paths (its ends counted from the row's first vertex), then joined in row
         // order: the same vertices in the same order whatever the thread count.
-        let rows: Vec<(LightPaths, u64)> = (0..height)
-            .into_par_iter()
-            .map(|y| {
-                let mut row = LightPaths {
-                    vertices: Vec::new(),
-                    ends: Vec::with_capacity(width as usize),
-                    origins: Vec::with_capacity(width as usize),
-                };
+        let rays = rows
+            .par_iter_mut()
+            .enumerate()
+            .map(|(y, row)| {
+                row.clear();
                 let mut rays = 0u64;
                 for x in 0..width {
                     let pixel = y as u64 * width as u64 + x as u64;
@@ -259,23 +270,17 @@ impl Vcm {
                     row.origins.push(origin);
                     row.ends.push(row.vertices.len() as u32);
                 }
-                (row, rays)
+                rays
             })
-            .collect();
-        let mut paths = LightPaths {
-            vertices: Vec::new(),
-            ends: Vec::with_capacity(width as usize * height as usize),
-            origins: Vec::with_capacity(width as usize * height as usize),
-        };
-        let mut rays = 0;
-        for (row, r) in rows {
+            .sum();
+        paths.clear();
+        for row in rows.iter() {
             let base = paths.vertices.len() as u32;
             paths.ends.extend(row.ends.iter().map(|e| e + base));
-            paths.vertices.extend(row.vertices);
-            paths.origins.extend(row.origins);
-            rays += r;
+            paths.vertices.extend_from_slice(&row.vertices);
+            paths.origins.extend_from_slice(&row.origins);
         }
-        (paths, rays)
+        rays
     }
 
     /// The camera pass: every pixel's camera subpath, its connections with its own light
@@ -287,70 +292,75 @@ impl Vcm {
         lights: &LightPaths,
         grid: Option<&HashGrid>,
         iteration: u64,
-    ) -> Vec<Row> {
+        rows: &mut Vec<Row>,
+    ) {
         let (width, height) = (scene.film().width, scene.film().height);
         let filter = &scene.film().filter;
         let light_paths = width as f32 * height as f32;
-        (0..height)
-            .into_par_iter()
-            .map(|y| {
-                let mut row = Row {
-                    sums: Vec::with_capacity(width as usize),
-                    splats: RowSplats(Vec::new(), width, 0),
-                    rays: 0,
-                    bad: 0,
-                };
-                let mut camera = Vec::new();
-                for x in 0..width {
-                    let pixel = y as usize * width as usize + x as usize;
-                    let mut sampler = self.sampler(scene, STREAM_CAMERA, pixel as u64, iteration);
-                    let rays = &mut row.rays;
-                    // ---- t = 1: this pixel's light subpath connected to the camera ----
-                    if self.mode.connects() {
-                        if let Some(o) = &lights.origins[pixel] {
-                            bidir.splat_origin(scene, o, &mut row.splats, rays);
-                        }
-                        for v in lights.of(pixel) {
-                            bidir.splat_vertex(scene, v, &mut row.splats, rays);
-                        }
+        rows.resize_with(height as usize, || Row {
+            sums: Vec::with_capacity(width as usize),
+            splats: RowSplats(Vec::new(), width, 0),
+            rays: 0,
+            bad: 0,
+            camera: Vec::new(),
+        });
+        rows.par_iter_mut().enumerate().for_each(|(y, row)| {
+            let y = y as u32;
+            row.sums.clear();
+            row.splats.0.clear();
+            row.splats.2 = 0;
+            row.rays = 0;
+            row.bad = 0;
+            let mut camera = std::mem::take(&mut row.camera);
+            for x in 0..width {
+                let pixel = y as usize * width as usize + x as usize;
+                let mut sampler = self.sampler(scene, STREAM_CAMERA, pixel as u64, iteration);
+                let rays = &mut row.rays;
+                // ---- t = 1: this pixel's light subpath connected to the camera ----
+                if self.mode.connects() {
+                    if let Some(o) = &lights.origins[pixel] {
+                        bidir.splat_origin(scene, o, &mut row.splats, rays);
                     }
-                    let mut l = Rgb::ZERO;
-                    if self.mode != Mode::Lt {
-                        let at = filter.film_position(x, y, sampler.next_2d());
-                        let ps = PixelSample {
-                            ray: scene.camera().generate_ray(at),
-                            x,
-                            y,
-                            film: at,
-                            filter_pdf: filter.pdf(x, y, at),
-                        };
-                        camera.clear();
-                        l = bidir.camera_subpath(scene, &ps, &mut sampler, &mut camera, rays);
-                        for c in &camera {
-                            if self.mode.connects() {
-                                // ---- s >= 1, t >= 2: connections ----
-                                l += bidir.direct(scene, c, &mut sampler, rays);
-                                for v in lights.of(pixel) {
-                                    l += bidir.connect(scene, c, v, rays);
-                                }
-                            }
-                            if let Some(grid) = grid {
-                                // ---- merges ----
-                                l += self.merge(bidir, c, &lights.vertices, grid) / light_paths;
-                            }
-                        }
+                    for v in lights.of(pixel) {
+                        bidir.splat_vertex(scene, v, &mut row.splats, rays);
                     }
-                    if !usable(l) {
-                        row.bad += 1;
-                        l = Rgb::ZERO;
-                    }
-                    let mut sum = RadianceSum::ZERO;
-                    sum.add(l);
-                    row.sums.push(sum);
                 }
-                row
-            })
-            .collect()
+                let mut l = Rgb::ZERO;
+                if self.mode != Mode::Lt {
+                    let at = filter.film_position(x, y, sampler.next_2d());
+                    let ps = PixelSample {
+                        ray: scene.camera().generate_ray(at),
+                        x,
+                        y,
+                        film: at,
+                        filter_pdf: filter.pdf(x, y, at),
+                    };
+                    camera.clear();
+                    l = bidir.camera_subpath(scene, &ps, &mut sampler, &mut camera, rays);
+                    for c in &camera {
+                        if self.mode.connects() {
+                            // ---- s >= 1, t >= 2: connections ----
+                            l += bidir.direct(scene, c, &mut sampler, rays);
+                            for v in lights.of(pixel) {
+                                l += bidir.connect(scene, c, v, rays);
+                            }
+                        }
+                        if let Some(grid) = grid {
+                            // ---- merges ----
+                            l += self.merge(bidir, c, &lights.vertices, grid) / light_paths;
+                        }
+                    }
+                }
+                if !usable(l) {
+                    row.bad += 1;
+                    l = Rgb::ZERO;
+                }
+                let mut sum = RadianceSum::ZERO;
+                sum.add(l);
+                row.sums.push(sum);
+            }
+            row.camera = camera;
+        });
     }
 
     /// The merges of camera vertex `c` with the light vertices within the grid's radius: sum_v
@@ -406,6 +416,18 @@ struct VcmPasses<'a> {
     media: Vec<Option<u32>>,
     film: Film,
     tally: Tally,
+    /// Memory kept from one iteration to the next.
+    buffers: Buffers,
+}
+
+/// An iteration's light paths, their grid and the camera pass's rows, kept for the next
+/// iteration: refilled, not allocated anew (their pages faulted in again each iteration were
+/// a tenth of the time).
+struct Buffers {
+    light_rows: Vec<LightPaths>,
+    lights: LightPaths,
+    grid: HashGrid,
+    rows: Vec<Row>,
 }
 
 impl Passes for VcmPasses<'_> {
@@ -415,21 +437,31 @@ impl Passes for VcmPasses<'_> {
         let (vcm, scene) = (self.vcm, self.scene);
         let (bidir, radius) = vcm.estimator(scene, iteration + 1);
         let media = &self.media;
-        let (rows, mut rays) = with_pool(quiet.threads, || {
-            let (lights, light_rays) = vcm.light_pass(scene, &bidir, media, iteration);
-            let grid = vcm
-                .mode
-                .merges()
-                .then(|| HashGrid::build(lights.vertices.iter().map(|v| v.p).collect(), radius));
-            let rows = vcm.camera_pass(scene, &bidir, &lights, grid.as_ref(), iteration);
-            (rows, light_rays)
+        let b = &mut self.buffers;
+        let mut rays = with_pool(quiet.threads, || {
+            let light_rays = vcm.light_pass(
+                scene,
+                &bidir,
+                media,
+                iteration,
+                &mut b.light_rows,
+                &mut b.lights,
+            );
+            let merges = vcm.mode.merges();
+            if merges {
+                b.grid
+                    .rebuild(b.lights.vertices.iter().map(|v| v.p), radius);
+            }
+            let grid = merges.then_some(&b.grid);
+            vcm.camera_pass(scene, &bidir, &b.lights, grid, iteration, &mut b.rows);
+            light_rays
         })?;
         if quiet.cancelled() {
             // An iteration cut short would leave pixels without their sample: drop it.
             return Ok(None);
         }
         let width = scene.film().width as usize;
-        for (y, row) in rows.into_iter().enumerate() {
+        for (y, row) in self.buffers.rows.iter().enumerate() {
             let y0 = y * width;
             for (x, sum) in row.sums.iter().enumerate() {
                 self.film.add_pixel(y0 + x, sum, 1);
@@ -468,6 +500,12 @@ impl Integrator for Vcm {
             media: scene.emission_media()?,
             film: Film::new(scene.film().width, scene.film().height),
             tally: Tally::default(),
+            buffers: Buffers {
+                light_rows: Vec::new(),
+                lights: LightPaths::default(),
+                grid: HashGrid::empty(),
+                rows: Vec::new(),
+            },
         };
         // Iteration i's radius and random streams depend on i alone: any share of them can
         // be rendered apart.
