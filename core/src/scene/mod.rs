@@ -245,6 +245,15 @@ impl Scene {
                 vec![false; objects.len()],
             )
         };
+        let mut warnings = warnings;
+        if uses_media {
+            warnings.extend(volumes::coincident_boundaries(
+                &objects,
+                &materials,
+                &interfaces,
+                &accel,
+            ));
+        }
         let mut camera_medium = camera_placed.flatten();
         if uses_media && camera_placed.is_none() {
             camera_medium = locate_medium(

@@ -264,6 +264,73 @@ fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
     }
 }
 
+/// Warnings for medium boundaries (null shapes that bound a medium) lying on an opaque
+/// surface: a boundary face and a floor in the same plane, which rays restarted past the
+/// boundary can slip through (docs/scene-format.md, "where the media are"). Each boundary
+/// triangle, quad and disk is probed at its centroid and near its corners by a ray across
+/// its plane; one warning per pair of objects.
+pub(super) fn coincident_boundaries(
+    objects: &[Object],
+    materials: &[Named<Material>],
+    interfaces: &[Option<MediumInterface>],
+    accel: &Accel,
+) -> Vec<String> {
+    let null = |o: u32| {
+        materials[objects[o as usize].material as usize]
+            .value
+            .is_null()
+    };
+    let mut pairs: Vec<(u32, u32, Vec3)> = Vec::new();
+    for prim in accel.primitives() {
+        let o = prim.object;
+        let bounds_medium =
+            interfaces[o as usize].is_some_and(|i| i.inside.is_some() || i.outside.is_some());
+        if !bounds_medium || !null(o) {
+            continue;
+        }
+        let (centre, corners) = match prim.shape {
+            Shape::Triangle { p0, e1, e2 } => (p0 + (e1 + e2) / 3.0, [p0, p0 + e1, p0 + e2]),
+            Shape::Quad { origin, u, v, .. } => {
+                (origin + 0.5 * (u + v), [origin, origin + u + v, origin + u])
+            }
+            Shape::Disk { center, u, v, .. } => (center, [center + u, center + v, center - u]),
+            Shape::Sphere { .. } => continue,
+        };
+        let n = prim.shape.normal(centre);
+        let size = corners
+            .iter()
+            .map(|c| c.distance(centre))
+            .fold(0.0, f32::max);
+        let delta = 1e-4 * centre.abs().max_element().max(size);
+        for p in std::iter::once(centre).chain(corners.map(|c| centre + 0.9 * (c - centre))) {
+            let ray = Ray::new(p + n * delta, -n);
+            accel.for_each_hit(&ray, 2.0 * delta, |k, _| {
+                let other = &accel.primitives()[k as usize];
+                let q = other.object;
+                if q != o
+                    && !null(q)
+                    && !matches!(other.shape, Shape::Sphere { .. })
+                    && other.shape.normal(p).dot(n).abs() > 0.99
+                    && !pairs.iter().any(|&(a, b, _)| a == o && b == q)
+                {
+                    pairs.push((o, q, p));
+                }
+            });
+        }
+    }
+    pairs
+        .into_iter()
+        .map(|(o, q, p)| {
+            format!(
+                "{}, a medium boundary, lies on the surface of {} (at {:.4}, {:.4}, {:.4}): rays \
+                 restarted past the boundary can slip through that surface; move the boundary \
+                 off it a little (a fog box 1 mm above the floor)",
+                objects[o as usize].name, objects[q as usize].name, p.x, p.y, p.z
+            )
+        })
+        .collect()
+}
+
 /// Which objects bound volumes, and the medium interfaces of all objects. A shape whose file
 /// names its `exterior` has the interface written there; it bounds a volume if it is closed
 /// (and not a sphere turned inside out). Another closed shape bounds a volume if it has an

@@ -295,6 +295,73 @@ fn a_medium_whose_boundary_leaks_is_an_error_naming_the_shape() {
     );
 }
 
+/// A fog box standing on the floor (its bottom face in the floor's plane) is a warning naming
+/// both shapes; 1 mm above it, none.
+#[test]
+fn a_medium_boundary_on_a_floor_is_a_warning() {
+    let scene = |bottom: f32| {
+        let half = 0.5 * (1.0 - bottom);
+        format!(
+            r#"{}
+[camera]
+position = [0.0, 0.5, 4.0]
+look_at = [0.0, 0.5, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 30.0
+[materials.white]
+type = "diffuse"
+reflectance = [0.5, 0.5, 0.5]
+[materials.boundary]
+type = "null"
+[media.fog]
+type = "homogeneous"
+sigma_a = [0.1, 0.1, 0.1]
+sigma_s = [0.5, 0.5, 0.5]
+[[shapes]]
+type = "quad"
+origin = [-2.0, 0.0, 2.0]
+u = [4.0, 0.0, 0.0]
+v = [0.0, 0.0, -4.0]
+material = "white"
+[[shapes]]
+type = "mesh"
+file = "{}"
+material = "boundary"
+interior = "fog"
+transform = {{ translate = [0.0, {}, 0.0], scale = [0.5, {half}, 0.5] }}
+[[lights]]
+type = "point"
+position = [0.0, 3.0, 1.0]
+intensity = [1.0, 1.0, 1.0]
+"#,
+            header("path", 1, 4, 4, 4),
+            repo_root().join("scenes/meshes/cube.obj").display(),
+            bottom + half,
+        )
+    };
+    let on = load_toml("sides-on-floor", &scene(0.0));
+    let warned: Vec<&String> = on
+        .warnings()
+        .iter()
+        .filter(|w| w.contains("a medium boundary"))
+        .collect();
+    assert_eq!(warned.len(), 1, "{:?}", on.warnings());
+    assert!(
+        warned[0].contains("shapes[1]") && warned[0].contains("shapes[0]"),
+        "{}",
+        warned[0]
+    );
+    let above = load_toml("sides-above-floor", &scene(0.001));
+    assert!(
+        !above
+            .warnings()
+            .iter()
+            .any(|w| w.contains("a medium boundary")),
+        "{:?}",
+        above.warnings()
+    );
+}
+
 /// Bitterli's volumetric caustic (Mitsuba 3 port: the fog in a `cube` with a `null` BSDF,
 /// walls and light in the fog, a glass sphere with the fog outside): `path` and `vpm` render
 /// the fog; `vpm` shows the light the sphere focuses below it, brighter than the fog beside.
