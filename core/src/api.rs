@@ -26,8 +26,8 @@ pub use crate::error::{Error, Result};
 #[doc(hidden)]
 pub use crate::integrator::CreateIntegrator;
 pub use crate::integrator::{
-    Budget, Integrator, MapPhoton, NoProgress, ParamValue, Parameter, Part, PhotonMapView,
-    Progress, RenderContext, Work, describe,
+    Budget, Integrator, MapPhoton, NoProgress, ParamValue, Parameter, Part, PhaseTimer,
+    PhotonMapView, Progress, RenderContext, Work, describe,
 };
 pub use crate::plugin::PLUGIN_API_VERSION;
 #[doc(hidden)]

@@ -13,6 +13,7 @@ use crate::props::Properties;
 use crate::scene::Scene;
 use glam::Vec3;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::{Duration, Instant};
 
 // Parts of the interface in modules of their own, below it, so that `film` and `kernel`
 // need not import it; their paths here are kept.
@@ -38,6 +39,10 @@ pub trait Progress: Send + Sync {
     /// A progressive integrator finished iteration `iteration` (1-based); `image` makes the
     /// current estimate. The host writes it when the user asked for checkpoints.
     fn checkpoint(&self, _iteration: u64, _image: &dyn Fn() -> Film) {}
+    /// Phase `name` of the render ran once more, for `wall` of wall-clock time and `cpu` of
+    /// the process's CPU time (all threads): see [`RenderContext::timed`]. A progressive
+    /// integrator reports its phases once per iteration; `foton bench --json` sums them.
+    fn phase(&self, _name: &str, _wall: Duration, _cpu: Duration) {}
 }
 
 /// Progress that reports nothing.
@@ -75,6 +80,71 @@ impl<'a> RenderContext<'a> {
     pub fn cancelled(&self) -> bool {
         self.cancel.load(Ordering::Relaxed)
     }
+
+    /// Runs `f` as phase `name` of the render (photon tracing, the map's build, the camera
+    /// pass...), reporting its wall-clock and CPU time to [`Progress::phase`].
+    pub fn timed<R>(&self, name: &str, f: impl FnOnce() -> R) -> R {
+        let _phase = self.phase(name);
+        f()
+    }
+
+    /// Phase `name` of the render from now until the returned guard is dropped (see
+    /// [`RenderContext::timed`]).
+    pub fn phase<'n>(&self, name: &'n str) -> PhaseTimer<'_, 'n> {
+        PhaseTimer {
+            progress: self.progress,
+            name,
+            wall: Instant::now(),
+            cpu: process_cpu_time(),
+        }
+    }
+}
+
+/// A phase of a render being timed: reports itself to [`Progress::phase`] when dropped.
+pub struct PhaseTimer<'a, 'n> {
+    progress: &'a dyn Progress,
+    name: &'n str,
+    wall: Instant,
+    cpu: Duration,
+}
+
+impl Drop for PhaseTimer<'_, '_> {
+    fn drop(&mut self) {
+        let cpu = process_cpu_time().saturating_sub(self.cpu);
+        self.progress.phase(self.name, self.wall.elapsed(), cpu);
+    }
+}
+
+/// The CPU time the process has used so far, all its threads together (zero where the
+/// platform has no such clock).
+pub fn process_cpu_time() -> Duration {
+    #[cfg(unix)]
+    {
+        let mut t = libc::timespec {
+            tv_sec: 0,
+            tv_nsec: 0,
+        };
+        // SAFETY: clock_gettime writes the timespec it is given and nothing else.
+        if unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut t) } == 0 {
+            return Duration::new(t.tv_sec as u64, t.tv_nsec as u32);
+        }
+    }
+    Duration::ZERO
+}
+
+/// The process's peak resident memory in bytes (zero where the platform does not say).
+pub fn peak_rss_bytes() -> u64 {
+    #[cfg(unix)]
+    {
+        // SAFETY: getrusage fills the struct it is given; zeroed is a valid rusage.
+        let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+        if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } == 0 {
+            // Linux reports kilobytes, macOS bytes.
+            let scale = if cfg!(target_os = "macos") { 1 } else { 1024 };
+            return u.ru_maxrss.max(0) as u64 * scale;
+        }
+    }
+    0
 }
 
 /// "name(a = 1, b = box)": the form of [`Integrator::describe`].

@@ -189,58 +189,66 @@ where
     while done < spp && !ctx.cancelled() {
         let batch = (done - first).max(1).min(spp - done);
         let (s0, s1) = (done, done + batch);
-        let results: Vec<Vec<(usize, RadianceSum, u32)>> = with_pool(ctx.threads, || {
-            tiles
-                .par_iter()
-                .map(|&(x0, y0)| {
-                    let mut out = Vec::with_capacity((TILE * TILE) as usize);
-                    let mut tile_rays = 0u64;
-                    let mut splats = Splats {
-                        width,
-                        pending: Vec::new(),
-                        buffer: splatting.then_some(&splat_buffer),
-                        bad: 0,
-                    };
-                    for y in y0..(y0 + TILE).min(height) {
-                        if ctx.cancelled() {
-                            break;
-                        }
-                        for x in x0..(x0 + TILE).min(width) {
-                            let mut sum = RadianceSum::ZERO;
-                            let samplers = pixel_samplers(&scene.render, width, x, y);
-                            for s in s0..s1 {
-                                let mut sampler = samplers.sample(s);
-                                let at = filter.film_position(x, y, sampler.next_2d());
-                                let sample = PixelSample {
-                                    ray: scene.camera.generate_ray(at),
-                                    x,
-                                    y,
-                                    film: at,
-                                    filter_pdf: filter.pdf(x, y, at),
-                                };
-                                let mut l =
-                                    radiance(&sample, &mut sampler, &mut splats, &mut tile_rays);
-                                if !usable(l) {
-                                    bad_samples.fetch_add(1, Ordering::Relaxed);
-                                    l = Rgb::ZERO;
-                                }
-                                sum.add(l);
+        let results: Vec<Vec<(usize, RadianceSum, u32)>> = ctx.timed("camera pass", || {
+            with_pool(ctx.threads, || {
+                tiles
+                    .par_iter()
+                    .map(|&(x0, y0)| {
+                        let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                        let mut tile_rays = 0u64;
+                        let mut splats = Splats {
+                            width,
+                            pending: Vec::new(),
+                            buffer: splatting.then_some(&splat_buffer),
+                            bad: 0,
+                        };
+                        for y in y0..(y0 + TILE).min(height) {
+                            if ctx.cancelled() {
+                                break;
                             }
-                            out.push((film.index(x, y), sum, s1 - s0));
+                            for x in x0..(x0 + TILE).min(width) {
+                                let mut sum = RadianceSum::ZERO;
+                                let samplers = pixel_samplers(&scene.render, width, x, y);
+                                for s in s0..s1 {
+                                    let mut sampler = samplers.sample(s);
+                                    let at = filter.film_position(x, y, sampler.next_2d());
+                                    let sample = PixelSample {
+                                        ray: scene.camera.generate_ray(at),
+                                        x,
+                                        y,
+                                        film: at,
+                                        filter_pdf: filter.pdf(x, y, at),
+                                    };
+                                    let mut l = radiance(
+                                        &sample,
+                                        &mut sampler,
+                                        &mut splats,
+                                        &mut tile_rays,
+                                    );
+                                    if !usable(l) {
+                                        bad_samples.fetch_add(1, Ordering::Relaxed);
+                                        l = Rgb::ZERO;
+                                    }
+                                    sum.add(l);
+                                }
+                                out.push((film.index(x, y), sum, s1 - s0));
+                            }
                         }
-                    }
-                    splats.flush();
-                    bad_splats.fetch_add(splats.bad, Ordering::Relaxed);
-                    rays.fetch_add(tile_rays, Ordering::Relaxed);
-                    ctx.progress.rays(tile_rays);
-                    ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
-                    out
-                })
-                .collect()
+                        splats.flush();
+                        bad_splats.fetch_add(splats.bad, Ordering::Relaxed);
+                        rays.fetch_add(tile_rays, Ordering::Relaxed);
+                        ctx.progress.rays(tile_rays);
+                        ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
+                        out
+                    })
+                    .collect()
+            })
         })?;
-        for (i, sum, n) in results.into_iter().flatten() {
-            film.add_pixel(i, &sum, n);
-        }
+        ctx.timed("film accumulation", || {
+            for (i, sum, n) in results.into_iter().flatten() {
+                film.add_pixel(i, &sum, n);
+            }
+        });
         done = s1;
     }
     ctx.progress.finish();

@@ -71,7 +71,7 @@
 use foton_core::api::{
     Bsdf, Budget, CameraWalk, Direct, Error, Film, Hit, Integrator, NormalizedKernel, Parameter,
     PhotonMapView, Properties, Ray, RenderContext, Result, Rgb, Sampler, Scene, TransportMode,
-    Vec3, Work, first_surface, offset_origin, trace_to_diffuse,
+    Vec3, Work, first_surface, offset_origin, trace_to_diffuse, with_pool,
 };
 use foton_photonmap::surface::{
     SurfaceMaps, SurfaceParams, render_with_maps, surface_views, trace_surface_photons,
@@ -118,7 +118,8 @@ impl PhotonMapper {
             ctx.progress
                 .warn("no photon reached a second diffuse surface: the indirect map is empty");
         }
-        Ok(SurfaceMaps::build(lists, need_direct))
+        let _build = ctx.phase("photon map build");
+        with_pool(ctx.threads, || SurfaceMaps::build(lists, need_direct))
     }
 
     /// Indirect light at a diffuse point by final gathering: rays by the BSDF's non-delta part,

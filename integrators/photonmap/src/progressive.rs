@@ -7,12 +7,12 @@
 
 use crate::map::{DISC_THICKNESS, DiscClip, PhotonMap};
 use foton_core::api::{
-    Budget, Error, Film, NoProgress, NormalizedKernel, Parameter, Properties, RenderContext,
-    Result, Rgb, Scene, VisiblePoint, Work, usable, warn_unusable,
+    Budget, Error, Film, NormalizedKernel, Parameter, Progress, Properties, RenderContext, Result,
+    Rgb, Scene, VisiblePoint, Work, usable, warn_unusable,
 };
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU64, Ordering};
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
 /// How many passes a progressive integrator runs and how many photons each traces: the
 /// `iterations`, `time` and `photons_per_iteration` of its table, read and checked here once.
@@ -153,6 +153,20 @@ impl Tally {
     }
 }
 
+/// The progress of a pass's inner work: only its phase timings go to the host (the bar and
+/// messages are the passes' own).
+struct PhasesOnly<'a>(&'a dyn Progress);
+
+impl Progress for PhasesOnly<'_> {
+    fn begin(&self, _: &str, _: u64) {}
+    fn advance(&self, _: u64) {}
+    fn finish(&self) {}
+    fn warn(&self, _: &str) {}
+    fn phase(&self, name: &str, wall: Duration, cpu: Duration) {
+        self.0.phase(name, wall, cpu);
+    }
+}
+
 /// The pass loop of a progressive integrator: runs the passes `budget` and the part ask for
 /// (until `time` runs out with a time budget, or Ctrl-C), reports progress, writes
 /// checkpoints (`--checkpoint`: the image after the passes so far), and returns the image of
@@ -170,7 +184,8 @@ pub fn run_passes(
 ) -> Result<Film> {
     let (first, last) = budget.range(plugin, ctx, splittable)?;
     let start = Instant::now();
-    let quiet = RenderContext::new(ctx.threads, ctx.cancel, &NoProgress);
+    let phases = PhasesOnly(ctx.progress);
+    let quiet = RenderContext::new(ctx.threads, ctx.cancel, &phases);
     match (last, budget.time) {
         (Some(n), None) => ctx.progress.begin("iterations", n - first),
         (_, Some(t)) => ctx.progress.begin("seconds", t.ceil() as u64),

@@ -292,6 +292,7 @@ pub fn trace_photons_and_beams(
     let media = scene.emission_media()?;
     ctx.progress.begin("photons", opts.photons);
     let chunks = opts.photons.div_ceil(CHUNK);
+    let _tracing = ctx.phase("photon tracing");
     let parts: Vec<(Vec<Vec<Photon>>, Vec<Beam>)> = with_pool(ctx.threads, || {
         (0..chunks)
             .into_par_iter()

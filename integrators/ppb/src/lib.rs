@@ -205,14 +205,17 @@ impl Ppb {
         let (photons, beams) = self.trace(scene, iteration, ctx)?;
         let scale = global_radius2_scale(iteration + 1, self.alpha);
         let r = (self.initial_beam_radius as f64 * scale) as f32;
-        let beams = BeamMap::build(beams, r);
+        let _build = ctx.phase("beam and photon map build");
         let margin = scene.film().filter.margin();
-        Ok(Pass {
-            surface: PhotonMap::build(photons),
-            screen: ScreenBeams::build(&beams, scene.camera(), margin),
-            beams,
-            surface_shrink: scale.sqrt(),
-            pixel_angle: pixel_angle(scene),
+        with_pool(ctx.threads, || {
+            let beams = BeamMap::build(beams, r);
+            Pass {
+                surface: PhotonMap::build(photons),
+                screen: ScreenBeams::build(&beams, scene.camera(), margin),
+                beams,
+                surface_shrink: scale.sqrt(),
+                pixel_angle: pixel_angle(scene),
+            }
         })
     }
 
@@ -341,6 +344,7 @@ impl Passes for PpbPasses<'_> {
             return Ok(None);
         }
         let width = scene.film().width as usize;
+        let _camera = quiet.phase("camera pass");
         with_pool(quiet.threads, || {
             self.sums
                 .par_chunks_mut(width)

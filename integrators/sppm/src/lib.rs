@@ -300,15 +300,20 @@ impl Passes for SppmPasses<'_> {
             }
         }
         self.started = true;
-        let camera = with_pool(quiet.threads, || {
-            sppm.camera_pass(scene, iteration, &mut rays)
+        let camera = quiet.timed("camera pass", || {
+            with_pool(quiet.threads, || {
+                sppm.camera_pass(scene, iteration, &mut rays)
+            })
         })?;
         Tally::add(&tally.rays, rays);
         let photons = sppm.iteration_photons(scene, iteration, quiet)?;
         if quiet.cancelled() {
             return Ok(None);
         }
-        let map = PhotonMap::build(photons);
+        let map = quiet.timed("photon map build", || {
+            with_pool(quiet.threads, || PhotonMap::build(photons))
+        })?;
+        let _gather = quiet.phase("photon gather and radius update");
         let alpha = sppm.alpha;
         // r_i / r_1 of this iteration under the global schedule, the same for every pixel.
         let global_shrink = global_radius2_scale(iteration + 1, alpha).sqrt();

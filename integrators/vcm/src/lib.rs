@@ -439,21 +439,27 @@ impl Passes for VcmPasses<'_> {
         let media = &self.media;
         let b = &mut self.buffers;
         let mut rays = with_pool(quiet.threads, || {
-            let light_rays = vcm.light_pass(
-                scene,
-                &bidir,
-                media,
-                iteration,
-                &mut b.light_rows,
-                &mut b.lights,
-            );
+            let light_rays = quiet.timed("light tracing", || {
+                vcm.light_pass(
+                    scene,
+                    &bidir,
+                    media,
+                    iteration,
+                    &mut b.light_rows,
+                    &mut b.lights,
+                )
+            });
             let merges = vcm.mode.merges();
             if merges {
-                b.grid
-                    .rebuild(b.lights.vertices.iter().map(|v| v.p), radius);
+                quiet.timed("hash grid build", || {
+                    b.grid
+                        .rebuild(b.lights.vertices.iter().map(|v| v.p), radius)
+                });
             }
             let grid = merges.then_some(&b.grid);
-            vcm.camera_pass(scene, &bidir, &b.lights, grid, iteration, &mut b.rows);
+            quiet.timed("camera pass", || {
+                vcm.camera_pass(scene, &bidir, &b.lights, grid, iteration, &mut b.rows)
+            });
             light_rays
         })?;
         if quiet.cancelled() {
@@ -461,6 +467,7 @@ impl Passes for VcmPasses<'_> {
             return Ok(None);
         }
         let width = scene.film().width as usize;
+        let _accumulate = quiet.phase("film accumulation");
         for (y, row) in self.buffers.rows.iter().enumerate() {
             let y0 = y * width;
             for (x, sum) in row.sums.iter().enumerate() {

@@ -240,10 +240,15 @@ impl Vpm {
     pub fn build_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Maps> {
         let photons_direct = self.direct == Direct::Photons;
         let (surface, volume, beams) = self.trace_lists(scene, ctx, photons_direct)?;
-        let beams = (self.estimate == VolumeEstimate::Beams)
-            .then(|| BeamMap::build(beams, self.beam_radius));
-        let surface = SurfaceMaps::build(surface, photons_direct);
-        let volume = PhotonMap::build(volume);
+        let _build = ctx.phase("photon map build");
+        let (beams, surface, volume) = with_pool(ctx.threads, || {
+            (
+                (self.estimate == VolumeEstimate::Beams)
+                    .then(|| BeamMap::build(beams, self.beam_radius)),
+                SurfaceMaps::build(surface, photons_direct),
+                PhotonMap::build(volume),
+            )
+        })?;
         let volume_radius: Vec<f32> = if self.estimate == VolumeEstimate::Beam {
             with_pool(ctx.threads, || {
                 volume

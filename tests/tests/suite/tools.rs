@@ -107,7 +107,7 @@ fn json_number(json: &str, integrator: &str, field: &str) -> Option<f64> {
     let rest = &json[entry..];
     let key = format!("\"{field}\": ");
     let at = rest.find(&key).unwrap() + key.len();
-    let value = rest[at..].split([',', '\n']).next().unwrap().trim();
+    let value = rest[at..].split([',', '\n', '}']).next().unwrap().trim();
     (value != "null").then(|| value.parse().unwrap())
 }
 
@@ -725,5 +725,81 @@ fn curve_without_a_reference_or_a_time_is_refused() {
     ]);
     fails_with(&run, &["--curve 3 needs --time"]);
     assert!(!out.exists());
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+// ---------------------------------------------------------------------------------------------
+// foton bench --json
+// ---------------------------------------------------------------------------------------------
+
+/// The phase profile of `sppm` on the box: its phases (the load, photon tracing, the map's
+/// build, the gather, the camera pass) at one thread and at two, wall and CPU seconds that
+/// add up to the totals, Amdahl's predictions consistent with the serial fraction, the peak
+/// memory.
+#[test]
+fn bench_profiles_the_phases_of_a_render() {
+    let (dir, scene) = setup("bench-json");
+    let json = dir.join("profile.json");
+    let run = foton_with_plugins(&[
+        "bench",
+        s(&scene),
+        "--integrator",
+        "sppm",
+        "--set",
+        "integrators.sppm.iterations=4",
+        "--set",
+        "integrators.sppm.photons_per_iteration=20000",
+        "--threads",
+        "2",
+        "--json",
+        s(&json),
+    ]);
+    ok(&run);
+    let text = std::fs::read_to_string(&json).unwrap();
+    let phases = [
+        "scene load and BVH build",
+        "camera pass",
+        "photon tracing",
+        "photon map build",
+        "photon gather and radius update",
+    ];
+    let (mut sum_1, mut sum_all) = (0.0, 0.0);
+    for phase in phases {
+        let field = |f: &str| json_number(&text, phase, f).unwrap();
+        let (w1, c1, wn, cn) = (
+            field("wall_1"),
+            field("cpu_1"),
+            field("wall_all"),
+            field("cpu_all"),
+        );
+        assert!(w1 > 0.0 && wn > 0.0 && c1 >= 0.0 && cn >= 0.0, "{phase}: {text}");
+        sum_1 += w1;
+        sum_all += wn;
+    }
+    // The work of the passes is counted once per iteration, summed: the photon tracing of
+    // four iterations of 20000 photons takes longer than no time, and the phases listed
+    // are most of the total (the rest is set-up).
+    let total = |f: &str| {
+        let at = text.find("\"total\"").unwrap();
+        let rest = &text[at..];
+        let key = format!("\"{f}\": ");
+        let i = rest.find(&key).unwrap() + key.len();
+        rest[i..].split([',', '}']).next().unwrap().trim().parse::<f64>().unwrap()
+    };
+    assert!(sum_1 <= total("wall_1") * 1.0001 && sum_1 >= 0.8 * total("wall_1"), "{text}");
+    assert!(sum_all <= total("wall_all") * 1.0001, "{text}");
+    let number = |key: &str| {
+        let k = format!("\"{key}\": ");
+        let i = text.find(&k).unwrap_or_else(|| panic!("no {key}: {text}")) + k.len();
+        text[i..].split([',', '\n']).next().unwrap().trim().to_string()
+    };
+    let f: f64 = number("serial_fraction").parse().unwrap();
+    let s16: f64 = number("predicted_speedup_16").parse().unwrap();
+    let s64: f64 = number("predicted_speedup_64").parse().unwrap();
+    assert!((0.0..=1.0).contains(&f), "{text}");
+    assert!((1.0 / (f + (1.0 - f) / 16.0) - s16).abs() < 1e-3, "{text}");
+    assert!(1.0 <= s16 && s16 <= s64 && s64 <= 64.0, "{text}");
+    let rss: u64 = number("peak_rss_bytes").parse().unwrap();
+    assert!(rss > 1 << 20, "peak RSS {rss}");
     let _ = std::fs::remove_dir_all(dir);
 }
