@@ -771,6 +771,29 @@ fn heterogeneous_media_read_their_grids() {
     assert!((vector(&doc.root, "media.fog.sigma_t") - Vec3::new(1.0, 2.0, 3.0)).length() < 1e-4);
     assert_eq!(text(&doc.root, "media.fog.density.outside"), "box");
     assert!((vector(&doc.root, "media.fog.albedo") - Vec3::splat(0.75)).length() < 1e-4);
+    // `mirror` reads as `clamp` in the extinction volume (the medium is only in its box),
+    // not in an albedo volume, which may be looked up beyond its own.
+    let wrap = "<string name=\"wrap_mode\" value=\"mirror\"/>";
+    let grid = |name: &str| {
+        format!(
+            "<volume name=\"{name}\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/>{wrap}</volume>"
+        )
+    };
+    let body = format!(
+        "<medium type=\"heterogeneous\" id=\"smoke\">{}</medium>\n{SENSOR}",
+        grid("sigma_t")
+    );
+    let xml = write(&dir, "mirror.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert!(text(&doc.root, "media.smoke.density.file").ends_with("smoke.vol"));
+    let body = format!(
+        "<medium type=\"heterogeneous\" id=\"smoke\">{}{}</medium>\n{SENSOR}",
+        grid("sigma_t"),
+        grid("albedo")
+    );
+    let xml = write(&dir, "mirror-albedo.xml", &scene("3.0.0", &body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("albedo") && e.contains("wrap mode"), "{e}");
     // A grid in a homogeneous medium (Mitsuba 3's textured albedo): its mean, said.
     let body = format!(
         "<medium type=\"homogeneous\" id=\"milk\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume><rgb name=\"sigma_t\" value=\"1\"/></medium>\n{SENSOR}"

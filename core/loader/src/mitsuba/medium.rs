@@ -172,8 +172,15 @@ impl Reader {
                     "`{name}`: only trilinear grid lookups are supported"
                 ));
             }
-            if value("wrap_mode").is_some_and(|w| w != "clamp") {
-                return Some(format!("`{name}`: only the `clamp` wrap mode is supported"));
+            // Inside the extinction volume's box (all of the medium that exists in Mitsuba
+            // 3) `mirror` reads what `clamp` reads: the sample beyond the first one,
+            // mirrored, is the first. An albedo volume may be looked up beyond its box.
+            let extinction = !self.v1 && (name == "sigma_t" || name == "density");
+            if value("wrap_mode").is_some_and(|w| w != "clamp" && !(w == "mirror" && extinction)) {
+                return Some(format!(
+                    "`{name}`: only the `clamp` wrap mode is supported{}",
+                    if extinction { " (and `mirror`)" } else { "" }
+                ));
             }
         }
         None
