@@ -772,7 +772,10 @@ fn bench_profiles_the_phases_of_a_render() {
             field("wall_all"),
             field("cpu_all"),
         );
-        assert!(w1 > 0.0 && wn > 0.0 && c1 >= 0.0 && cn >= 0.0, "{phase}: {text}");
+        assert!(
+            w1 > 0.0 && wn > 0.0 && c1 >= 0.0 && cn >= 0.0,
+            "{phase}: {text}"
+        );
         sum_1 += w1;
         sum_all += wn;
     }
@@ -784,14 +787,28 @@ fn bench_profiles_the_phases_of_a_render() {
         let rest = &text[at..];
         let key = format!("\"{f}\": ");
         let i = rest.find(&key).unwrap() + key.len();
-        rest[i..].split([',', '}']).next().unwrap().trim().parse::<f64>().unwrap()
+        rest[i..]
+            .split([',', '}'])
+            .next()
+            .unwrap()
+            .trim()
+            .parse::<f64>()
+            .unwrap()
     };
-    assert!(sum_1 <= total("wall_1") * 1.0001 && sum_1 >= 0.8 * total("wall_1"), "{text}");
+    assert!(
+        sum_1 <= total("wall_1") * 1.0001 && sum_1 >= 0.8 * total("wall_1"),
+        "{text}"
+    );
     assert!(sum_all <= total("wall_all") * 1.0001, "{text}");
     let number = |key: &str| {
         let k = format!("\"{key}\": ");
         let i = text.find(&k).unwrap_or_else(|| panic!("no {key}: {text}")) + k.len();
-        text[i..].split([',', '\n']).next().unwrap().trim().to_string()
+        text[i..]
+            .split([',', '\n'])
+            .next()
+            .unwrap()
+            .trim()
+            .to_string()
     };
     let f: f64 = number("serial_fraction").parse().unwrap();
     let s16: f64 = number("predicted_speedup_16").parse().unwrap();
