@@ -170,14 +170,32 @@ impl LightPaths {
     }
 }
 
-/// Splats of one row of pixels, as exact sums per pixel index.
-struct RowSplats(Vec<(u32, RadianceSum)>, u32, u64);
+/// Splats of one row of pixels, as exact sums per pixel index, listed by the band of
+/// `band_rows` image rows they land in (so that each band of the film takes its own lists).
+struct RowSplats {
+    bands: Vec<Vec<(u32, RadianceSum)>>,
+    band_rows: u32,
+    width: u32,
+    /// Splats dropped: not finite, or negative.
+    bad: u64,
+}
+
+impl RowSplats {
+    /// Empty, for a film of `height` rows in bands of `band_rows`.
+    fn reset(&mut self, height: u32, band_rows: u32) {
+        self.band_rows = band_rows;
+        self.bands
+            .resize_with(height.div_ceil(band_rows) as usize, Vec::new);
+        self.bands.iter_mut().for_each(Vec::clear);
+        self.bad = 0;
+    }
+}
 
 impl SplatSink for RowSplats {
     #[inline]
     fn add(&mut self, x: u32, y: u32, value: Rgb) {
         if !usable(value) {
-            self.2 += 1;
+            self.bad += 1;
             return;
         }
         if value == Rgb::ZERO {
@@ -185,7 +203,7 @@ impl SplatSink for RowSplats {
         }
         let mut s = RadianceSum::ZERO;
         s.add(value);
-        self.0.push((y * self.1 + x, s));
+        self.bands[(y / self.band_rows) as usize].push((y * self.width + x, s));
     }
 }
 
@@ -295,11 +313,19 @@ impl Vcm {
         rows: &mut Vec<Row>,
     ) {
         let (width, height) = (scene.film().width, scene.film().height);
+        // The film's splats are added in bands of rows, one per thread of the pool this runs
+        // in (the accumulation reads the bands from the rows).
+        let band_rows = height.div_ceil(rayon::current_num_threads() as u32).max(1);
         let filter = &scene.film().filter;
         let light_paths = width as f32 * height as f32;
         rows.resize_with(height as usize, || Row {
             sums: Vec::with_capacity(width as usize),
-            splats: RowSplats(Vec::new(), width, 0),
+            splats: RowSplats {
+                bands: Vec::new(),
+                band_rows,
+                width,
+                bad: 0,
+            },
             rays: 0,
             bad: 0,
             camera: Vec::new(),
@@ -307,8 +333,7 @@ impl Vcm {
         rows.par_iter_mut().enumerate().for_each(|(y, row)| {
             let y = y as u32;
             row.sums.clear();
-            row.splats.0.clear();
-            row.splats.2 = 0;
+            row.splats.reset(height, band_rows);
             row.rays = 0;
             row.bad = 0;
             let mut camera = std::mem::take(&mut row.camera);
@@ -414,7 +439,11 @@ struct VcmPasses<'a> {
     vcm: &'a Vcm,
     scene: &'a Scene,
     media: Vec<Option<u32>>,
-    film: Film,
+    /// The film's exact sums: per pixel its samples' and its splats' (empty until the
+    /// first splat), and the passes added.
+    sums: Vec<RadianceSum>,
+    splats: Vec<RadianceSum>,
+    passes: u32,
     tally: Tally,
     /// Memory kept from one iteration to the next.
     buffers: Buffers,
@@ -468,17 +497,46 @@ impl Passes for VcmPasses<'_> {
         }
         let width = scene.film().width as usize;
         let _accumulate = quiet.phase("film accumulation");
-        for (y, row) in self.buffers.rows.iter().enumerate() {
-            let y0 = y * width;
-            for (x, sum) in row.sums.iter().enumerate() {
-                self.film.add_pixel(y0 + x, sum, 1);
-            }
-            for (i, s) in &row.splats.0 {
-                self.film.add_splat(*i as usize, s);
-            }
+        let rows = &self.buffers.rows;
+        let splatted = |r: &Row| r.splats.bands.iter().any(|b| !b.is_empty());
+        if self.splats.is_empty() && rows.iter().any(splatted) {
+            self.splats = vec![RadianceSum::ZERO; self.sums.len()];
+        }
+        // Integer sums: added in any order, the same film. The splats by bands of rows, each
+        // band's task taking its own list from every row.
+        let band = width * rows.first().map_or(1, |r| r.splats.band_rows) as usize;
+        let (sums, splats) = (&mut self.sums, &mut self.splats);
+        with_pool(quiet.threads, || {
+            rayon::join(
+                || {
+                    sums.par_chunks_mut(width)
+                        .zip(rows.par_iter())
+                        .for_each(|(dst, row)| {
+                            for (d, s) in dst.iter_mut().zip(&row.sums) {
+                                d.merge(s);
+                            }
+                        })
+                },
+                || {
+                    splats
+                        .par_chunks_mut(band)
+                        .enumerate()
+                        .for_each(|(b, chunk)| {
+                            let start = b * band;
+                            for row in rows {
+                                for (i, s) in &row.splats.bands[b] {
+                                    chunk[*i as usize - start].merge(s);
+                                }
+                            }
+                        })
+                },
+            )
+        })?;
+        self.passes += 1;
+        for row in rows {
             rays += row.rays;
             Tally::add(&self.tally.bad_samples, row.bad);
-            Tally::add(&self.tally.bad_splats, row.splats.2);
+            Tally::add(&self.tally.bad_splats, row.splats.bad);
         }
         Tally::add(&self.tally.rays, rays);
         let done = iteration + 1;
@@ -491,7 +549,15 @@ impl Passes for VcmPasses<'_> {
     /// The film holds the exact sums: each pixel's mean over its samples, the splats scaled
     /// by the samples taken.
     fn film(&self, _passes: u64) -> Film {
-        self.film.clone()
+        let (width, height) = (self.scene.film().width, self.scene.film().height);
+        Film::from_sums(
+            width,
+            height,
+            self.sums.clone(),
+            vec![self.passes; self.sums.len()],
+            self.splats.clone(),
+        )
+        .expect("sums of the film's size")
     }
 
     fn tally(&self) -> &Tally {
@@ -505,7 +571,12 @@ impl Integrator for Vcm {
             vcm: self,
             scene,
             media: scene.emission_media()?,
-            film: Film::new(scene.film().width, scene.film().height),
+            sums: vec![
+                RadianceSum::ZERO;
+                scene.film().width as usize * scene.film().height as usize
+            ],
+            splats: Vec::new(),
+            passes: 0,
             tally: Tally::default(),
             buffers: Buffers {
                 light_rows: Vec::new(),
