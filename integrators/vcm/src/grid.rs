@@ -7,6 +7,7 @@
 //! order, so the sum a pixel makes of its merges is the same whatever the thread count.
 
 use foton_core::api::Vec3;
+use rayon::prelude::*;
 
 pub struct HashGrid {
     min: Vec3,
@@ -25,7 +26,7 @@ impl HashGrid {
     /// A grid over `positions` for queries of radius `radius`.
     pub fn build(positions: Vec<Vec3>, radius: f32) -> HashGrid {
         let mut grid = HashGrid::empty();
-        grid.rebuild(positions.into_iter(), radius);
+        grid.rebuild(positions.into_par_iter(), radius);
         grid
     }
 
@@ -44,14 +45,16 @@ impl HashGrid {
     }
 
     /// The grid over `positions` for queries of radius `radius`, in this grid's memory (an
-    /// iteration's grid reuses the last one's: no allocation once it is large enough).
-    pub fn rebuild(&mut self, positions: impl Iterator<Item = Vec3>, radius: f32) {
+    /// iteration's grid reuses the last one's: no allocation once it is large enough). The
+    /// positions, their box and their buckets in parallel; the counting sort in order.
+    pub fn rebuild(&mut self, positions: impl IndexedParallelIterator<Item = Vec3>, radius: f32) {
         self.positions.clear();
-        self.positions.extend(positions);
+        self.positions.par_extend(positions);
         self.min = self
             .positions
-            .iter()
-            .fold(Vec3::splat(f32::INFINITY), |m, p| m.min(*p));
+            .par_iter()
+            .copied()
+            .reduce(|| Vec3::splat(f32::INFINITY), Vec3::min);
         let buckets = self.positions.len().max(1);
         self.inv_cell = 1.0 / (2.0 * radius);
         self.radius = radius;
@@ -60,7 +63,12 @@ impl HashGrid {
         self.starts.resize(buckets + 1, 0);
         let mut keys = std::mem::take(&mut self.keys);
         keys.clear();
-        keys.extend(self.positions.iter().map(|p| self.bucket(self.cell(*p))));
+        let this = &*self;
+        keys.par_extend(
+            this.positions
+                .par_iter()
+                .map(|p| this.bucket(this.cell(*p))),
+        );
         for &k in &keys {
             self.starts[k as usize + 1] += 1;
         }

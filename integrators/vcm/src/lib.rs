@@ -292,12 +292,32 @@ impl Vcm {
             })
             .sum();
         paths.clear();
+        let mut base = 0u32;
         for row in rows.iter() {
-            let base = paths.vertices.len() as u32;
             paths.ends.extend(row.ends.iter().map(|e| e + base));
-            paths.vertices.extend_from_slice(&row.vertices);
             paths.origins.extend_from_slice(&row.origins);
+            base += row.vertices.len() as u32;
         }
+        // The vertices, the bulk of it, copied in parallel, each row to its place.
+        let total = base as usize;
+        paths.vertices.reserve(total);
+        let mut places = Vec::with_capacity(rows.len());
+        let mut rest = &mut paths.vertices.spare_capacity_mut()[..total];
+        for row in rows.iter() {
+            let (place, tail) = rest.split_at_mut(row.vertices.len());
+            places.push(place);
+            rest = tail;
+        }
+        places
+            .into_par_iter()
+            .zip(rows.par_iter())
+            .for_each(|(place, row)| {
+                for (slot, v) in place.iter_mut().zip(&row.vertices) {
+                    slot.write(*v);
+                }
+            });
+        // SAFETY: the places cover the first `total` slots, and each row wrote all of its own.
+        unsafe { paths.vertices.set_len(total) };
         rays
     }
 
@@ -482,7 +502,7 @@ impl Passes for VcmPasses<'_> {
             if merges {
                 quiet.timed("hash grid build", || {
                     b.grid
-                        .rebuild(b.lights.vertices.iter().map(|v| v.p), radius)
+                        .rebuild(b.lights.vertices.par_iter().map(|v| v.p), radius)
                 });
             }
             let grid = merges.then_some(&b.grid);
