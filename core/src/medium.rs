@@ -21,6 +21,7 @@ use glam::Vec3;
 
 pub mod grid;
 mod phase;
+pub mod tracking;
 pub use phase::Phase;
 
 crate::registry::builtins! {

@@ -257,8 +257,29 @@ impl Grid {
         (sum / (self.values.len() / self.channels) as f64).as_vec3()
     }
 
+    /// Samples per axis.
+    pub(crate) fn res(&self) -> [usize; 3] {
+        self.res
+    }
+
+    /// World position to continuous lattice coordinates (sample (i, j, k) at (i, j, k)).
+    pub(crate) fn to_lattice(&self) -> Mat4 {
+        self.to_lattice
+    }
+
+    /// Whether a lookup beyond the outermost samples takes the nearest one's value
+    /// ([`Outside::Clamp`] and [`Outside::ClampInBox`]) rather than zero.
+    pub(crate) fn clamps(&self) -> bool {
+        self.outside == Outside::Clamp
+    }
+
+    /// The world-space box beyond which lookups are zero ([`Outside::ClampInBox`]).
+    pub(crate) fn support(&self) -> Option<(Vec3, Vec3)> {
+        self.support
+    }
+
     #[inline]
-    fn sample(&self, i: usize, j: usize, k: usize, c: usize) -> f32 {
+    pub(crate) fn sample(&self, i: usize, j: usize, k: usize, c: usize) -> f32 {
         self.values[((k * self.res[1] + j) * self.res[0] + i) * self.channels + c]
     }
 
