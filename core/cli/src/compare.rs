@@ -4,10 +4,12 @@
 //! With `--time S` each integrator gets about S seconds (`budget`).
 
 mod budget;
+mod flip;
 mod json;
 mod metrics;
 
 pub use budget::{CALIBRATION_SECONDS, CostModel, Plan, curve_budgets, spp_for_budget};
+pub use flip::{default_ppd, flip};
 pub use metrics::{Errors, REL_EPSILON, difference_image, errors};
 
 use crate::TermProgress;
@@ -20,7 +22,7 @@ use budget::{budget_text, calibrate};
 use clap::Args;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
-use foton_core::film::{DisplayTransform, Film, check_output};
+use foton_core::film::{DisplayTransform, Film, check_output, srgb_encode};
 use foton_core::integrator::Work;
 use foton_core::props::unknown_value;
 use foton_core::sampling::SamplerKind;
@@ -99,6 +101,8 @@ struct Entry {
     display: DisplayTransform,
     image: PathBuf,
     errors: Option<Errors>,
+    /// The mean LDR-FLIP error against the reference, both through `display` (`srgb`).
+    flip: Option<f64>,
     /// With --curve: the renders at the smaller budgets, then this one.
     curve: Vec<Point>,
 }
@@ -119,6 +123,9 @@ impl Entry {
         }
         if let Some(e) = self.errors {
             let _ = write!(out, "; {}", errors_text(e));
+        }
+        if let Some(f) = self.flip {
+            let _ = write!(out, ", FLIP {f:.4}");
         }
         let _ = writeln!(out);
     }
@@ -294,6 +301,18 @@ impl Session<'_> {
         }
         let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
         let errors = self.reference.as_ref().map(|r| errors(&film.pixels(), r));
+        let display = p.scene.film().display();
+        let flip_mean = self.reference.as_ref().map(|r| {
+            let (w, h) = (film.width as usize, film.height as usize);
+            flip(
+                &srgb(r, &display),
+                &srgb(&film.pixels(), &display),
+                w,
+                h,
+                default_ppd(),
+            )
+            .1
+        });
         Ok(Some(Entry {
             name: name.to_string(),
             description: p.integrator.describe(),
@@ -302,12 +321,23 @@ impl Session<'_> {
             seconds: elapsed.as_secs_f64(),
             settings,
             film,
-            display: p.scene.film().display(),
+            display,
             image: self.outputs.exr_of(name),
             errors,
+            flip: flip_mean,
             curve,
         }))
     }
+}
+
+/// The display's sRGB values in [0, 1] of linear `pixels`: the scene's exposure and tone map
+/// (`display`), then the sRGB curve, as a PNG of them (the montage's tiles) stores them before
+/// quantisation to 8 bits. FLIP's input.
+fn srgb(pixels: &[Rgb], display: &DisplayTransform) -> Vec<[f32; 3]> {
+    pixels
+        .iter()
+        .map(|&p| display.map(p).to_array().map(srgb_encode))
+        .collect()
 }
 
 /// Whether Ctrl-C stopped the comparison (then nothing is written, and it says so).

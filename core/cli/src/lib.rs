@@ -87,7 +87,7 @@ enum Command {
     ///
     /// Each render is labelled with the integrator's name, samples per pixel, render time and
     /// parameters, and written beside the output as <output stem>-<integrator>.exr; the numbers
-    /// go to <output stem>.json (name, description, spp, seconds, rel_mse, bias, image).
+    /// go to <output stem>.json (name, description, spp, seconds, rel_mse, bias, flip, image).
     ///
     /// --time S: each integrator gets about S seconds, found by short calibration renders that
     /// measure a fixed cost (a photon pass) and a per-step cost: path-like integrators get the

@@ -1,5 +1,6 @@
 //! The numbers of `foton compare` as JSON (<output stem>.json): per integrator its name,
-//! description, spp, seconds, errors, the values --time chose, the error curve and its image.
+//! description, spp, seconds, errors against the reference (rel_mse, bias and the mean LDR-FLIP
+//! `flip`; null without one), the values --time chose, the error curve and its image.
 
 use super::Entry;
 use std::path::Path;
@@ -67,6 +68,10 @@ pub(super) fn json(
         s += &format!("      \"seconds\": {},\n", json_number(e.seconds));
         s += &format!("      \"rel_mse\": {},\n", json_number(rel_mse));
         s += &format!("      \"bias\": {},\n", json_number(bias));
+        s += &format!(
+            "      \"flip\": {},\n",
+            e.flip.map_or("null".into(), json_number)
+        );
         s += &format!("      \"set\": {},\n", json_settings(&e.settings));
         if !e.curve.is_empty() {
             s += "      \"curve\": [\n";
