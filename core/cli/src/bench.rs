@@ -6,6 +6,7 @@ use crate::common::{
     INTERRUPTED, Overrides, PluginArgs, Prepared, prepare, prepare_scene, render_prepared,
     render_with, threads, warn,
 };
+use crate::compare::json::json_string;
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::Film;
@@ -319,18 +320,4 @@ fn profile(
     }
     let _ = writeln!(out, "-> {}", json.display());
     Ok(0)
-}
-
-fn json_string(s: &str) -> String {
-    let mut out = String::from("\"");
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
 }

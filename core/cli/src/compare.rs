@@ -5,7 +5,7 @@
 
 mod budget;
 mod flip;
-mod json;
+pub(crate) mod json;
 mod metrics;
 
 pub use budget::{CALIBRATION_SECONDS, CostModel, Plan, curve_budgets, spp_for_budget};

@@ -5,7 +5,8 @@
 use super::Entry;
 use std::path::Path;
 
-fn json_string(s: &str) -> String {
+/// `s` as a JSON string literal (quotes, backslashes and control characters escaped).
+pub(crate) fn json_string(s: &str) -> String {
     let mut out = String::from("\"");
     for c in s.chars() {
         match c {
