@@ -99,15 +99,24 @@ fn count_before(text: &str, word: &str) -> u64 {
         .unwrap_or_else(|_| panic!("no number before `{word}` in {text}"))
 }
 
+/// The text of the JSON value of `field` after the first `anchor` (from the start when
+/// empty): a number, `null` or a string with its quotes.
+fn json_value<'a>(json: &'a str, anchor: &str, field: &str) -> &'a str {
+    let at = json
+        .find(anchor)
+        .unwrap_or_else(|| panic!("no {anchor} in {json}"));
+    let rest = &json[at..];
+    let key = format!("\"{field}\": ");
+    let i = rest
+        .find(&key)
+        .unwrap_or_else(|| panic!("no {field} after {anchor} in {json}"))
+        + key.len();
+    rest[i..].split([',', '\n', '}']).next().unwrap().trim()
+}
+
 /// A numeric field of one integrator's entry in compare's JSON (None for null).
 fn json_number(json: &str, integrator: &str, field: &str) -> Option<f64> {
-    let entry = json
-        .find(&format!("\"name\": \"{integrator}\""))
-        .unwrap_or_else(|| panic!("no entry for {integrator} in {json}"));
-    let rest = &json[entry..];
-    let key = format!("\"{field}\": ");
-    let at = rest.find(&key).unwrap() + key.len();
-    let value = rest[at..].split([',', '\n', '}']).next().unwrap().trim();
+    let value = json_value(json, &format!("\"name\": \"{integrator}\""), field);
     (value != "null").then(|| value.parse().unwrap())
 }
 
@@ -782,34 +791,13 @@ fn bench_profiles_the_phases_of_a_render() {
     // The work of the passes is counted once per iteration, summed: the photon tracing of
     // four iterations of 20000 photons takes longer than no time, and the phases listed
     // are most of the total (the rest is set-up).
-    let total = |f: &str| {
-        let at = text.find("\"total\"").unwrap();
-        let rest = &text[at..];
-        let key = format!("\"{f}\": ");
-        let i = rest.find(&key).unwrap() + key.len();
-        rest[i..]
-            .split([',', '}'])
-            .next()
-            .unwrap()
-            .trim()
-            .parse::<f64>()
-            .unwrap()
-    };
+    let total = |f: &str| json_value(&text, "\"total\"", f).parse::<f64>().unwrap();
     assert!(
         sum_1 <= total("wall_1") * 1.0001 && sum_1 >= 0.8 * total("wall_1"),
         "{text}"
     );
     assert!(sum_all <= total("wall_all") * 1.0001, "{text}");
-    let number = |key: &str| {
-        let k = format!("\"{key}\": ");
-        let i = text.find(&k).unwrap_or_else(|| panic!("no {key}: {text}")) + k.len();
-        text[i..]
-            .split([',', '\n'])
-            .next()
-            .unwrap()
-            .trim()
-            .to_string()
-    };
+    let number = |key: &str| json_value(&text, "", key);
     let f: f64 = number("serial_fraction").parse().unwrap();
     let s16: f64 = number("predicted_speedup_16").parse().unwrap();
     let s64: f64 = number("predicted_speedup_64").parse().unwrap();
