@@ -452,6 +452,14 @@ pub fn check_output(path: &Path) -> Result<()> {
         ));
     }
     format_of(path)?;
+    check_writable(path)
+}
+
+/// Checks that `path` can be written, as [`check_output`] does, whatever its format.
+pub fn check_writable(path: &Path) -> Result<()> {
+    if path.is_dir() {
+        return Err(Error::io(path, "is a directory, not a file"));
+    }
     if path.exists() && !path.is_file() {
         return Err(Error::io(
             path,

@@ -399,29 +399,61 @@ class Errors(NamedTuple):
     bias: float
 
 
-def compare(images: Any, reference: Any) -> Any:
+def compare(
+    images: Any,
+    reference: Any,
+    report: PathLike | None = None,
+    *,
+    exposure: float = 0.0,
+    tonemap: str = "clamp",
+) -> Any:
     """``foton compare``'s error figures (``rel_mse``, ``bias``) of images against a reference.
 
     ``reference`` is an array or an image file. ``images`` is one array (returns one
     :class:`Errors`), a dict of arrays (returns a dict of the same keys) or a list of arrays
     (returns a list).
+
+    With ``report="x.html"`` also writes ``foton compare --report``'s interactive page: a tab
+    per image (named by the dict's keys; ``image 1``, ``image 2``... for a list), then
+    ``reference``, with the error images (and FLIP) against it, shown through ``exposure``
+    (stops) and ``tonemap`` ("clamp" or "filmic").
     """
     if isinstance(reference, (str, os.PathLike)):
         reference = read(reference)
     ref = _image(reference, "reference")
     ref_bytes = ref.tobytes()
+    arrays: list[tuple[str, np.ndarray]] = []
 
-    def one(x: Any, what: str) -> Errors:
+    def one(x: Any, what: str, name: str) -> Errors:
         a = _image(x, what)
         if a.shape != ref.shape:
             raise ValueError(f"{what}: shape {a.shape} is not the reference's {ref.shape}")
+        arrays.append((name, a))
         return Errors(*_foton.errors(a.tobytes(), ref_bytes, ref.shape[1], ref.shape[0]))
 
     if isinstance(images, Mapping):
-        return {k: one(v, f"image {k!r}") for k, v in images.items()}
-    if isinstance(images, (list, tuple)):
-        return [one(v, f"image {i}") for i, v in enumerate(images)]
-    return one(images, "image")
+        result: Any = {k: one(v, f"image {k!r}", str(k)) for k, v in images.items()}
+    elif isinstance(images, (list, tuple)):
+        result = [one(v, f"image {i}", f"image {i + 1}") for i, v in enumerate(images)]
+    else:
+        result = one(images, "image", "image")
+    if report is not None:
+        names = [n for n, _ in arrays]
+        if "reference" in names:
+            raise ValueError("report: an image named 'reference' would hide the reference's tab")
+        _foton.report(
+            os.fspath(report),
+            names,
+            [a.tobytes() for _, a in arrays],
+            ref_bytes,
+            ref.shape[1],
+            ref.shape[0],
+            float(exposure),
+            tonemap,
+            "foton.compare",
+            "",
+        )
+    return result
 
 
 # --- plugins -------------------------------------------------------------------------------------

@@ -25,7 +25,7 @@ use foton_core::scene::Scene;
 use foton_core::value::Document;
 use foton_loader::TomlDocument;
 use foton_loader::image::{read_image, write_image};
-use pyo3::exceptions::{PyRuntimeError, PyValueError};
+use pyo3::exceptions::{PyOSError, PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyByteArray, PyDict, PyList};
 use std::path::PathBuf;
@@ -616,6 +616,35 @@ fn errors(data: &[u8], reference: &[u8], width: u32, height: u32) -> PyResult<(f
     Ok((e.rel_mse, e.bias))
 }
 
+/// `foton compare --report`'s page of named images against a reference, written to `path`.
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn report(
+    path: &str,
+    names: Vec<String>,
+    images: Vec<Vec<u8>>,
+    reference: &[u8],
+    width: u32,
+    height: u32,
+    exposure: f32,
+    tonemap: &str,
+    title: &str,
+    command: &str,
+) -> PyResult<()> {
+    let display = DisplayTransform::new(exposure, tone_map(tonemap)?);
+    let reference = pixels_of(reference, width, height)?;
+    let images = names
+        .into_iter()
+        .zip(&images)
+        .map(|(name, data)| Ok((name, pixels_of(data, width, height)?)))
+        .collect::<PyResult<Vec<_>>>()?;
+    let report = foton_cli::compare::report::of_images(
+        title, command, width, height, display, images, reference,
+    );
+    foton_cli::compare::report::write(std::path::Path::new(path), &report)
+        .map_err(|e| PyOSError::new_err(e.to_string()))
+}
+
 #[pymodule]
 fn _foton(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<NativeScene>()?;
@@ -626,5 +655,6 @@ fn _foton(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(read, m)?)?;
     m.add_function(wrap_pyfunction!(to_display, m)?)?;
     m.add_function(wrap_pyfunction!(errors, m)?)?;
+    m.add_function(wrap_pyfunction!(report, m)?)?;
     Ok(())
 }

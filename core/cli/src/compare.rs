@@ -7,6 +7,7 @@ mod budget;
 mod flip;
 pub(crate) mod json;
 mod metrics;
+pub mod report;
 
 pub use budget::{CALIBRATION_SECONDS, CostModel, Plan, curve_budgets, spp_for_budget};
 pub use flip::{default_ppd, flip};
@@ -22,8 +23,8 @@ use budget::{budget_text, calibrate};
 use clap::Args;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
-use foton_core::film::{DisplayTransform, Film, check_output, srgb_encode};
-use foton_core::integrator::Work;
+use foton_core::film::{DisplayTransform, Film, check_output, check_writable, srgb_encode};
+use foton_core::integrator::{Work, peak_rss_bytes};
 use foton_core::props::unknown_value;
 use foton_core::sampling::SamplerKind;
 use foton_loader::FilmFile;
@@ -69,6 +70,11 @@ pub(crate) struct CompareArgs {
     /// stem>.json.
     #[arg(short, long)]
     output: Option<PathBuf>,
+    /// Also write an interactive report: one self-contained HTML page with every image
+    /// (tabs, zoom to the pixel, exposure, error images against the reference, the error
+    /// curves, each run's numbers and this command line; docs/tools.md).
+    #[arg(long, value_name = "FILE.html")]
+    report: Option<PathBuf>,
     /// Random seed (overrides render.seed).
     #[arg(long)]
     seed: Option<u64>,
@@ -103,6 +109,12 @@ struct Entry {
     errors: Option<Errors>,
     /// The mean LDR-FLIP error against the reference, both through `display` (`srgb`).
     flip: Option<f64>,
+    /// The per-pixel LDR-FLIP error against the reference.
+    flip_map: Option<Vec<f32>>,
+    /// The photon (or beam) budgets in force, "key value" each.
+    photons: Vec<String>,
+    /// The process's peak resident memory when the render had ended.
+    peak_rss_bytes: u64,
     /// With --curve: the renders at the smaller budgets, then this one.
     curve: Vec<Point>,
 }
@@ -135,6 +147,8 @@ impl Entry {
 struct Point {
     budget: f64,
     seconds: f64,
+    /// Samples per pixel or iterations, where the integrator counts its work so.
+    work: Option<f64>,
     errors: Errors,
     settings: Vec<String>,
 }
@@ -275,6 +289,7 @@ impl Session<'_> {
                         let point = Point {
                             budget: b,
                             seconds: elapsed.as_secs_f64(),
+                            work: work_done(&q, &settings),
                             errors: errors(&film.pixels(), r),
                             settings: settings.clone(),
                         };
@@ -302,7 +317,7 @@ impl Session<'_> {
         let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
         let errors = self.reference.as_ref().map(|r| errors(&film.pixels(), r));
         let display = p.scene.film().display();
-        let flip_mean = self.reference.as_ref().map(|r| {
+        let flip = self.reference.as_ref().map(|r| {
             let (w, h) = (film.width as usize, film.height as usize);
             flip(
                 &srgb(r, &display),
@@ -311,8 +326,16 @@ impl Session<'_> {
                 h,
                 default_ppd(),
             )
-            .1
         });
+        let (flip_map, flip_mean) = flip.map_or((None, None), |(m, mean)| (Some(m), Some(mean)));
+        let photons = p
+            .integrator
+            .budget()
+            .scaled
+            .iter()
+            .filter(|(key, _)| key.contains("photon") || key.contains("beam"))
+            .map(|(key, n)| format!("{} {n}", key.rsplit('.').next().unwrap_or(key)))
+            .collect();
         Ok(Some(Entry {
             name: name.to_string(),
             description: p.integrator.describe(),
@@ -325,6 +348,9 @@ impl Session<'_> {
             image: self.outputs.exr_of(name),
             errors,
             flip: flip_mean,
+            flip_map,
+            photons,
+            peak_rss_bytes: peak_rss_bytes(),
             curve,
         }))
     }
@@ -422,6 +448,18 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     if a.curve.is_some() {
         check_output(&outputs.curve)?;
     }
+    if let Some(report) = &a.report {
+        if !report
+            .extension()
+            .is_some_and(|e| e.eq_ignore_ascii_case("html") || e.eq_ignore_ascii_case("htm"))
+        {
+            return Err(Error::io(
+                report,
+                "--report writes an HTML page: name it FILE.html",
+            ));
+        }
+        check_writable(report)?;
+    }
     let reference = a.reference.as_deref().map(read_reference).transpose()?;
     let mut session = Session {
         a: &a,
@@ -506,7 +544,92 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             outputs.json.display()
         );
     }
+    if let Some(path) = &a.report {
+        report::write(
+            path,
+            &report_of(&a, width, height, &entries, session.reference),
+        )?;
+        let _ = writeln!(out, "-> {}", path.display());
+    }
     Ok(0)
+}
+
+/// The samples per pixel or iterations of a render of `p` with `settings` (the number that
+/// `budget_text` shows), where the integrator counts its work so.
+fn work_done(p: &Prepared, settings: &[String]) -> Option<f64> {
+    budget_text(p, settings).split(' ').next()?.parse().ok()
+}
+
+/// The interactive report's content: a tab per render, then the reference's.
+fn report_of(
+    a: &CompareArgs,
+    width: u32,
+    height: u32,
+    entries: &[Entry],
+    reference: Option<Vec<Rgb>>,
+) -> report::Report {
+    let scene_name = a
+        .file
+        .scene
+        .file_name()
+        .map_or_else(String::new, |n| n.to_string_lossy().into_owned());
+    let mut tabs: Vec<report::Tab> = entries
+        .iter()
+        .map(|e| report::Tab {
+            name: e.name.clone(),
+            reference: false,
+            pixels: e.film.pixels(),
+            flip: e.flip_map.clone(),
+            layers: Vec::new(),
+        })
+        .collect();
+    if let Some(pixels) = reference {
+        tabs.push(report::Tab {
+            name: "reference".into(),
+            reference: true,
+            pixels,
+            flip: None,
+            layers: Vec::new(),
+        });
+    }
+    report::Report {
+        title: format!("foton compare: {scene_name}"),
+        command: report::command_line(std::env::args()),
+        width,
+        height,
+        display: entries
+            .first()
+            .map_or_else(DisplayTransform::default, |e| e.display),
+        tabs,
+        runs: entries
+            .iter()
+            .map(|e| report::Run {
+                name: e.name.clone(),
+                description: e.description.clone(),
+                budget: e.budget.clone(),
+                photons: e.photons.join(", "),
+                seconds: Some(e.seconds),
+                peak_rss_bytes: Some(e.peak_rss_bytes),
+                errors: e.errors,
+                flip: e.flip,
+            })
+            .collect(),
+        curves: entries
+            .iter()
+            .map(|e| {
+                let points = e
+                    .curve
+                    .iter()
+                    .map(|p| report::CurvePoint {
+                        seconds: p.seconds,
+                        work: p.work,
+                        rel_mse: p.errors.rel_mse,
+                    })
+                    .collect();
+                (e.name.clone(), points)
+            })
+            .collect(),
+    }
 }
 
 /// The labelled tiles: the renders in a row, and with a reference their differences from it
