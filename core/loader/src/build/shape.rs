@@ -89,7 +89,18 @@ pub(super) fn read_shapes(
                 let path = ld.dir.join(file);
                 let mesh = load_mesh(&s, &path, transform, options)?;
                 ld.sources.push(path);
-                closed = mesh.closed;
+                // Closedness matters only to a shape that may bound a medium (as
+                // `volumes::medium_interfaces` decides): one with media named, or whose
+                // material is null or encloses a volume. An unknown material is an error below.
+                let may_bound = s.has("interior")
+                    || s.has("exterior")
+                    || s.string_opt("material")?
+                        .and_then(|m| materials.get(m))
+                        .is_none_or(|&m| {
+                            let m = &material_defs[m as usize].value;
+                            m.is_null() || m.encloses_volume()
+                        });
+                closed = may_bound && mesh.closed();
                 attrs = mesh.attrs;
                 mesh.triangles
             }
