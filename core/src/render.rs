@@ -34,12 +34,27 @@ use std::sync::atomic::{AtomicU64, Ordering};
 pub const TILE: u32 = 16;
 
 /// Runs `f` on a pool of `threads` workers. Each plugin links its own rayon, so the pool is
-/// built here, in the caller's copy, from the host's thread count.
+/// built here, in the caller's copy, from the host's thread count. Pools are kept (one per
+/// thread count) and reused: a progressive integrator runs several phases per iteration, and
+/// starting the threads anew for each cost about a millisecond per phase at 16 threads.
 pub fn with_pool<R: Send>(threads: usize, f: impl FnOnce() -> R + Send) -> Result<R> {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads.max(1))
-        .build()
-        .map_err(|e| Error::Render(format!("cannot start {threads} threads: {e}")))?;
+    static POOLS: Mutex<Vec<(usize, std::sync::Arc<rayon::ThreadPool>)>> = Mutex::new(Vec::new());
+    let threads = threads.max(1);
+    let pool = {
+        let mut pools = POOLS.lock().unwrap_or_else(|e| e.into_inner());
+        match pools.iter().find(|(n, _)| *n == threads) {
+            Some((_, pool)) => pool.clone(),
+            None => {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .map_err(|e| Error::Render(format!("cannot start {threads} threads: {e}")))?;
+                let pool = std::sync::Arc::new(pool);
+                pools.push((threads, pool.clone()));
+                pool
+            }
+        }
+    };
     Ok(pool.install(f))
 }
 
