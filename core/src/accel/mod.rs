@@ -121,6 +121,17 @@ impl Accel {
         &self.prims
     }
 
+    /// The bytes the BVH holds on the heap: its nodes (both forms) and its primitives.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        let bvh = self.bvh.as_ref().map_or(0, |b| {
+            b.nodes.capacity() * size_of::<obvhs::cwbvh::node::CwBvhNode>()
+                + b.primitive_indices.capacity() * size_of::<u32>()
+        });
+        bvh + self.nodes.capacity() * size_of::<Node>()
+            + self.prims.capacity() * size_of::<Primitive>()
+    }
+
     /// Closest intersection with t in (0, tmax).
     #[inline]
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {

@@ -337,6 +337,14 @@ impl BeamMap {
         self.bounds
     }
 
+    /// The bytes the map holds on the heap: the beams, their pieces and the pieces' BVH.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.beams.capacity() * size_of::<Beam>()
+            + self.pieces.capacity() * size_of::<Piece>()
+            + self.bvh.heap_bytes()
+    }
+
     pub fn len(&self) -> usize {
         self.beams.len()
     }
@@ -672,6 +680,31 @@ mod tests {
             });
             assert_eq!(found, 1, "{dir:?}");
         }
+    }
+
+    /// The bytes a beam map holds per beam (docs/PERFORMANCE.md): beams across a unit box,
+    /// a tenth of it wide, one piece each.
+    #[test]
+    fn a_beam_map_reports_bytes_per_beam() {
+        let mut rng = foton_core::api::Rng::new(&[6]);
+        let mut point = || Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+        let n = 20_000;
+        let beams: Vec<Beam> = (0..n)
+            .map(|i| Beam::unit_test(point(), point(), i % 2))
+            .collect();
+        let map = BeamMap::build(beams, 0.1);
+        let per_beam = map.heap_bytes() as f64 / n as f64;
+        let record = std::mem::size_of::<Beam>() as f64;
+        println!(
+            "beam map: {per_beam:.1} bytes per beam ({} pieces), records of {record} bytes",
+            map.pieces.len()
+        );
+        assert!(per_beam >= record, "{per_beam}");
+        // Not yet within twice the records (docs/PERFORMANCE.md); no worse than today's.
+        assert!(
+            per_beam <= 4.5 * record,
+            "{per_beam} bytes per {record}-byte beam"
+        );
     }
 
     /// The BVH's traversal finds exactly the beams a loop over all of them finds (random

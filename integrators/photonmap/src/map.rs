@@ -456,6 +456,16 @@ impl PhotonMap {
     pub fn is_empty(&self) -> bool {
         self.photons.is_empty()
     }
+
+    /// The bytes the map holds on the heap: the photon records and the kd-tree's positions,
+    /// split axes and split coordinates beside them.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        self.photons.capacity() * size_of::<Photon>()
+            + self.positions.capacity() * size_of::<[f32; 3]>()
+            + self.axis.capacity()
+            + self.split.capacity() * size_of::<f32>()
+    }
     pub fn photons(&self) -> &[Photon] {
         &self.photons
     }
@@ -823,6 +833,21 @@ mod tests {
             })
             .collect();
         (photons.clone(), PhotonMap::build(photons))
+    }
+
+    /// Issue 35: a photon map within twice the size of its photon records.
+    #[test]
+    fn a_photon_map_holds_at_most_twice_its_records() {
+        let n = 100_000;
+        let (_, map) = random_map(n, 9);
+        let per_photon = map.heap_bytes() as f64 / n as f64;
+        let record = std::mem::size_of::<Photon>() as f64;
+        println!("photon map: {per_photon:.1} bytes per photon, records of {record} bytes");
+        assert!(per_photon >= record, "{per_photon}");
+        assert!(
+            per_photon <= 2.0 * record,
+            "{per_photon} bytes per {record}-byte photon"
+        );
     }
 
     #[test]
