@@ -22,7 +22,7 @@ use crate::common::{
 use crate::montage::{Series, Tile, grid, log_log_plot, render_image};
 use budget::{budget_text, calibrate};
 use clap::Args;
-use consistency::{Estimate, MIN_RENDERS, Pair, Renders, bias_note, block_means, block_variances};
+use consistency::{Estimate, MIN_RENDERS, Pair, Renders, block_means, block_variances};
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::{DisplayTransform, Film, check_output, srgb_encode};
@@ -121,8 +121,8 @@ struct Entry {
     flip: Option<f64>,
     /// With --curve: the renders at the smaller budgets, then this one.
     curve: Vec<Point>,
-    /// What shrinks the bias of a biased-but-consistent integrator (`consistency::bias_note`).
-    bias: Option<&'static str>,
+    /// What shrinks the bias of a biased-but-consistent integrator (`Integrator::bias`).
+    bias: Option<String>,
     /// With --consistency N: the number of renders averaged in `film`.
     renders: u32,
 }
@@ -342,7 +342,7 @@ impl Session<'_> {
             errors,
             flip: flip_mean,
             curve,
-            bias: bias_note(p.integrator.as_ref()),
+            bias: p.integrator.bias(),
             renders: 1,
         };
         Ok(Some((entry, p)))
@@ -666,7 +666,7 @@ fn consistency_pairs(
     let estimates: Vec<Estimate> = repetitions.iter().map(Renders::estimate).collect();
     let notes = |es: &[&Entry]| {
         es.iter()
-            .filter_map(|e| e.bias.map(|note| (e.name.clone(), note)))
+            .filter_map(|e| e.bias.clone().map(|note| (e.name.clone(), note)))
             .collect()
     };
     let mut pairs = Vec::new();

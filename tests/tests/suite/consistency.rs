@@ -135,7 +135,7 @@ fn a_biased_photon_map_is_caught() {
     for words in [
         "consistency path vs photon: ",
         ": DIFFER; photon is biased but consistent: a difference may be its bias at this budget",
-        "photon.global_photons",
+        "more photons (integrators.photon.global_photons",
     ] {
         assert!(run.stdout.contains(words), "{words}: {}", run.stdout);
     }

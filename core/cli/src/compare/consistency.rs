@@ -15,7 +15,6 @@
 
 use crate::montage::{Image, Tile, grid};
 use foton_core::Rgb;
-use foton_core::integrator::{Integrator, ParamValue};
 
 /// The blocks are BLOCK x BLOCK pixels (partial at the right and bottom edges).
 pub const BLOCK: u32 = 8;
@@ -322,47 +321,15 @@ pub fn test(a: &Estimate, b: &Estimate) -> Outcome {
     }
 }
 
-/// What to say of an integrator whose estimator is biased but consistent (its bias shrinks to
-/// nothing with its budget): a difference may be its bias at this budget; the parameters that
-/// shrink it. None for an unbiased one. Keyed by the plugin's registered name (and `vcm`'s
-/// mode: `bpt` and `lt` do not merge).
-pub fn bias_note(integrator: &dyn Integrator) -> Option<&'static str> {
-    let parameter = |name: &str| {
-        integrator
-            .parameters()
-            .into_iter()
-            .find(|q| q.name == name)
-            .map(|q| q.value)
-    };
-    match integrator.name() {
-        "photon" => Some(
-            "more photons (photon.global_photons, photon.caustic_photons), a smaller k (photon.k) or max_radius (photon.max_radius) shrink it",
-        ),
-        "vpm" => Some(
-            "more photons (vpm.global_photons, vpm.caustic_photons, vpm.volume_photons), a smaller k (vpm.k, vpm.k_volume) or max_radius (vpm.max_radius, vpm.max_radius_volume) shrink it",
-        ),
-        "sppm" => Some(
-            "more iterations (sppm.iterations) or photons per iteration (sppm.photons_per_iteration), or a smaller sppm.initial_radius shrink it",
-        ),
-        "ppb" => Some(
-            "more iterations (ppb.iterations), or a smaller ppb.initial_beam_radius and ppb.initial_radius shrink it",
-        ),
-        "vcm" => match parameter("mode") {
-            Some(ParamValue::Str(mode)) if mode == "bpt" || mode == "lt" => None,
-            _ => Some("more iterations (vcm.iterations) or a smaller vcm.radius shrink it"),
-        },
-        _ => None,
-    }
-}
-
 /// One pair tested: two integrators, or an integrator and the reference (`b` = "reference").
 #[derive(Clone, Debug)]
 pub struct Pair {
     pub a: String,
     pub b: String,
     pub outcome: Outcome,
-    /// The bias notes (`bias_note`) of the pair's biased-but-consistent integrators, by name.
-    pub biased: Vec<(String, &'static str)>,
+    /// The pair's biased-but-consistent integrators, by name, with what shrinks their bias
+    /// (`Integrator::bias`).
+    pub biased: Vec<(String, String)>,
 }
 
 impl Pair {
@@ -819,6 +786,37 @@ mod tests {
         assert!(e.var.iter().all(|v| *v == [0.0; 3]));
         assert_eq!(test(&e, &e.clone()).tested(), 0);
         assert_eq!(exact.mean_pixels()[5], Rgb::splat(0.25));
+    }
+
+    #[test]
+    fn verdicts_say_what_differs_and_what_may_explain_it() {
+        let pair = |adjusted: Vec<Option<f64>>, biased: Vec<(String, String)>| Pair {
+            a: "path".into(),
+            b: "photon".into(),
+            outcome: Outcome { adjusted },
+            biased,
+        };
+        let note = || vec![("photon".to_string(), "more photons shrink it".to_string())];
+        let same = pair(vec![Some(0.41), None, Some(1.0)], note());
+        assert!(!same.differs());
+        assert_eq!(
+            same.verdict(),
+            "consistency path vs photon: 0 of 2 blocks differ (smallest adjusted p 0.41): consistent"
+        );
+        let differ = pair(vec![Some(2.34e-9), Some(0.01), Some(0.5)], note());
+        assert!(differ.differs());
+        assert_eq!(
+            differ.verdict(),
+            "consistency path vs photon: 2 of 3 blocks differ (smallest adjusted p 2.3e-9): DIFFER; photon is biased but consistent: a difference may be its bias at this budget; more photons shrink it"
+        );
+        let untested = pair(vec![None; 4], Vec::new());
+        assert!(
+            untested
+                .verdict()
+                .ends_with("(no block to test: both exact and equal everywhere): consistent")
+        );
+        assert_eq!(p_text(0.0), "0");
+        assert_eq!(p_text(0.013), "0.01");
     }
 
     #[test]
