@@ -701,7 +701,14 @@ fn tiles(entries: &[Entry], reference: Option<&[Rgb]>, output: &Path) -> Vec<Til
         .map(|e| Tile {
             image: render_image(&e.film, &e.display, output),
             label: vec![
-                format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
+                if e.renders > 1 {
+                    format!(
+                        "{}: {}, mean of {}, {:.2} s each",
+                        e.name, e.budget, e.renders, e.seconds
+                    )
+                } else {
+                    format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds)
+                },
                 // Narrow tiles: `k=50` wraps better than `k = 50`.
                 e.description.replace(" = ", "="),
             ],
