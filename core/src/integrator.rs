@@ -235,6 +235,16 @@ pub trait Integrator: Send + Sync {
         Ok(Vec::new())
     }
 
+    /// Whether the estimator is biased but consistent (density estimation: photon mapping,
+    /// merging), its bias vanishing as its budget grows: None for an unbiased one (the
+    /// default); otherwise what shrinks the bias, in a few words that name the scene keys
+    /// ("more photons (integrators.photon.global_photons) or a smaller
+    /// integrators.photon.k"). `foton compare --consistency` says it when the integrator's
+    /// image differs from another's.
+    fn bias(&self) -> Option<String> {
+        None
+    }
+
     /// The configured integrator, for logs and labels (Mitsuba's `to_string`).
     fn describe(&self) -> String {
         describe(self.name(), &self.parameters())

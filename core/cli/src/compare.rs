@@ -1,9 +1,11 @@
 //! `foton compare`: one scene rendered by several integrators, side by side in one labelled
 //! image; against a reference, with a false-colour difference image and error numbers per
 //! render (`metrics`). Each render is also written as EXR, and the numbers as JSON (`json`).
-//! With `--time S` each integrator gets about S seconds (`budget`).
+//! With `--time S` each integrator gets about S seconds (`budget`). With `--consistency N`
+//! each renders N times and the pairs are tested block by block (`consistency`).
 
 mod budget;
+mod consistency;
 mod flip;
 pub(crate) mod json;
 mod metrics;
@@ -21,12 +23,13 @@ use crate::common::{
 use crate::montage::{Series, Tile, grid, log_log_plot, render_image};
 use budget::{budget_text, calibrate};
 use clap::Args;
+use consistency::{Estimate, MIN_RENDERS, Pair, Renders, block_means, block_variances};
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::{DisplayTransform, Film, check_output, check_writable, srgb_encode};
 use foton_core::integrator::{Work, peak_rss_bytes};
 use foton_core::props::unknown_value;
-use foton_core::sampling::SamplerKind;
+use foton_core::sampling::{SamplerKind, splitmix64};
 use foton_loader::FilmFile;
 use foton_loader::image::read_image;
 use metrics::errors_text;
@@ -65,6 +68,19 @@ pub(crate) struct CompareArgs {
     /// stem>-curve.png (the points go to the JSON).
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(2..=12))]
     curve: Option<u32>,
+    /// Test whether the integrators converge to the same image: render each N times (N >= 4)
+    /// with independent seeds and test, per 8x8 block of pixels, whether their means differ by
+    /// more than their standard errors allow (Welch's t-test; false discovery rate 1% over the
+    /// blocks, Benjamini-Hochberg); with --reference, each against it too. Prints a verdict per
+    /// pair, writes the blocks that differ to <output stem>-consistency.png and the counts to
+    /// the JSON; the EXRs and the image show the mean of the N renders. Exit status 3 when a
+    /// pair differs.
+    #[arg(long, value_name = "N")]
+    consistency: Option<u32>,
+    /// With --consistency and --reference: the reference's per-pixel standard errors (an image
+    /// of its size, .exr); without, the reference is taken as exact.
+    #[arg(long, value_name = "IMAGE")]
+    reference_se: Option<PathBuf>,
     /// Output image (.png or .exr); default: <scene stem>-compare.png beside the scene. The
     /// renders go beside it as <output stem>-<integrator>.exr, the numbers as <output
     /// stem>.json.
@@ -117,19 +133,26 @@ struct Entry {
     peak_rss_bytes: u64,
     /// With --curve: the renders at the smaller budgets, then this one.
     curve: Vec<Point>,
+    /// What shrinks the bias of a biased-but-consistent integrator (`Integrator::bias`).
+    bias: Option<String>,
+    /// With --consistency N: the number of renders averaged in `film`.
+    renders: u32,
 }
 
 impl Entry {
     /// The render's summary line.
     fn print(&self, out: &mut dyn Write) {
-        let _ = write!(
-            out,
-            "{}: {} in {:.2} s -> {}",
-            self.description,
-            self.budget,
-            self.seconds,
-            self.image.display()
-        );
+        let _ = write!(out, "{}: {}", self.description, self.budget);
+        if self.renders > 1 {
+            let _ = write!(
+                out,
+                ", mean of {} renders, {:.2} s each",
+                self.renders, self.seconds
+            );
+        } else {
+            let _ = write!(out, " in {:.2} s", self.seconds);
+        }
+        let _ = write!(out, " -> {}", self.image.display());
         if !self.settings.is_empty() {
             let _ = write!(out, " (--time chose {})", self.settings.join(" "));
         }
@@ -161,6 +184,8 @@ struct Outputs {
     json: PathBuf,
     /// The error curve's plot (--curve).
     curve: PathBuf,
+    /// The map of the blocks that differ (--consistency).
+    consistency: PathBuf,
 }
 
 impl Outputs {
@@ -171,6 +196,7 @@ impl Outputs {
         Outputs {
             json: image.with_file_name(format!("{stem}.json")),
             curve: image.with_file_name(format!("{stem}-curve.png")),
+            consistency: image.with_file_name(format!("{stem}-consistency.png")),
             image,
             stem,
         }
@@ -235,14 +261,15 @@ impl Session<'_> {
     }
 
     /// Renders integrator `name` (created as `p`): once, or with --time after calibrating its
-    /// budget, and with --curve at every budget of the curve. None when interrupted.
+    /// budget, and with --curve at every budget of the curve; with the integrator as it
+    /// rendered (--time's choices set). None when interrupted.
     fn render_entry(
         &self,
         name: &str,
         mut p: Prepared,
         out: &mut dyn Write,
         err: &mut dyn Write,
-    ) -> Result<Option<Entry>> {
+    ) -> Result<Option<(Entry, Prepared)>> {
         let a = self.a;
         let mut curve = Vec::new();
         let (p, film, elapsed, settings) = match a.time {
@@ -315,19 +342,8 @@ impl Session<'_> {
             return Ok(None);
         }
         let spp = (p.integrator.budget().work == Work::Samples).then_some(p.scene.render().spp);
-        let errors = self.reference.as_ref().map(|r| errors(&film.pixels(), r));
         let display = p.scene.film().display();
-        let flip = self.reference.as_ref().map(|r| {
-            let (w, h) = (film.width as usize, film.height as usize);
-            flip(
-                &srgb(r, &display),
-                &srgb(&film.pixels(), &display),
-                w,
-                h,
-                default_ppd(),
-            )
-        });
-        let (flip_map, flip_mean) = flip.map_or((None, None), |(m, mean)| (Some(m), Some(mean)));
+        let (errors, flip_mean, flip_map) = self.score(&film, &display);
         let photons = p
             .integrator
             .budget()
@@ -336,7 +352,7 @@ impl Session<'_> {
             .filter(|(key, _)| key.contains("photon") || key.contains("beam"))
             .map(|(key, n)| format!("{} {n}", key.rsplit('.').next().unwrap_or(key)))
             .collect();
-        Ok(Some(Entry {
+        let entry = Entry {
             name: name.to_string(),
             description: p.integrator.describe(),
             spp,
@@ -352,7 +368,79 @@ impl Session<'_> {
             photons,
             peak_rss_bytes: peak_rss_bytes(),
             curve,
-        }))
+            bias: p.integrator.bias(),
+            renders: 1,
+        };
+        Ok(Some((entry, p)))
+    }
+
+    /// The errors, the mean LDR-FLIP error and its per-pixel map of `film` against the
+    /// reference, if there is one.
+    fn score(
+        &self,
+        film: &Film,
+        display: &DisplayTransform,
+    ) -> (Option<Errors>, Option<f64>, Option<Vec<f32>>) {
+        let Some(r) = &self.reference else {
+            return (None, None, None);
+        };
+        let pixels = film.pixels();
+        let (w, h) = (film.width as usize, film.height as usize);
+        let (flip_map, flip_mean) = flip(
+            &srgb(r, display),
+            &srgb(&pixels, display),
+            w,
+            h,
+            default_ppd(),
+        );
+        (Some(errors(&pixels, r)), Some(flip_mean), Some(flip_map))
+    }
+
+    /// --consistency N: renders the entry's integrator (`p`, as it rendered the entry) N - 1
+    /// more times, each with its own seed (`repetition_seed`), and makes the entry the mean of
+    /// the N renders (its film, errors and seconds per render). Returns the N renders, the
+    /// entry's own first; None when interrupted.
+    fn repeat(
+        &self,
+        entry: &mut Entry,
+        p: &mut Prepared,
+        n: u32,
+        err: &mut dyn Write,
+    ) -> Result<Option<Renders>> {
+        let (w, h) = (entry.film.width, entry.film.height);
+        let mut renders = Renders::new(w, h);
+        renders.add(&entry.film.pixels());
+        let mut seconds = entry.seconds;
+        let base = p.scene.render().seed;
+        for i in 1..n {
+            p.scene.render_mut().seed = repetition_seed(base, i);
+            let (film, elapsed) = self.render(p, self.a.run.quiet, err)?;
+            if interrupted(err) {
+                return Ok(None);
+            }
+            renders.add(&film.pixels());
+            seconds += elapsed.as_secs_f64();
+        }
+        p.scene.render_mut().seed = base;
+        let mut mean = Film::new(w, h);
+        for (i, c) in renders.mean_pixels().into_iter().enumerate() {
+            mean.set_pixel(i as u32 % w, i as u32 / w, c);
+        }
+        (entry.errors, entry.flip, entry.flip_map) = self.score(&mean, &entry.display);
+        entry.film = mean;
+        entry.seconds = seconds / n as f64;
+        entry.renders = n;
+        Ok(Some(renders))
+    }
+}
+
+/// The seed of render `i` (0, 1, ...) of --consistency: the scene's seed for the first (the
+/// render --consistency does not change), then seeds hashed from it and i.
+fn repetition_seed(base: u64, i: u32) -> u64 {
+    if i == 0 {
+        base
+    } else {
+        splitmix64(base ^ splitmix64(0x636f_6e73_6973_7400 ^ i as u64))
     }
 }
 
@@ -407,6 +495,23 @@ fn integrator_names(a: &CompareArgs) -> Result<Vec<String>> {
             "--time {t}: expected a positive number of seconds"
         )));
     }
+    if let Some(n) = a.consistency {
+        if n < MIN_RENDERS {
+            return Err(Error::Usage(format!(
+                "--consistency {n}: at least {MIN_RENDERS} renders per integrator are needed (the standard error of fewer has too few degrees of freedom to test with)"
+            )));
+        }
+        if names.len() < 2 && a.reference.is_none() {
+            return Err(Error::Usage(format!(
+                "--consistency {n} needs two integrators or a --reference to test against"
+            )));
+        }
+    }
+    if a.reference_se.is_some() && (a.consistency.is_none() || a.reference.is_none()) {
+        return Err(Error::Usage(
+            "--reference-se IMAGE needs --consistency N and --reference REF: it is the reference's standard error, for the consistency test".into(),
+        ));
+    }
     if let Some(n) = a.curve {
         if a.time.is_none() {
             return Err(Error::Usage(format!(
@@ -460,7 +565,11 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         }
         check_writable(report)?;
     }
+    if a.consistency.is_some() {
+        check_output(&outputs.consistency)?;
+    }
     let reference = a.reference.as_deref().map(read_reference).transpose()?;
+    let reference_se = a.reference_se.as_deref().map(read_reference).transpose()?;
     let mut session = Session {
         a: &a,
         outputs,
@@ -489,14 +598,31 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             format!("the reference is {w}x{h} but the scene renders {width}x{height}"),
         ));
     }
+    if let (Some((w, h, _)), Some(path)) = (&reference_se, &a.reference_se)
+        && (*w, *h) != (width, height)
+    {
+        return Err(Error::io(
+            path,
+            format!(
+                "the reference's standard errors are {w}x{h} but the scene renders {width}x{height}"
+            ),
+        ));
+    }
     session.reference = reference.map(|(_, _, pixels)| pixels);
 
     INTERRUPTED.store(false, Ordering::SeqCst);
     let mut entries = Vec::new();
+    let mut repetitions = Vec::new();
     for (name, p) in names.iter().zip(prepared) {
-        let Some(entry) = session.render_entry(name, p, out, err)? else {
+        let Some((mut entry, mut p)) = session.render_entry(name, p, out, err)? else {
             return Ok(130);
         };
+        if let Some(n) = a.consistency {
+            let Some(renders) = session.repeat(&mut entry, &mut p, n, err)? else {
+                return Ok(130);
+            };
+            repetitions.push(renders);
+        }
         entry.film.write(&entry.image, &entry.display)?;
         entry.print(out);
         entries.push(entry);
@@ -505,10 +631,34 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
     let outputs = &session.outputs;
     let tiles = tiles(&entries, session.reference.as_deref(), &outputs.image);
     grid(&tiles, entries.len()).write(&outputs.image)?;
+    let pairs = a.consistency.map(|_| {
+        let reference = session.reference.as_deref().map(|r| {
+            let var = reference_se
+                .as_ref()
+                .map(|(_, _, se)| block_variances(se, width, height));
+            Estimate::reference(block_means(r, width, height), var)
+        });
+        consistency_pairs(&entries, &repetitions, reference.as_ref())
+    });
     write_atomic(
         &outputs.json,
-        json::json(&a.file.scene, a.reference.as_deref(), a.time, &entries).as_bytes(),
+        json::json(
+            &a.file.scene,
+            a.reference.as_deref(),
+            a.time,
+            &entries,
+            pairs.as_deref(),
+        )
+        .as_bytes(),
     )?;
+    if let Some(pairs) = &pairs {
+        let base = render_image(&entries[0].film, &entries[0].display, &outputs.consistency);
+        consistency::map(&base, pairs).write(&outputs.consistency)?;
+        for pair in pairs {
+            let _ = writeln!(out, "{}", pair.verdict());
+        }
+        let _ = writeln!(out, "-> {}", outputs.consistency.display());
+    }
     if a.curve.is_some() {
         let series: Vec<Series> = entries
             .iter()
@@ -551,7 +701,45 @@ pub(crate) fn run(a: CompareArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
         )?;
         let _ = writeln!(out, "-> {}", path.display());
     }
-    Ok(0)
+    let differ = pairs.iter().flatten().any(Pair::differs);
+    Ok(if differ { 3 } else { 0 })
+}
+
+/// --consistency: every pair of integrators tested (in the order given), then each against the
+/// reference if there is one. `repetitions[i]`: entry i's renders.
+fn consistency_pairs(
+    entries: &[Entry],
+    repetitions: &[Renders],
+    reference: Option<&Estimate>,
+) -> Vec<Pair> {
+    let estimates: Vec<Estimate> = repetitions.iter().map(Renders::estimate).collect();
+    let notes = |es: &[&Entry]| {
+        es.iter()
+            .filter_map(|e| e.bias.clone().map(|note| (e.name.clone(), note)))
+            .collect()
+    };
+    let mut pairs = Vec::new();
+    for i in 0..entries.len() {
+        for j in i + 1..entries.len() {
+            pairs.push(Pair {
+                a: entries[i].name.clone(),
+                b: entries[j].name.clone(),
+                outcome: consistency::test(&estimates[i], &estimates[j]),
+                biased: notes(&[&entries[i], &entries[j]]),
+            });
+        }
+    }
+    if let Some(r) = reference {
+        for (e, estimate) in entries.iter().zip(&estimates) {
+            pairs.push(Pair {
+                a: e.name.clone(),
+                b: "reference".into(),
+                outcome: consistency::test(estimate, r),
+                biased: notes(&[e]),
+            });
+        }
+    }
+    pairs
 }
 
 /// The samples per pixel or iterations of a render of `p` with `settings` (the number that
@@ -640,7 +828,14 @@ fn tiles(entries: &[Entry], reference: Option<&[Rgb]>, output: &Path) -> Vec<Til
         .map(|e| Tile {
             image: render_image(&e.film, &e.display, output),
             label: vec![
-                format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds),
+                if e.renders > 1 {
+                    format!(
+                        "{}: {}, mean of {}, {:.2} s each",
+                        e.name, e.budget, e.renders, e.seconds
+                    )
+                } else {
+                    format!("{}: {}, {:.2} s", e.name, e.budget, e.seconds)
+                },
                 // Narrow tiles: `k=50` wraps better than `k = 50`.
                 e.description.replace(" = ", "="),
             ],

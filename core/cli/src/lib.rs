@@ -102,6 +102,14 @@ enum Command {
     /// false colour: blue where the render is darker, light grey where equal, red where
     /// brighter, saturated at 100%. The labels and the JSON give rel_mse (the mean over pixels
     /// and channels of (x - r)^2 / (r^2 + 0.01)) and bias ((mean x - mean r) / mean r).
+    ///
+    /// --consistency N: each integrator renders N times (N >= 4) with independent seeds, and
+    /// each pair (and each integrator against --reference) is tested per 8x8 block: Welch's
+    /// t-test per channel, Simes' combination of the channels, Benjamini-Hochberg at a 1%
+    /// false discovery rate over the blocks. A verdict per pair is printed (biased-but-
+    /// consistent integrators say what shrinks their bias), the blocks that differ are drawn
+    /// in <output stem>-consistency.png, the counts go to the JSON; the EXRs and the image are
+    /// the means of the N renders. Exit status 3 when a pair differs.
     Compare(compare::CompareArgs),
     /// Render a scene over the product of lists of --set values, in a labelled grid.
     ///

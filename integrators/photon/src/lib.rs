@@ -279,6 +279,11 @@ impl Integrator for PhotonMapper {
         }
     }
 
+    /// Each estimate averages over a disc as wide as its k-th photon (at most `max_radius`).
+    fn bias(&self) -> Option<String> {
+        Some("more photons (integrators.photon.global_photons, integrators.photon.caustic_photons) or a smaller integrators.photon.k or integrators.photon.max_radius shrink it".into())
+    }
+
     /// `global`: the direct and indirect photons of the global budget (Jensen's global map;
     /// a render keeps the direct ones only for `direct = "photons"` or final gathering), and
     /// `caustic`: the L S+ D photons of the caustic budget.

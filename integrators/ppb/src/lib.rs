@@ -447,6 +447,11 @@ impl Integrator for Ppb {
         PassBudget::budget("ppb")
     }
 
+    /// The beams' width and the surface radius shrink with the passes, and the bias with them.
+    fn bias(&self) -> Option<String> {
+        Some("more iterations (integrators.ppb.iterations) or a smaller integrators.ppb.initial_beam_radius and integrators.ppb.initial_radius shrink it".into())
+    }
+
     /// `iteration`: the surface photons of the first pass; `beams`: the starts of its beams.
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
         let (photons, beams) = self.trace(scene, 0, ctx)?;

@@ -478,6 +478,11 @@ impl Integrator for Sppm {
         PassBudget::budget("sppm")
     }
 
+    /// The gather radius shrinks with the iterations, and the bias with it.
+    fn bias(&self) -> Option<String> {
+        Some("more iterations (integrators.sppm.iterations) or a smaller integrators.sppm.initial_radius shrink it".into())
+    }
+
     /// `iteration`: the photons the first iteration stores (those of every iteration are
     /// alike, from their own random streams).
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {

@@ -643,6 +643,17 @@ impl Integrator for Vcm {
     fn budget(&self) -> Budget {
         PassBudget::budget("vcm")
     }
+
+    /// Merging is density estimation over the radius, which shrinks with the iterations;
+    /// connections alone (`bpt`, `lt`) are unbiased.
+    fn bias(&self) -> Option<String> {
+        match self.mode {
+            Mode::Bpt | Mode::Lt => None,
+            Mode::Vcm | Mode::Ppm => Some(
+                "more iterations (integrators.vcm.iterations) or a smaller integrators.vcm.radius shrink it".into(),
+            ),
+        }
+    }
 }
 
 /// SmallVCM's default first radius: 0.003 x the radius of the scene's bounding sphere.

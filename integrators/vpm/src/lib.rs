@@ -507,6 +507,11 @@ impl Integrator for Vpm {
         }
     }
 
+    /// Surface estimates average over a disc, volume estimates over a ball or a beam's width.
+    fn bias(&self) -> Option<String> {
+        Some("more photons (integrators.vpm.global_photons, integrators.vpm.caustic_photons, integrators.vpm.volume_photons) or a smaller integrators.vpm.k, integrators.vpm.k_volume, integrators.vpm.max_radius or integrators.vpm.max_radius_volume shrink it".into())
+    }
+
     /// `global` (direct and indirect surface photons of the global budget), `caustic` (L S+ D
     /// surface photons of the caustic budget) and `volume` (the volume map as rendered).
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {

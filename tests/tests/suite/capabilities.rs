@@ -116,6 +116,47 @@ fn budgets_name_real_scene_keys() {
     }
 }
 
+/// `bias()`: the unbiased integrators say nothing; the biased-but-consistent ones (density
+/// estimation, `vcm` when it merges) say what shrinks their bias, and every scene key they name
+/// is one of their parameters (so that `--set` takes it).
+#[test]
+fn biased_integrators_name_the_keys_that_shrink_their_bias() {
+    for name in ["path", "bdpt", "normals"] {
+        assert_eq!(prepared(name, &[]).integrator.bias(), None, "{name}");
+    }
+    for mode in ["bpt", "lt"] {
+        let p = prepared("vcm", &[format!("integrators.vcm.mode=\"{mode}\"")]);
+        assert_eq!(p.integrator.bias(), None, "vcm {mode}");
+    }
+    for (name, sets) in [
+        ("photon", vec![]),
+        ("vpm", vec![]),
+        ("sppm", vec![]),
+        ("ppb", vec![]),
+        ("vcm", vec![]),
+        ("vcm", vec!["integrators.vcm.mode=\"ppm\"".to_string()]),
+    ] {
+        let p = prepared(name, &sets);
+        let bias = p
+            .integrator
+            .bias()
+            .unwrap_or_else(|| panic!("{name}: no bias"));
+        let prefix = format!("integrators.{name}.");
+        let keys: Vec<&str> = bias
+            .split(|c: char| !(c.is_alphanumeric() || c == '.' || c == '_'))
+            .filter_map(|w| w.strip_prefix(&prefix))
+            .collect();
+        assert!(!keys.is_empty(), "{name}: {bias}");
+        let params = p.integrator.parameters();
+        for key in keys {
+            assert!(
+                params.iter().any(|q| q.name == key),
+                "{name}: {key} in {bias}"
+            );
+        }
+    }
+}
+
 /// `photon_maps()`: the maps as the integrator stores them, with the budgets in force.
 #[test]
 fn photon_maps_are_the_integrators_own() {

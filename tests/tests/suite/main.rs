@@ -19,6 +19,7 @@ mod blend;
 mod build_id;
 mod capabilities;
 mod conductor;
+mod consistency;
 mod crossing_limit;
 mod deploy;
 mod deploy_scripts;

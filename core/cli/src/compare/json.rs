@@ -1,8 +1,10 @@
 //! The numbers of `foton compare` as JSON (<output stem>.json): per integrator its name,
 //! description, spp, seconds, errors against the reference (rel_mse, bias and the mean LDR-FLIP
-//! `flip`; null without one), the values --time chose, the error curve and its image.
+//! `flip`; null without one), the values --time chose, the error curve and its image; with
+//! --consistency, the outcome of each pair's test.
 
 use super::Entry;
+use super::consistency::Pair;
 use std::path::Path;
 
 /// `s` as a JSON string literal (quotes, backslashes and control characters escaped).
@@ -39,6 +41,7 @@ pub(super) fn json(
     reference: Option<&Path>,
     time: Option<f64>,
     entries: &[Entry],
+    consistency: Option<&[Pair]>,
 ) -> String {
     let file_name = |p: &Path| {
         p.file_name()
@@ -74,6 +77,9 @@ pub(super) fn json(
             e.flip.map_or("null".into(), json_number)
         );
         s += &format!("      \"set\": {},\n", json_settings(&e.settings));
+        if e.renders > 1 {
+            s += &format!("      \"renders\": {},\n", e.renders);
+        }
         if !e.curve.is_empty() {
             s += "      \"curve\": [\n";
             for (j, p) in e.curve.iter().enumerate() {
@@ -96,7 +102,27 @@ pub(super) fn json(
             "    }\n"
         };
     }
-    s += "  ]\n}\n";
+    s += "  ]";
+    if let Some(pairs) = consistency {
+        s += ",\n  \"consistency\": [\n";
+        for (i, p) in pairs.iter().enumerate() {
+            let o = &p.outcome;
+            let biased: Vec<String> = p.biased.iter().map(|(n, _)| json_string(n)).collect();
+            s += &format!(
+                "    {{\"a\": {}, \"b\": {}, \"blocks_tested\": {}, \"blocks_differ\": {}, \"min_adjusted_p\": {}, \"differ\": {}, \"biased\": [{}]}}{}\n",
+                json_string(&p.a),
+                json_string(&p.b),
+                o.tested(),
+                o.differing(),
+                o.min_adjusted_p().map_or("null".into(), json_number),
+                p.differs(),
+                biased.join(", "),
+                if i + 1 < pairs.len() { "," } else { "" }
+            );
+        }
+        s += "  ]";
+    }
+    s += "\n}\n";
     s
 }
 
