@@ -1,12 +1,12 @@
 //! `foton render`: one scene to one image, or with `--part I/N` to a part file for
 //! `foton merge`; a summary line of the work done, and what an interrupted render kept.
 
-use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_part, warn};
+use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_with, warn};
 use crate::{TermProgress, part};
 use clap::Args;
 use foton_core::error::{Error, Result};
 use foton_core::film::{Film, ImageFormat, check_output, format_of};
-use foton_core::integrator::Part;
+use foton_core::integrator::{Part, RenderContext};
 use foton_core::scene::Scene;
 use foton_loader::FilmFile;
 use std::io::Write;
@@ -33,6 +33,17 @@ pub(crate) struct RenderArgs {
     /// output: <scene stem>-part-I-of-N.exr beside the scene.
     #[arg(long, value_name = "I/N", value_parser = part::parse_part)]
     part: Option<Part>,
+    /// Also write each sampling technique's share of the image into the EXR, one layer per
+    /// technique (channels <technique>.R, .G, .B), the layers summing to the image: bdpt's
+    /// (s, t) strategies (s<s>t<t>, rest), the terms of the other estimators that combine
+    /// techniques (docs/tools.md names them). EXR output only, not with --part; integrators
+    /// without techniques refuse it.
+    #[arg(long)]
+    techniques: bool,
+    /// With --techniques: the path length (edges, s + t - 1 in bdpt) up to which each
+    /// strategy has a layer of its own; longer paths share one layer, `rest`.
+    #[arg(long, value_name = "N", default_value_t = 5, requires = "techniques")]
+    techniques_depth: u32,
 }
 
 pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
@@ -60,6 +71,26 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
             ));
         }
     }
+    let techniques = a.techniques.then_some(a.techniques_depth);
+    if let Some(depth) = techniques {
+        if a.part.is_some() {
+            return Err(Error::Usage(
+                "--techniques and --part: a part file holds the image's exact sums only, not the technique layers; render the techniques in one process".into(),
+            ));
+        }
+        if format_of(&output)? != ImageFormat::Exr {
+            return Err(Error::Usage(format!(
+                "--techniques writes the technique layers into an EXR: name the output .exr, not {}",
+                output.display()
+            )));
+        }
+        if p.integrator.techniques(depth).is_empty() {
+            return Err(Error::Usage(format!(
+                "--techniques: {} has no techniques to show (it is one estimator; docs/tools.md lists the integrators that have them)",
+                p.integrator.name()
+            )));
+        }
+    }
     warn(err, &p.warnings);
     let mut progress = TermProgress::new(a.run.quiet);
     if let Some(every) = a.checkpoint {
@@ -67,7 +98,22 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = a.run.threads();
-    let (film, elapsed) = render_part(&p, threads, &progress, a.part.unwrap_or(Part::WHOLE))?;
+    let ctx = RenderContext {
+        part: a.part.unwrap_or(Part::WHOLE),
+        techniques,
+        ..RenderContext::new(threads, &INTERRUPTED, &progress)
+    };
+    let (film, elapsed) = render_with(&p, &ctx)?;
+    if let Some(depth) = techniques {
+        let names: Vec<&str> = film.layers().iter().map(|l| l.name.as_str()).collect();
+        if names != p.integrator.techniques(depth) {
+            return Err(Error::Render(format!(
+                "--techniques: {} returned the layers [{}], not the ones it names",
+                p.integrator.name(),
+                names.join(", ")
+            )));
+        }
+    }
     if a.checkpoint.is_some() && progress.checkpoints.load(Ordering::Relaxed) == 0 {
         let _ = writeln!(
             err,

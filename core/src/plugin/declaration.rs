@@ -184,6 +184,9 @@ impl Integrator for PanicGuard {
     fn photon_maps(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Vec<PhotonMapView>> {
         catch("photon_maps", || self.0.photon_maps(scene, ctx))
     }
+    fn techniques(&self, depth: u32) -> Vec<String> {
+        catch("techniques", || Ok(self.0.techniques(depth))).unwrap_or_default()
+    }
     fn describe(&self) -> String {
         catch("describe", || Ok(self.0.describe())).unwrap_or_else(|e| e.to_string())
     }
