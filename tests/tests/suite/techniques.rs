@@ -197,3 +197,60 @@ fn techniques_are_refused_where_they_cannot_be_written() {
     assert!(!Path::new(out).exists() && !Path::new(png).exists());
 }
 
+/// A Cornell box with a glass sphere (caustics) and a white one.
+fn glass_box(dir: &Path) -> std::path::PathBuf {
+    let glass = "\n[materials.glass]\ntype = \"dielectric\"\nior = 1.5\n";
+    write(
+        dir,
+        "glass.toml",
+        &cornell("glass", "white", glass, CEILING_LIGHT),
+    )
+}
+
+/// photon: emission seen from the camera, direct light, the caustic map and the global map,
+/// or the final gather in its place; the image is the plain render's, bit for bit.
+#[test]
+fn photon_terms_sum_to_the_image() {
+    let dir = temp_dir("techniques-photon");
+    let scene = glass_box(&dir);
+    for final_gather in [false, true] {
+        let gather = format!("integrators.photon.final_gather={final_gather}");
+        let set = [
+            "--integrator",
+            "photon",
+            "--spp",
+            "2",
+            "--set",
+            "film.width=24",
+            "--set",
+            "film.height=24",
+            "--set",
+            "integrators.photon.global_photons=5000",
+            "--set",
+            "integrators.photon.caustic_photons=5000",
+            "--set",
+            "integrators.photon.gather_rays=2",
+            "--set",
+            &gather,
+        ];
+        let mut args = set.to_vec();
+        args.push("--techniques");
+        let layered = render_channels(&scene, &dir.join("layers.exr"), &args);
+        let last = if final_gather {
+            "final_gather"
+        } else {
+            "global"
+        };
+        let names = ["emission", "direct", "caustic", last].map(String::from);
+        let totals = assert_layers_sum_to_image(&layered, &names, 4);
+        assert!(totals[last] > 0.0, "{totals:?}");
+        let plain = render_channels(&scene, &dir.join("plain.exr"), &set);
+        for c in ["R", "G", "B"] {
+            assert_eq!(
+                layered[c], plain[c],
+                "final_gather = {final_gather}, channel {c}"
+            );
+        }
+    }
+}
+
