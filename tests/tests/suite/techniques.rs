@@ -254,3 +254,55 @@ fn photon_terms_sum_to_the_image() {
     }
 }
 
+/// Renders `scene` into `dir` with `integrator` and `set` (`--set` values), with and without
+/// `--techniques`: the layers are `names` and sum to the image, `lit` of them hold light,
+/// and the image is the plain render's, bit for bit. Returns each layer's total.
+fn check_integrator(
+    scene: &Path,
+    dir: &Path,
+    integrator: &str,
+    set: &[&str],
+    names: &[&str],
+    lit: &[&str],
+) -> BTreeMap<String, f64> {
+    let mut plain_args = vec!["--integrator", integrator];
+    for s in set {
+        plain_args.extend(["--set", s]);
+    }
+    let mut args = plain_args.clone();
+    args.push("--techniques");
+    let layered = render_channels(scene, &dir.join(format!("{integrator}-layers.exr")), &args);
+    let names: Vec<String> = names.iter().map(|n| n.to_string()).collect();
+    let totals = assert_layers_sum_to_image(&layered, &names, lit.len());
+    for name in lit {
+        assert!(
+            totals[*name] > 0.0,
+            "{integrator}: {name} is black: {totals:?}"
+        );
+    }
+    let plain = render_channels(
+        scene,
+        &dir.join(format!("{integrator}-plain.exr")),
+        &plain_args,
+    );
+    for c in ["R", "G", "B"] {
+        assert_eq!(layered[c], plain[c], "{integrator}: channel {c}");
+    }
+    totals
+}
+
+/// vcm: connections, merges, camera paths reaching the light and light tracing (the splats).
+#[test]
+fn vcm_techniques_sum_to_the_image() {
+    let dir = temp_dir("techniques-vcm");
+    let scene = glass_box(&dir);
+    let set = [
+        "film.width=24",
+        "film.height=24",
+        "integrators.vcm.iterations=2",
+        "film.filter=\"tent\"",
+    ];
+    let names = ["connection", "merging", "emission", "light_tracing"];
+    check_integrator(&scene, &dir, "vcm", &set, &names, &names);
+}
+
