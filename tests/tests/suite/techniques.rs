@@ -7,7 +7,7 @@
 
 use crate::bdpt::{CEILING_LIGHT, cornell};
 use foton_loader::image::read_exr_channels;
-use foton_tests::{foton_with_plugins, temp_dir, write};
+use foton_tests::{foton_with_plugins, repo_root, temp_dir, write};
 use std::collections::BTreeMap;
 use std::path::Path;
 
@@ -306,3 +306,54 @@ fn vcm_techniques_sum_to_the_image() {
     check_integrator(&scene, &dir, "vcm", &set, &names, &names);
 }
 
+/// vpm in fog: emission, the surface estimates and the volume's (photon points, or photon
+/// beams).
+#[test]
+fn vpm_techniques_sum_to_the_image() {
+    let dir = temp_dir("techniques-vpm");
+    let scene = repo_root().join("scenes/cornell-fog.toml");
+    for (estimate, volume) in [("march", "volume_point"), ("beams", "beam")] {
+        let estimate = format!("integrators.vpm.estimate=\"{estimate}\"");
+        let set = [
+            "film.width=16",
+            "film.height=16",
+            "render.spp=2",
+            "integrators.vpm.global_photons=4000",
+            "integrators.vpm.caustic_photons=2000",
+            "integrators.vpm.volume_photons=4000",
+            &estimate,
+        ];
+        let names = ["emission", "direct", "caustic", "global", volume];
+        check_integrator(
+            &scene,
+            &dir,
+            "vpm",
+            &set,
+            &names,
+            &["direct", "global", volume],
+        );
+    }
+}
+
+/// ppb in fog: emission, the photon beams, direct light and the surface photons.
+#[test]
+fn ppb_techniques_sum_to_the_image() {
+    let dir = temp_dir("techniques-ppb");
+    let scene = repo_root().join("scenes/cornell-fog.toml");
+    let set = [
+        "film.width=16",
+        "film.height=16",
+        "integrators.ppb.iterations=2",
+        "integrators.ppb.photons_per_iteration=1000",
+        "integrators.ppb.surface_photons=4000",
+    ];
+    let names = ["emission", "beam", "direct", "surface"];
+    check_integrator(
+        &scene,
+        &dir,
+        "ppb",
+        &set,
+        &names,
+        &["beam", "direct", "surface"],
+    );
+}
