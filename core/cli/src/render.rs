@@ -2,15 +2,17 @@
 //! `foton merge`; a summary line of the work done, and what an interrupted render kept.
 
 use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_with, warn};
+use crate::montage::{Image, Tile, grid};
 use crate::{TermProgress, part};
 use clap::Args;
+use foton_core::Rgb;
 use foton_core::error::{Error, Result};
-use foton_core::film::{Film, ImageFormat, check_output, format_of};
+use foton_core::film::{DisplayTransform, Film, ImageFormat, check_output, format_of};
 use foton_core::integrator::{Part, RenderContext};
 use foton_core::scene::Scene;
 use foton_loader::FilmFile;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
@@ -44,6 +46,11 @@ pub(crate) struct RenderArgs {
     /// strategy has a layer of its own; longer paths share one layer, `rest`.
     #[arg(long, value_name = "N", default_value_t = 5, requires = "techniques")]
     techniques_depth: u32,
+    /// With --techniques: also write the layers as a labelled grid (.png through the scene's
+    /// display transform, or .exr), the image last; bdpt's strategies as Veach's pyramid (row
+    /// k = s + t - 1, column s).
+    #[arg(long, value_name = "FILE", requires = "techniques")]
+    techniques_grid: Option<PathBuf>,
 }
 
 pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
@@ -83,6 +90,9 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
                 "--techniques writes the technique layers into an EXR: name the output .exr, not {}",
                 output.display()
             )));
+        }
+        if let Some(grid) = &a.techniques_grid {
+            check_output(grid)?;
         }
         if p.integrator.techniques(depth).is_empty() {
             return Err(Error::Usage(format!(
@@ -133,6 +143,9 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
         }
         None => {
             film.write(&output, &p.scene.film().display())?;
+            if let Some(grid) = &a.techniques_grid {
+                technique_grid(&film, &p.scene.film().display(), grid).write(grid)?;
+            }
             String::new()
         }
     };
@@ -155,6 +168,63 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
         return Ok(130);
     }
     Ok(0)
+}
+
+/// The technique layers of `film` as one labelled grid for `output`, each tile shown as
+/// `foton render` would write it (a PNG through `display`), the image (their sum) last. Layers
+/// named `s<s>t<t>` (bdpt's strategies) make Veach's pyramid: row k = s + t - 1 (the path
+/// length), column s, blank cells to the right; the other layers (`rest`) follow in one row.
+fn technique_grid(film: &Film, display: &DisplayTransform, output: &Path) -> Image {
+    let png = matches!(format_of(output), Ok(ImageFormat::Png));
+    let tile = |mut pixels: Vec<Rgb>, label: &str| {
+        if png {
+            pixels.iter_mut().for_each(|p| *p = display.map(*p));
+        }
+        Tile {
+            image: Image {
+                width: film.width,
+                height: film.height,
+                pixels,
+            },
+            label: vec![label.to_string()],
+        }
+    };
+    let blank = || Tile {
+        image: Image::new(film.width, film.height, Rgb::ZERO),
+        label: Vec::new(),
+    };
+    let strategy = |name: &str| -> Option<(u32, u32)> {
+        let (s, t) = name.strip_prefix('s')?.split_once('t')?;
+        Some((s.parse().ok()?, t.parse().ok()?))
+    };
+    let layers = film.layers();
+    let longest = (layers.iter())
+        .filter_map(|l| strategy(&l.name))
+        .map(|(s, t)| s + t - 1)
+        .max();
+    let mut tiles = Vec::new();
+    let columns = match longest {
+        Some(longest) => {
+            for k in 1..=longest {
+                for s in 0..=longest {
+                    let name = format!("s{s}t{}", (k + 1).saturating_sub(s));
+                    match layers.iter().position(|l| s <= k && l.name == name) {
+                        Some(i) => tiles.push(tile(film.layer_pixels(i), &name)),
+                        None => tiles.push(blank()),
+                    }
+                }
+            }
+            longest as usize + 1
+        }
+        None => layers.len() + 1,
+    };
+    for (i, layer) in layers.iter().enumerate() {
+        if strategy(&layer.name).is_none() {
+            tiles.push(tile(film.layer_pixels(i), &layer.name));
+        }
+    }
+    tiles.push(tile(film.pixels(), "image (the sum)"));
+    grid(&tiles, columns)
 }
 
 /// A rate with a unit prefix that keeps its digits: "1.27 M", "4.8 k" (a progressive render of

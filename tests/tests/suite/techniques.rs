@@ -148,8 +148,14 @@ fn bdpt_default_depth_names_the_pyramid() {
     }
     names.push("rest".into());
     assert_eq!(names.len(), 21);
-    let channels = render_channels(&scene, &dir.join("a.exr"), &small);
+    let grid = dir.join("grid.png");
+    let mut args = small.to_vec();
+    args.extend(["--techniques-grid", grid.to_str().unwrap()]);
+    let channels = render_channels(&scene, &dir.join("a.exr"), &args);
     assert_layers_sum_to_image(&channels, &names, 2);
+    // The pyramid: 5 rows of 6 cells, then `rest` and the image; 8 x 8 tiles under labels.
+    let (w, h, _) = foton_loader::image::read_image(&grid).unwrap();
+    assert!(w > 6 * 8 && h > 6 * 8, "{w} x {h}");
     let mut args = small.to_vec();
     args.extend(["--set", "render.max_depth=1"]);
     let channels = render_channels(&scene, &dir.join("b.exr"), &args);
