@@ -714,6 +714,42 @@ mod tests {
         assert!(Film::new(2, 1).splats().is_empty());
     }
 
+    /// Technique layers: their pixels use the film's counts and splat scale, so that they
+    /// sum to the image (an interrupted render's uneven counts and the splats included), and
+    /// merging films adds their layers by name.
+    #[test]
+    fn layers_sum_to_the_image() {
+        let sum = |v: f32| {
+            let mut s = RadianceSum::ZERO;
+            s.add(Rgb::splat(v));
+            s
+        };
+        let mut film = Film::new(2, 1);
+        let (a, b) = (film.add_layer("a"), film.add_layer("b"));
+        assert_eq!((a, b, film.add_layer("a")), (0, 1, 0));
+        // Pixel 0: 4 samples of 0.5 = 0.25 (a) + 0.25 (b); pixel 1: 2 samples of 0.5, all a.
+        film.add_pixel(0, &sum(2.0), 4);
+        film.add_layer_pixel(a, 0, &sum(1.0));
+        film.add_layer_pixel(b, 0, &sum(1.0));
+        film.add_pixel(1, &sum(1.0), 2);
+        film.add_layer_pixel(a, 1, &sum(1.0));
+        // Splats on pixel 1, all b's.
+        film.add_splat(1, &sum(0.75));
+        film.add_layer_splat(b, 1, &sum(0.75));
+        let total = |f: &Film| -> Vec<Rgb> {
+            let (la, lb) = (f.layer_pixels(0), f.layer_pixels(1));
+            la.iter().zip(&lb).map(|(x, y)| *x + *y).collect()
+        };
+        assert_eq!(total(&film), film.pixels());
+        assert_eq!(film.layer_pixels(b)[1], Rgb::splat(0.25));
+        let mut merged = Film::new(2, 1);
+        merged.merge(&film);
+        merged.merge(&film);
+        assert_eq!(merged.layers().len(), 2);
+        assert_eq!(total(&merged), merged.pixels());
+        assert_eq!(merged.pixels(), film.pixels());
+    }
+
     #[test]
     fn srgb_decode_inverts_encode() {
         for i in 0..=1000 {

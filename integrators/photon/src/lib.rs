@@ -67,6 +67,10 @@
 //! The method is consistent, not unbiased: estimates blur light over the radius r, which
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission` (the camera walk's), `direct`, `caustic`, and `global` or,
+//! with `final_gather`, `final_gather`.
 
 use foton_core::api::{
     Bsdf, Budget, CameraWalk, Direct, Error, Film, Hit, Integrator, NormalizedKernel, Parameter,

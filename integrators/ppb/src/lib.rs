@@ -95,6 +95,10 @@
 //! built in a fixed order; images are
 //! identical for any number of threads and any split into parts. Memory holds one pass's
 //! photons and beams at a time.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission`, `beam` (the photon beams in media), `direct` (shadow
+//! rays) and `surface` (the surface photons).
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Film, Integrator, Mis, NormalizedKernel, Parameter, PhotonMapView,

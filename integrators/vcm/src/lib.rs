@@ -62,6 +62,10 @@
 //! `hide_emitters` as `bdpt` (camera rays pass through emitters until they first scatter, and
 //! so do light vertices' connections to the camera). **Not supported**, refused with an error:
 //! participating media (`bdpt` and `vpm` render them).
+//!
+//! `foton render --techniques` keeps the estimator's four techniques apart as layers of the
+//! film (docs/tools.md), summing to the image: `connection` (s >= 1, t >= 2), `merging`,
+//! `emission` (s = 0) and `light_tracing` (t = 1, the splats), each MIS-weighted.
 
 pub mod grid;
 

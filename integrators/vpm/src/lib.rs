@@ -114,6 +114,10 @@
 //!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
 //!   the direct light and every medium query (`dyn Medium`) are core's, shared with `path`,
 //!   `photon` and `sppm`; the gap after a crossing is sampled, as `path` samples it.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission`, `direct`, `caustic`, `global` (as `photon`'s), and the
+//! media's in-scattered radiance, `volume_point` (photon points) or `beam` (photon beams).
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Film, Integrator, Medium, Mis, NormalizedKernel, Parameter,
