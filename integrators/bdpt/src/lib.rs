@@ -124,6 +124,8 @@ impl StrategyLayers<'_, '_, '_> {
 }
 
 impl SplatSink for StrategyLayers<'_, '_, '_> {
+    const SHARES: bool = true;
+
     fn add(&mut self, x: u32, y: u32, value: Rgb) {
         // Every splat of the estimator comes with its strategy (add_strategy).
         self.splats.add(x, y, value);

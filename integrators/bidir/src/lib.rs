@@ -56,6 +56,10 @@ pub struct Bidir {
 /// --techniques`, also where each strategy's share goes ([`SplatSink::add_strategy`],
 /// [`SplatSink::share`]); the defaults keep none (nothing is done for them in a plain render).
 pub trait SplatSink {
+    /// Whether the sink keeps the strategies' shares ([`SplatSink::share`]); false: the camera
+    /// subpath is traced without reporting them.
+    const SHARES: bool = false;
+
     /// Adds `value` to pixel (x, y).
     fn add(&mut self, x: u32, y: u32, value: Rgb);
 
@@ -198,21 +202,24 @@ impl Bidir {
 
     /// One camera sample: its own estimate (strategies t >= 2); what its light path brings to
     /// the camera (t = 1) goes to `splats`. `light_media` is the medium each light emits into.
-    pub fn sample(
+    pub fn sample<S: SplatSink>(
         &self,
         scene: &Scene,
         light_media: &[Option<u32>],
         ps: &PixelSample,
         sampler: &mut Sampler,
-        splats: &mut impl SplatSink,
+        splats: &mut S,
         rays: &mut u64,
     ) -> Rgb {
         let cap = (self.max_depth as usize + 2).min(32);
         let mut camera = Vec::with_capacity(cap);
-        let mut radiance =
+        let mut radiance = if S::SHARES {
             self.camera_subpath_with(scene, ps, sampler, &mut camera, rays, |t, value| {
                 splats.share(0, t, value)
-            });
+            })
+        } else {
+            self.camera_subpath(scene, ps, sampler, &mut camera, rays)
+        };
         let mut light = Vec::with_capacity(cap);
         let origin = self.light_subpath(scene, light_media, sampler, &mut light, rays);
 
@@ -248,7 +255,7 @@ impl Bidir {
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
     ) -> Rgb {
-        self.camera_subpath_with(scene, ps, sampler, vertices, rays, |_, _| {})
+        self.camera_walk(scene, ps, sampler, vertices, rays, None)
     }
 
     /// [`Bidir::camera_subpath`] that also hands `emitted` each emitter's weighted
@@ -261,6 +268,20 @@ impl Bidir {
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
         mut emitted: impl FnMut(u32, Rgb),
+    ) -> Rgb {
+        self.camera_walk(scene, ps, sampler, vertices, rays, Some(&mut emitted))
+    }
+
+    /// The camera subpath of [`Bidir::camera_subpath`], its emitter hits also handed to
+    /// `emitted` if there is one (once per hit: no cost per vertex without it).
+    fn camera_walk(
+        &self,
+        scene: &Scene,
+        ps: &PixelSample,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+        emitted: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let margin = scene.film().filter.margin();
         let (_, pdf_we) = scene.camera().pdf_we(ps.ray.dir, margin);
@@ -284,7 +305,7 @@ impl Bidir {
             sampler,
             vertices,
             rays,
-            &mut emitted,
+            emitted,
         )
     }
 
@@ -342,7 +363,7 @@ impl Bidir {
             sampler,
             vertices,
             rays,
-            &mut |_, _| {},
+            None,
         );
         origin
     }
@@ -363,7 +384,7 @@ impl Bidir {
         sampler: &mut Sampler,
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
-        on_emission: &mut impl FnMut(u32, Rgb),
+        mut on_emission: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let mode = match side {
             Side::Camera => TransportMode::Radiance,
@@ -458,7 +479,9 @@ impl Bidir {
                         weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
                     });
                     let value = beta * le * w;
-                    on_emission(t, value);
+                    if let Some(f) = on_emission.as_mut() {
+                        f(t, value);
+                    }
                     radiance += value;
                 }
                 break;
@@ -491,7 +514,9 @@ impl Bidir {
                     weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
                 });
                 let value = beta * le * w;
-                on_emission(length + 1, value);
+                if let Some(f) = on_emission.as_mut() {
+                    f(length + 1, value);
+                }
                 radiance += value;
             }
             if side == Side::Camera && length > self.max_depth {
