@@ -12,8 +12,9 @@
 //! The items, by concept:
 //! - the plugin itself: [`Integrator`], [`declare_integrator!`], its parameters
 //!   ([`Properties`]) and what it reports ([`Parameter`], [`Budget`], [`PhotonMapView`]);
-//! - the render: [`RenderContext`], [`Film`], the shared image loops ([`render_pixels`],
-//!   [`render_pixels_splatting`]) and thread pool ([`with_pool`]);
+//! - the render: [`RenderContext`], [`Film`] (with its technique [`Layer`]s), the shared
+//!   image loops ([`render_pixels`], [`render_pixels_splatting`], [`render_pixels_techniques`]
+//!   with its [`Techniques`]) and thread pool ([`with_pool`]);
 //! - the scene and its queries: [`Scene`], [`Ray`], [`Hit`], [`Bsdf`], [`Light`], [`Medium`],
 //!   the walks that cross null boundaries and media ([`RayWalk`], [`CameraWalk`]) and
 //!   next-event estimation ([`estimate_direct`]);
@@ -65,9 +66,10 @@ pub use crate::sampling::{
 };
 
 // The image.
-pub use crate::film::{Film, RadianceSum};
+pub use crate::film::{Film, Layer, RadianceSum};
 pub use crate::render::{
-    PixelSample, Splats, render_pixels, render_pixels_splatting, usable, warn_unusable, with_pool,
+    PixelSample, Splats, Techniques, render_pixels, render_pixels_splatting,
+    render_pixels_techniques, usable, warn_unusable, with_pool,
 };
 
 // Density estimation.

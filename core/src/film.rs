@@ -116,6 +116,20 @@ impl RadianceSum {
     }
 }
 
+/// One sampling technique's share of the image (`foton render --techniques`): exact sums of
+/// the contributions that technique made, to the camera samples and to the splats, kept as the
+/// film's own. Its pixels are made with the film's sample counts and splat scale
+/// ([`Film::layer_pixels`]), so that a film's layers sum to its image (to float rounding)
+/// when the integrator gives every contribution to exactly one technique.
+#[derive(Clone, Debug)]
+pub struct Layer {
+    /// The technique's name, as the EXR's channels `<name>.R`, `<name>.G`, `<name>.B` carry it.
+    pub name: String,
+    sum: Vec<RadianceSum>,
+    /// Empty until the technique's first splat.
+    splat: Vec<RadianceSum>,
+}
+
 #[derive(Clone, Debug)]
 pub struct Film {
     pub width: u32,
@@ -138,6 +152,9 @@ pub struct Film {
     pub iterations_planned: u64,
     /// Photons emitted over all the iterations of a progressive integrator; 0 for the others.
     pub photons: u64,
+    /// Each technique's share of the image, when the render was asked for them
+    /// (`RenderContext::techniques`); empty otherwise.
+    layers: Vec<Layer>,
 }
 
 impl Film {
@@ -154,6 +171,7 @@ impl Film {
             iterations: 0,
             iterations_planned: 0,
             photons: 0,
+            layers: Vec::new(),
         }
     }
 
@@ -228,6 +246,60 @@ impl Film {
         for (i, s) in other.splats().iter().enumerate() {
             self.add_splat(i, s);
         }
+        for layer in &other.layers {
+            let k = self.add_layer(&layer.name);
+            for (i, s) in layer.sum.iter().enumerate() {
+                self.add_layer_pixel(k, i, s);
+            }
+            for (i, s) in layer.splat.iter().enumerate() {
+                self.add_layer_splat(k, i, s);
+            }
+        }
+    }
+
+    /// The index of the technique layer `name`, added (black) if the film has none of that
+    /// name yet.
+    pub fn add_layer(&mut self, name: &str) -> usize {
+        if let Some(k) = self.layers.iter().position(|l| l.name == name) {
+            return k;
+        }
+        self.layers.push(Layer {
+            name: name.to_string(),
+            sum: vec![RadianceSum::ZERO; self.sum.len()],
+            splat: Vec::new(),
+        });
+        self.layers.len() - 1
+    }
+
+    /// The technique layers, in the order they were added.
+    pub fn layers(&self) -> &[Layer] {
+        &self.layers
+    }
+
+    /// Adds to pixel `i` of layer `k` the sum of its technique's shares of camera samples the
+    /// film counts (with [`Film::add_pixel`]) in the pixel.
+    pub fn add_layer_pixel(&mut self, k: usize, i: usize, sum: &RadianceSum) {
+        self.layers[k].sum[i].merge(sum);
+    }
+
+    /// Adds to pixel `i` of layer `k` a splat sum of its technique (one also given to
+    /// [`Film::add_splat`]).
+    pub fn add_layer_splat(&mut self, k: usize, i: usize, sum: &RadianceSum) {
+        let layer = &mut self.layers[k];
+        if layer.splat.is_empty() {
+            layer.splat = vec![RadianceSum::ZERO; self.sum.len()];
+        }
+        layer.splat[i].merge(sum);
+    }
+
+    /// The pixels of layer `k`, row-major: its sums over the film's sample counts, plus its
+    /// splats times the film's splat scale, as [`Film::pixels`] makes the image.
+    pub fn layer_pixels(&self, k: usize) -> Vec<Rgb> {
+        let scale = self.splat_scale();
+        let layer = &self.layers[k];
+        (0..self.sum.len())
+            .map(|i| value(&layer.sum[i], self.count[i], layer.splat.get(i), scale))
+            .collect()
     }
 
     /// Adds a pixel's accumulated sum and count (used when merging tiles and parts).
@@ -271,19 +343,7 @@ impl Film {
     }
 
     fn pixel_at(&self, i: usize, splat_scale: f64) -> Rgb {
-        let n = self.count[i];
-        let mut v = [0.0f64; 3];
-        if n > 0 {
-            let s = self.sum[i].to_f64();
-            v = s.map(|s| s / n as f64);
-        }
-        if let Some(splat) = self.splat.get(i) {
-            let s = splat.to_f64();
-            for c in 0..3 {
-                v[c] += s[c] * splat_scale;
-            }
-        }
-        Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32)
+        value(&self.sum[i], self.count[i], self.splat.get(i), splat_scale)
     }
 
     /// All pixels, row-major from the top-left.
@@ -300,6 +360,24 @@ impl Film {
         let sum: glam::DVec3 = px.iter().map(|p| p.as_dvec3()).sum();
         (sum / px.len().max(1) as f64).as_vec3()
     }
+}
+
+/// A pixel's value from its sum of `n` samples and its splat sum (if any): the mean sample
+/// plus the splats times `splat_scale`.
+#[inline]
+fn value(sum: &RadianceSum, n: u32, splat: Option<&RadianceSum>, splat_scale: f64) -> Rgb {
+    let mut v = [0.0f64; 3];
+    if n > 0 {
+        let s = sum.to_f64();
+        v = s.map(|s| s / n as f64);
+    }
+    if let Some(splat) = splat {
+        let s = splat.to_f64();
+        for c in 0..3 {
+            v[c] += s[c] * splat_scale;
+        }
+    }
+    Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32)
 }
 
 /// How exposed radiance is squeezed into the [0, 1] an 8-bit image can hold.
@@ -642,6 +720,42 @@ mod tests {
         });
         // A film without splats has no splat buffer.
         assert!(Film::new(2, 1).splats().is_empty());
+    }
+
+    /// Technique layers: their pixels use the film's counts and splat scale, so that they
+    /// sum to the image (an interrupted render's uneven counts and the splats included), and
+    /// merging films adds their layers by name.
+    #[test]
+    fn layers_sum_to_the_image() {
+        let sum = |v: f32| {
+            let mut s = RadianceSum::ZERO;
+            s.add(Rgb::splat(v));
+            s
+        };
+        let mut film = Film::new(2, 1);
+        let (a, b) = (film.add_layer("a"), film.add_layer("b"));
+        assert_eq!((a, b, film.add_layer("a")), (0, 1, 0));
+        // Pixel 0: 4 samples of 0.5 = 0.25 (a) + 0.25 (b); pixel 1: 2 samples of 0.5, all a.
+        film.add_pixel(0, &sum(2.0), 4);
+        film.add_layer_pixel(a, 0, &sum(1.0));
+        film.add_layer_pixel(b, 0, &sum(1.0));
+        film.add_pixel(1, &sum(1.0), 2);
+        film.add_layer_pixel(a, 1, &sum(1.0));
+        // Splats on pixel 1, all b's.
+        film.add_splat(1, &sum(0.75));
+        film.add_layer_splat(b, 1, &sum(0.75));
+        let total = |f: &Film| -> Vec<Rgb> {
+            let (la, lb) = (f.layer_pixels(0), f.layer_pixels(1));
+            la.iter().zip(&lb).map(|(x, y)| *x + *y).collect()
+        };
+        assert_eq!(total(&film), film.pixels());
+        assert_eq!(film.layer_pixels(b)[1], Rgb::splat(0.25));
+        let mut merged = Film::new(2, 1);
+        merged.merge(&film);
+        merged.merge(&film);
+        assert_eq!(merged.layers().len(), 2);
+        assert_eq!(total(&merged), merged.pixels());
+        assert_eq!(merged.pixels(), film.pixels());
     }
 
     #[test]

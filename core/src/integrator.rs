@@ -64,6 +64,10 @@ pub struct RenderContext<'a> {
     pub progress: &'a dyn Progress,
     /// The share of the work to do (`foton render --part I/N`); [`Part::WHOLE`] for all of it.
     pub part: Part,
+    /// `Some(depth)`: keep each sampling technique's share of the image as a layer of the
+    /// film (`foton render --techniques`), the layers [`Integrator::techniques`] names for
+    /// `depth`; None: the image alone.
+    pub techniques: Option<u32>,
 }
 
 impl<'a> RenderContext<'a> {
@@ -74,6 +78,7 @@ impl<'a> RenderContext<'a> {
             cancel,
             progress,
             part: Part::WHOLE,
+            techniques: None,
         }
     }
 
@@ -243,6 +248,16 @@ pub trait Integrator: Send + Sync {
     /// image differs from another's.
     fn bias(&self) -> Option<String> {
         None
+    }
+
+    /// The sampling techniques whose shares of the image [`Integrator::render`] keeps as layers
+    /// of the film when `RenderContext::techniques` is `Some(depth)` (`foton render
+    /// --techniques`), by name, in the order of the film's layers; they sum to the image.
+    /// `depth` is the path length past which an estimator with a technique per length
+    /// (`bdpt`) pools them. Empty (the default): the integrator has no techniques to show, and
+    /// the host refuses the option.
+    fn techniques(&self, _depth: u32) -> Vec<String> {
+        Vec::new()
     }
 
     /// The configured integrator, for logs and labels (Mitsuba's `to_string`).

@@ -136,6 +136,56 @@ impl Splats<'_> {
     }
 }
 
+/// Where a camera sample reports each sampling technique's share of its estimate, when the
+/// render keeps them (`foton render --techniques`, [`render_pixels_techniques`]): technique
+/// `k`'s share of the radiance the sample returns ([`Techniques::add`]) and of what it splats
+/// ([`Techniques::splat`]). Each technique's shares go to a layer of the film, summed exactly as
+/// the image is (a sample whose radiance is not [`usable`] is dropped from every layer as it is
+/// replaced by zero in the image), so that the layers sum to the image when every contribution
+/// is given to exactly one technique.
+pub struct Techniques<'a> {
+    width: u32,
+    pixels: usize,
+    /// The current camera sample's shares, per technique.
+    sample: Vec<Rgb>,
+    /// Splats not yet added to `buffer`: (technique, pixel, sum).
+    pending: Vec<(u32, u32, RadianceSum)>,
+    /// Every technique's splat sums, technique after technique.
+    buffer: &'a Mutex<Vec<RadianceSum>>,
+}
+
+impl Techniques<'_> {
+    /// Adds `value` to technique `technique`'s share of the camera sample's radiance (the
+    /// value the sample returns must be the sum of its shares).
+    #[inline]
+    pub fn add(&mut self, technique: usize, value: Rgb) {
+        self.sample[technique] += value;
+    }
+
+    /// Adds `value` to technique `technique`'s splats at pixel (x, y): the same value given to
+    /// [`Splats::add`] (dropped, as there, when not [`usable`] or zero).
+    #[inline]
+    pub fn splat(&mut self, technique: usize, x: u32, y: u32, value: Rgb) {
+        if !usable(value) || value == Rgb::ZERO {
+            return;
+        }
+        let mut sum = RadianceSum::ZERO;
+        sum.add(value);
+        self.pending
+            .push((technique as u32, y * self.width + x, sum));
+        if self.pending.len() >= SPLAT_BATCH {
+            self.flush();
+        }
+    }
+
+    fn flush(&mut self) {
+        let mut buffer = self.buffer.lock().unwrap_or_else(|e| e.into_inner());
+        for (k, i, sum) in self.pending.drain(..) {
+            buffer[k as usize * self.pixels + i as usize].merge(&sum);
+        }
+    }
+}
+
 /// Renders `scene.render.spp` samples per pixel, or the share of them `ctx.part` names;
 /// `radiance` estimates the radiance arriving along a camera ray and adds the rays it traced to
 /// its last argument (for statistics). The film position is drawn from the scene's
@@ -144,7 +194,7 @@ pub fn render_pixels<F>(scene: &Scene, ctx: &RenderContext<'_>, radiance: F) -> 
 where
     F: Fn(&Ray, &mut Sampler, &mut u64) -> Rgb + Sync,
 {
-    render_loop(scene, ctx, false, |sample, sampler, _, rays| {
+    render_loop::<false, _>(scene, ctx, false, &[], |sample, sampler, _, _, rays| {
         radiance(&sample.ray, sampler, rays)
     })
 }
@@ -160,23 +210,50 @@ pub fn render_pixels_splatting<F>(
 where
     F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut u64) -> Rgb + Sync,
 {
-    render_loop(scene, ctx, true, radiance)
+    render_loop::<false, _>(scene, ctx, true, &[], |sample, sampler, splats, _, rays| {
+        radiance(sample, sampler, splats, rays)
+    })
 }
 
-fn render_loop<F>(
+/// [`render_pixels_splatting`] that also keeps each sampling technique's share of the image
+/// (`foton render --techniques`): `radiance` reports the shares of technique `k` (the k-th of
+/// `techniques`, the layers' names) to its [`Techniques`], and the film gets one layer per
+/// technique ([`Film::layers`]).
+pub fn render_pixels_techniques<F>(
     scene: &Scene,
     ctx: &RenderContext<'_>,
-    splatting: bool,
+    techniques: &[String],
     radiance: F,
 ) -> Result<Film>
 where
-    F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut u64) -> Rgb + Sync,
+    F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut Techniques<'_>, &mut u64) -> Rgb + Sync,
+{
+    render_loop::<true, _>(scene, ctx, true, techniques, radiance)
+}
+
+/// The pixel loop; `LAYERS`: the render keeps the techniques' shares (a constant, so that a
+/// render without them pays nothing per sample).
+fn render_loop<const LAYERS: bool, F>(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    splatting: bool,
+    techniques: &[String],
+    radiance: F,
+) -> Result<Film>
+where
+    F: Fn(&PixelSample, &mut Sampler, &mut Splats<'_>, &mut Techniques<'_>, &mut u64) -> Rgb + Sync,
 {
     let (width, height) = (scene.film.width, scene.film.height);
     let share = ctx.part.share(scene.render.spp as u64);
     let (first, spp) = (share.start as u32, share.end as u32);
     let mut film = Film::new(width, height);
     film.part = ctx.part;
+    let pixels = width as usize * height as usize;
+    let layers = if LAYERS { techniques.len() } else { 0 };
+    for name in &techniques[..layers] {
+        film.add_layer(name);
+    }
+    let layer_splats = Mutex::new(vec![RadianceSum::ZERO; layers * pixels]);
     let tiles: Vec<(u32, u32)> = (0..height.div_ceil(TILE))
         .flat_map(|ty| (0..width.div_ceil(TILE)).map(move |tx| (tx * TILE, ty * TILE)))
         .collect();
@@ -204,7 +281,8 @@ where
     while done < spp && !ctx.cancelled() {
         let batch = (done - first).max(1).min(spp - done);
         let (s0, s1) = (done, done + batch);
-        let results: Vec<Vec<(usize, RadianceSum, u32)>> = ctx.timed("camera pass", || {
+        type TileOut = (Vec<(usize, RadianceSum, u32)>, Vec<RadianceSum>);
+        let results: Vec<TileOut> = ctx.timed("camera pass", || {
             with_pool(ctx.threads, || {
                 tiles
                     .par_iter()
@@ -217,12 +295,25 @@ where
                             buffer: splatting.then_some(&splat_buffer),
                             bad: 0,
                         };
+                        // Per pixel of `out`, each technique's sum (LAYERS only).
+                        let mut layer_out = Vec::new();
+                        let mut techniques = Techniques {
+                            width,
+                            pixels,
+                            sample: vec![Rgb::ZERO; layers],
+                            pending: Vec::new(),
+                            buffer: &layer_splats,
+                        };
                         for y in y0..(y0 + TILE).min(height) {
                             if ctx.cancelled() {
                                 break;
                             }
                             for x in x0..(x0 + TILE).min(width) {
                                 let mut sum = RadianceSum::ZERO;
+                                let first_layer = layer_out.len();
+                                if LAYERS {
+                                    layer_out.resize(first_layer + layers, RadianceSum::ZERO);
+                                }
                                 let samplers = pixel_samplers(&scene.render, width, x, y);
                                 for s in s0..s1 {
                                     let mut sampler = samplers.sample(s);
@@ -238,30 +329,51 @@ where
                                         &sample,
                                         &mut sampler,
                                         &mut splats,
+                                        &mut techniques,
                                         &mut tile_rays,
                                     );
                                     if !usable(l) {
                                         bad_samples.fetch_add(1, Ordering::Relaxed);
                                         l = Rgb::ZERO;
+                                        if LAYERS {
+                                            techniques.sample.fill(Rgb::ZERO);
+                                        }
                                     }
                                     sum.add(l);
+                                    if LAYERS {
+                                        let sums = &mut layer_out[first_layer..];
+                                        for (s, v) in sums.iter_mut().zip(&mut techniques.sample) {
+                                            s.add(*v);
+                                            *v = Rgb::ZERO;
+                                        }
+                                    }
                                 }
                                 out.push((film.index(x, y), sum, s1 - s0));
                             }
                         }
                         splats.flush();
+                        if LAYERS {
+                            techniques.flush();
+                        }
                         bad_splats.fetch_add(splats.bad, Ordering::Relaxed);
                         rays.fetch_add(tile_rays, Ordering::Relaxed);
                         ctx.progress.rays(tile_rays);
                         ctx.progress.advance(out.len() as u64 * (s1 - s0) as u64);
-                        out
+                        (out, layer_out)
                     })
                     .collect()
             })
         })?;
         ctx.timed("film accumulation", || {
-            for (i, sum, n) in results.into_iter().flatten() {
-                film.add_pixel(i, &sum, n);
+            for (out, layer_out) in results {
+                for (j, (i, sum, n)) in out.into_iter().enumerate() {
+                    film.add_pixel(i, &sum, n);
+                    if LAYERS {
+                        for (k, s) in layer_out[j * layers..(j + 1) * layers].iter().enumerate() {
+                            film.add_layer_pixel(k, i, s);
+                        }
+                    }
+                }
             }
         });
         done = s1;
@@ -271,6 +383,12 @@ where
         let buffer = splat_buffer.into_inner().unwrap_or_else(|e| e.into_inner());
         for (i, sum) in buffer.iter().enumerate() {
             film.add_splat(i, sum);
+        }
+        let buffer = layer_splats.into_inner().unwrap_or_else(|e| e.into_inner());
+        for (j, sum) in buffer.iter().enumerate() {
+            if *sum != RadianceSum::ZERO {
+                film.add_layer_splat(j / pixels, j % pixels, sum);
+            }
         }
     }
     film.rays = rays.load(Ordering::Relaxed);

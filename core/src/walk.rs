@@ -243,6 +243,11 @@ pub struct CameraPath {
     /// Radiance met along the way, weighted by the throughput: emission (the visible point's
     /// own included, E S* L paths) and what the media scattered towards the camera.
     pub emitted: Rgb,
+    /// `emitted`'s terms from the media alone (what they scattered towards the camera), and
+    /// the rest (emission, and the direct light of the glossy vertices followed), each summed
+    /// apart for `foton render --techniques`: `emitted` is their sum to float rounding.
+    pub in_scattered: Rgb,
+    pub emission: Rgb,
     /// None if the path left the scene, ended on a delta surface or at `max_depth` bounces.
     pub visible: Option<VisiblePoint>,
 }
@@ -311,6 +316,7 @@ pub fn walk_to_diffuse(
 ) -> CameraPath {
     let mut walk = RayWalk::camera(scene, ray);
     let mut emitted = Rgb::ZERO;
+    let (mut in_scattered, mut emission) = (Rgb::ZERO, Rgb::ZERO);
     let mut beta = Rgb::ONE;
     let mut bounces = 0u32;
     let mut distance = 0.0;
@@ -321,7 +327,9 @@ pub fn walk_to_diffuse(
     loop {
         let seg = walk.segment(scene, rays);
         if let Some(m) = seg.interacting_medium(scene) {
-            emitted += beta * in_medium(&seg, m, bounces, sampler, rays);
+            let scattered = beta * in_medium(&seg, m, bounces, sampler, rays);
+            emitted += scattered;
+            in_scattered += scattered;
             beta *= m.transmittance(&seg.start(), seg.length());
             if beta == Rgb::ZERO {
                 break;
@@ -333,7 +341,9 @@ pub fn walk_to_diffuse(
             {
                 let far = glossy_from.map(|(_, p)| p + seg.ray.dir);
                 let w = emission_weight(scene, glossy_from, light_id, far, Vec3::ZERO);
-                emitted += beta * le * w;
+                let e = beta * le * w;
+                emitted += e;
+                emission += e;
             }
             break;
         };
@@ -346,7 +356,9 @@ pub fn walk_to_diffuse(
         let wo = -seg.ray.dir;
         if let Some((light_id, _, le)) = seg.emitted(scene) {
             let w = emission_weight(scene, glossy_from, light_id, Some(hit.p), hit.ng);
-            emitted += beta * le * w;
+            let e = beta * le * w;
+            emitted += e;
+            emission += e;
         }
         if bounces >= how.max_depth {
             break;
@@ -359,7 +371,9 @@ pub fn walk_to_diffuse(
                 bsdf: &bsdf,
             };
             let mis = Mis::WithScatterSampling;
-            emitted += beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
+            let e = beta * estimate_direct(scene, at, wo, walk.medium, mis, sampler, rays);
+            emitted += e;
+            emission += e;
         }
         let p_delta = if glossy {
             0.0
@@ -388,6 +402,8 @@ pub fn walk_to_diffuse(
         };
         return CameraPath {
             emitted,
+            in_scattered,
+            emission,
             visible: Some(VisiblePoint {
                 hit,
                 bsdf,
@@ -402,6 +418,8 @@ pub fn walk_to_diffuse(
     }
     CameraPath {
         emitted,
+        in_scattered,
+        emission,
         visible: None,
     }
 }

@@ -87,6 +87,35 @@ def test_compare_report_in_a_browser(program, browser, tmp_path):
     assert not [e for e in browser.log() if e.get("level") in ("SEVERE", "WARNING")]
 
 
+def test_technique_layers_in_the_report(program, browser, tmp_path):
+    """`--techniques`: the page holds each technique's layer, as the EXR does, and they sum to
+    the image (up to the half floats the page stores)."""
+    scene = SCENES / "cornell-box.toml"
+    out, page = tmp_path / "t.png", tmp_path / "t.html"
+    run_program(
+        program, "compare", scene, "--integrators", "path,bdpt", "--spp", 2, "--techniques",
+        "--techniques-depth", 3, "-o", out, "--report", page, "-q", *as_sets(TINY),
+    )
+    browser.log()
+    browser.open(page)
+    assert browser.script("return window.fotonReport.layers('path')") == []
+    names = browser.script("return window.fotonReport.layers('bdpt')")
+    assert names[:3] == ["s0t2", "s1t1", "s0t3"] and names[-1] == "rest", names
+    image = foton.read(tmp_path / "t-bdpt.exr")
+    h, w, _ = image.shape
+    for x, y in [(w // 2, h // 2), (3, h - 4), (w // 3, h // 5)]:
+        layers = np.array(
+            [browser.script("return window.fotonReport.layerPixel('bdpt', arguments[0], arguments[1], arguments[2])", n, x, y) for n in names],
+            dtype=np.float64,
+        )
+        total = layers.sum(axis=0)
+        want = image[y, x].astype(np.float64)
+        # Each layer is rounded to a half float (relative 2^-11).
+        tolerance = np.abs(layers).sum(axis=0) * 2.0**-10 + 1e-6
+        assert np.all(np.abs(total - want) <= tolerance), (x, y, total, want)
+    assert not [e for e in browser.log() if e.get("level") in ("SEVERE", "WARNING")]
+
+
 def test_python_compare_writes_the_same_report(browser, tmp_path):
     rng = np.random.default_rng(1)
     reference = rng.random((12, 20, 3), dtype=np.float32) * 2

@@ -17,7 +17,7 @@ pub use metrics::{Errors, REL_EPSILON, difference_image, errors};
 
 use crate::TermProgress;
 use crate::common::{
-    INTERRUPTED, PluginArgs, Prepared, RunArgs, SceneFile, WarnOnce, parse_spp, render_prepared,
+    INTERRUPTED, PluginArgs, Prepared, RunArgs, SceneFile, WarnOnce, parse_spp, render_with,
     write_atomic,
 };
 use crate::montage::{Series, Tile, grid, log_log_plot, render_image};
@@ -27,7 +27,7 @@ use consistency::{Estimate, MIN_RENDERS, Pair, Renders, block_means, block_varia
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::film::{DisplayTransform, Film, check_output, check_writable, srgb_encode};
-use foton_core::integrator::{Work, peak_rss_bytes};
+use foton_core::integrator::{RenderContext, Work, peak_rss_bytes};
 use foton_core::props::unknown_value;
 use foton_core::sampling::{SamplerKind, splitmix64};
 use foton_loader::FilmFile;
@@ -77,6 +77,16 @@ pub(crate) struct CompareArgs {
     /// pair differs.
     #[arg(long, value_name = "N")]
     consistency: Option<u32>,
+    /// Keep each sampling technique's share of the image (as `foton render --techniques`) for
+    /// the integrators that combine techniques: layers in their EXRs and, with --report, a
+    /// grid of them per tab (bdpt's (s, t) strategies as Veach's pyramid). The others render
+    /// their image alone.
+    #[arg(long)]
+    techniques: bool,
+    /// With --techniques: the path length up to which each of bdpt's strategies has a layer
+    /// of its own; longer paths share one layer, `rest`.
+    #[arg(long, value_name = "N", default_value_t = 5, requires = "techniques")]
+    techniques_depth: u32,
     /// With --consistency and --reference: the reference's per-pixel standard errors (an image
     /// of its size, .exr); without, the reference is taken as exact.
     #[arg(long, value_name = "IMAGE")]
@@ -253,7 +263,12 @@ impl Session<'_> {
     /// printed with the integrator's name.
     fn render(&self, p: &Prepared, quiet: bool, err: &mut dyn Write) -> Result<(Film, Duration)> {
         let progress = TermProgress::new(quiet);
-        let result = render_prepared(p, self.threads, &progress);
+        let depth = self.a.techniques.then_some(self.a.techniques_depth);
+        let ctx = RenderContext {
+            techniques: depth.filter(|&d| !p.integrator.techniques(d).is_empty()),
+            ..RenderContext::new(self.threads, &INTERRUPTED, &progress)
+        };
+        let result = render_with(p, &ctx);
         for w in progress.take_warnings() {
             let _ = writeln!(err, "warning: {}: {w}", p.plugin.name);
         }
@@ -768,7 +783,9 @@ fn report_of(
             reference: false,
             pixels: e.film.pixels(),
             flip: e.flip_map.clone(),
-            layers: Vec::new(),
+            layers: (e.film.layers().iter().enumerate())
+                .map(|(k, l)| (l.name.clone(), e.film.layer_pixels(k)))
+                .collect(),
         })
         .collect();
     if let Some(pixels) = reference {

@@ -1,16 +1,18 @@
 //! `foton render`: one scene to one image, or with `--part I/N` to a part file for
 //! `foton merge`; a summary line of the work done, and what an interrupted render kept.
 
-use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_part, warn};
+use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_with, warn};
+use crate::montage::{Image, Tile, grid};
 use crate::{TermProgress, part};
 use clap::Args;
+use foton_core::Rgb;
 use foton_core::error::{Error, Result};
-use foton_core::film::{Film, ImageFormat, check_output, format_of};
-use foton_core::integrator::Part;
+use foton_core::film::{DisplayTransform, Film, ImageFormat, check_output, format_of};
+use foton_core::integrator::{Part, RenderContext};
 use foton_core::scene::Scene;
 use foton_loader::FilmFile;
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::Ordering;
 use std::time::Duration;
 
@@ -33,6 +35,22 @@ pub(crate) struct RenderArgs {
     /// output: <scene stem>-part-I-of-N.exr beside the scene.
     #[arg(long, value_name = "I/N", value_parser = part::parse_part)]
     part: Option<Part>,
+    /// Also write each sampling technique's share of the image into the EXR, one layer per
+    /// technique (channels <technique>.R, .G, .B), the layers summing to the image: bdpt's
+    /// (s, t) strategies (s<s>t<t>, rest), the terms of the other estimators that combine
+    /// techniques (docs/tools.md names them). EXR output only, not with --part; integrators
+    /// without techniques refuse it.
+    #[arg(long)]
+    techniques: bool,
+    /// With --techniques: the path length (edges, s + t - 1 in bdpt) up to which each
+    /// strategy has a layer of its own; longer paths share one layer, `rest`.
+    #[arg(long, value_name = "N", default_value_t = 5, requires = "techniques")]
+    techniques_depth: u32,
+    /// With --techniques: also write the layers as a labelled grid (.png through the scene's
+    /// display transform, or .exr), the image last; bdpt's strategies as Veach's pyramid (row
+    /// k = s + t - 1, column s).
+    #[arg(long, value_name = "FILE", requires = "techniques")]
+    techniques_grid: Option<PathBuf>,
 }
 
 pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
@@ -60,6 +78,29 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
             ));
         }
     }
+    let techniques = a.techniques.then_some(a.techniques_depth);
+    if let Some(depth) = techniques {
+        if a.part.is_some() {
+            return Err(Error::Usage(
+                "--techniques and --part: a part file holds the image's exact sums only, not the technique layers; render the techniques in one process".into(),
+            ));
+        }
+        if format_of(&output)? != ImageFormat::Exr {
+            return Err(Error::Usage(format!(
+                "--techniques writes the technique layers into an EXR: name the output .exr, not {}",
+                output.display()
+            )));
+        }
+        if let Some(grid) = &a.techniques_grid {
+            check_output(grid)?;
+        }
+        if p.integrator.techniques(depth).is_empty() {
+            return Err(Error::Usage(format!(
+                "--techniques: {} has no techniques to show (it is one estimator; docs/tools.md lists the integrators that have them)",
+                p.integrator.name()
+            )));
+        }
+    }
     warn(err, &p.warnings);
     let mut progress = TermProgress::new(a.run.quiet);
     if let Some(every) = a.checkpoint {
@@ -67,7 +108,22 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = a.run.threads();
-    let (film, elapsed) = render_part(&p, threads, &progress, a.part.unwrap_or(Part::WHOLE))?;
+    let ctx = RenderContext {
+        part: a.part.unwrap_or(Part::WHOLE),
+        techniques,
+        ..RenderContext::new(threads, &INTERRUPTED, &progress)
+    };
+    let (film, elapsed) = render_with(&p, &ctx)?;
+    if let Some(depth) = techniques {
+        let names: Vec<&str> = film.layers().iter().map(|l| l.name.as_str()).collect();
+        if names != p.integrator.techniques(depth) {
+            return Err(Error::Render(format!(
+                "--techniques: {} returned the layers [{}], not the ones it names",
+                p.integrator.name(),
+                names.join(", ")
+            )));
+        }
+    }
     if a.checkpoint.is_some() && progress.checkpoints.load(Ordering::Relaxed) == 0 {
         let _ = writeln!(
             err,
@@ -87,6 +143,9 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
         }
         None => {
             film.write(&output, &p.scene.film().display())?;
+            if let Some(grid) = &a.techniques_grid {
+                technique_grid(&film, &p.scene.film().display(), grid).write(grid)?;
+            }
             String::new()
         }
     };
@@ -109,6 +168,63 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
         return Ok(130);
     }
     Ok(0)
+}
+
+/// The technique layers of `film` as one labelled grid for `output`, each tile shown as
+/// `foton render` would write it (a PNG through `display`), the image (their sum) last. Layers
+/// named `s<s>t<t>` (bdpt's strategies) make Veach's pyramid: row k = s + t - 1 (the path
+/// length), column s, blank cells to the right; the other layers (`rest`) follow in one row.
+fn technique_grid(film: &Film, display: &DisplayTransform, output: &Path) -> Image {
+    let png = matches!(format_of(output), Ok(ImageFormat::Png));
+    let tile = |mut pixels: Vec<Rgb>, label: &str| {
+        if png {
+            pixels.iter_mut().for_each(|p| *p = display.map(*p));
+        }
+        Tile {
+            image: Image {
+                width: film.width,
+                height: film.height,
+                pixels,
+            },
+            label: vec![label.to_string()],
+        }
+    };
+    let blank = || Tile {
+        image: Image::new(film.width, film.height, Rgb::ZERO),
+        label: Vec::new(),
+    };
+    let strategy = |name: &str| -> Option<(u32, u32)> {
+        let (s, t) = name.strip_prefix('s')?.split_once('t')?;
+        Some((s.parse().ok()?, t.parse().ok()?))
+    };
+    let layers = film.layers();
+    let longest = (layers.iter())
+        .filter_map(|l| strategy(&l.name))
+        .map(|(s, t)| s + t - 1)
+        .max();
+    let mut tiles = Vec::new();
+    let columns = match longest {
+        Some(longest) => {
+            for k in 1..=longest {
+                for s in 0..=longest {
+                    let name = format!("s{s}t{}", (k + 1).saturating_sub(s));
+                    match layers.iter().position(|l| s <= k && l.name == name) {
+                        Some(i) => tiles.push(tile(film.layer_pixels(i), &name)),
+                        None => tiles.push(blank()),
+                    }
+                }
+            }
+            longest as usize + 1
+        }
+        None => layers.len() + 1,
+    };
+    for (i, layer) in layers.iter().enumerate() {
+        if strategy(&layer.name).is_none() {
+            tiles.push(tile(film.layer_pixels(i), &layer.name));
+        }
+    }
+    tiles.push(tile(film.pixels(), "image (the sum)"));
+    grid(&tiles, columns)
 }
 
 /// A rate with a unit prefix that keeps its digits: "1.27 M", "4.8 k" (a progressive render of

@@ -16,8 +16,73 @@ pub trait FilmFile {
 
 impl FilmFile for Film {
     fn write(&self, path: &Path, display: &DisplayTransform) -> Result<()> {
-        write_image(path, self.width, self.height, &self.pixels(), display)
+        if self.layers().is_empty() {
+            return write_image(path, self.width, self.height, &self.pixels(), display);
+        }
+        if format_of(path)? != ImageFormat::Exr {
+            return Err(Error::io(
+                path,
+                "the technique layers can only be written to an EXR: name the output .exr",
+            ));
+        }
+        let layers: Vec<(&str, Vec<Rgb>)> = (self.layers().iter().enumerate())
+            .map(|(k, l)| (l.name.as_str(), self.layer_pixels(k)))
+            .collect();
+        write_exr_layers(path, self.width, self.height, &self.pixels(), &layers)
     }
+}
+
+/// Writes linear RGB pixels as an EXR's R, G, B channels, and each of `layers` as channels
+/// `<name>.R`, `<name>.G`, `<name>.B` of the same image (the multi-layer convention of one
+/// EXR part, as renderers write their AOVs): float32, atomically.
+pub fn write_exr_layers(
+    path: &Path,
+    width: u32,
+    height: u32,
+    pixels: &[Rgb],
+    layers: &[(&str, Vec<Rgb>)],
+) -> Result<()> {
+    use exr::prelude::{
+        AnyChannel, AnyChannels, Encoding, FlatSamples, Image, Layer, LayerAttributes, SmallVec,
+        WritableImage,
+    };
+    let n = width as usize * height as usize;
+    if pixels.len() != n || layers.iter().any(|(_, p)| p.len() != n) {
+        return Err(Error::io(path, "pixel buffer has the wrong size"));
+    }
+    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::with_capacity(3 * (layers.len() + 1));
+    let mut push = |prefix: &str, pixels: &[Rgb]| {
+        for (c, name) in ["R", "G", "B"].iter().enumerate() {
+            let values = pixels.iter().map(|p| p[c]).collect();
+            channels.push(AnyChannel::new(
+                format!("{prefix}{name}").as_str(),
+                FlatSamples::F32(values),
+            ));
+        }
+    };
+    push("", pixels);
+    for (name, pixels) in layers {
+        push(&format!("{name}."), pixels);
+    }
+    let layer = Layer::new(
+        (width as usize, height as usize),
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        AnyChannels::sort(SmallVec::from_vec(channels)),
+    );
+    let file_name = path
+        .file_name()
+        .ok_or_else(|| Error::io(path, "not a file name"))?
+        .to_string_lossy();
+    let tmp = path.with_file_name(format!(".{file_name}.tmp-{}", std::process::id()));
+    if let Err(e) = Image::from_layer(layer).write().to_file(&tmp) {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(Error::io(path, e.to_string()));
+    }
+    std::fs::rename(&tmp, path).map_err(|e| {
+        let _ = std::fs::remove_file(&tmp);
+        Error::io(path, e)
+    })
 }
 
 /// Writes linear RGB pixels (row-major, top-left first): EXR as linear float32, unchanged
@@ -79,6 +144,32 @@ pub fn write_image(
         let _ = std::fs::remove_file(&tmp);
         Error::io(path, e)
     })
+}
+
+/// An image's channels by name, each its values row-major.
+pub type Channels = Vec<(String, Vec<f32>)>;
+
+/// Reads every float channel of an EXR's first image, by name (`R`, `G`, `B` and the technique
+/// layers' `<name>.R`...), in the file's (alphabetical) order; its width and height.
+pub fn read_exr_channels(path: &Path) -> Result<(u32, u32, Channels)> {
+    use exr::prelude::{FlatSamples, read_all_flat_layers_from_file};
+    let image = read_all_flat_layers_from_file(path).map_err(|e| Error::io(path, e.to_string()))?;
+    let layer = image
+        .layer_data
+        .first()
+        .ok_or_else(|| Error::io(path, "an EXR without any image"))?;
+    let channels = (layer.channel_data.list.iter())
+        .map(|c| {
+            let values = match &c.sample_data {
+                FlatSamples::F32(v) => v.clone(),
+                FlatSamples::F16(v) => v.iter().map(|x| x.to_f32()).collect(),
+                FlatSamples::U32(v) => v.iter().map(|&x| x as f32).collect(),
+            };
+            (c.name.to_string(), values)
+        })
+        .collect();
+    let (w, h) = (layer.size.0 as u32, layer.size.1 as u32);
+    Ok((w, h, channels))
 }
 
 /// Reads an image as linear RGB (EXR as stored; PNG decoded from sRGB).

@@ -187,6 +187,9 @@ impl Integrator for PanicGuard {
     fn bias(&self) -> Option<String> {
         catch("bias", || Ok(self.0.bias())).unwrap_or(None)
     }
+    fn techniques(&self, depth: u32) -> Vec<String> {
+        catch("techniques", || Ok(self.0.techniques(depth))).unwrap_or_default()
+    }
     fn describe(&self) -> String {
         catch("describe", || Ok(self.0.describe())).unwrap_or_else(|e| e.to_string())
     }

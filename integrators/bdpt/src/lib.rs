@@ -60,28 +60,130 @@
 //! camera sees through those). Refused with participating media (that connection would have to
 //! carry the media's transmittance past the emitters).
 //!
+//! `foton render --techniques` keeps each strategy's MIS-weighted share of the image as a layer
+//! named `s<s>t<t>` (the t = 1 ones from their splats), for the strategies of path length
+//! k = s + t - 1 (edges, Veach's convention: 1 is an emitter seen directly, 2 direct lighting)
+//! up to `--techniques-depth` N (default 5), and the longer ones pooled in one layer, `rest`
+//! (present when `max_depth + 1 > N`): Veach's pyramid of strategies, row k holding
+//! s = 0 ... k.
+//!
 //! The subpaths, the connections and their MIS quantities live in `foton-bidir`
 //! (integrators/bidir), which `vcm` shares: this crate reads the parameters and runs core's
 //! splatting pixel loop, one light subpath per camera sample.
 
 pub use foton_bidir::{Strategy, mis};
 
-use foton_bidir::Bidir;
+use foton_bidir::{Bidir, SplatSink};
 use foton_core::api::{
-    Error, Film, Integrator, Parameter, Properties, RenderContext, Result, Scene,
-    render_pixels_splatting,
+    Error, Film, Integrator, Parameter, Properties, RenderContext, Result, Rgb, Scene, Splats,
+    Techniques, render_pixels_splatting, render_pixels_techniques,
 };
 
 /// The plugin: foton-bidir's estimator with merging off, one light subpath per camera sample.
 pub struct Bdpt(pub Bidir);
 
+impl Bdpt {
+    /// The longest path length (s + t - 1) with a layer of its own under `--techniques-depth
+    /// depth`: no more than the longest path rendered (`max_depth + 1`).
+    fn layered_length(&self, depth: u32) -> u32 {
+        depth.min(self.0.max_depth.saturating_add(1))
+    }
+}
+
+/// The layer of strategy (s, t) when paths up to length `layered` have a layer per strategy:
+/// row k = s + t - 1 of the pyramid starts after the k - 1 rows above it (2 + 3 + ... + k
+/// strategies), and the longer paths share the layer after the last row (`rest`).
+#[inline]
+pub fn strategy_layer(s: u32, t: u32, layered: u32) -> usize {
+    let k = s + t - 1;
+    let row = k.min(layered + 1);
+    let start = (row as usize - 1) * (row as usize + 2) / 2;
+    if k <= layered {
+        start + s as usize
+    } else {
+        start
+    }
+}
+
+/// Where `--techniques` sends bdpt's contributions: every splat to the film's splats and its
+/// strategy's layer, every share of a camera sample to its strategy's layer.
+struct StrategyLayers<'a, 'b, 'c> {
+    splats: &'a mut Splats<'b>,
+    techniques: &'a mut Techniques<'c>,
+    layered: u32,
+    /// The last layer: `rest`, or without it the last strategy of row `layered` (where the
+    /// strategies past `max_depth`, all of weight zero, are sent).
+    last: usize,
+}
+
+impl StrategyLayers<'_, '_, '_> {
+    #[inline]
+    fn layer(&self, s: u32, t: u32) -> usize {
+        strategy_layer(s, t, self.layered).min(self.last)
+    }
+}
+
+impl SplatSink for StrategyLayers<'_, '_, '_> {
+    const SHARES: bool = true;
+
+    fn add(&mut self, x: u32, y: u32, value: Rgb) {
+        // Every splat of the estimator comes with its strategy (add_strategy).
+        self.splats.add(x, y, value);
+    }
+
+    fn add_strategy(&mut self, s: u32, x: u32, y: u32, value: Rgb) {
+        self.splats.add(x, y, value);
+        let k = self.layer(s, 1);
+        self.techniques.splat(k, x, y, value);
+    }
+
+    fn share(&mut self, s: u32, t: u32, value: Rgb) {
+        self.techniques.add(self.layer(s, t), value);
+    }
+}
+
 impl Integrator for Bdpt {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
         let light_media = scene.emission_media()?;
-        render_pixels_splatting(scene, ctx, |ps, sampler, splats, rays| {
-            self.0
-                .sample(scene, &light_media, ps, sampler, splats, rays)
-        })
+        let Some(depth) = ctx.techniques else {
+            return render_pixels_splatting(scene, ctx, |ps, sampler, splats, rays| {
+                self.0
+                    .sample(scene, &light_media, ps, sampler, splats, rays)
+            });
+        };
+        let layered = self.layered_length(depth);
+        let names = self.techniques(depth);
+        render_pixels_techniques(
+            scene,
+            ctx,
+            &names,
+            |ps, sampler, splats, techniques, rays| {
+                let mut layers = StrategyLayers {
+                    splats,
+                    techniques,
+                    layered,
+                    last: names.len() - 1,
+                };
+                self.0
+                    .sample(scene, &light_media, ps, sampler, &mut layers, rays)
+            },
+        )
+    }
+
+    /// `s<s>t<t>` for each strategy of path length s + t - 1 up to `depth`, row by row (s = 0
+    /// first), then `rest` if longer paths are rendered.
+    fn techniques(&self, depth: u32) -> Vec<String> {
+        let layered = self.layered_length(depth);
+        let mut names = Vec::new();
+        for k in 1..=layered {
+            for s in 0..=k {
+                names.push(format!("s{s}t{}", k + 1 - s));
+            }
+        }
+        if self.0.max_depth.saturating_add(1) > layered {
+            names.push("rest".into());
+        }
+        names
     }
 
     fn name(&self) -> &str {

@@ -53,7 +53,7 @@ impl Bidir {
                 let w = self.weight(s, 1, || {
                     weight_to_camera(&self.factors, &v.running, h * pdf_camera, pdf_rev)
                 });
-                splats.add(x, y, base * (h * w));
+                splats.add_strategy(s, x, y, base * (h * w));
             });
     }
 
@@ -103,7 +103,7 @@ impl Bidir {
                 let w = self.weight(1, 1, || {
                     weight_to_camera(&Factors::CONNECT, &running, h * pdf_camera, 0.0)
                 });
-                splats.add(x, y, base * (h * w));
+                splats.add_strategy(1, x, y, base * (h * w));
             });
     }
 

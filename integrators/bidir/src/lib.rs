@@ -52,10 +52,27 @@ pub struct Bidir {
 }
 
 /// Where the contributions of light paths connected to the camera (t = 1) go: the splatting
-/// film of core's pixel loop ([`Splats`]) or an integrator's own buffer.
+/// film of core's pixel loop ([`Splats`]) or an integrator's own buffer. With `foton render
+/// --techniques`, also where each strategy's share goes ([`SplatSink::add_strategy`],
+/// [`SplatSink::share`]); the defaults keep none (nothing is done for them in a plain render).
 pub trait SplatSink {
+    /// Whether the sink keeps the strategies' shares ([`SplatSink::share`]); false: the camera
+    /// subpath is traced without reporting them.
+    const SHARES: bool = false;
+
     /// Adds `value` to pixel (x, y).
     fn add(&mut self, x: u32, y: u32, value: Rgb);
+
+    /// Adds `value`, the (MIS-weighted) contribution of strategy (s, t = 1), to pixel (x, y).
+    #[inline(always)]
+    fn add_strategy(&mut self, _s: u32, x: u32, y: u32, value: Rgb) {
+        self.add(x, y, value)
+    }
+
+    /// Strategy (s, t)'s (t >= 2) MIS-weighted share of the camera sample's own estimate,
+    /// which [`Bidir::sample`] also adds to what it returns.
+    #[inline(always)]
+    fn share(&mut self, _s: u32, _t: u32, _value: Rgb) {}
 }
 
 impl SplatSink for Splats<'_> {
@@ -185,18 +202,24 @@ impl Bidir {
 
     /// One camera sample: its own estimate (strategies t >= 2); what its light path brings to
     /// the camera (t = 1) goes to `splats`. `light_media` is the medium each light emits into.
-    pub fn sample(
+    pub fn sample<S: SplatSink>(
         &self,
         scene: &Scene,
         light_media: &[Option<u32>],
         ps: &PixelSample,
         sampler: &mut Sampler,
-        splats: &mut impl SplatSink,
+        splats: &mut S,
         rays: &mut u64,
     ) -> Rgb {
         let cap = (self.max_depth as usize + 2).min(32);
         let mut camera = Vec::with_capacity(cap);
-        let mut radiance = self.camera_subpath(scene, ps, sampler, &mut camera, rays);
+        let mut radiance = if S::SHARES {
+            self.camera_subpath_with(scene, ps, sampler, &mut camera, rays, |t, value| {
+                splats.share(0, t, value)
+            })
+        } else {
+            self.camera_subpath(scene, ps, sampler, &mut camera, rays)
+        };
         let mut light = Vec::with_capacity(cap);
         let origin = self.light_subpath(scene, light_media, sampler, &mut light, rays);
 
@@ -210,9 +233,13 @@ impl Bidir {
 
         // ---- s >= 1, t >= 2: connections from each camera vertex ----
         for c in &camera {
-            radiance += self.direct(scene, c, sampler, rays);
+            let direct = self.direct(scene, c, sampler, rays);
+            splats.share(1, c.length + 1, direct);
+            radiance += direct;
             for v in &light {
-                radiance += self.connect(scene, c, v, rays);
+                let connected = self.connect(scene, c, v, rays);
+                splats.share(v.length + 1, c.length + 1, connected);
+                radiance += connected;
             }
         }
         radiance
@@ -227,6 +254,34 @@ impl Bidir {
         sampler: &mut Sampler,
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
+    ) -> Rgb {
+        self.camera_walk(scene, ps, sampler, vertices, rays, None)
+    }
+
+    /// [`Bidir::camera_subpath`] that also hands `emitted` each emitter's weighted
+    /// contribution as it is met, with its strategy's t (s = 0).
+    pub fn camera_subpath_with(
+        &self,
+        scene: &Scene,
+        ps: &PixelSample,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+        mut emitted: impl FnMut(u32, Rgb),
+    ) -> Rgb {
+        self.camera_walk(scene, ps, sampler, vertices, rays, Some(&mut emitted))
+    }
+
+    /// The camera subpath of [`Bidir::camera_subpath`], its emitter hits also handed to
+    /// `emitted` if there is one (once per hit: no cost per vertex without it).
+    fn camera_walk(
+        &self,
+        scene: &Scene,
+        ps: &PixelSample,
+        sampler: &mut Sampler,
+        vertices: &mut Vec<Vertex>,
+        rays: &mut u64,
+        emitted: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let margin = scene.film().filter.margin();
         let (_, pdf_we) = scene.camera().pdf_we(ps.ray.dir, margin);
@@ -250,6 +305,7 @@ impl Bidir {
             sampler,
             vertices,
             rays,
+            emitted,
         )
     }
 
@@ -307,6 +363,7 @@ impl Bidir {
             sampler,
             vertices,
             rays,
+            None,
         );
         origin
     }
@@ -314,7 +371,7 @@ impl Bidir {
     /// The random walk of a subpath (both sides): free flights through media, null boundaries
     /// crossed, BSDFs and phase functions sampled, Russian roulette; the connectable vertices
     /// go to `vertices` with their MIS quantities. A camera subpath also gathers the emission
-    /// it meets (s = 0), which it returns.
+    /// it meets (s = 0), which it returns, each term also handed to `on_emission` with its t.
     #[allow(clippy::too_many_arguments)]
     fn random_walk(
         &self,
@@ -327,6 +384,7 @@ impl Bidir {
         sampler: &mut Sampler,
         vertices: &mut Vec<Vertex>,
         rays: &mut u64,
+        mut on_emission: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let mode = match side {
             Side::Camera => TransportMode::Radiance,
@@ -420,7 +478,11 @@ impl Bidir {
                         let (pos, pdf_dir) = light.pdf_le(Vec3::ZERO, -dir);
                         weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
                     });
-                    radiance += beta * le * w;
+                    let value = beta * le * w;
+                    if let Some(f) = on_emission.as_mut() {
+                        f(t, value);
+                    }
+                    radiance += value;
                 }
                 break;
             };
@@ -451,7 +513,11 @@ impl Bidir {
                     };
                     weight_emitter_hit(&running, direct, pick * pos * pdf_dir)
                 });
-                radiance += beta * le * w;
+                let value = beta * le * w;
+                if let Some(f) = on_emission.as_mut() {
+                    f(length + 1, value);
+                }
+                radiance += value;
             }
             if side == Side::Camera && length > self.max_depth {
                 break;

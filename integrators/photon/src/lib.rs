@@ -67,6 +67,10 @@
 //! The method is consistent, not unbiased: estimates blur light over the radius r, which
 //! shrinks as photons grow. Caustics from point lights, which a path tracer cannot render,
 //! come out well.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission` (the camera walk's), `direct`, `caustic`, and `global` or,
+//! with `final_gather`, `final_gather`.
 
 use foton_core::api::{
     Bsdf, Budget, CameraWalk, Direct, Error, Film, Hit, Integrator, NormalizedKernel, Parameter,
@@ -74,7 +78,8 @@ use foton_core::api::{
     Vec3, Work, first_surface, offset_origin, trace_to_diffuse, with_pool,
 };
 use foton_photonmap::surface::{
-    SurfaceMaps, SurfaceParams, render_with_maps, surface_views, trace_surface_photons,
+    SurfaceMaps, SurfaceParams, render_with_maps, render_with_maps_techniques, surface_views,
+    trace_surface_photons,
 };
 
 pub struct PhotonMapper {
@@ -215,14 +220,30 @@ impl PhotonMapper {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
+        self.li_with(scene, maps, ray, sampler, rays, |_, _| {})
+    }
+
+    /// [`PhotonMapper::li`] that also hands `share` each term with its technique
+    /// (`EMISSION`, `DIRECT`, `CAUSTIC`, `GLOBAL` or `FINAL_GATHER`), weighted by the camera
+    /// path's throughput: their sum is the radiance returned, to float rounding.
+    pub fn li_with(
+        &self,
+        scene: &Scene,
+        maps: &SurfaceMaps,
+        ray: Ray,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+        mut share: impl FnMut(usize, Rgb),
+    ) -> Rgb {
         let path = trace_to_diffuse(scene, ray, self.camera, sampler, rays);
+        share(EMISSION, path.emitted);
         let Some(vp) = path.visible else {
             return path.emitted;
         };
         // Photons here may have taken the scattering events the camera path has left.
         let depth = self.max_depth - vp.bounces;
         let estimate = self.surface.estimate(&self.kernel);
-        let mut l = maps.reflected_at(
+        let [direct, caustic, global] = maps.reflected_parts(
             scene,
             &vp,
             &estimate,
@@ -232,6 +253,10 @@ impl PhotonMapper {
             sampler,
             rays,
         );
+        let mut l = direct;
+        l += caustic;
+        share(DIRECT, vp.beta * direct);
+        share(CAUSTIC, vp.beta * caustic);
         if self.final_gather {
             let vertex = Vertex {
                 hit: &vp.hit,
@@ -239,21 +264,60 @@ impl PhotonMapper {
                 wo: vp.wo,
                 bounces: vp.bounces,
             };
-            l += self.final_gather(scene, maps, &vertex, sampler, rays);
+            let gathered = self.final_gather(scene, maps, &vertex, sampler, rays);
+            l += gathered;
+            share(FINAL_GATHER, vp.beta * gathered);
+        } else {
+            l += global;
+            share(GLOBAL, vp.beta * global);
         }
         path.emitted + vp.beta * l
     }
 }
 
+/// The techniques of `foton render --techniques`, as layers: emission seen from the camera
+/// (directly or through mirrors and glass), direct light, the caustic map's estimate, and the
+/// global (indirect) map's estimate or, with `final_gather`, the gather's (the last layer).
+const EMISSION: usize = 0;
+const DIRECT: usize = 1;
+const CAUSTIC: usize = 2;
+const GLOBAL: usize = 3;
+const FINAL_GATHER: usize = 3;
+
 impl Integrator for PhotonMapper {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        render_with_maps(
+        let Some(depth) = ctx.techniques else {
+            return render_with_maps(
+                scene,
+                ctx,
+                &self.kernel,
+                || self.build_maps(scene, ctx),
+                |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+            );
+        };
+        render_with_maps_techniques(
             scene,
             ctx,
             &self.kernel,
+            &self.techniques(depth),
             || self.build_maps(scene, ctx),
-            |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+            |maps, ray, sampler, techniques, rays| {
+                self.li_with(scene, maps, ray, sampler, rays, |k, v| techniques.add(k, v))
+            },
         )
+    }
+
+    /// `emission`, `direct`, `caustic`, then `global` or (with `final_gather`)
+    /// `final_gather`.
+    fn techniques(&self, _depth: u32) -> Vec<String> {
+        let last = if self.final_gather {
+            "final_gather"
+        } else {
+            "global"
+        };
+        ["emission", "direct", "caustic", last]
+            .map(String::from)
+            .to_vec()
     }
 
     fn name(&self) -> &str {

@@ -15,8 +15,8 @@ use crate::map::{CLIP_PROBES, Disc, DiscClip, Estimate, Photon, PhotonMap};
 use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
 use foton_core::api::{
     Bsdf, Direct, Film, Hit, Mis, NormalizedKernel, Parameter, PhotonMapView, Properties, Ray,
-    RenderContext, Result, Rgb, Sampler, Scatter, Scene, Vec3, VisiblePoint, estimate_direct,
-    render_pixels,
+    RenderContext, Result, Rgb, Sampler, Scatter, Scene, Techniques, Vec3, VisiblePoint,
+    estimate_direct, render_pixels, render_pixels_techniques,
 };
 
 /// The photon budgets of the surface maps.
@@ -268,6 +268,32 @@ pub fn render_with_maps<M: Sync>(
     Ok(film)
 }
 
+/// [`render_with_maps`] that also keeps each technique's share of the image (`foton render
+/// --techniques`): `li` reports technique `k` (of `techniques`, the layers' names) to its
+/// [`Techniques`].
+pub fn render_with_maps_techniques<M: Sync>(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    kernel: &NormalizedKernel,
+    techniques: &[String],
+    build: impl FnOnce() -> Result<M>,
+    li: impl Fn(&M, Ray, &mut Sampler, &mut Techniques<'_>, &mut u64) -> Rgb + Sync,
+) -> Result<Film> {
+    let maps = build()?;
+    if ctx.cancelled() {
+        let mut film = Film::new(scene.film().width, scene.film().height);
+        for name in techniques {
+            film.add_layer(name);
+        }
+        return Ok(film);
+    }
+    let film = render_pixels_techniques(scene, ctx, techniques, |ps, sampler, _, t, rays| {
+        li(&maps, ps.ray, sampler, t, rays)
+    })?;
+    kernel.check_weights()?;
+    Ok(film)
+}
+
 /// An error if an estimate's `k` (parameter `key`) exceeds a photon budget it is drawn from:
 /// no estimate could ever find k photons, a mistake in the parameters. A map that merely
 /// stores fewer than k (a sparse caustic map) is no error: see [`SurfaceMaps::build`].
@@ -329,6 +355,30 @@ impl SurfaceMaps {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
+        let [d, c, i] =
+            self.reflected_parts(scene, vp, estimate, direct, depth, indirect, sampler, rays);
+        let mut l = d;
+        l += c;
+        if indirect {
+            l += i;
+        }
+        l
+    }
+
+    /// The three terms of [`SurfaceMaps::reflected_at`] apart: direct, caustic and indirect
+    /// (zero when `indirect` is false), each a technique of `foton render --techniques`.
+    #[allow(clippy::too_many_arguments)]
+    pub fn reflected_parts(
+        &self,
+        scene: &Scene,
+        vp: &VisiblePoint,
+        estimate: &Estimate<'_>,
+        direct: Direct,
+        depth: u32,
+        indirect: bool,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+    ) -> [Rgb; 3] {
         let (hit, bsdf, wo, n) = (&vp.hit, &vp.bsdf, vp.wo, vp.n);
         // The walls the estimates' discs may reach across, found once for the three maps.
         let clip = if depth > 0 {
@@ -338,18 +388,20 @@ impl SurfaceMaps {
             DiscClip::NONE
         };
         let disc = Disc::new(hit.p, n, depth).clipped(&clip);
-        let mut l = match (direct, &self.direct) {
+        let d = match (direct, &self.direct) {
             (Direct::Photons, Some(map)) => map.reflected(estimate, &disc, bsdf, wo),
             _ => {
                 let at = Scatter::Surface { hit, bsdf };
                 estimate_direct(scene, at, wo, vp.medium, Mis::LightOnly, sampler, rays)
             }
         };
-        l += self.caustic.reflected(estimate, &disc, bsdf, wo);
-        if indirect {
-            l += self.indirect.reflected(estimate, &disc, bsdf, wo);
-        }
-        l
+        let c = self.caustic.reflected(estimate, &disc, bsdf, wo);
+        let i = if indirect {
+            self.indirect.reflected(estimate, &disc, bsdf, wo)
+        } else {
+            Rgb::ZERO
+        };
+        [d, c, i]
     }
 
     /// Radiance reflected towards `wo` at `hit` by the photons of every map (direct, caustic

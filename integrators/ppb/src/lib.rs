@@ -95,6 +95,10 @@
 //! built in a fixed order; images are
 //! identical for any number of threads and any split into parts. Memory holds one pass's
 //! photons and beams at a time.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission`, `beam` (the photon beams in media), `direct` (shadow
+//! rays) and `surface` (the surface photons).
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Film, Integrator, Mis, NormalizedKernel, Parameter, PhotonMapView,
@@ -219,7 +223,10 @@ impl Ppb {
         })
     }
 
-    /// Pass `iteration`'s estimate of the radiance through pixel `pixel` at (x, y).
+    /// Pass `iteration`'s estimate of the radiance through pixel `pixel` at (x, y); `share`
+    /// gets each term with its technique (`EMISSION`, `BEAM`, `DIRECT`, `SURFACE`), weighted
+    /// by the camera path's throughput (their sum is the estimate, to float rounding).
+    #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
         scene: &Scene,
@@ -228,6 +235,7 @@ impl Ppb {
         (x, y): (u32, u32),
         rays: &mut u64,
         bad_photons: &mut u64,
+        mut share: impl FnMut(usize, Rgb),
     ) -> Rgb {
         let seed = scene.render().seed;
         let pixel = y as u64 * scene.film().width as u64 + x as u64;
@@ -291,6 +299,8 @@ impl Ppb {
             },
         );
         let mut l = path.emitted;
+        share(EMISSION, path.emission);
+        share(BEAM, path.in_scattered);
         if let Some(vp) = &path.visible {
             let mut lv = Rgb::ZERO;
             if self.direct == Direct::ShadowRays {
@@ -298,7 +308,7 @@ impl Ppb {
                     hit: &vp.hit,
                     bsdf: &vp.bsdf,
                 };
-                lv += estimate_direct(
+                let direct = estimate_direct(
                     scene,
                     at,
                     vp.wo,
@@ -307,6 +317,8 @@ impl Ppb {
                     &mut sampler,
                     rays,
                 );
+                lv += direct;
+                share(DIRECT, vp.beta * direct);
             }
             let r1 = match self.initial_radius {
                 Some(r) => r as f64,
@@ -320,7 +332,9 @@ impl Ppb {
                 gather_disc_clipped(&pass.surface, vp, r, depth, &self.kernel, &clip);
             *bad_photons += g.bad;
             let disc = std::f64::consts::PI * (r as f64) * (r as f64) * coverage as f64;
-            lv += (g.phi / disc).as_vec3();
+            let gathered = (g.phi / disc).as_vec3();
+            lv += gathered;
+            share(SURFACE, vp.beta * gathered);
             l += vp.beta * lv;
         }
         l
@@ -333,6 +347,8 @@ struct PpbPasses<'a> {
     ppb: &'a Ppb,
     scene: &'a Scene,
     sums: Vec<RadianceSum>,
+    /// With `--techniques`: per pixel, each technique's sum; empty otherwise.
+    layer_sums: Vec<[RadianceSum; 4]>,
     tally: &'a Tally,
 }
 
@@ -345,6 +361,9 @@ impl Passes for PpbPasses<'_> {
         }
         let width = scene.film().width as usize;
         let _camera = quiet.phase("camera pass");
+        if !self.layer_sums.is_empty() {
+            return self.pass_techniques(&pass, iteration, quiet);
+        }
         with_pool(quiet.threads, || {
             self.sums
                 .par_chunks_mut(width)
@@ -359,6 +378,7 @@ impl Passes for PpbPasses<'_> {
                             (x as u32, y as u32),
                             &mut row_rays,
                             &mut row_bad,
+                            |_, _| {},
                         );
                         if usable(l) {
                             sum.add(l);
@@ -391,9 +411,82 @@ impl Passes for PpbPasses<'_> {
         for (i, sum) in self.sums.iter().enumerate() {
             film.add_pixel(i, sum, count);
         }
+        if !self.layer_sums.is_empty() {
+            for name in TECHNIQUES {
+                film.add_layer(name);
+            }
+            for (i, sums) in self.layer_sums.iter().enumerate() {
+                for (k, s) in sums.iter().enumerate() {
+                    film.add_layer_pixel(k, i, s);
+                }
+            }
+        }
         film
     }
 }
+
+impl PpbPasses<'_> {
+    /// [`Passes::pass`]'s camera pass with `--techniques`: each pixel's estimate and its
+    /// techniques' shares (a sample that is not usable is dropped from both).
+    fn pass_techniques(
+        &mut self,
+        pass: &Pass,
+        iteration: u64,
+        quiet: &RenderContext<'_>,
+    ) -> Result<Option<String>> {
+        let (ppb, scene, tally) = (self.ppb, self.scene, self.tally);
+        let width = scene.film().width as usize;
+        with_pool(quiet.threads, || {
+            self.sums
+                .par_chunks_mut(width)
+                .zip(self.layer_sums.par_chunks_mut(width))
+                .enumerate()
+                .for_each(|(y, (row, layer_row))| {
+                    let (mut row_rays, mut row_bad, mut row_unusable) = (0u64, 0u64, 0u64);
+                    for (x, (sum, layers)) in row.iter_mut().zip(layer_row).enumerate() {
+                        let mut shares = [Rgb::ZERO; 4];
+                        let l = ppb.estimate(
+                            scene,
+                            pass,
+                            iteration,
+                            (x as u32, y as u32),
+                            &mut row_rays,
+                            &mut row_bad,
+                            |k, v| shares[k] += v,
+                        );
+                        if usable(l) {
+                            sum.add(l);
+                            for (layer, v) in layers.iter_mut().zip(shares) {
+                                layer.add(v);
+                            }
+                        } else {
+                            row_unusable += 1;
+                        }
+                    }
+                    Tally::add(&tally.rays, row_rays);
+                    Tally::add(&tally.bad_photons, row_bad);
+                    Tally::add(&tally.bad_samples, row_unusable);
+                })
+        })?;
+        let photons = (iteration + 1) * ppb.passes.photons_per_iteration;
+        Ok(Some(format!(
+            "iteration {}, {photons} photons, {} beams of width {:.5}",
+            iteration + 1,
+            pass.beams.len(),
+            pass.beams.radius()
+        )))
+    }
+}
+
+/// The layers of `foton render --techniques`: emission met by the camera walk (and the direct
+/// light of the glossy vertices it follows), the photon beams' estimate along the camera
+/// rays through media, direct light by shadow rays at the visible surface point, and the
+/// surface photons' estimate there.
+const TECHNIQUES: [&str; 4] = ["emission", "beam", "direct", "surface"];
+const EMISSION: usize = 0;
+const BEAM: usize = 1;
+const DIRECT: usize = 2;
+const SURFACE: usize = 3;
 
 impl Integrator for Ppb {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
@@ -402,6 +495,10 @@ impl Integrator for Ppb {
             ppb: self,
             scene,
             sums: per_pixel(scene),
+            layer_sums: match ctx.techniques {
+                Some(_) => per_pixel(scene),
+                None => Vec::new(),
+            },
             tally: &tally,
         };
         // Passes are independent (r_1 from each pass's own visible point): any split works.
@@ -419,6 +516,12 @@ impl Integrator for Ppb {
 
     fn name(&self) -> &str {
         "ppb"
+    }
+
+    /// `emission`, `beam` (the photon beams in media), `direct` (shadow rays at the visible
+    /// surface point; black with `direct = "photons"`) and `surface` (the surface photons).
+    fn techniques(&self, _depth: u32) -> Vec<String> {
+        TECHNIQUES.map(String::from).to_vec()
     }
 
     fn parameters(&self) -> Vec<Parameter> {

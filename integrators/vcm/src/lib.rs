@@ -62,6 +62,10 @@
 //! `hide_emitters` as `bdpt` (camera rays pass through emitters until they first scatter, and
 //! so do light vertices' connections to the camera). **Not supported**, refused with an error:
 //! participating media (`bdpt` and `vpm` render them).
+//!
+//! `foton render --techniques` keeps the estimator's four techniques apart as layers of the
+//! film (docs/tools.md), summing to the image: `connection` (s >= 1, t >= 2), `merging`,
+//! `emission` (s = 0) and `light_tracing` (t = 1, the splats), each MIS-weighted.
 
 pub mod grid;
 
@@ -207,9 +211,20 @@ impl SplatSink for RowSplats {
     }
 }
 
+/// The layers of `foton render --techniques`, in the order of [`Integrator::techniques`]:
+/// the first three are a camera sample's shares, the last the splats.
+const TECHNIQUES: [&str; 4] = ["connection", "merging", "emission", "light_tracing"];
+const CONNECTION: usize = 0;
+const MERGING: usize = 1;
+const EMISSION: usize = 2;
+const LIGHT_TRACING: usize = 3;
+
 /// What one row of the camera pass gives back.
 struct Row {
     sums: Vec<RadianceSum>,
+    /// With `--techniques`: per pixel, the sums of its connections, merges and emission
+    /// (`CONNECTION`, `MERGING`, `EMISSION`); empty otherwise.
+    layer_sums: Vec<[RadianceSum; 3]>,
     splats: RowSplats,
     rays: u64,
     bad: u64,
@@ -322,8 +337,9 @@ impl Vcm {
     }
 
     /// The camera pass: every pixel's camera subpath, its connections with its own light
-    /// subpath (whose t = 1 splats it also makes) and its merges.
-    fn camera_pass(
+    /// subpath (whose t = 1 splats it also makes) and its merges. `LAYERS`: each row also
+    /// keeps its pixels' techniques apart (`--techniques`).
+    fn camera_pass<const LAYERS: bool>(
         &self,
         scene: &Scene,
         bidir: &Bidir,
@@ -340,6 +356,7 @@ impl Vcm {
         let light_paths = width as f32 * height as f32;
         rows.resize_with(height as usize, || Row {
             sums: Vec::with_capacity(width as usize),
+            layer_sums: Vec::new(),
             splats: RowSplats {
                 bands: Vec::new(),
                 band_rows,
@@ -353,6 +370,7 @@ impl Vcm {
         rows.par_iter_mut().enumerate().for_each(|(y, row)| {
             let y = y as u32;
             row.sums.clear();
+            row.layer_sums.clear();
             row.splats.reset(height, band_rows);
             row.rays = 0;
             row.bad = 0;
@@ -371,6 +389,8 @@ impl Vcm {
                     }
                 }
                 let mut l = Rgb::ZERO;
+                // The techniques' shares of l (LAYERS only).
+                let mut shares = [Rgb::ZERO; 3];
                 if self.mode != Mode::Lt {
                     let at = filter.film_position(x, y, sampler.next_2d());
                     let ps = PixelSample {
@@ -382,27 +402,50 @@ impl Vcm {
                     };
                     camera.clear();
                     l = bidir.camera_subpath(scene, &ps, &mut sampler, &mut camera, rays);
+                    if LAYERS {
+                        shares[EMISSION] = l;
+                    }
                     for c in &camera {
                         if self.mode.connects() {
                             // ---- s >= 1, t >= 2: connections ----
-                            l += bidir.direct(scene, c, &mut sampler, rays);
+                            let direct = bidir.direct(scene, c, &mut sampler, rays);
+                            l += direct;
+                            if LAYERS {
+                                shares[CONNECTION] += direct;
+                            }
                             for v in lights.of(pixel) {
-                                l += bidir.connect(scene, c, v, rays);
+                                let connected = bidir.connect(scene, c, v, rays);
+                                l += connected;
+                                if LAYERS {
+                                    shares[CONNECTION] += connected;
+                                }
                             }
                         }
                         if let Some(grid) = grid {
                             // ---- merges ----
-                            l += self.merge(bidir, c, &lights.vertices, grid) / light_paths;
+                            let merged = self.merge(bidir, c, &lights.vertices, grid) / light_paths;
+                            l += merged;
+                            if LAYERS {
+                                shares[MERGING] += merged;
+                            }
                         }
                     }
                 }
                 if !usable(l) {
                     row.bad += 1;
                     l = Rgb::ZERO;
+                    shares = [Rgb::ZERO; 3];
                 }
                 let mut sum = RadianceSum::ZERO;
                 sum.add(l);
                 row.sums.push(sum);
+                if LAYERS {
+                    row.layer_sums.push(shares.map(|v| {
+                        let mut sum = RadianceSum::ZERO;
+                        sum.add(v);
+                        sum
+                    }));
+                }
             }
             row.camera = camera;
         });
@@ -463,6 +506,9 @@ struct VcmPasses<'a> {
     /// first splat), and the passes added.
     sums: Vec<RadianceSum>,
     splats: Vec<RadianceSum>,
+    /// With `--techniques`: per pixel, the sums of its connections, merges and emission
+    /// (`CONNECTION`, `MERGING`, `EMISSION`); empty otherwise. Light tracing is the splats.
+    layer_sums: Vec<[RadianceSum; 3]>,
     passes: u32,
     tally: Tally,
     /// Memory kept from one iteration to the next.
@@ -486,6 +532,7 @@ impl Passes for VcmPasses<'_> {
         let (vcm, scene) = (self.vcm, self.scene);
         let (bidir, radius) = vcm.estimator(scene, iteration + 1);
         let media = &self.media;
+        let layers = !self.layer_sums.is_empty();
         let b = &mut self.buffers;
         let mut rays = with_pool(quiet.threads, || {
             let light_rays = quiet.timed("light tracing", || {
@@ -507,7 +554,11 @@ impl Passes for VcmPasses<'_> {
             }
             let grid = merges.then_some(&b.grid);
             quiet.timed("camera pass", || {
-                vcm.camera_pass(scene, &bidir, &b.lights, grid, iteration, &mut b.rows)
+                if layers {
+                    vcm.camera_pass::<true>(scene, &bidir, &b.lights, grid, iteration, &mut b.rows)
+                } else {
+                    vcm.camera_pass::<false>(scene, &bidir, &b.lights, grid, iteration, &mut b.rows)
+                }
             });
             light_rays
         })?;
@@ -552,6 +603,15 @@ impl Passes for VcmPasses<'_> {
                 },
             )
         })?;
+        if layers {
+            for (dst, row) in self.layer_sums.chunks_mut(width).zip(rows) {
+                for (d, s) in dst.iter_mut().zip(&row.layer_sums) {
+                    for (d, s) in d.iter_mut().zip(s) {
+                        d.merge(s);
+                    }
+                }
+            }
+        }
         self.passes += 1;
         for row in rows {
             rays += row.rays;
@@ -570,14 +630,29 @@ impl Passes for VcmPasses<'_> {
     /// by the samples taken.
     fn film(&self, _passes: u64) -> Film {
         let (width, height) = (self.scene.film().width, self.scene.film().height);
-        Film::from_sums(
+        let mut film = Film::from_sums(
             width,
             height,
             self.sums.clone(),
             vec![self.passes; self.sums.len()],
             self.splats.clone(),
         )
-        .expect("sums of the film's size")
+        .expect("sums of the film's size");
+        if !self.layer_sums.is_empty() {
+            for name in TECHNIQUES {
+                film.add_layer(name);
+            }
+            for (i, sums) in self.layer_sums.iter().enumerate() {
+                for (k, s) in sums.iter().enumerate() {
+                    film.add_layer_pixel(k, i, s);
+                }
+            }
+            // Every splat is a light vertex connected to the camera (t = 1).
+            for (i, s) in self.splats.iter().enumerate() {
+                film.add_layer_splat(LIGHT_TRACING, i, s);
+            }
+        }
+        film
     }
 
     fn tally(&self) -> &Tally {
@@ -596,6 +671,13 @@ impl Integrator for Vcm {
                 scene.film().width as usize * scene.film().height as usize
             ],
             splats: Vec::new(),
+            layer_sums: match ctx.techniques {
+                Some(_) => {
+                    let pixels = scene.film().width as usize * scene.film().height as usize;
+                    vec![[RadianceSum::ZERO; 3]; pixels]
+                }
+                None => Vec::new(),
+            },
             passes: 0,
             tally: Tally::default(),
             buffers: Buffers {
@@ -619,6 +701,13 @@ impl Integrator for Vcm {
 
     fn name(&self) -> &str {
         "vcm"
+    }
+
+    /// `connection` (s >= 1, t >= 2: next-event estimation and connections), `merging`
+    /// (vertex merging), `emission` (camera paths reaching emitters, s = 0) and
+    /// `light_tracing` (light vertices connected to the camera, t = 1: the splats).
+    fn techniques(&self, _depth: u32) -> Vec<String> {
+        TECHNIQUES.map(String::from).to_vec()
     }
 
     fn parameters(&self) -> Vec<Parameter> {

@@ -114,6 +114,10 @@
 //!   `MAX_NULL_CROSSINGS` crossings in a row, past which a ray is ended and carries nothing),
 //!   the direct light and every medium query (`dyn Medium`) are core's, shared with `path`,
 //!   `photon` and `sppm`; the gap after a crossing is sampled, as `path` samples it.
+//!
+//! `foton render --techniques` keeps the terms apart as layers of the film (docs/tools.md),
+//! summing to the image: `emission`, `direct`, `caustic`, `global` (as `photon`'s), and the
+//! media's in-scattered radiance, `volume_point` (photon points) or `beam` (photon beams).
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Film, Integrator, Medium, Mis, NormalizedKernel, Parameter,
@@ -126,7 +130,7 @@ use foton_photonmap::beams::{
 use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
 use foton_photonmap::surface::{
     SurfaceDefaults, SurfaceMaps, SurfaceParams, check_k, diagonal, read_k, read_positive,
-    render_with_maps, surface_views, trace_surface_photons,
+    render_with_maps, render_with_maps_techniques, surface_views, trace_surface_photons,
 };
 use foton_photonmap::trace::{
     PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons_and_beams,
@@ -429,6 +433,21 @@ impl Vpm {
         sampler: &mut Sampler,
         rays: &mut u64,
     ) -> Rgb {
+        self.li_with(scene, maps, ray, sampler, rays, |_, _| {})
+    }
+
+    /// [`Vpm::li`] that also hands `share` each term with its technique (`EMISSION`,
+    /// `DIRECT`, `CAUSTIC`, `GLOBAL`, `VOLUME`), weighted by the camera path's throughput:
+    /// their sum is the radiance returned, to float rounding.
+    pub fn li_with(
+        &self,
+        scene: &Scene,
+        maps: &Maps,
+        ray: Ray,
+        sampler: &mut Sampler,
+        rays: &mut u64,
+        mut share: impl FnMut(usize, Rgb),
+    ) -> Rgb {
         let path = walk_to_diffuse(
             scene,
             ray,
@@ -439,12 +458,14 @@ impl Vpm {
                 self.in_medium(scene, maps, seg, m, bounces, sampler, rays)
             },
         );
+        share(EMISSION, path.emission);
+        share(VOLUME, path.in_scattered);
         let Some(vp) = path.visible else {
             return path.emitted;
         };
         let depth = self.max_depth - vp.bounces;
         let estimate = self.surface.estimate(&self.kernel);
-        let l = maps.surface.reflected_at(
+        let [direct, caustic, global] = maps.surface.reflected_parts(
             scene,
             &vp,
             &estimate,
@@ -454,19 +475,50 @@ impl Vpm {
             sampler,
             rays,
         );
+        share(DIRECT, vp.beta * direct);
+        share(CAUSTIC, vp.beta * caustic);
+        share(GLOBAL, vp.beta * global);
+        let mut l = direct;
+        l += caustic;
+        l += global;
         path.emitted + vp.beta * l
     }
 }
 
 impl Integrator for Vpm {
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
-        render_with_maps(
+        let Some(depth) = ctx.techniques else {
+            return render_with_maps(
+                scene,
+                ctx,
+                &self.kernel,
+                || self.build_maps(scene, ctx),
+                |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+            );
+        };
+        render_with_maps_techniques(
             scene,
             ctx,
             &self.kernel,
+            &self.techniques(depth),
             || self.build_maps(scene, ctx),
-            |maps, ray, sampler, rays| self.li(scene, maps, ray, sampler, rays),
+            |maps, ray, sampler, techniques, rays| {
+                self.li_with(scene, maps, ray, sampler, rays, |k, v| techniques.add(k, v))
+            },
         )
+    }
+
+    /// `emission`, `direct`, `caustic`, `global` (the surface estimates at the visible
+    /// point), then the media's in-scattered radiance: `volume_point` (photon points:
+    /// `estimate = "march"` or `"beam"`) or `beam` (photon beams, `estimate = "beams"`).
+    fn techniques(&self, _depth: u32) -> Vec<String> {
+        let volume = match self.estimate {
+            VolumeEstimate::Beams => "beam",
+            VolumeEstimate::March | VolumeEstimate::Beam => "volume_point",
+        };
+        ["emission", "direct", "caustic", "global", volume]
+            .map(String::from)
+            .to_vec()
     }
 
     fn name(&self) -> &str {
@@ -555,6 +607,13 @@ pub const BEAM_VOLUME_PHOTONS: u64 = 200_000;
 /// jitter averages neighbouring estimates (a 16x16 block's error is set by the photons in
 /// it, not by k) and a small k keeps the radius, and its bias at edges, small.
 pub const DEFAULT_K: u32 = 8;
+
+/// The layers of `foton render --techniques`, in the order of `techniques`.
+const EMISSION: usize = 0;
+const DIRECT: usize = 1;
+const CAUSTIC: usize = 2;
+const GLOBAL: usize = 3;
+const VOLUME: usize = 4;
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {

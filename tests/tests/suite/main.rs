@@ -63,6 +63,7 @@ mod spectra;
 mod sphere_light;
 mod spot;
 mod sppm;
+mod techniques;
 mod textures;
 mod thin_dielectric;
 mod tonemap;
