@@ -21,6 +21,7 @@ pub mod image;
 mod load;
 pub mod mesh;
 pub mod mitsuba;
+pub mod pbrt;
 pub mod reader;
 pub mod texture;
 
