@@ -139,6 +139,8 @@ struct Reader {
     /// `ObjectBegin` blocks: their names and shapes; the one being read.
     objects: HashMap<String, Vec<Recorded>>,
     object: Option<(String, Vec<Recorded>)>,
+    /// Whether the note on plymesh orientation was given (once a scene).
+    ply_noted: bool,
 }
 
 impl Reader {
@@ -170,6 +172,7 @@ impl Reader {
             filter: None,
             objects: HashMap::new(),
             object: None,
+            ply_noted: false,
         }
     }
 
@@ -365,9 +368,8 @@ impl Reader {
             }
             "Material" => {
                 let name = self.new_name("material");
-                if self.material(d, &name)? {
-                    self.state.material = Some(name);
-                }
+                // Left out (lenient): pbrt-v4's default material stands in.
+                self.state.material = self.material(d, &name)?.then_some(name);
             }
             "MakeNamedMaterial" => {
                 let pbrt_name = d.string(0).to_string();
@@ -503,7 +505,7 @@ impl Reader {
     }
 
     /// The material of a shape: the current one, or pbrt-v4's default (diffuse 0.5).
-    fn current_material(&mut self, state: &State, loc: &Loc) -> String {
+    fn current_material(&mut self, state: &State) -> String {
         if let Some(m) = &state.material {
             return m.clone();
         }
@@ -527,7 +529,6 @@ impl Reader {
                 },
             );
         }
-        let _ = loc;
         "default".into()
     }
 

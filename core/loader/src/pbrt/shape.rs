@@ -115,7 +115,10 @@ impl Reader {
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.push(("file", self.string(&rel.to_string_lossy(), &l)));
                 entries.push(("transform", self.matrix(m, &loc)));
-                self.note(&loc, &what, "triangles keep their winding's side; pbrt-v4 turns a triangle with vertex normals towards them (the same for consistently oriented meshes)");
+                if !self.ply_noted {
+                    self.ply_noted = true;
+                    self.note(&loc, &what, "a PLY mesh's triangles keep their winding's side; pbrt-v4 turns a triangle with vertex normals towards them (the same for consistently oriented meshes)");
+                }
             }
             other @ ("bilinearmesh" | "cylinder" | "loopsubdiv" | "curve") => {
                 return self.unsupported(
@@ -147,7 +150,7 @@ impl Reader {
         {
             entries.push(("emission", self.vec3(emission, &light.loc)));
         }
-        let material = self.current_material(state, &loc);
+        let material = self.current_material(state);
         entries.push(("material", self.string(&material, &loc)));
         let shape = self.table(entries, &loc);
         self.shapes.push(shape);
