@@ -340,3 +340,33 @@ fn object_instances_are_copies_under_the_instance_transform() {
     assert_eq!(shapes.len(), 1);
     assert!(close(&nums(&t, "shapes.0.center"), &[1.0, 5.0, 0.0]));
 }
+
+#[test]
+fn plymesh_reads_ply_and_ply_gz_and_inline_meshes_build() {
+    use std::io::Write;
+    let dir = std::env::temp_dir().join(format!("foton-pbrt-ply-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+               element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    std::fs::write(dir.join("tri.ply"), ply).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(ply.as_bytes()).unwrap();
+    std::fs::write(dir.join("tri.ply.gz"), gz.finish().unwrap()).unwrap();
+    let scene = dir.join("scene.pbrt");
+    std::fs::write(
+        &scene,
+        "WorldBegin\nLightSource \"point\" \"point3 from\" [0 0 3]\n\
+         Translate 0 0 2\nShape \"plymesh\" \"string filename\" \"tri.ply\"\n\
+         Translate 0 0 2\nShape \"plymesh\" \"string filename\" \"tri.ply.gz\"\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0 3 0 0 0 3 0] \"integer indices\" [0 1 2]\n",
+    )
+    .unwrap();
+    let built = crate::load_with(&scene, &[], &[], false).unwrap_or_else(|e| panic!("{e}"));
+    let (lo, hi) = built.bounds();
+    std::fs::remove_dir_all(&dir).ok();
+    // The bounds are padded a little; the .ply at z = 2, the .ply.gz and the inline mesh
+    // (its 3 x 3 triangle) at z = 4.
+    let near = |a: f32, b: f32| (a - b).abs() < 1e-3;
+    assert!(near(lo.z, 2.0) && near(hi.z, 4.0), "{lo} {hi}");
+    assert!(near(hi.x, 3.0) && near(hi.y, 3.0), "{lo} {hi}");
+}
