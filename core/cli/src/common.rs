@@ -42,7 +42,7 @@ pub(crate) struct PluginArgs {
 /// The scene file and how to read a Mitsuba one.
 #[derive(Args, Clone, Default)]
 pub(crate) struct SceneFile {
-    /// The scene file (TOML, or a Mitsuba scene: .xml, version 3 or 0.4 to 0.6).
+    /// The scene file (TOML, a Mitsuba scene: .xml, version 3 or 0.4 to 0.6, or a pbrt-v4 scene: .pbrt).
     pub scene: PathBuf,
     /// NAME=VALUE: set a Mitsuba XML scene's <default name="NAME"> (Mitsuba's -D;
     /// repeatable).

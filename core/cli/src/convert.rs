@@ -1,5 +1,6 @@
-//! `foton convert`: a Mitsuba XML scene written as the equivalent TOML scene (the same image
-//! for the same seed), checked to load from where it is written before it is written.
+//! `foton convert`: a Mitsuba XML or pbrt-v4 scene written as the equivalent TOML scene (the
+//! same image for the same seed), checked to load from where it is written before it is
+//! written.
 
 use crate::common::{warn, write_atomic};
 use clap::Args;
@@ -10,7 +11,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(Args)]
 pub(crate) struct ConvertArgs {
-    /// The Mitsuba scene (.xml, version 3 or 0.4 to 0.6).
+    /// The Mitsuba scene (.xml, version 3 or 0.4 to 0.6) or pbrt-v4 scene (.pbrt).
     scene: PathBuf,
     /// The TOML scene to write; default: <scene stem>.toml beside the scene.
     #[arg(short, long)]
@@ -37,7 +38,19 @@ pub(crate) fn run(a: ConvertArgs, out: &mut dyn Write, err: &mut dyn Write) -> R
             output.display()
         )));
     }
-    let (mut doc, report) = foton_loader::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?;
+    let is_pbrt = a
+        .scene
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pbrt"));
+    let (mut doc, report) = if is_pbrt {
+        let options = foton_loader::reader::Options {
+            defines: &a.defines,
+            lenient: a.lenient,
+        };
+        foton_loader::pbrt::read(&a.scene, &options)?
+    } else {
+        foton_loader::mitsuba::read_xml(&a.scene, &a.defines, a.lenient)?
+    };
     if a.strict
         && let Some(w) = report.warnings.first()
     {

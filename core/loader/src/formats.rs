@@ -24,6 +24,10 @@ pub static FORMATS: &[Format] = &[
         extensions: &["xml"],
         read: crate::mitsuba::read,
     },
+    Format {
+        extensions: &["pbrt"],
+        read: crate::pbrt::read,
+    },
 ];
 
 /// The format of the scene file `path`, by its extension.

@@ -8,8 +8,9 @@
 //!
 //! [`load`] is three steps. A format's reader ([`reader`]; chosen by the file's extension, [`formats`])
 //! reads the file into core's `Document`, a tree of values each with its file and line:
-//! TOML ([`document`]: TOML text into the `Document`, `--set`) or Mitsuba XML ([`mitsuba`]:
-//! Mitsuba 3 and 0.4 to 0.6, read as the TOML document it stands for). `--set` overrides
+//! TOML ([`document`]: TOML text into the `Document`, `--set`), Mitsuba XML ([`mitsuba`]:
+//! Mitsuba 3 and 0.4 to 0.6) or pbrt-v4 ([`pbrt`]), each read as the TOML document it stands
+//! for. `--set` overrides
 //! change the document. The builder ([`from_document`]) turns any document into the `Scene`,
 //! reading meshes ([`mesh`]: OBJ and [`ply`]) and images ([`texture`]: texture tables and
 //! bitmaps; [`image`]: image files read and written).
@@ -21,6 +22,7 @@ pub mod image;
 mod load;
 pub mod mesh;
 pub mod mitsuba;
+pub mod pbrt;
 pub mod reader;
 pub mod texture;
 

@@ -5,8 +5,9 @@
 //! so its errors name the line of whatever file the value came from. A file's format is
 //! chosen by its extension ([`crate::formats`]).
 //!
-//! The formats: TOML ([`crate::document::read`], docs/scene-format.md) and Mitsuba XML
-//! ([`crate::mitsuba::read`], read as the TOML document it stands for). A new format is a
+//! The formats: TOML ([`crate::document::read`], docs/scene-format.md), Mitsuba XML
+//! ([`crate::mitsuba::read`]) and pbrt-v4 ([`crate::pbrt::read`], docs/pbrt.md), each read as
+//! the TOML document it stands for. A new format is a
 //! module with a [`ReadFn`] that reads a file into the document a TOML scene of the same
 //! content would parse to, and one entry in [`crate::formats::FORMATS`]; nothing after the
 //! document changes. This module names only what they share, so that the formats and the

@@ -44,6 +44,7 @@ mod mitsuba_materials;
 mod mitsuba_shapes;
 mod one_sided;
 mod parts;
+mod pbrt;
 mod photon;
 mod photon_coats;
 mod physics;

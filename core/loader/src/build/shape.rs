@@ -5,7 +5,7 @@ use super::common::{
     Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined,
 };
 use super::medium::medium_ref;
-use crate::mesh::{MeshOptions, load_mesh};
+use crate::mesh::{MeshOptions, inline_mesh, load_mesh};
 use foton_core::error::Result;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
 use foton_core::light::area_light;
@@ -79,16 +79,22 @@ pub(super) fn read_shapes(
                 vec![Shape::disk(center, u, v)]
             }
             "mesh" => {
-                let file = s.string_required("file")?;
                 let transform = read_transform(&s, ld)?;
                 let options = MeshOptions {
                     face_normals: s.bool("face_normals", false)?,
                     flip_tex_coords: s.bool("flip_tex_coords", true)?,
                     flip_normals: flip,
                 };
-                let path = ld.dir.join(file);
-                let mesh = load_mesh(&s, &path, transform, options)?;
-                ld.sources.push(path);
+                // The triangles written in the scene (a pbrt-v4 trianglemesh), or a file.
+                let mesh = if s.has("positions") && !s.has("file") {
+                    inline_mesh(&s, transform, options)?
+                } else {
+                    let file = s.string_required("file")?;
+                    let path = ld.dir.join(file);
+                    let mesh = load_mesh(&s, &path, transform, options)?;
+                    ld.sources.push(path);
+                    mesh
+                };
                 // Closedness matters only to a shape that may bound a medium (as
                 // `volumes::medium_interfaces` decides): one with media named, or whose
                 // material is null or encloses a volume. An unknown material is an error below.

@@ -75,8 +75,27 @@ pub(super) fn load_mesh(
             }
             raw
         }
-        Some("ply") => {
-            let mut raw = ply::parse(&read_all(s, path)?).map_err(fail)?;
+        Some("ply") | Some("gz") => {
+            let mut bytes = read_all(s, path)?;
+            if extension.as_deref() == Some("gz") {
+                // pbrt-v4 reads `.ply.gz` files (gzip-compressed PLY).
+                let inner = path.file_stem().map(Path::new).and_then(Path::extension);
+                if !inner.is_some_and(|e| e.eq_ignore_ascii_case("ply")) {
+                    return Err(s.error(
+                        "file",
+                        format!(
+                            "mesh {}: unknown mesh format; a compressed mesh must be a .ply.gz",
+                            path.display()
+                        ),
+                    ));
+                }
+                let mut plain = Vec::new();
+                flate2::read::GzDecoder::new(&bytes[..])
+                    .read_to_end(&mut plain)
+                    .map_err(|e| fail(format!("cannot decompress: {e}")))?;
+                bytes = plain;
+            }
+            let mut raw = ply::parse(&bytes).map_err(fail)?;
             // A PLY's texture coordinates are flipped only when the scene says so (Mitsuba 3's
             // default for PLY, unlike OBJ).
             if options.flip_tex_coords && s.has("flip_tex_coords") {
@@ -126,6 +145,122 @@ pub(super) fn load_mesh(
         )));
     }
     Ok(mesh)
+}
+
+/// A mesh written in the scene itself (`positions`, `indices`, optional `normals` and
+/// `uvs`, flat lists: 3 numbers a vertex, 3 indices a triangle, 2 numbers a texture
+/// coordinate), as a file's mesh would be read.
+pub(super) fn inline_mesh(
+    s: &Properties<'_>,
+    transform: Mat4,
+    options: MeshOptions,
+) -> Result<Mesh> {
+    let numbers = |name: &str| -> Result<Option<Vec<f32>>> {
+        let Some(node) = s.node(name) else {
+            return Ok(None);
+        };
+        let foton_core::value::Value::Array(items) = &node.value else {
+            return Err(s.error(name, "expected an array of numbers"));
+        };
+        items
+            .iter()
+            .map(|n| {
+                n.value
+                    .as_f64()
+                    .map(|x| x as f32)
+                    .filter(|x| x.is_finite())
+                    .ok_or_else(|| {
+                        s.error(
+                            name,
+                            format!("expected finite numbers, found `{}`", n.value.show()),
+                        )
+                    })
+            })
+            .collect::<Result<Vec<_>>>()
+            .map(Some)
+    };
+    let positions = numbers("positions")?.ok_or_else(|| {
+        s.error(
+            "positions",
+            "missing: a mesh needs `file` or `positions` and `indices`",
+        )
+    })?;
+    if positions.len() % 3 != 0 {
+        return Err(s.error(
+            "positions",
+            format!("{} numbers: not 3 per vertex", positions.len()),
+        ));
+    }
+    let n = positions.len() / 3;
+    let Some(indices) = s.node("indices") else {
+        return Err(s.error(
+            "indices",
+            "missing: the triangles' vertex indices, 3 a triangle",
+        ));
+    };
+    let foton_core::value::Value::Array(items) = &indices.value else {
+        return Err(s.error("indices", "expected an array of integers"));
+    };
+    let mut flat = Vec::with_capacity(items.len());
+    for item in items {
+        match item.value {
+            foton_core::value::Value::Int(i) if i >= 0 && (i as usize) < n => flat.push(i as u32),
+            _ => {
+                return Err(s.error(
+                    "indices",
+                    format!(
+                        "`{}`: expected an integer in 0..{n} (the vertices)",
+                        item.value.show()
+                    ),
+                ));
+            }
+        }
+    }
+    if flat.len() % 3 != 0 {
+        return Err(s.error(
+            "indices",
+            format!("{} indices: not 3 per triangle", flat.len()),
+        ));
+    }
+    let tris: Vec<[u32; 3]> = flat.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+    let mut raw = RawMesh {
+        positions: positions
+            .chunks(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect(),
+        triangles: tris.clone(),
+        ..RawMesh::default()
+    };
+    if let Some(normals) = numbers("normals")? {
+        if normals.len() != positions.len() {
+            return Err(s.error(
+                "normals",
+                format!(
+                    "{} numbers for {n} vertices: expected 3 per vertex",
+                    normals.len()
+                ),
+            ));
+        }
+        raw.normals = normals
+            .chunks(3)
+            .map(|p| Vec3::new(p[0], p[1], p[2]))
+            .collect();
+        raw.normal_triangles = tris.clone();
+    }
+    if let Some(uvs) = numbers("uvs")? {
+        if uvs.len() != 2 * n {
+            return Err(s.error(
+                "uvs",
+                format!(
+                    "{} numbers for {n} vertices: expected 2 per vertex",
+                    uvs.len()
+                ),
+            ));
+        }
+        raw.uvs = uvs.chunks(2).map(|p| Vec2::new(p[0], p[1])).collect();
+        raw.uv_triangles = tris;
+    }
+    triangles(raw, transform, options, None).map_err(|m| s.error("positions", m))
 }
 
 fn read_all(s: &Properties<'_>, path: &Path) -> Result<Vec<u8>> {

@@ -1,0 +1,443 @@
+//! The scene-wide statements: `Camera` into `[camera]`, `Film` into `[film]`, `Sampler`
+//! and `Integrator` into `[render]` (and `[integrators.NAME]`), `PixelFilter` into the film's
+//! `filter`, each with pbrt-v4's defaults when the file has none (cameras.cpp, film.cpp,
+//! samplers.cpp, integrators.cpp, filters.cpp).
+
+use super::params::Bag;
+use super::parse::{Arg, Directive};
+use super::{Loc, Reader, table_mut};
+use foton_core::error::Result;
+use foton_core::value::{Node, Value};
+use glam::{DMat4, DVec3};
+
+impl Reader {
+    pub(super) fn scene_wide(&mut self) -> Result<()> {
+        let (camera, camera_from_world) = self.camera.clone().expect("set at WorldBegin");
+        self.camera(&camera, camera_from_world)?;
+        let film = self
+            .film
+            .clone()
+            .unwrap_or_else(|| default("Film", "rgb", &camera.loc));
+        self.film(&film)?;
+        let filter = self
+            .filter
+            .clone()
+            .unwrap_or_else(|| default("PixelFilter", "gaussian", &camera.loc));
+        self.filter(&filter, self.filter.is_some())?;
+        let sampler = self
+            .sampler
+            .clone()
+            .unwrap_or_else(|| default("Sampler", "zsobol", &camera.loc));
+        self.sampler(&sampler, self.sampler.is_some())?;
+        let integrator = self
+            .integrator
+            .clone()
+            .unwrap_or_else(|| default("Integrator", "volpath", &camera.loc));
+        self.integrator(&integrator)
+    }
+
+    fn camera(&mut self, d: &Directive, camera_from_world: DMat4) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = &d.loc;
+        match d.string(0) {
+            "perspective" => {}
+            "orthographic" | "realistic" | "spherical" => {
+                return self.unsupported(loc, &d.what(), "only the perspective camera is read yet");
+            }
+            other => {
+                return Err(loc.error(
+                    &d.what(),
+                    format!("unknown camera {other:?}; pbrt-v4 has perspective, orthographic, realistic and spherical"),
+                ));
+            }
+        }
+        let world_from_camera = camera_from_world.inverse();
+        if !world_from_camera.is_finite() {
+            return Err(loc.error(&d.what(), "the camera transform is singular"));
+        }
+        let position = world_from_camera.transform_point3(DVec3::ZERO);
+        let forward = world_from_camera.transform_vector3(DVec3::Z);
+        let up = world_from_camera.transform_vector3(DVec3::Y);
+        let right = world_from_camera.transform_vector3(DVec3::X);
+        if forward.length_squared() == 0.0 || up.length_squared() == 0.0 {
+            return Err(loc.error(&d.what(), "the camera transform is singular"));
+        }
+        // pbrt's image right is camera +x; foton's is forward x up.
+        let mirror = forward.cross(up).dot(right) < 0.0;
+        let fov = p.float("fov", 90.0)?;
+        if !(fov > 0.0 && fov < 180.0) {
+            return Err(loc.error(
+                &d.what(),
+                format!("\"float fov\" {fov}: must be in (0, 180) degrees"),
+            ));
+        }
+        if let Some((r, l)) = p.float_opt("lensradius")?
+            && r > 0.0
+        {
+            self.unsupported(
+                &l,
+                &d.what(),
+                "a lens (\"float lensradius\" > 0): foton's camera is a pinhole",
+            )?;
+        }
+        p.float_opt("focaldistance")?;
+        for name in ["screenwindow", "frameaspectratio"] {
+            if let Some(q) = p.take(name) {
+                self.unsupported(&q.loc, &d.what(), &format!("{} is not read yet", q.decl()))?;
+            }
+        }
+        // Times only matter with motion.
+        p.float_opt("shutteropen")?;
+        p.float_opt("shutterclose")?;
+        self.finish(&mut p)?;
+        let mut entries = vec![
+            ("position", self.vec3(position, loc)),
+            ("look_at", self.vec3(position + forward.normalize(), loc)),
+            ("up", self.vec3(up.normalize(), loc)),
+            ("fov", self.num(fov, loc)),
+            ("fov_axis", self.string("smaller", loc)),
+        ];
+        if mirror {
+            entries.push(("mirror", self.node(Value::Bool(true), loc)));
+        }
+        let camera = self.table(entries, loc);
+        self.root.insert("camera", camera);
+        Ok(())
+    }
+
+    fn film(&mut self, d: &Directive) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = &d.loc;
+        match d.string(0) {
+            "rgb" => {}
+            "gbuffer" | "spectral" => {
+                self.note(loc, &d.what(), "rendered as an RGB film (foton writes RGB)");
+            }
+            other => {
+                return Err(loc.error(
+                    &d.what(),
+                    format!("unknown film {other:?}; pbrt-v4 has rgb, gbuffer and spectral"),
+                ));
+            }
+        }
+        let width = p.int("xresolution", 1280)?;
+        let height = p.int("yresolution", 720)?;
+        if !(1..=32768).contains(&width) || !(1..=32768).contains(&height) {
+            return Err(loc.error(
+                &d.what(),
+                format!("resolution {width} x {height}: each must be 1 to 32768"),
+            ));
+        }
+        let filename = p.string_opt("filename")?;
+        let (name, name_loc) = filename.unwrap_or(("pbrt.exr".into(), loc.clone()));
+        let lower = name.to_ascii_lowercase();
+        let output = if lower.ends_with(".exr") || lower.ends_with(".png") {
+            name
+        } else {
+            let stem = std::path::Path::new(&name).with_extension("exr");
+            let out = stem.to_string_lossy().into_owned();
+            self.note(
+                &name_loc,
+                &d.what(),
+                &format!("\"filename\" {name:?}: written as {out:?} (foton writes EXR or PNG)"),
+            );
+            out
+        };
+        // The sensor's imaging ratio (film.cpp): exposure time x ISO / 100, 1 by default.
+        let iso = p.float("iso", 100.0)?;
+        let exposure = p.float("exposuretime", 1.0)?;
+        if (iso * exposure / 100.0 - 1.0).abs() > 1e-9 {
+            self.unsupported(
+                loc,
+                &d.what(),
+                "\"iso\" and \"exposuretime\" that scale the image are not read yet",
+            )?;
+        }
+        if let Some((s, l)) = p.string_opt("sensor")?
+            && s != "cie1931"
+        {
+            self.unsupported(
+                &l,
+                &d.what(),
+                &format!("\"string sensor\" {s:?}: only cie1931 (pbrt-v4's default) is read"),
+            )?;
+        }
+        if let Some((w, l)) = p.float_opt("whitebalance")?
+            && w != 0.0
+        {
+            self.unsupported(&l, &d.what(), "\"whitebalance\" is not read yet")?;
+        }
+        if let Some(q) = p.take("cropwindow").or_else(|| p.take("pixelbounds")) {
+            self.unsupported(&q.loc, &d.what(), &format!("{} is not read yet", q.decl()))?;
+        }
+        if let Some((m, l)) = p.float_opt("maxcomponentvalue")?
+            && m.is_finite()
+        {
+            self.warn(
+                &l,
+                &d.what(),
+                &format!("\"maxcomponentvalue\" {m} ignored: foton does not clamp samples"),
+            );
+        }
+        // What changes the file written, not the image.
+        p.bool("savefp16", true)?;
+        p.float_opt("diagonal")?;
+        p.bool("writefp16", true)?;
+        self.finish(&mut p)?;
+        let film = table_mut(&mut self.root, "film");
+        let (w, h, o) = (
+            Node {
+                value: Value::Int(width),
+                line: 0,
+                column: 0,
+            },
+            Node {
+                value: Value::Int(height),
+                line: 0,
+                column: 0,
+            },
+            Node {
+                value: Value::Str(output),
+                line: 0,
+                column: 0,
+            },
+        );
+        film.insert("width", w);
+        film.insert("height", h);
+        film.insert("output", o);
+        Ok(())
+    }
+
+    /// pbrt-v4's filters (filters.cpp) as foton's: `box` (radius 0.5: the pixel) and
+    /// `gaussian` as they are, `triangle` as `tent`; the default gaussian of sigma 0.5 and
+    /// radius 1.5 as foton's gaussian of that standard deviation (support 2).
+    fn filter(&mut self, d: &Directive, given: bool) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = &d.loc;
+        let filter = match d.string(0) {
+            "box" => {
+                let r = p.numbers("radius", &[super::parse::Type::Vector2])?;
+                if let Some((r, l)) = r
+                    && r.iter().any(|x| (x - 0.5).abs() > 1e-9)
+                {
+                    self.unsupported(
+                        &l,
+                        &d.what(),
+                        "a box of another radius than 0.5 (the pixel) is not read yet",
+                    )?;
+                }
+                self.string("box", loc)
+            }
+            "gaussian" => {
+                let sigma = p.float("sigma", 0.5)?;
+                if let Some((r, l)) = p.numbers("radius", &[super::parse::Type::Vector2])? {
+                    self.note(
+                        &l,
+                        &d.what(),
+                        &format!("radius {r:?}: foton's gaussian has support 4 sigma"),
+                    );
+                }
+                if given {
+                    self.note(loc, &d.what(), "rendered by foton's gaussian filter of the same sigma (support 4 sigma, pbrt-v4's 3 sigma by default)");
+                }
+                let entries = vec![
+                    ("type", self.string("gaussian", loc)),
+                    ("stddev", self.num(sigma, loc)),
+                ];
+                self.table(entries, loc)
+            }
+            "triangle" => {
+                let r = p.numbers("radius", &[super::parse::Type::Vector2])?;
+                let radius = match r {
+                    Some((r, l)) => {
+                        if (r[0] - r[1]).abs() > 1e-12 {
+                            self.unsupported(
+                                &l,
+                                &d.what(),
+                                "a triangle filter of two radii is not read yet",
+                            )?;
+                        }
+                        r[0]
+                    }
+                    None => 2.0,
+                };
+                let entries = vec![
+                    ("type", self.string("tent", loc)),
+                    ("radius", self.num(radius, loc)),
+                ];
+                self.table(entries, loc)
+            }
+            "mitchell" | "sinc" => {
+                self.unsupported(loc, &d.what(), "foton has box, tent and gaussian filters")?;
+                return Ok(());
+            }
+            other => {
+                return Err(loc.error(&d.what(), format!("unknown filter {other:?}; pbrt-v4 has box, gaussian, mitchell, sinc and triangle")));
+            }
+        };
+        self.finish(&mut p)?;
+        table_mut(&mut self.root, "film").insert("filter", filter);
+        Ok(())
+    }
+
+    fn sampler(&mut self, d: &Directive, given: bool) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = &d.loc;
+        let (sampler, spp) = match d.string(0) {
+            "independent" => ("independent", p.int("pixelsamples", 16)?),
+            "stratified" => {
+                let x = p.int("xsamples", 4)?;
+                let y = p.int("ysamples", 4)?;
+                if !p.bool("jitter", true)? {
+                    let no = self.node(Value::Bool(false), loc);
+                    table_mut(&mut self.root, "render").insert("jitter", no);
+                }
+                ("stratified", x * y)
+            }
+            kind @ ("sobol" | "zsobol" | "paddedsobol" | "halton" | "pmj02bn") => {
+                let spp = p.int("pixelsamples", 16)?;
+                p.string_opt("randomization")?;
+                p.int_opt("seed")?;
+                if given {
+                    self.note(loc, &d.what(), &format!("sampled by foton's sobol sampler (Owen-scrambled Sobol points), not pbrt-v4's {kind}: the same image, other noise"));
+                }
+                ("sobol", spp)
+            }
+            other => {
+                return Err(loc.error(&d.what(), format!("unknown sampler {other:?}; pbrt-v4 has independent, stratified, sobol, zsobol, paddedsobol, halton and pmj02bn")));
+            }
+        };
+        p.int_opt("seed")?;
+        if spp < 1 {
+            return Err(loc.error(
+                &d.what(),
+                format!("{spp} samples per pixel: must be at least 1"),
+            ));
+        }
+        self.finish(&mut p)?;
+        let render = table_mut(&mut self.root, "render");
+        render.insert(
+            "sampler",
+            Node {
+                value: Value::Str(sampler.into()),
+                line: 0,
+                column: 0,
+            },
+        );
+        render.insert(
+            "spp",
+            Node {
+                value: Value::Int(spp),
+                line: 0,
+                column: 0,
+            },
+        );
+        Ok(())
+    }
+
+    fn integrator(&mut self, d: &Directive) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = &d.loc;
+        let kind = d.string(0).to_string();
+        let depth = p.int("maxdepth", 5)?;
+        if depth < 0 {
+            return Err(loc.error(
+                &d.what(),
+                format!("\"maxdepth\" {depth}: must not be negative"),
+            ));
+        }
+        let name = match kind.as_str() {
+            "path" | "volpath" => {
+                if p.bool("regularize", false)? {
+                    self.warn(
+                        loc,
+                        &d.what(),
+                        "\"regularize\" ignored: foton does not regularize BSDFs",
+                    );
+                }
+                p.string_opt("lightsampler")?;
+                "path"
+            }
+            "bdpt" => {
+                p.string_opt("lightsampler")?;
+                for name in ["visualizestrategies", "visualizeweights", "regularize"] {
+                    if p.bool(name, false)? {
+                        self.warn(loc, &d.what(), &format!("\"{name}\" ignored"));
+                    }
+                }
+                "bdpt"
+            }
+            "sppm" => {
+                let iterations = p.int("iterations", 64)?;
+                let photons = p.int("photonsperiteration", -1)?;
+                let radius = p.float("radius", 1.0)?;
+                p.int_opt("seed")?;
+                let render = table_mut(&mut self.root, "render");
+                render.insert(
+                    "spp",
+                    Node {
+                        value: Value::Int(iterations.max(1)),
+                        line: 0,
+                        column: 0,
+                    },
+                );
+                let mut entries = vec![("initial_radius", self.num(radius, loc))];
+                if photons > 0 {
+                    entries.push(("photons_per_iteration", self.node(Value::Int(photons), loc)));
+                } else {
+                    let film = table_mut(&mut self.root, "film");
+                    let pixels = [film.get("width"), film.get("height")]
+                        .iter()
+                        .map(|n| n.and_then(|n| n.value.as_f64()).unwrap_or(1.0))
+                        .product::<f64>();
+                    entries.push((
+                        "photons_per_iteration",
+                        self.node(Value::Int(pixels as i64), loc),
+                    ));
+                }
+                let t = self.table(entries, loc);
+                table_mut(&mut self.root, "integrators").insert("sppm", t);
+                "sppm"
+            }
+            "ambientocclusion" | "lightpath" | "simplepath" | "simplevolpath" | "randomwalk"
+            | "mlt" | "aov" => {
+                self.unsupported(loc, &d.what(), "not read yet (path, volpath, bdpt and sppm are); --lenient renders it with foton's path tracer")?;
+                "path"
+            }
+            other => {
+                return Err(loc.error(&d.what(), format!("unknown integrator {other:?}; pbrt-v4 has volpath, path, bdpt, sppm, mlt, lightpath, simplepath, simplevolpath, randomwalk, ambientocclusion and aov")));
+            }
+        };
+        self.finish(&mut p)?;
+        let render = table_mut(&mut self.root, "render");
+        render.insert(
+            "integrator",
+            Node {
+                value: Value::Str(name.into()),
+                line: 0,
+                column: 0,
+            },
+        );
+        // pbrt-v4's maxdepth counts the bounces after the camera ray's first hit as foton's
+        // max_depth counts scattering events: 1 is direct lighting.
+        render.insert(
+            "max_depth",
+            Node {
+                value: Value::Int(depth),
+                line: 0,
+                column: 0,
+            },
+        );
+        Ok(())
+    }
+}
+
+/// A statement the file does not have, with pbrt-v4's default type.
+fn default(name: &str, ty: &str, loc: &Loc) -> Directive {
+    Directive {
+        name: name.into(),
+        loc: loc.clone(),
+        args: vec![Arg::Str(ty.into())],
+        params: Vec::new(),
+    }
+}

@@ -1,0 +1,215 @@
+//! `Material` and `MakeNamedMaterial` into `[materials.NAME]` (materials.cpp): `diffuse`,
+//! `dielectric` (smooth or rough), `conductor` (named metal spectra, or `eta` and `k`; smooth
+//! or rough) and `interface` (foton's `null`). pbrt-v4's rough materials use the
+//! Trowbridge-Reitz (GGX) distribution with alpha = sqrt(roughness) when `remaproughness` is
+//! true (its default); an alpha below 1e-3 is smooth (`EffectivelySmooth`).
+
+use super::params::Bag;
+use super::parse::{Directive, Type, Values};
+use super::spectra::{Kind, rgb};
+use super::{Loc, Reader, table_mut};
+use foton_core::error::Result;
+use foton_core::value::Node;
+
+/// pbrt-v4's named metals (`metal-X-eta`, `metal-X-k`) that Mitsuba's measured data, which
+/// foton carries, also has.
+const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"];
+
+impl Reader {
+    /// Reads the material `d` into `[materials.name]`. false: left out (`lenient`).
+    pub(super) fn material(&mut self, d: &Directive, name: &str) -> Result<bool> {
+        let mut p = Bag::new(d);
+        let loc = d.loc.clone();
+        // MakeNamedMaterial gives the type as a parameter.
+        let (ty, what) = if d.name == "MakeNamedMaterial" {
+            let (ty, _) = p
+                .string_opt("type")?
+                .ok_or_else(|| loc.error(&d.what(), "missing \"string type\""))?;
+            (
+                ty.clone(),
+                format!("MakeNamedMaterial {:?} (type {ty:?})", d.string(0)),
+            )
+        } else {
+            (d.string(0).to_string(), d.what())
+        };
+        if let Some(q) = p.take("normalmap").or_else(|| p.take("displacement")) {
+            self.unsupported(&q.loc, &what, &format!("{} is not read yet", q.decl()))?;
+        }
+        let mut entries: Vec<(&str, Node)> = Vec::new();
+        match ty.as_str() {
+            "diffuse" => {
+                let c = self.colour(&mut p, "reflectance", Kind::Albedo, &what)?;
+                entries.push(("type", self.string("diffuse", &loc)));
+                if let Some((c, l)) = c {
+                    entries.push(("reflectance", self.vec3(c, &l)));
+                } else {
+                    entries.push(("reflectance", self.vec3(glam::DVec3::splat(0.5), &loc)));
+                }
+            }
+            "dielectric" | "conductor" => {
+                let alpha = self.roughness(&mut p, &what)?;
+                let rough = alpha.is_some();
+                if ty == "dielectric" {
+                    let eta = match p.take("eta") {
+                        None => 1.5,
+                        Some(q) => match (&q.ty, &q.values) {
+                            (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
+                            _ => {
+                                self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float eta\"", q.decl()))?;
+                                return Ok(false);
+                            }
+                        },
+                    };
+                    if eta <= 0.0 {
+                        return Err(loc.error(&what, format!("\"eta\" {eta}: must be positive")));
+                    }
+                    entries.push((
+                        "type",
+                        self.string(
+                            if rough {
+                                "roughdielectric"
+                            } else {
+                                "dielectric"
+                            },
+                            &loc,
+                        ),
+                    ));
+                    entries.push(("ior", self.num(eta, &loc)));
+                } else {
+                    entries.push((
+                        "type",
+                        self.string(if rough { "roughconductor" } else { "conductor" }, &loc),
+                    ));
+                    if let Some(q) = p.take("reflectance") {
+                        self.unsupported(&q.loc, &what, "a conductor given by its \"reflectance\" is not read yet (eta and k are)")?;
+                        return Ok(false);
+                    }
+                    let (eta, k) = (p.take("eta"), p.take("k"));
+                    let named = |q: &Option<super::parse::Param>, suffix: &str| match q {
+                        None => Some("Cu".to_string()),
+                        Some(q) => match (&q.ty, &q.values) {
+                            (Type::Spectrum, Values::Strs(s)) => s[0]
+                                .strip_prefix("metal-")
+                                .and_then(|m| m.strip_suffix(suffix))
+                                .map(str::to_string),
+                            _ => None,
+                        },
+                    };
+                    match (named(&eta, "-eta"), named(&k, "-k")) {
+                        (Some(a), Some(b)) if a == b => {
+                            if !METALS.contains(&a.as_str())
+                                || foton_core::material::conductor_ior(&a).is_none()
+                            {
+                                self.unsupported(
+                                    &loc,
+                                    &what,
+                                    &format!("the metal {a:?}: foton has no data for it"),
+                                )?;
+                                return Ok(false);
+                            }
+                            if eta.is_some() {
+                                self.note(&loc, &what, &format!("metal-{a}: Mitsuba's measured index of {a} reduced to RGB as Mitsuba 3 does, not pbrt-v4's spectral rendering of it (colours may differ slightly)"));
+                            }
+                            entries.push(("material", self.string(&a, &loc)));
+                        }
+                        _ => {
+                            let (Some(eta), Some(k)) = (eta, k) else {
+                                return Err(loc.error(
+                                    &what,
+                                    "give both \"eta\" and \"k\" (or neither: copper)",
+                                ));
+                            };
+                            let e = rgb(&eta, Kind::Unbounded, &what, &self.dir)?;
+                            let kk = rgb(&k, Kind::Unbounded, &what, &self.dir)?;
+                            entries.push(("eta", self.vec3(e, &eta.loc)));
+                            entries.push(("k", self.vec3(kk, &k.loc)));
+                        }
+                    }
+                }
+                if let Some((au, av)) = alpha {
+                    entries.push(("distribution", self.string("ggx", &loc)));
+                    if au == av {
+                        entries.push(("alpha", self.num(au, &loc)));
+                    } else {
+                        entries.push(("alpha_u", self.num(au, &loc)));
+                        entries.push(("alpha_v", self.num(av, &loc)));
+                    }
+                }
+            }
+            "interface" => entries.push(("type", self.string("null", &loc))),
+            other @ ("coateddiffuse"
+            | "coatedconductor"
+            | "thindielectric"
+            | "diffusetransmission"
+            | "mix"
+            | "measured"
+            | "subsurface"
+            | "hair") => {
+                self.unsupported(
+                    &loc,
+                    &what,
+                    &format!("the {other} material is not read yet"),
+                )?;
+                return Ok(false);
+            }
+            other => {
+                return Err(loc.error(&what, format!("unknown material {other:?}; pbrt-v4 has diffuse, coateddiffuse, coatedconductor, conductor, dielectric, thindielectric, diffusetransmission, mix, measured, subsurface, hair and interface")));
+            }
+        }
+        self.finish(&mut p)?;
+        let t = self.table(entries, &loc);
+        table_mut(&mut self.root, "materials").insert(name, t);
+        Ok(true)
+    }
+
+    /// A colour parameter: a spectrum, an rgb or a float grey; a texture is refused.
+    fn colour(
+        &mut self,
+        p: &mut Bag,
+        name: &str,
+        kind: Kind,
+        what: &str,
+    ) -> Result<Option<(glam::DVec3, Loc)>> {
+        let Some(q) = p.take(name) else {
+            return Ok(None);
+        };
+        if q.ty == Type::Texture {
+            self.unsupported(
+                &q.loc,
+                what,
+                &format!(
+                    "{}: textures are not read yet (--lenient: the default colour)",
+                    q.decl()
+                ),
+            )?;
+            return Ok(None);
+        }
+        Ok(Some((rgb(&q, kind, what, &self.dir)?, q.loc)))
+    }
+
+    /// pbrt-v4's roughness parameters as GGX alphas (None: smooth).
+    fn roughness(&mut self, p: &mut Bag, what: &str) -> Result<Option<(f64, f64)>> {
+        let r = p.float_opt("roughness")?;
+        let u = p.float_opt("uroughness")?.or(r.clone());
+        let v = p.float_opt("vroughness")?.or(r);
+        let remap = p.bool("remaproughness", true)?;
+        let alpha = |x: Option<(f64, Loc)>| -> Result<f64> {
+            let x = x.map_or(0.0, |(x, _)| x);
+            if x < 0.0 {
+                return Err(p
+                    .loc
+                    .error(what, format!("roughness {x}: must not be negative")));
+            }
+            Ok(if remap { x.sqrt() } else { x })
+        };
+        let (au, av) = (alpha(u)?, alpha(v)?);
+        // TrowbridgeReitzDistribution::EffectivelySmooth.
+        if au.max(av) < 1e-3 {
+            return Ok(None);
+        }
+        if au.min(av) <= 0.0 {
+            return Err(p.loc.error(what, "one roughness zero and the other not: foton's rough materials need both above zero"));
+        }
+        Ok(Some((au, av)))
+    }
+}

@@ -1,0 +1,358 @@
+//! `Shape`: `sphere`, `disk`, `trianglemesh` (written inline in the document) and `plymesh`
+//! as `[[shapes]]` entries, each with the current material and, under an `AreaLightSource`,
+//! its emission (shapes.cpp, lights.cpp's `DiffuseAreaLight::Create`).
+//!
+//! Orientation as pbrt-v4 computes a surface's normal: a triangle's is its winding's in the
+//! object's space (pbrt-v4 flips the world-space cross product when the transform mirrors),
+//! turned towards its vertex normals when it has them; a sphere's and a disk's are their
+//! object-space cross products dp/du x dp/dv (outward, +z) flipped when the transform
+//! mirrors, then transformed as normals: a mirrored sphere faces inward, as in pbrt-v4, while
+//! a disk's u x v already carries the mirror. `ReverseOrientation` turns each of them.
+
+use super::params::Bag;
+use super::parse::{Directive, Type};
+use super::spectra::{Kind, rgb};
+use super::{Loc, Reader, State};
+use foton_core::error::Result;
+use foton_core::value::{Node, Table, Value};
+use glam::{DMat3, DMat4, DVec3};
+
+impl Reader {
+    pub(super) fn shape(&mut self, d: &Directive, state: &State) -> Result<()> {
+        let mut p = Bag::new(d);
+        let loc = d.loc.clone();
+        let what = d.what();
+        let m = state.ctm;
+        let mirrored = m.determinant() < 0.0;
+        let mut entries: Vec<(&str, Node)> = Vec::new();
+        // The shape's area in the world, for an area light's `power`.
+        let area: Option<f64>;
+        let mut flip = state.reverse_orientation;
+        match d.string(0) {
+            "sphere" => {
+                let r = p.float("radius", 1.0)?;
+                if r <= 0.0 {
+                    return Err(loc.error(&what, format!("\"radius\" {r}: must be positive")));
+                }
+                let partial = [
+                    p.float_opt("zmin")?.filter(|(z, _)| *z > -r),
+                    p.float_opt("zmax")?.filter(|(z, _)| *z < r),
+                    p.float_opt("phimax")?.filter(|(x, _)| *x < 360.0),
+                ];
+                if let Some((_, l)) = partial.into_iter().flatten().next() {
+                    return self.unsupported(
+                        &l,
+                        &what,
+                        "a partial sphere (zmin, zmax, phimax) is not supported",
+                    );
+                }
+                let Some(s) = uniform_scale(m) else {
+                    return self.unsupported(&loc, &what, "a sphere under a transform that is not a rotation and a uniform scale (an ellipsoid) is not supported");
+                };
+                flip ^= mirrored;
+                area = Some(4.0 * std::f64::consts::PI * (r * s) * (r * s));
+                entries.push(("type", self.string("sphere", &loc)));
+                entries.push(("center", self.vec3(m.transform_point3(DVec3::ZERO), &loc)));
+                entries.push(("radius", self.num(r * s, &loc)));
+            }
+            "disk" => {
+                let h = p.float("height", 0.0)?;
+                let r = p.float("radius", 1.0)?;
+                if r <= 0.0 {
+                    return Err(loc.error(&what, format!("\"radius\" {r}: must be positive")));
+                }
+                let partial = [
+                    p.float_opt("innerradius")?.filter(|(x, _)| *x > 0.0),
+                    p.float_opt("phimax")?.filter(|(x, _)| *x < 360.0),
+                ];
+                if let Some((_, l)) = partial.into_iter().flatten().next() {
+                    return self.unsupported(
+                        &l,
+                        &what,
+                        "a partial disk (innerradius, phimax) is not supported",
+                    );
+                }
+                let (u, v) = (
+                    m.transform_vector3(DVec3::X * r),
+                    m.transform_vector3(DVec3::Y * r),
+                );
+                area = Some(std::f64::consts::PI * u.cross(v).length());
+                entries.push(("type", self.string("disk", &loc)));
+                entries.push(("center", self.vec3(m.transform_point3(DVec3::Z * h), &loc)));
+                entries.push(("u", self.vec3(u, &loc)));
+                entries.push(("v", self.vec3(v, &loc)));
+            }
+            "trianglemesh" => {
+                let Some(mesh) = self.triangle_mesh(&mut p, &what, &loc)? else {
+                    return Ok(());
+                };
+                area = Some(mesh.area(m));
+                entries.push(("type", self.string("mesh", &loc)));
+                entries.extend(mesh.entries(self, &loc));
+                entries.push(("transform", self.matrix(m, &loc)));
+            }
+            "plymesh" => {
+                let (name, l) = p
+                    .string_opt("filename")?
+                    .ok_or_else(|| loc.error(&what, "missing \"string filename\""))?;
+                let path = super::parse::resolve(&self.dir, &l.file, &name);
+                if !path.is_file() {
+                    return Err(l.error(&what, format!("\"filename\" {name:?}: no such file")));
+                }
+                let rel = path
+                    .strip_prefix(&self.dir)
+                    .map_or(path.clone(), std::path::Path::to_path_buf);
+                if p.has("displacement") {
+                    let q = p.take("displacement").expect("has it");
+                    self.warn(
+                        &q.loc,
+                        &what,
+                        "displacement ignored: the mesh is rendered as its file's triangles",
+                    );
+                }
+                p.float_opt("edgelength")?;
+                area = None;
+                entries.push(("type", self.string("mesh", &loc)));
+                entries.push(("file", self.string(&rel.to_string_lossy(), &l)));
+                entries.push(("transform", self.matrix(m, &loc)));
+                if !self.ply_noted {
+                    self.ply_noted = true;
+                    self.note(&loc, &what, "a PLY mesh's triangles keep their winding's side; pbrt-v4 turns a triangle with vertex normals towards them (the same for consistently oriented meshes)");
+                }
+            }
+            other @ ("bilinearmesh" | "cylinder" | "loopsubdiv" | "curve") => {
+                return self.unsupported(
+                    &loc,
+                    &what,
+                    &format!("the {other} shape is not read yet"),
+                );
+            }
+            other => {
+                return Err(loc.error(&what, format!("unknown shape {other:?}; pbrt-v4 has sphere, disk, cylinder, trianglemesh, plymesh, bilinearmesh, loopsubdiv and curve")));
+            }
+        }
+        if let Some(q) = p.take("alpha") {
+            let opaque = q.ty == Type::Float && q.values == super::parse::Values::Nums(vec![1.0]);
+            if !opaque {
+                self.unsupported(
+                    &q.loc,
+                    &what,
+                    &format!("{}: cut-outs (alpha) are not read yet", q.decl()),
+                )?;
+            }
+        }
+        self.finish(&mut p)?;
+        if flip {
+            entries.push(("flip_normals", self.node(Value::Bool(true), &loc)));
+        }
+        if let Some(light) = state.area_light.clone()
+            && let Some(emission) = self.area_light(&light, area)?
+        {
+            entries.push(("emission", self.vec3(emission, &light.loc)));
+        }
+        let material = self.current_material(state);
+        entries.push(("material", self.string(&material, &loc)));
+        let shape = self.table(entries, &loc);
+        self.shapes.push(shape);
+        Ok(())
+    }
+
+    /// The 4x4 transform as the document's `{ matrix = [16 numbers, row-major] }`.
+    pub(super) fn matrix(&self, m: DMat4, loc: &Loc) -> Node {
+        let rows: Vec<Node> = (0..4)
+            .flat_map(|r| m.row(r).to_array())
+            .map(|x| self.num(x, loc))
+            .collect();
+        let mut t = Table::default();
+        t.insert("matrix", self.node(Value::Array(rows), loc));
+        self.node(Value::Table(t), loc)
+    }
+
+    /// A `trianglemesh`'s data, checked (None: left out, `lenient`).
+    fn triangle_mesh(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
+        let (positions, ploc) = p
+            .numbers("P", &[Type::Point3])?
+            .ok_or_else(|| loc.error(what, "missing \"point3 P\" (the vertices)"))?;
+        let n = positions.len() / 3;
+        let indices = match p.numbers("indices", &[Type::Integer])? {
+            Some((v, l)) => {
+                if v.len() % 3 != 0 {
+                    return Err(l.error(what, format!("\"indices\": {} values, not a multiple of 3", v.len())));
+                }
+                if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i as usize >= n) {
+                    return Err(l.error(what, format!("\"indices\": {bad} is out of range: there are {n} vertices")));
+                }
+                v.iter().map(|&i| i as u32).collect::<Vec<_>>()
+            }
+            None if n == 3 => vec![0, 1, 2],
+            None => return Err(ploc.error(what, "missing \"integer indices\" (only a mesh of exactly 3 vertices may leave them out)")),
+        };
+        let per_vertex =
+            |name: &str, v: Option<(Vec<f64>, Loc)>, width: usize| -> Result<Option<Vec<f64>>> {
+                match v {
+                    Some((v, l)) if v.len() != n * width => Err(l.error(
+                        what,
+                        format!(
+                            "\"{name}\": {} values for {n} vertices, expected {}",
+                            v.len(),
+                            n * width
+                        ),
+                    )),
+                    v => Ok(v.map(|(v, _)| v)),
+                }
+            };
+        let normals = p.numbers("N", &[Type::Normal])?;
+        let normals = per_vertex("N", normals, 3)?;
+        let uvs = p.numbers("uv", &[Type::Point2])?;
+        let uvs = per_vertex("uv", uvs, 2)?;
+        if let Some(q) = p.take("S") {
+            self.warn(
+                &q.loc,
+                what,
+                "\"S\" (tangents) ignored: foton takes the shading frame from dp/du",
+            );
+        }
+        if let Some(q) = p.take("faceIndices") {
+            let _ = q;
+        }
+        let mut mesh = InlineMesh {
+            positions,
+            indices,
+            normals,
+            uvs,
+        };
+        mesh.orient_to_normals();
+        Ok(Some(mesh))
+    }
+}
+
+/// A `trianglemesh` as the document's inline mesh: flat lists, 3 numbers a vertex, 3 indices
+/// a triangle.
+struct InlineMesh {
+    positions: Vec<f64>,
+    indices: Vec<u32>,
+    normals: Option<Vec<f64>>,
+    uvs: Option<Vec<f64>>,
+}
+
+impl InlineMesh {
+    fn vertex(v: &[f64], i: u32) -> DVec3 {
+        let i = i as usize * 3;
+        DVec3::new(v[i], v[i + 1], v[i + 2])
+    }
+
+    /// pbrt-v4 turns a triangle's geometric normal towards its interpolated vertex normal:
+    /// where the winding disagrees with the vertex normals, it is reversed here.
+    fn orient_to_normals(&mut self) {
+        let Some(n) = &self.normals else { return };
+        for t in self.indices.chunks_mut(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| Self::vertex(&self.positions, i));
+            let winding = (b - a).cross(c - a);
+            let shading: DVec3 = [t[0], t[1], t[2]].iter().map(|&i| Self::vertex(n, i)).sum();
+            if winding.dot(shading) < 0.0 {
+                t.swap(1, 2);
+            }
+        }
+    }
+
+    fn area(&self, m: DMat4) -> f64 {
+        self.indices
+            .chunks(3)
+            .map(|t| {
+                let [a, b, c] = [t[0], t[1], t[2]]
+                    .map(|i| m.transform_point3(Self::vertex(&self.positions, i)));
+                0.5 * (b - a).cross(c - a).length()
+            })
+            .sum()
+    }
+
+    fn entries(&self, r: &Reader, loc: &Loc) -> Vec<(&'static str, Node)> {
+        let nums = |v: &[f64]| {
+            r.node(
+                Value::Array(v.iter().map(|x| r.num(*x, loc)).collect()),
+                loc,
+            )
+        };
+        let mut e = vec![
+            ("positions", nums(&self.positions)),
+            (
+                "indices",
+                r.node(
+                    Value::Array(
+                        self.indices
+                            .iter()
+                            .map(|&i| r.node(Value::Int(i64::from(i)), loc))
+                            .collect(),
+                    ),
+                    loc,
+                ),
+            ),
+        ];
+        if let Some(n) = &self.normals {
+            e.push(("normals", nums(n)));
+        }
+        if let Some(uv) = &self.uvs {
+            e.push(("uvs", nums(uv)));
+        }
+        e
+    }
+}
+
+/// The uniform scale of a transform's linear part when it is a rotation (or mirror) times a
+/// uniform scale.
+fn uniform_scale(m: DMat4) -> Option<f64> {
+    let l = DMat3::from_mat4(m);
+    let s = l.x_axis.length();
+    let ok =
+        |a: DVec3, b: DVec3| (a.length() - s).abs() <= 1e-6 * s && a.dot(b).abs() <= 1e-6 * s * s;
+    (s > 0.0 && ok(l.y_axis, l.z_axis) && ok(l.z_axis, l.x_axis) && ok(l.x_axis, l.y_axis))
+        .then_some(s)
+}
+
+impl Reader {
+    /// The emission of a shape under the `AreaLightSource` `d` (pbrt-v4's `DiffuseAreaLight`):
+    /// `L` (default: the colour space's illuminant, white) times `scale`; `power` sets the
+    /// emitted power (with the shape's `area`). None: nothing emitted (left out, `lenient`).
+    fn area_light(&mut self, d: &Directive, area: Option<f64>) -> Result<Option<DVec3>> {
+        let mut p = Bag::new(d);
+        let what = d.what();
+        if d.string(0) != "diffuse" {
+            return Err(d
+                .loc
+                .error(&what, "unknown area light; pbrt-v4 has diffuse"));
+        }
+        let l = match p.take("L") {
+            Some(q) => rgb(&q, Kind::Illuminant, &what, &self.dir)?,
+            None => DVec3::ONE,
+        };
+        let mut scale = p.float("scale", 1.0)?;
+        if let Some((f, fl)) = p.string_opt("filename")? {
+            self.unsupported(
+                &fl,
+                &what,
+                &format!("\"filename\" {f:?}: image area lights are not read yet"),
+            )?;
+            return Ok(None);
+        }
+        if p.bool("twosided", false)? {
+            self.unsupported(&d.loc, &what, "\"twosided\" true: foton's area lights emit on one side (--lenient: on the normal's side only)")?;
+        }
+        if let Some((phi, pl)) = p.float_opt("power")?
+            && phi > 0.0
+        {
+            match area {
+                // k_e: the power of unit radiance (pbrt-v4 does not count the rgb's colour).
+                Some(a) if a > 0.0 => scale *= phi / (std::f64::consts::PI * a),
+                _ => {
+                    self.unsupported(
+                        &pl,
+                        &what,
+                        "\"power\" on a shape whose area the reader does not know (a plymesh)",
+                    )?;
+                }
+            }
+        }
+        self.finish(&mut p)?;
+        Ok(Some(l * scale))
+    }
+}

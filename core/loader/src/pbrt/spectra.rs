@@ -1,0 +1,146 @@
+//! pbrt-v4's spectral parameters (`rgb`, `blackbody`, `spectrum`) reduced to the linear sRGB
+//! colour its RGB film reports for them.
+//!
+//! pbrt-v4 reads an `rgb` colour as a spectrum whose film RGB is that colour (an
+//! `RGBAlbedoSpectrum` for reflectances, an `RGBIlluminantSpectrum`, the colour times the
+//! colour space's illuminant, for emitters), so it is kept as written. A light divides its
+//! spectrum by the spectrum's luminance (`SpectrumToPhotometric`; for an `rgb` colour, by its
+//! illuminant's only), so that a `blackbody` or a measured spectrum emits luminance 1 times
+//! `scale`: its colour here is the spectrum's sRGB colour divided by its luminance Y. A
+//! reflectance given as a spectrum is its colour under D65 ([`Quantity::Reflectance`]).
+
+use super::Loc;
+use super::parse::{Param, Type, Values};
+use foton_core::error::Result;
+use foton_core::spectrum::{Quantity, Spectrum, blackbody, to_srgb};
+use glam::DVec3;
+use std::path::Path;
+
+/// What a spectrum stands for (pbrt-v4's `SpectrumType`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// A reflectance: within [0, 1].
+    Albedo,
+    /// An index of refraction, an absorption coefficient: not bounded above.
+    Unbounded,
+    /// What a light emits, normalised to luminance 1.
+    Illuminant,
+}
+
+/// The luminance Y of a linear sRGB colour.
+pub fn luminance(c: DVec3) -> f64 {
+    c.dot(DVec3::new(0.212671, 0.715160, 0.072169))
+}
+
+/// The colour of the spectral parameter `p` (`rgb`, `blackbody`, `spectrum`, or a `float`
+/// grey). A named spectrum other than an illuminant's is an error (the caller reads the named
+/// metals itself); `scene_dir` is where a spectrum file is looked for.
+pub fn rgb(p: &Param, kind: Kind, what: &str, scene_dir: &Path) -> Result<DVec3> {
+    let err = |loc: &Loc, m: String| loc.error(what, format!("{}: {m}", p.decl()));
+    match (&p.ty, &p.values) {
+        (Type::Rgb, Values::Nums(v)) if v.len() == 3 => {
+            let c = DVec3::new(v[0], v[1], v[2]);
+            if c.min_element() < 0.0 {
+                return Err(err(&p.loc, "a negative component".into()));
+            }
+            if kind == Kind::Albedo && c.max_element() > 1.0 {
+                return Err(err(
+                    &p.loc,
+                    "a component above 1 (pbrt-v4 refuses a reflectance above 1)".into(),
+                ));
+            }
+            Ok(c)
+        }
+        (Type::Float, Values::Nums(v)) if v.len() == 1 => Ok(DVec3::splat(v[0])),
+        (Type::Blackbody, Values::Nums(v)) if v.len() == 1 => {
+            if kind != Kind::Illuminant {
+                return Err(err(&p.loc, "a blackbody is an emission spectrum".into()));
+            }
+            let t = v[0];
+            if t <= 0.0 {
+                return Err(err(&p.loc, format!("temperature {t} K: must be positive")));
+            }
+            Ok(reduce(&|l| Some(blackbody(l, t)), kind))
+        }
+        (Type::Spectrum, Values::Nums(v)) => {
+            let (w, x): (Vec<f64>, Vec<f64>) = v.chunks(2).map(|c| (c[0], c[1])).unzip();
+            let s = Spectrum::new(w, x).map_err(|m| err(&p.loc, m))?;
+            Ok(reduce(&|l| s.eval(l), kind))
+        }
+        (Type::Spectrum, Values::Strs(names)) => {
+            let name = &names[0];
+            if kind == Kind::Illuminant && name == "stdillum-D65" {
+                // The colour space's own illuminant: white.
+                return Ok(DVec3::ONE);
+            }
+            let path = super::parse::resolve(scene_dir, &p.loc.file, name);
+            if !path.is_file() {
+                return Err(err(
+                    &p.loc,
+                    format!(
+                        "{name:?}: not a named spectrum foton has (it knows the metal-X-eta and metal-X-k pairs of conductors, and stdillum-D65), nor a spectrum file"
+                    ),
+                ));
+            }
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| err(&p.loc, format!("{}: {e}", path.display())))?;
+            let s = Spectrum::parse_spd(&text)
+                .map_err(|m| err(&p.loc, format!("{}: {m}", path.display())))?;
+            Ok(reduce(&|l| s.eval(l), kind))
+        }
+        _ => Err(err(
+            &p.loc,
+            "expected an rgb colour, a blackbody temperature or a spectrum".into(),
+        )),
+    }
+}
+
+fn reduce(s: &dyn Fn(f64) -> Option<f64>, kind: Kind) -> DVec3 {
+    match kind {
+        Kind::Albedo => to_srgb(s, Quantity::Reflectance),
+        Kind::Unbounded => to_srgb(s, Quantity::Unbounded),
+        Kind::Illuminant => {
+            let c = to_srgb(s, Quantity::Emission);
+            let y = luminance(c);
+            if y > 0.0 { c / y } else { DVec3::ZERO }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::rc::Rc;
+
+    fn param(ty: Type, values: Values) -> Param {
+        Param {
+            ty,
+            name: "L".into(),
+            values,
+            loc: Loc {
+                file: Rc::from(Path::new("t.pbrt")),
+                line: 1,
+                column: 1,
+            },
+        }
+    }
+
+    #[test]
+    fn lights_emit_luminance_one_per_unit_scale() {
+        let p = param(Type::Blackbody, Values::Nums(vec![6500.0]));
+        let c = rgb(&p, Kind::Illuminant, "x", Path::new("")).unwrap();
+        assert!((luminance(c) - 1.0).abs() < 1e-9, "{c}");
+        // 6500 K is close to D65's white.
+        assert!((c - DVec3::ONE).abs().max_element() < 0.1, "{c}");
+        let p = param(Type::Rgb, Values::Nums(vec![2.0, 3.0, 4.0]));
+        assert_eq!(
+            rgb(&p, Kind::Illuminant, "x", Path::new("")).unwrap(),
+            DVec3::new(2.0, 3.0, 4.0)
+        );
+        let p = param(Type::Rgb, Values::Nums(vec![0.5, 1.5, 0.0]));
+        assert!(rgb(&p, Kind::Albedo, "x", Path::new("")).is_err());
+        let p = param(Type::Spectrum, Values::Nums(vec![300.0, 0.5, 900.0, 0.5]));
+        let c = rgb(&p, Kind::Albedo, "x", Path::new("")).unwrap();
+        assert!((c - DVec3::splat(0.5)).abs().max_element() < 0.01, "{c}");
+    }
+}

@@ -1,0 +1,372 @@
+//! Directive by directive: a small pbrt-v4 text and the document values it reads as.
+
+use crate::reader::{Options, Report};
+use foton_core::value::{Document, Node, Table, Value};
+
+fn read(text: &str, lenient: bool) -> Result<(Document, Report), String> {
+    static COUNTER: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(0);
+    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    let dir = std::env::temp_dir().join(format!("foton-pbrt-{}-{n}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("scene.pbrt");
+    std::fs::write(&path, text).unwrap();
+    let out = super::read(
+        &path,
+        &Options {
+            defines: &[],
+            lenient,
+        },
+    )
+    .map_err(|e| e.to_string());
+    std::fs::remove_dir_all(&dir).ok();
+    out
+}
+
+fn doc(text: &str) -> Table {
+    read(text, false).unwrap_or_else(|e| panic!("{e}")).0.root
+}
+
+fn node<'d>(t: &'d Table, path: &str) -> &'d Node {
+    let mut keys = path.split('.');
+    let mut n = t
+        .get(keys.next().unwrap())
+        .unwrap_or_else(|| panic!("{path}"));
+    for k in keys {
+        n = match &n.value {
+            Value::Table(t) => t.get(k).unwrap_or_else(|| panic!("{path}: {k}")),
+            Value::Array(a) => &a[k.parse::<usize>().unwrap()],
+            other => panic!("{path}: {k} in {other:?}"),
+        };
+    }
+    n
+}
+
+fn has(t: &Table, path: &str) -> bool {
+    let (head, last) = path.rsplit_once('.').unwrap();
+    match &node(t, head).value {
+        Value::Table(t) => t.get(last).is_some(),
+        _ => false,
+    }
+}
+
+fn num(t: &Table, path: &str) -> f64 {
+    node(t, path)
+        .value
+        .as_f64()
+        .unwrap_or_else(|| panic!("{path}"))
+}
+
+fn text(t: &Table, path: &str) -> String {
+    match &node(t, path).value {
+        Value::Str(s) => s.clone(),
+        other => panic!("{path}: {other:?}"),
+    }
+}
+
+fn nums(t: &Table, path: &str) -> Vec<f64> {
+    let Value::Array(a) = &node(t, path).value else {
+        panic!("{path}")
+    };
+    a.iter().map(|n| n.value.as_f64().unwrap()).collect()
+}
+
+fn close(a: &[f64], b: &[f64]) -> bool {
+    a.len() == b.len() && a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9)
+}
+
+const WORLD: &str = "WorldBegin\nLightSource \"point\" \"rgb I\" [1 1 1]\n";
+
+#[test]
+fn lookat_camera_is_mirrored_unless_scaled_by_minus_one_in_x() {
+    let t = doc(&format!(
+        "LookAt 0 1 5  0 1 0  0 1 0\nCamera \"perspective\" \"float fov\" 45\n{WORLD}"
+    ));
+    assert!(close(&nums(&t, "camera.position"), &[0.0, 1.0, 5.0]));
+    assert!(close(&nums(&t, "camera.look_at"), &[0.0, 1.0, 4.0]));
+    assert!(close(&nums(&t, "camera.up"), &[0.0, 1.0, 0.0]));
+    assert_eq!(num(&t, "camera.fov"), 45.0);
+    assert_eq!(text(&t, "camera.fov_axis"), "smaller");
+    // pbrt's camera space is left-handed: a LookAt alone puts world -x on the image's right.
+    assert_eq!(node(&t, "camera.mirror").value, Value::Bool(true));
+    let t = doc(&format!(
+        "Scale -1 1 1\nLookAt 0 1 5  0 1 0  0 1 0\nCamera \"perspective\"\n{WORLD}"
+    ));
+    assert!(!has(&t, "camera.mirror"));
+    assert!(close(&nums(&t, "camera.position"), &[0.0, 1.0, 5.0]));
+    assert_eq!(num(&t, "camera.fov"), 90.0);
+    // The line of the statement is kept.
+    assert_eq!(node(&t, "camera.fov").line, 3);
+}
+
+#[test]
+fn camera_without_lookat_looks_down_z_and_coordinate_systems_are_named() {
+    let t = doc(&format!("Camera \"perspective\"\n{WORLD}"));
+    assert!(close(&nums(&t, "camera.position"), &[0.0, 0.0, 0.0]));
+    assert!(close(&nums(&t, "camera.look_at"), &[0.0, 0.0, 1.0]));
+    // CoordSysTransform "camera": world from camera, so a light there sits at the eye.
+    let t = doc(
+        "LookAt 3 4 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+         AttributeBegin\nCoordSysTransform \"camera\"\nLightSource \"point\" \"point3 from\" [0 0 0]\nAttributeEnd\n",
+    );
+    assert!(close(&nums(&t, "lights.0.position"), &[3.0, 4.0, 5.0]));
+}
+
+#[test]
+fn film_sampler_integrator_and_their_defaults() {
+    let t = doc(&format!("Camera \"perspective\"\n{WORLD}"));
+    assert_eq!(node(&t, "film.width").value, Value::Int(1280));
+    assert_eq!(node(&t, "film.height").value, Value::Int(720));
+    assert_eq!(text(&t, "film.output"), "pbrt.exr");
+    assert_eq!(node(&t, "render.spp").value, Value::Int(16));
+    assert_eq!(node(&t, "render.max_depth").value, Value::Int(5));
+    assert_eq!(text(&t, "render.integrator"), "path");
+    assert_eq!(text(&t, "render.sampler"), "sobol");
+    assert_eq!(text(&t, "film.filter.type"), "gaussian");
+    let t = doc(&format!(
+        "Film \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 32 \"string filename\" \"x.png\"\n\
+         Sampler \"independent\" \"integer pixelsamples\" 4\nIntegrator \"bdpt\" \"integer maxdepth\" 7\n\
+         PixelFilter \"box\"\nCamera \"perspective\"\n{WORLD}"
+    ));
+    assert_eq!(node(&t, "film.width").value, Value::Int(64));
+    assert_eq!(text(&t, "film.output"), "x.png");
+    assert_eq!(text(&t, "film.filter"), "box");
+    assert_eq!(node(&t, "render.spp").value, Value::Int(4));
+    assert_eq!(text(&t, "render.sampler"), "independent");
+    assert_eq!(text(&t, "render.integrator"), "bdpt");
+    assert_eq!(node(&t, "render.max_depth").value, Value::Int(7));
+    let t = doc(&format!(
+        "Integrator \"sppm\" \"integer iterations\" 10 \"integer photonsperiteration\" 1000 \"float radius\" 0.1\n{WORLD}"
+    ));
+    assert_eq!(node(&t, "render.spp").value, Value::Int(10));
+    assert_eq!(num(&t, "integrators.sppm.initial_radius"), 0.1);
+    assert_eq!(
+        node(&t, "integrators.sppm.photons_per_iteration").value,
+        Value::Int(1000)
+    );
+}
+
+#[test]
+fn transforms_compose_as_pbrt_does() {
+    // Translate then Scale: the scale applies first to the object.
+    let t = doc(&format!(
+        "{WORLD}AttributeBegin\nTranslate 1 2 3\nScale 2 2 2\nShape \"sphere\" \"float radius\" 0.5\nAttributeEnd\n\
+         Shape \"sphere\"\n\
+         AttributeBegin\nRotate 90 0 0 1\nTranslate 1 0 0\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nTransform [1 0 0 0  0 1 0 0  0 0 1 0  4 5 6 1]\nShape \"sphere\"\nAttributeEnd\n\
+         AttributeBegin\nTranslate 1 0 0\nConcatTransform [1 0 0 0  0 1 0 0  0 0 1 0  0 1 0 1]\nShape \"sphere\"\nAttributeEnd\n"
+    ));
+    assert!(close(&nums(&t, "shapes.0.center"), &[1.0, 2.0, 3.0]));
+    assert!((num(&t, "shapes.0.radius") - 1.0).abs() < 1e-12);
+    // AttributeEnd restored the identity.
+    assert!(close(&nums(&t, "shapes.1.center"), &[0.0, 0.0, 0.0]));
+    // Rotate 90 about z of (1, 0, 0): (0, 1, 0), counter-clockwise as pbrt's matrix is.
+    let c = nums(&t, "shapes.2.center");
+    assert!(
+        close(
+            &c.iter().map(|x| x.round()).collect::<Vec<_>>(),
+            &[0.0, 1.0, 0.0]
+        ),
+        "{c:?}"
+    );
+    // The 16 numbers are the matrix column by column: the translation last.
+    assert!(close(&nums(&t, "shapes.3.center"), &[4.0, 5.0, 6.0]));
+    assert!(close(&nums(&t, "shapes.4.center"), &[1.0, 1.0, 0.0]));
+    let e = read(&format!("{WORLD}Scale 1 2 1\nShape \"sphere\"\n"), false).unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:4:1") && e.contains("ellipsoid"),
+        "{e}"
+    );
+}
+
+#[test]
+fn orientation_reverse_and_mirrors() {
+    let t = doc(&format!(
+        "{WORLD}ReverseOrientation\nShape \"sphere\"\nShape \"disk\"\nReverseOrientation\n\
+         Scale -1 1 1\nShape \"sphere\"\nShape \"disk\"\n"
+    ));
+    assert_eq!(node(&t, "shapes.0.flip_normals").value, Value::Bool(true));
+    assert_eq!(node(&t, "shapes.1.flip_normals").value, Value::Bool(true));
+    // pbrt-v4 flips a sphere's normal under a mirroring transform (it faces inward); a disk's
+    // u x v carries the mirror already.
+    assert_eq!(node(&t, "shapes.2.flip_normals").value, Value::Bool(true));
+    assert!(!has(&t, "shapes.3.flip_normals"));
+    assert!(close(&nums(&t, "shapes.3.u"), &[-1.0, 0.0, 0.0]));
+}
+
+#[test]
+fn triangle_meshes_inline_and_turned_towards_their_normals() {
+    let t = doc(&format!(
+        "{WORLD}Translate 0 0 1\nShape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n\
+         \"integer indices\" [0 1 2  2 1 3] \"normal N\" [0 0 -1  0 0 -1  0 0 -1  0 0 -1]\n\
+         \"point2 uv\" [0 0 1 0 0 1 1 1]\n"
+    ));
+    assert_eq!(text(&t, "shapes.0.type"), "mesh");
+    assert_eq!(nums(&t, "shapes.0.positions").len(), 12);
+    assert_eq!(nums(&t, "shapes.0.uvs").len(), 8);
+    // Both triangles wind towards +z but their normals point to -z: reversed.
+    assert!(close(
+        &nums(&t, "shapes.0.indices"),
+        &[0.0, 2.0, 1.0, 2.0, 3.0, 1.0]
+    ));
+    let m = nums(&t, "shapes.0.transform.matrix");
+    assert!(close(&m[8..12], &[0.0, 0.0, 1.0, 1.0]), "{m:?}");
+    let e = read(
+        &format!("{WORLD}Shape \"trianglemesh\" \"point3 P\" [0 0 0 1 0 0 0 1 0 1 1 1] \"integer indices\" [0 1 4]\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("4 is out of range"), "{e}");
+}
+
+#[test]
+fn area_lights_attach_to_the_shapes_that_follow_in_their_attribute_block() {
+    let t = doc(&format!(
+        "{WORLD}AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [1 2 3] \"float scale\" 2\n\
+         Shape \"sphere\"\nAttributeEnd\nShape \"sphere\"\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"float power\" 10\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0 2 0 0 0 2 0]\nAttributeEnd\n"
+    ));
+    assert!(close(&nums(&t, "shapes.0.emission"), &[2.0, 4.0, 6.0]));
+    assert!(!has(&t, "shapes.1.emission"));
+    // power / (pi area): the triangle's area is 2.
+    let e = nums(&t, "shapes.2.emission");
+    let want = 10.0 / (std::f64::consts::PI * 2.0);
+    assert!(close(&e, &[want, want, want]), "{e:?}");
+    let e = read(
+        &format!("{WORLD}AreaLightSource \"diffuse\" \"bool twosided\" true\nShape \"sphere\"\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3:1") && e.contains("twosided") && e.contains("--lenient"),
+        "{e}"
+    );
+}
+
+#[test]
+fn materials_named_and_anonymous() {
+    let t = doc(&format!(
+        "{WORLD}MakeNamedMaterial \"red wall\" \"string type\" \"diffuse\" \"rgb reflectance\" [0.6 0.1 0.1]\n\
+         Material \"dielectric\" \"float eta\" 1.33\nShape \"sphere\"\n\
+         NamedMaterial \"red wall\"\nShape \"sphere\"\n\
+         Material \"conductor\" \"spectrum eta\" \"metal-Au-eta\" \"spectrum k\" \"metal-Au-k\" \"float roughness\" 0.04\nShape \"sphere\"\n\
+         Material \"conductor\" \"rgb eta\" [0.2 0.9 1.1] \"rgb k\" [3.9 2.4 2.2]\nShape \"sphere\"\n\
+         Material \"interface\"\nShape \"sphere\"\n"
+    ));
+    let m = |i: usize| text(&t, &format!("shapes.{i}.material"));
+    assert_eq!(text(&t, &format!("materials.{}.type", m(0))), "dielectric");
+    assert_eq!(num(&t, &format!("materials.{}.ior", m(0))), 1.33);
+    assert_eq!(text(&t, &format!("materials.{}.type", m(1))), "diffuse");
+    assert!(close(
+        &nums(&t, &format!("materials.{}.reflectance", m(1))),
+        &[0.6, 0.1, 0.1]
+    ));
+    assert_eq!(
+        text(&t, &format!("materials.{}.type", m(2))),
+        "roughconductor"
+    );
+    assert_eq!(text(&t, &format!("materials.{}.material", m(2))), "Au");
+    assert_eq!(text(&t, &format!("materials.{}.distribution", m(2))), "ggx");
+    assert!((num(&t, &format!("materials.{}.alpha", m(2))) - 0.2).abs() < 1e-12);
+    assert_eq!(text(&t, &format!("materials.{}.type", m(3))), "conductor");
+    assert!(close(
+        &nums(&t, &format!("materials.{}.k", m(3))),
+        &[3.9, 2.4, 2.2]
+    ));
+    assert_eq!(text(&t, &format!("materials.{}.type", m(4))), "null");
+    // Before any Material: pbrt-v4's default, diffuse 0.5.
+    let t = doc(&format!("{WORLD}Shape \"sphere\"\n"));
+    assert_eq!(text(&t, "shapes.0.material"), "default");
+    assert_eq!(text(&t, "materials.default.type"), "diffuse");
+    let e = read(&format!("{WORLD}NamedMaterial \"nope\"\n"), false).unwrap_err();
+    assert!(e.contains("no material named \"nope\""), "{e}");
+}
+
+#[test]
+fn lights_point_distant_infinite() {
+    let t = doc(
+        "WorldBegin\nTranslate 0 1 0\nLightSource \"point\" \"rgb I\" [1 2 3] \"point3 from\" [1 0 0] \"float scale\" 2\n\
+         LightSource \"point\" \"float power\" 100\n\
+         LightSource \"distant\" \"point3 from\" [0 10 0] \"point3 to\" [0 0 0] \"rgb L\" [3 3 3]\n\
+         LightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n",
+    );
+    assert!(close(&nums(&t, "lights.0.position"), &[1.0, 1.0, 0.0]));
+    assert!(close(&nums(&t, "lights.0.intensity"), &[2.0, 4.0, 6.0]));
+    let i = 100.0 / (4.0 * std::f64::consts::PI);
+    assert!(close(&nums(&t, "lights.1.intensity"), &[i, i, i]));
+    assert_eq!(text(&t, "lights.2.type"), "directional");
+    assert!(close(&nums(&t, "lights.2.direction"), &[0.0, -1.0, 0.0]));
+    assert!(close(&nums(&t, "lights.2.irradiance"), &[3.0, 3.0, 3.0]));
+    assert_eq!(text(&t, "lights.3.type"), "constant");
+}
+
+#[test]
+fn unsupported_is_an_error_or_left_out_with_lenient() {
+    let text = format!(
+        "{WORLD}Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n"
+    );
+    let e = read(&text, false).unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3:1") && e.contains("Shape \"curve\""),
+        "{e}"
+    );
+    let (d, report) = read(&text, true).unwrap();
+    assert_eq!(report.left_out.len(), 2, "{:?}", report.left_out);
+    assert!(report.left_out[0].contains("curve"));
+    assert!(
+        report.left_out[1].contains("\"float bogus\""),
+        "{:?}",
+        report.left_out
+    );
+    assert_eq!(nums(&d.root, "shapes.0.center").len(), 3);
+    let e = read("Shape \"sphere\"\n", false).unwrap_err();
+    assert!(e.contains("no WorldBegin"), "{e}");
+    let e = read(&format!("{WORLD}AttributeBegin\n"), false).unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3:1") && e.contains("never ended"),
+        "{e}"
+    );
+}
+
+#[test]
+fn object_instances_are_copies_under_the_instance_transform() {
+    let t = doc(&format!(
+        "{WORLD}ObjectBegin \"ball\"\nTranslate 1 0 0\nShape \"sphere\"\nObjectEnd\n\
+         Translate 0 5 0\nObjectInstance \"ball\"\n"
+    ));
+    let Value::Array(shapes) = &node(&t, "shapes").value else {
+        panic!()
+    };
+    assert_eq!(shapes.len(), 1);
+    assert!(close(&nums(&t, "shapes.0.center"), &[1.0, 5.0, 0.0]));
+}
+
+#[test]
+fn plymesh_reads_ply_and_ply_gz_and_inline_meshes_build() {
+    use std::io::Write;
+    let dir = std::env::temp_dir().join(format!("foton-pbrt-ply-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let ply = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n\
+               element face 1\nproperty list uchar int vertex_indices\nend_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+    std::fs::write(dir.join("tri.ply"), ply).unwrap();
+    let mut gz = flate2::write::GzEncoder::new(Vec::new(), flate2::Compression::default());
+    gz.write_all(ply.as_bytes()).unwrap();
+    std::fs::write(dir.join("tri.ply.gz"), gz.finish().unwrap()).unwrap();
+    let scene = dir.join("scene.pbrt");
+    std::fs::write(
+        &scene,
+        "WorldBegin\nLightSource \"point\" \"point3 from\" [0 0 3]\n\
+         Translate 0 0 2\nShape \"plymesh\" \"string filename\" \"tri.ply\"\n\
+         Translate 0 0 2\nShape \"plymesh\" \"string filename\" \"tri.ply.gz\"\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0 3 0 0 0 3 0] \"integer indices\" [0 1 2]\n",
+    )
+    .unwrap();
+    let built = crate::load_with(&scene, &[], &[], false).unwrap_or_else(|e| panic!("{e}"));
+    let (lo, hi) = built.bounds();
+    std::fs::remove_dir_all(&dir).ok();
+    // The bounds are padded a little; the .ply at z = 2, the .ply.gz and the inline mesh
+    // (its 3 x 3 triangle) at z = 4.
+    let near = |a: f32, b: f32| (a - b).abs() < 1e-3;
+    assert!(near(lo.z, 2.0) && near(hi.z, 4.0), "{lo} {hi}");
+    assert!(near(hi.x, 3.0) && near(hi.y, 3.0), "{lo} {hi}");
+}

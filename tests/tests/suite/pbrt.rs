@@ -1,0 +1,192 @@
+//! pbrt-v4 scenes (issue 33): a scene written in pbrt-v4's format renders as the same scene
+//! written in foton's TOML. The strongest check of the reader's conventions: pbrt's
+//! left-handed camera space (`Scale -1 1 1` before `LookAt`), `fov` across the shorter image
+//! axis (the images are wider than tall), the side an area light's triangles emit on, and
+//! the walls' colours on their sides of the image.
+
+use foton_tests::stats::{Tolerance, assert_blocks_agree};
+use foton_tests::{render_file, render_toml, repo_root, temp_dir, write};
+
+const Z: Tolerance = Tolerance {
+    rel: 0.0,
+    z: 4.5,
+    floor: 2e-3,
+};
+
+/// A Cornell box lit by a small square area light under its ceiling, seen through an image
+/// of 48 x 32 pixels.
+const PBRT_BOX: &str = r#"
+Scale -1 1 1
+LookAt 0 1 3.9  0 1 0  0 1 0
+Camera "perspective" "float fov" 39.3
+Film "rgb" "integer xresolution" 48 "integer yresolution" 32 "string filename" "box.exr"
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 256
+Integrator "path" "integer maxdepth" 5
+WorldBegin
+MakeNamedMaterial "white" "string type" "diffuse" "rgb reflectance" [0.73 0.73 0.73]
+MakeNamedMaterial "red" "string type" "diffuse" "rgb reflectance" [0.63 0.065 0.05]
+MakeNamedMaterial "green" "string type" "diffuse" "rgb reflectance" [0.14 0.45 0.091]
+NamedMaterial "white"
+Shape "trianglemesh" "point3 P" [-1 0 1  1 0 1  1 0 -1  -1 0 -1] "integer indices" [0 1 2  0 2 3]
+Shape "trianglemesh" "point3 P" [-1 2 -1  1 2 -1  1 2 1  -1 2 1] "integer indices" [0 1 2  0 2 3]
+Shape "trianglemesh" "point3 P" [-1 0 -1  1 0 -1  1 2 -1  -1 2 -1] "integer indices" [0 1 2  0 2 3]
+NamedMaterial "red"
+Shape "trianglemesh" "point3 P" [-1 0 -1  -1 2 -1  -1 2 1  -1 0 1] "integer indices" [0 1 2  0 2 3]
+NamedMaterial "green"
+Shape "trianglemesh" "point3 P" [1 0 -1  1 0 1  1 2 1  1 2 -1] "integer indices" [0 1 2  0 2 3]
+NamedMaterial "white"
+AttributeBegin
+  Translate -0.45 0.35 -0.35
+  Shape "sphere" "float radius" 0.35
+AttributeEnd
+AttributeBegin
+  Material "diffuse" "rgb reflectance" [0 0 0]
+  # Wound so that its normal points down, into the box.
+  AreaLightSource "diffuse" "rgb L" [4 4 4] "float scale" 2
+  Shape "trianglemesh" "point3 P" [-0.25 1.99 -0.25  0.25 1.99 -0.25  0.25 1.99 0.25  -0.25 1.99 0.25]
+    "integer indices" [0 1 2  0 2 3]
+AttributeEnd
+"#;
+
+const TOML_BOX: &str = r#"
+[render]
+integrator = "path"
+spp = 256
+seed = 7
+max_depth = 5
+sampler = "independent"
+
+[film]
+width = 48
+height = 32
+output = "box.exr"
+
+[camera]
+position = [0.0, 1.0, 3.9]
+look_at = [0.0, 1.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 39.3
+fov_axis = "y"
+
+[materials.white]
+type = "diffuse"
+reflectance = [0.73, 0.73, 0.73]
+
+[materials.red]
+type = "diffuse"
+reflectance = [0.63, 0.065, 0.05]
+
+[materials.green]
+type = "diffuse"
+reflectance = [0.14, 0.45, 0.091]
+
+[materials.black]
+type = "diffuse"
+reflectance = [0.0, 0.0, 0.0]
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, 0.0, 1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 0.0, -2.0]
+material = "white"
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, 2.0, -1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 0.0, 2.0]
+material = "white"
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, 0.0, -1.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 2.0, 0.0]
+material = "white"
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, 0.0, -1.0]
+u = [0.0, 2.0, 0.0]
+v = [0.0, 0.0, 2.0]
+material = "red"
+
+[[shapes]]
+type = "quad"
+origin = [1.0, 0.0, -1.0]
+u = [0.0, 0.0, 2.0]
+v = [0.0, 2.0, 0.0]
+material = "green"
+
+[[shapes]]
+type = "sphere"
+center = [-0.45, 0.35, -0.35]
+radius = 0.35
+material = "white"
+
+[[shapes]]
+type = "quad"
+origin = [-0.25, 1.99, -0.25]
+u = [0.5, 0.0, 0.0]
+v = [0.0, 0.0, 0.5]
+material = "black"
+emission = [8.0, 8.0, 8.0]
+"#;
+
+#[test]
+fn a_pbrt_cornell_box_renders_as_the_same_scene_written_in_toml() {
+    let dir = temp_dir("pbrt-box");
+    let scene = write(&dir, "box.pbrt", PBRT_BOX);
+    let pbrt = render_file(&scene, &[], 2);
+    let toml = render_toml("pbrt-box-toml", TOML_BOX, &[], 2);
+    assert_eq!((pbrt.width, pbrt.height), (48, 32));
+    assert_blocks_agree("pbrt box against its TOML", &pbrt, &toml, 4, Z);
+    // The side walls lie within x in [8, 15] and [33, 40] (the image's sides see past the box).
+    let walls = |f: &foton_core::film::Film| {
+        (
+            foton_tests::region_mean(f, 9, 8, 14, 24).0,
+            foton_tests::region_mean(f, 34, 8, 39, 24).0,
+        )
+    };
+    let (left, right) = walls(&pbrt);
+    assert!(
+        left.x > left.y && right.y > right.x,
+        "left {left}, right {right}"
+    );
+    // Without `Scale -1 1 1` pbrt-v4's image is mirrored: red on the right.
+    let mirrored = write(
+        &dir,
+        "mirrored.pbrt",
+        &PBRT_BOX.replacen("Scale -1 1 1", "", 1),
+    );
+    let (left, right) = walls(&render_file(&mirrored, &[], 2));
+    assert!(
+        left.y > left.x && right.x > right.y,
+        "left {left}, right {right}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn the_cornell_box_pbrt_scene_renders_as_the_toml_one() {
+    let scenes = repo_root().join("scenes");
+    let set = [
+        "film.width=32",
+        "film.height=32",
+        "render.spp=64",
+        "render.sampler=\"independent\"",
+    ];
+    let pbrt = render_file(&scenes.join("cornell-box.pbrt"), &set, 2);
+    let mut toml_set = set.to_vec();
+    toml_set.push("render.seed=3");
+    let toml = render_file(&scenes.join("cornell-box.toml"), &toml_set, 2);
+    assert_blocks_agree(
+        "cornell-box.pbrt against cornell-box.toml",
+        &pbrt,
+        &toml,
+        4,
+        Z,
+    );
+}
