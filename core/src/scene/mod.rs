@@ -83,7 +83,9 @@ pub struct Object {
     /// None being vacuum): the shape is a medium interface as written, open or closed, and
     /// nothing about it is inferred.
     pub explicit_media: bool,
-    /// Whether the shape is closed (a sphere, a watertight consistently oriented mesh).
+    /// Whether the shape is closed (a sphere, a watertight consistently oriented mesh). The
+    /// loader finds it out only for a shape that may bound a medium (media named, a null or
+    /// volume-enclosing material) and says false for the others, which bound no volume.
     pub closed: bool,
 }
 

@@ -330,14 +330,16 @@ fn mesh_triangles(scene: &Scene) -> Vec<[u32; 9]> {
 fn ply_cube_loads_like_the_obj_cube() {
     let dir = temp_dir("ply-cube");
     let obj = write(&dir, "cube.obj", &cube_obj(&QUADS));
-    let reference = load(&dir, &obj, "");
+    // Filled with fog: closedness is asked only of shapes that may bound a medium.
+    let fog = "\ninterior = \"fog\"";
+    let reference = load(&dir, &obj, fog);
     let want = mesh_triangles(&reference);
     assert_eq!(want.len(), 12, "the OBJ cube has 12 triangles");
     assert!(reference.objects()[1].closed);
     for enc in ENCODINGS {
         let ply = dir.join(format!("cube-{}.ply", enc.name()));
         std::fs::write(&ply, cube_ply(enc, &QUADS)).unwrap();
-        let scene = load(&dir, &ply, "");
+        let scene = load(&dir, &ply, fog);
         assert_eq!(
             mesh_triangles(&scene),
             want,
@@ -382,7 +384,12 @@ fn polygons_are_fan_triangulated() {
         ];
         let ply = dir.join(format!("pentagon-{}.ply", enc.name()));
         std::fs::write(&ply, ply_bytes(enc, &elements)).unwrap();
-        let scene = write(&dir, "scene.toml", &scene_text(&ply, ""));
+        // With a medium named, so that its closedness is found out.
+        let scene = write(
+            &dir,
+            "scene.toml",
+            &scene_text(&ply, "\nexterior = \"fog\""),
+        );
         let scene = foton_loader::load(&scene, &[]).unwrap();
         let mut corners: Vec<[[f32; 3]; 3]> = Vec::new();
         for p in scene.accel().primitives().iter().filter(|p| p.object == 1) {
