@@ -30,6 +30,13 @@ impl HashGrid {
         grid
     }
 
+    /// The bytes the grid holds on the heap: buckets, indices, positions and the build's keys.
+    pub fn heap_bytes(&self) -> usize {
+        use std::mem::size_of;
+        (self.starts.capacity() + self.indices.capacity() + self.keys.capacity()) * size_of::<u32>()
+            + self.positions.capacity() * size_of::<Vec3>()
+    }
+
     /// A grid over nothing, to be rebuilt.
     pub fn empty() -> HashGrid {
         HashGrid {

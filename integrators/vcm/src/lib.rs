@@ -822,6 +822,25 @@ mod tests {
         }
     }
 
+    /// Issue 35: an iteration's light vertices and their hash grid within twice the size of
+    /// the vertex records (with each pixel's path end, 4 bytes per pixel, beside them).
+    #[test]
+    fn light_vertices_and_their_grid_hold_at_most_twice_the_records() {
+        let n = 50_000;
+        let mut rng = foton_core::api::Rng::new(&[8]);
+        let positions: Vec<foton_core::api::Vec3> = (0..n)
+            .map(|_| foton_core::api::Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()))
+            .collect();
+        let grid = grid::HashGrid::build(positions, 0.01);
+        let record = std::mem::size_of::<Vertex>();
+        let per_vertex = (n * record + grid.heap_bytes()) as f64 / n as f64;
+        println!("vcm: {per_vertex:.1} bytes per light vertex, records of {record} bytes");
+        assert!(
+            per_vertex <= 2.0 * record as f64,
+            "{per_vertex} per {record}"
+        );
+    }
+
     /// The schedule: r_1 at the first iteration, r_1 i^((alpha - 1) / 2) after.
     #[test]
     fn the_radius_shrinks_as_the_schedule_says() {
