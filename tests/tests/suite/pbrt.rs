@@ -190,3 +190,35 @@ fn the_cornell_box_pbrt_scene_renders_as_the_toml_one() {
         Z,
     );
 }
+
+/// `foton convert` writes a pbrt-v4 scene as the TOML document it reads to: the converted
+/// file renders bit for bit as the pbrt file (inline meshes, the mirrored camera, the area
+/// light and the sampler carried over).
+#[test]
+fn convert_writes_the_toml_that_renders_as_the_pbrt_file() {
+    let dir = temp_dir("pbrt-convert");
+    let pbrt = write(&dir, "box.pbrt", PBRT_BOX);
+    let toml = dir.join("box.toml");
+    let run = foton_tests::foton(&[
+        "convert",
+        pbrt.to_str().unwrap(),
+        "-o",
+        toml.to_str().unwrap(),
+    ]);
+    assert_eq!(run.code, 0, "{}", run.stderr);
+    let text = std::fs::read_to_string(&toml).unwrap();
+    assert!(text.contains("positions"), "no inline mesh in:\n{text}");
+    let set = ["render.spp=4"];
+    let a = render_file(&pbrt, &set, 2);
+    let b = render_file(&toml, &set, 2);
+    assert!(
+        a.pixels().iter().any(|p| p.x > 0.0),
+        "a black image proves nothing"
+    );
+    assert_eq!(
+        a.pixels(),
+        b.pixels(),
+        "the converted TOML renders otherwise"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
