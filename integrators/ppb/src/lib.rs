@@ -354,42 +354,32 @@ struct PpbPasses<'a> {
 
 impl Passes for PpbPasses<'_> {
     fn pass(&mut self, iteration: u64, quiet: &RenderContext<'_>) -> Result<Option<String>> {
-        let (ppb, scene, tally) = (self.ppb, self.scene, self.tally);
+        let (ppb, scene) = (self.ppb, self.scene);
         let pass = ppb.pass(scene, iteration, quiet)?;
         if quiet.cancelled() {
             return Ok(None);
         }
         let width = scene.film().width as usize;
         let _camera = quiet.phase("camera pass");
-        if !self.layer_sums.is_empty() {
-            return self.pass_techniques(&pass, iteration, quiet);
-        }
+        let camera = CameraPass {
+            ppb,
+            scene,
+            tally: self.tally,
+            pass: &pass,
+            iteration,
+        };
+        let (sums, layer_sums) = (&mut self.sums, &mut self.layer_sums);
         with_pool(quiet.threads, || {
-            self.sums
-                .par_chunks_mut(width)
-                .enumerate()
-                .for_each(|(y, row)| {
-                    let (mut row_rays, mut row_bad, mut row_unusable) = (0u64, 0u64, 0u64);
-                    for (x, sum) in row.iter_mut().enumerate() {
-                        let l = ppb.estimate(
-                            scene,
-                            &pass,
-                            iteration,
-                            (x as u32, y as u32),
-                            &mut row_rays,
-                            &mut row_bad,
-                            |_, _| {},
-                        );
-                        if usable(l) {
-                            sum.add(l);
-                        } else {
-                            row_unusable += 1;
-                        }
-                    }
-                    Tally::add(&tally.rays, row_rays);
-                    Tally::add(&tally.bad_photons, row_bad);
-                    Tally::add(&tally.bad_samples, row_unusable);
-                })
+            if layer_sums.is_empty() {
+                sums.par_chunks_mut(width)
+                    .enumerate()
+                    .for_each(|(y, row)| camera.row(y, row, None));
+            } else {
+                sums.par_chunks_mut(width)
+                    .zip(layer_sums.par_chunks_mut(width))
+                    .enumerate()
+                    .for_each(|(y, (row, layers))| camera.row(y, row, Some(layers)));
+            }
         })?;
         let photons = (iteration + 1) * ppb.passes.photons_per_iteration;
         Ok(Some(format!(
@@ -425,56 +415,50 @@ impl Passes for PpbPasses<'_> {
     }
 }
 
-impl PpbPasses<'_> {
-    /// [`Passes::pass`]'s camera pass with `--techniques`: each pixel's estimate and its
-    /// techniques' shares (a sample that is not usable is dropped from both).
-    fn pass_techniques(
-        &mut self,
-        pass: &Pass,
-        iteration: u64,
-        quiet: &RenderContext<'_>,
-    ) -> Result<Option<String>> {
-        let (ppb, scene, tally) = (self.ppb, self.scene, self.tally);
-        let width = scene.film().width as usize;
-        with_pool(quiet.threads, || {
-            self.sums
-                .par_chunks_mut(width)
-                .zip(self.layer_sums.par_chunks_mut(width))
-                .enumerate()
-                .for_each(|(y, (row, layer_row))| {
-                    let (mut row_rays, mut row_bad, mut row_unusable) = (0u64, 0u64, 0u64);
-                    for (x, (sum, layers)) in row.iter_mut().zip(layer_row).enumerate() {
-                        let mut shares = [Rgb::ZERO; 4];
-                        let l = ppb.estimate(
-                            scene,
-                            pass,
-                            iteration,
-                            (x as u32, y as u32),
-                            &mut row_rays,
-                            &mut row_bad,
-                            |k, v| shares[k] += v,
-                        );
-                        if usable(l) {
-                            sum.add(l);
-                            for (layer, v) in layers.iter_mut().zip(shares) {
-                                layer.add(v);
-                            }
-                        } else {
-                            row_unusable += 1;
-                        }
+/// One pass's camera pass over the pixels.
+struct CameraPass<'a> {
+    ppb: &'a Ppb,
+    scene: &'a Scene,
+    tally: &'a Tally,
+    pass: &'a Pass,
+    iteration: u64,
+}
+
+impl CameraPass<'_> {
+    /// Row `y`: each pixel's estimate added to `row` and, with `--techniques`, its
+    /// techniques' shares to `layers` (a sample that is not usable is dropped from both).
+    fn row(&self, y: usize, row: &mut [RadianceSum], mut layers: Option<&mut [[RadianceSum; 4]]>) {
+        let (mut rays, mut bad, mut unusable) = (0u64, 0u64, 0u64);
+        for (x, sum) in row.iter_mut().enumerate() {
+            let mut shares = [Rgb::ZERO; 4];
+            let keep = layers.is_some();
+            let l = self.ppb.estimate(
+                self.scene,
+                self.pass,
+                self.iteration,
+                (x as u32, y as u32),
+                &mut rays,
+                &mut bad,
+                |k, v| {
+                    if keep {
+                        shares[k] += v
                     }
-                    Tally::add(&tally.rays, row_rays);
-                    Tally::add(&tally.bad_photons, row_bad);
-                    Tally::add(&tally.bad_samples, row_unusable);
-                })
-        })?;
-        let photons = (iteration + 1) * ppb.passes.photons_per_iteration;
-        Ok(Some(format!(
-            "iteration {}, {photons} photons, {} beams of width {:.5}",
-            iteration + 1,
-            pass.beams.len(),
-            pass.beams.radius()
-        )))
+                },
+            );
+            if usable(l) {
+                sum.add(l);
+                if let Some(layers) = layers.as_deref_mut() {
+                    for (layer, v) in layers[x].iter_mut().zip(shares) {
+                        layer.add(v);
+                    }
+                }
+            } else {
+                unusable += 1;
+            }
+        }
+        Tally::add(&self.tally.rays, rays);
+        Tally::add(&self.tally.bad_photons, bad);
+        Tally::add(&self.tally.bad_samples, unusable);
     }
 }
 
