@@ -23,7 +23,8 @@ pub(crate) fn json_string(s: &str) -> String {
     out
 }
 
-fn json_number(x: f64) -> String {
+/// `x` as a JSON number; `null` when it is not finite.
+pub(crate) fn json_number(x: f64) -> String {
     if x.is_finite() {
         format!("{x}")
     } else {

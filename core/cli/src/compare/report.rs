@@ -9,7 +9,7 @@
 //! loaded: `tabs` (the tab names) and `pixel(tab, x, y)` (a tab's linear RGB at column x, row
 //! y, row 0 at the top).
 
-use super::json::json_string;
+use super::json::{json_number as number, json_string};
 use super::metrics::Errors;
 use flate2::Compression;
 use flate2::write::DeflateEncoder;
@@ -142,14 +142,6 @@ pub fn html(report: &Report) -> String {
     // Inside a <script> element, "</" could end it; "<\/" is the same JSON string.
     let data = data.replace("</", "<\\/");
     TEMPLATE.replacen("/*FOTON_DATA*/", &data, 1)
-}
-
-fn number(x: f64) -> String {
-    if x.is_finite() {
-        format!("{x}")
-    } else {
-        "null".into()
-    }
 }
 
 fn optional(x: Option<f64>) -> String {
