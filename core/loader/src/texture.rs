@@ -74,8 +74,20 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path) -> Result<Texture> {
                 _ => WrapMode::Repeat,
             };
             let to_uv = read_to_uv(t)?;
-            let bitmap = load_bitmap(&base_dir.join(filename), raw)
+            let scale = match t.node("scale").map(|n| &n.value) {
+                None => Rgb::ONE,
+                Some(Value::Array(_)) => t.rgb("scale", Rgb::ONE)?,
+                Some(_) => Rgb::splat(t.f32_required("scale")?),
+            };
+            if scale.min_element() < 0.0 {
+                return Err(t.error("scale", "must not be negative"));
+            }
+            let mut bitmap = load_bitmap(&base_dir.join(filename), raw)
                 .map_err(|e| t.error("filename", e.to_string()))?;
+            if scale != Rgb::ONE {
+                let texels = bitmap.texels().iter().map(|c| *c * scale).collect();
+                bitmap = Bitmap::new(bitmap.width(), bitmap.height(), texels).expect("same size");
+            }
             Ok(Texture::Bitmap {
                 bitmap: Arc::new(bitmap),
                 filter,

@@ -26,7 +26,7 @@ lights! {
 }
 
 pub use area::area_light;
-pub use spot::{spot_falloff, spot_solid_angle};
+pub use spot::{Falloff, smoothstep, spot_falloff, spot_solid_angle};
 
 /// What is singular about a light (pbrt-v4's `LightType`): its position (a point or spot
 /// light), its direction (a directional light), neither (an area light), or that it lies
@@ -353,6 +353,7 @@ mod tests {
                     intensity: Rgb::splat(2.0),
                     beam_width: 0.3,
                     cutoff: 0.6,
+                    falloff: Falloff::Linear,
                 }),
             ),
             (

@@ -1,5 +1,7 @@
 //! `spot`: a point light emitting in a cone (Mitsuba's `spot`), at full intensity within
-//! `beam_width` of its axis, falling linearly in angle to zero at `cutoff_angle`.
+//! `beam_width` of its axis, falling to zero at `cutoff_angle`: linearly in the angle
+//! (Mitsuba's falloff), or as a smoothstep in the cosine (pbrt-v4's `spot`, `falloff =
+//! "smoothstep"`).
 //!
 //! | Parameter      | Type       | Meaning                                      | Default              |
 //! |----------------|------------|----------------------------------------------|----------------------|
@@ -9,6 +11,7 @@
 //! | `intensity`    | RGB (W/sr) | intensity at the centre of the cone          | `[1, 1, 1]`          |
 //! | `cutoff_angle` | degrees    | no light past it, in (0, 90]                 | `20`                 |
 //! | `beam_width`   | degrees    | full intensity within it, in [0, cutoff]     | 3/4 of the cutoff    |
+//! | `falloff`      | string     | `"linear"` (in the angle) or `"smoothstep"` (in the cosine) | `"linear"` |
 
 use super::{EmittedRay, LightSample, LightSource, LightType, towards};
 use crate::Rgb;
@@ -28,6 +31,53 @@ pub struct SpotLight {
     /// `cutoff`.
     pub beam_width: f32,
     pub cutoff: f32,
+    pub falloff: Falloff,
+}
+
+/// How the intensity falls from the beam width to the cutoff.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Falloff {
+    /// Linear in the angle (Mitsuba's `falloff_curve`).
+    Linear,
+    /// pbrt-v4's `SmoothStep(cos cutoff, cos beam width, cos theta)`.
+    Smoothstep,
+}
+
+impl SpotLight {
+    /// The falloff at angle theta from the axis.
+    #[inline]
+    fn falloff(&self, cos_theta: f32) -> f32 {
+        match self.falloff {
+            Falloff::Linear => spot_falloff(cos_theta, self.beam_width, self.cutoff),
+            Falloff::Smoothstep => {
+                smoothstep(self.cutoff.cos(), self.beam_width.cos(), cos_theta)
+            }
+        }
+    }
+
+    /// The integral of the falloff over the sphere of directions.
+    fn solid_angle(&self) -> f32 {
+        match self.falloff {
+            Falloff::Linear => spot_solid_angle(self.beam_width, self.cutoff),
+            // The smoothstep's mean over its ramp is 1/2: 2 pi [(1 - cos b) + (cos b - cos
+            // c) / 2] (pbrt-v4's `SpotLight::Phi`).
+            Falloff::Smoothstep => {
+                let (cb, cc) = (self.beam_width.cos() as f64, self.cutoff.cos() as f64);
+                (2.0 * std::f64::consts::PI * ((1.0 - cb) + (cb - cc) / 2.0)) as f32
+            }
+        }
+    }
+}
+
+/// 0 at and below `a`, 1 at and above `b`, the cubic 3t^2 - 2t^3 between (pbrt-v4's
+/// `SmoothStep`; a step at `a` when a = b).
+#[inline]
+pub fn smoothstep(a: f32, b: f32, x: f32) -> f32 {
+    if a == b {
+        return if x < a { 0.0 } else { 1.0 };
+    }
+    let t = ((x - a) / (b - a)).clamp(0.0, 1.0);
+    t * t * (3.0 - 2.0 * t)
 }
 
 /// The spot light's falloff at angle theta from its axis (Mitsuba's `falloff_curve`): 1 within
@@ -63,7 +113,7 @@ impl LightSource for SpotLight {
 
     /// I times the falloff's solid angle.
     fn power(&self) -> Rgb {
-        self.intensity * spot_solid_angle(self.beam_width, self.cutoff)
+        self.intensity * self.solid_angle()
     }
 
     fn position(&self) -> Option<Vec3> {
@@ -73,7 +123,7 @@ impl LightSource for SpotLight {
     #[inline(never)]
     fn sample_li(&self, x: Vec3, _: Vec2, _: f32) -> Option<LightSample> {
         let (wi, dist, dist2) = towards(x, self.position)?;
-        let falloff = spot_falloff(self.axis.dot(-wi), self.beam_width, self.cutoff);
+        let falloff = self.falloff(self.axis.dot(-wi));
         Some(LightSample {
             wi,
             dist,
@@ -93,7 +143,7 @@ impl LightSource for SpotLight {
     fn sample_emission(&self, _: Vec2, u_dir: Vec2, _: f32) -> EmittedRay {
         let cos_max = self.cutoff.cos();
         let dir = to_world(uniform_cone(u_dir, cos_max), self.axis);
-        let falloff = spot_falloff(self.axis.dot(dir), self.beam_width, self.cutoff);
+        let falloff = self.falloff(self.axis.dot(dir));
         EmittedRay {
             origin: self.position,
             dir,
@@ -157,12 +207,17 @@ pub const FACTORY: Factory<SpotLight> = Factory {
                 format!("must be in [0, cutoff_angle = {cutoff}] degrees, found {beam_width}"),
             ));
         }
+        let falloff = match l.choice("falloff", &["linear", "smoothstep"], "linear")? {
+            "smoothstep" => Falloff::Smoothstep,
+            _ => Falloff::Linear,
+        };
         Ok(Box::new(SpotLight {
             position,
             axis: axis.normalize(),
             intensity,
             beam_width: beam_width.to_radians(),
             cutoff: cutoff.to_radians(),
+            falloff,
         }))
     },
 };

@@ -222,3 +222,104 @@ fn convert_writes_the_toml_that_renders_as_the_pbrt_file() {
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pbrt-v4 puts texture coordinates (0, 0) at an image's lower-left corner
+/// (`SpectrumImageTexture::Evaluate` reads the image at (s, 1 - t)): an image whose top half
+/// is red and bottom half blue, on a quad whose uv (0, 0) is its lower-left corner, appears
+/// upright, red above blue, and its `scale` brightens it. PNG texels are sRGB-decoded.
+#[test]
+fn image_textures_read_the_image_at_s_and_one_minus_t() {
+    let dir = temp_dir("pbrt-imagemap");
+    let mut img = image::RgbImage::new(1, 2);
+    img.put_pixel(0, 0, image::Rgb([255, 0, 0]));
+    img.put_pixel(0, 1, image::Rgb([0, 0, 255]));
+    img.save(dir.join("rb.png")).unwrap();
+    let scene = |scale: f64| {
+        format!(
+            r#"
+Scale -1 1 1
+LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8 "string filename" "t.exr"
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+Texture "rb" "spectrum" "imagemap" "string filename" "rb.png" "string filter" "point" "float scale" {scale}
+Material "diffuse" "texture reflectance" "rb"
+Shape "trianglemesh" "point3 P" [-1 -1 0  1 -1 0  1 1 0  -1 1 0] "integer indices" [0 1 2  0 2 3]
+  "point2 uv" [0 0  1 0  1 1  0 1]
+"#
+        )
+    };
+    let plain = write(&dir, "plain.pbrt", &scene(1.0));
+    let film = render_file(&plain, &[], 2);
+    let (top, _) = foton_tests::region_mean(&film, 0, 0, 8, 4);
+    let (bottom, _) = foton_tests::region_mean(&film, 0, 4, 8, 8);
+    assert!(
+        top.x > 0.5 && top.z < 0.01 && bottom.z > 0.5 && bottom.x < 0.01,
+        "red above blue: top {top}, bottom {bottom}"
+    );
+    // The constant environment of radiance 1 reflected by a diffuse white is 1 (it sees
+    // only the environment): the texel's linear value times `scale`.
+    let (top, se) = foton_tests::region_mean(&film, 0, 0, 8, 4);
+    assert!((top.x - 1.0).abs() < 4.0 * se.x + 1e-3, "{top} +- {se}");
+    let bright = write(&dir, "bright.pbrt", &scene(0.5));
+    let (top, se) = foton_tests::region_mean(&render_file(&bright, &[], 2), 0, 0, 8, 4);
+    assert!((top.x - 0.5).abs() < 4.0 * se.x + 1e-3, "{top} +- {se}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// exp(-tau) through pbrt-v4's media, seen against a white environment through a cube of
+/// side 1 that holds them: a `homogeneous` absorber of sigma_a = 2 gives exp(-2); a
+/// `uniformgrid` of constant density 1 on 4 cells per axis with the same sigma_a reads zero
+/// beyond its samples (pbrt-v4's `SampledGrid`), so the density falls linearly to 1/2 over
+/// the half cell at each face it crosses, and tau = 2 (1 - cell / 4) = 1.875.
+#[test]
+fn transmittance_through_pbrt_media_is_exp_minus_tau() {
+    let dir = temp_dir("pbrt-media");
+    let scene = |medium: &str| {
+        format!(
+            r#"
+Scale -1 1 1
+LookAt 0 0 3  0 0 0  0 1 0
+Camera "perspective" "float fov" 4
+Film "rgb" "integer xresolution" 6 "integer yresolution" 6 "string filename" "m.exr"
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "volpath" "integer maxdepth" 4
+WorldBegin
+LightSource "infinite" "rgb L" [1 1 1]
+MakeNamedMedium "m" "rgb sigma_a" [2 2 2] "rgb sigma_s" [0 0 0] {medium}
+AttributeBegin
+MediumInterface "m" ""
+Material "interface"
+Shape "trianglemesh" "point3 P" [-0.5 -0.5 -0.5  0.5 -0.5 -0.5  0.5 0.5 -0.5  -0.5 0.5 -0.5
+                                -0.5 -0.5 0.5  0.5 -0.5 0.5  0.5 0.5 0.5  -0.5 0.5 0.5]
+  "integer indices" [0 3 2  0 2 1  4 5 6  4 6 7  0 1 5  0 5 4  3 7 6  3 6 2  0 4 7  0 7 3  1 2 6  1 6 5]
+AttributeEnd
+"#
+        )
+    };
+    let homogeneous = write(&dir, "h.pbrt", &scene("\"string type\" \"homogeneous\""));
+    let grid = write(
+        &dir,
+        "g.pbrt",
+        &scene(&format!(
+            "\"string type\" \"uniformgrid\" \"integer nx\" 4 \"integer ny\" 4 \"integer nz\" 4 \"float density\" [{}] \"point3 p0\" [-0.5 -0.5 -0.5] \"point3 p1\" [0.5 0.5 0.5]",
+            vec!["1"; 64].join(" ")
+        )),
+    );
+    for (file, tau) in [(&homogeneous, 2.0f32), (&grid, 1.875)] {
+        let film = render_file(file, &[], 2);
+        let (mean, se) = foton_tests::region_mean(&film, 0, 0, 6, 6);
+        let want = (-tau).exp();
+        assert!(
+            (mean.x - want).abs() < 4.0 * se.x + 2e-3 * want,
+            "{}: {mean} +- {se}, exp(-{tau}) = {want}",
+            file.display()
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

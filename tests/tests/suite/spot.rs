@@ -1,8 +1,9 @@
-//! The spot light (Mitsuba's `spot`): its falloff, its power, its photons and its light on a
-//! plane against the formulas, and path and photon mapping agreeing under it.
+//! The spot light (Mitsuba's `spot`, and pbrt-v4's with `falloff = "smoothstep"`): its
+//! falloff, its power, its photons and its light on a plane against the formulas, and path
+//! and photon mapping agreeing under it.
 
 use foton_core::Rgb;
-use foton_core::light::{Light, SpotLight, spot_falloff, spot_solid_angle};
+use foton_core::light::{Falloff, Light, SpotLight, smoothstep, spot_falloff, spot_solid_angle};
 use foton_core::sampling::Rng;
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
 use foton_tests::{header, render_toml};
@@ -10,13 +11,72 @@ use glam::{Vec2, Vec3};
 use std::f64::consts::PI;
 
 fn spot() -> Light {
+    spot_with(Falloff::Linear)
+}
+
+fn spot_with(falloff: Falloff) -> Light {
     Light::Spot(SpotLight {
         position: Vec3::new(0.0, 2.0, 0.0),
         axis: Vec3::NEG_Y,
         intensity: Rgb::new(3.0, 2.0, 1.0),
         beam_width: 15f32.to_radians(),
         cutoff: 30f32.to_radians(),
+        falloff,
     })
+}
+
+/// pbrt-v4's falloff: smoothstep(cos cutoff, cos beam width, cos theta), its power
+/// 2 pi [(1 - cos b) + (cos b - cos c) / 2] I against a quadrature of the falloff the light
+/// applies (through its light sample), and the photons' mean flux against that power.
+#[test]
+fn smoothstep_falloff_power_and_photons() {
+    let (b, c) = (15f32.to_radians(), 30f32.to_radians());
+    assert_eq!(smoothstep(0.2, 0.4, 0.1), 0.0);
+    assert_eq!(smoothstep(0.2, 0.4, 0.5), 1.0);
+    assert!((smoothstep(0.2, 0.4, 0.3) - 0.5).abs() < 1e-6);
+    assert!((smoothstep(0.0, 1.0, 0.25) - 0.15625).abs() < 1e-6);
+    assert_eq!(smoothstep(0.5, 0.5, 0.4), 0.0);
+    assert_eq!(smoothstep(0.5, 0.5, 0.5), 1.0);
+    let light = spot_with(Falloff::Smoothstep);
+    // The falloff as the light applies it: I f / d^2 at distance 1 along each angle.
+    let falloff = |theta: f64| {
+        let p =
+            Vec3::new(0.0, 2.0, 0.0) + Vec3::new(theta.sin() as f32, -(theta.cos() as f32), 0.0);
+        light.sample_li(p, Vec2::splat(0.5), 0.5).unwrap().li.x as f64 / 3.0
+    };
+    assert!((falloff(0.0) - 1.0).abs() < 1e-5);
+    assert_eq!(falloff(31f64.to_radians()), 0.0);
+    let mid = ((b.cos() + c.cos()) / 2.0).acos() as f64;
+    assert!((falloff(mid) - 0.5).abs() < 1e-3, "{}", falloff(mid));
+    let n = 100_000;
+    let quadrature: f64 = (0..n)
+        .map(|i| {
+            let theta = (i as f64 + 0.5) / n as f64 * PI / 2.0;
+            falloff(theta) * 2.0 * PI * theta.sin() * PI / 2.0 / n as f64
+        })
+        .sum();
+    let power = light.power().x as f64 / 3.0;
+    let closed = 2.0 * PI * ((1.0 - b.cos() as f64) + (b.cos() as f64 - c.cos() as f64) / 2.0);
+    assert!(
+        (power - closed).abs() < 1e-5 * closed,
+        "{power} against {closed}"
+    );
+    assert!(
+        (power - quadrature).abs() < 1e-3 * power,
+        "{power} against {quadrature}"
+    );
+    let mut rng = Rng::new(&[7]);
+    let photons = 400_000;
+    let mut sum = 0.0;
+    for _ in 0..photons {
+        let e = light.sample_emission(rng.next_2d(), rng.next_2d(), rng.next_f32());
+        sum += e.flux.x as f64 / 3.0;
+    }
+    let mean = sum / photons as f64;
+    assert!(
+        (mean - power).abs() < 5e-3 * power,
+        "{mean} against {power}"
+    );
 }
 
 /// Full intensity inside the beam, none past the cutoff, linear in the angle between.

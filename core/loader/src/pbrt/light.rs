@@ -1,5 +1,7 @@
 //! `LightSource` into `[[lights]]` (lights.cpp): `point` (`I`, `from`, `scale`, `power`),
-//! `distant` (`L`, `from`, `to`, `scale`, `illuminance`) and `infinite` with a constant `L`
+//! `spot` (`I`, `from`, `to`, `coneangle`, `conedeltaangle`, `scale`, `power`; foton's spot
+//! with pbrt-v4's smoothstep falloff), `distant` (`L`, `from`, `to`, `scale`, `illuminance`)
+//! and `infinite` with a constant `L`
 //! (`scale`, `illuminance`). Each light's spectrum is normalised to luminance 1 (`spectra`),
 //! so an `rgb` is its own colour and `scale` the rest; `power` is the power of the light as
 //! if its colour were white, as pbrt-v4 computes it.
@@ -78,7 +80,47 @@ impl Reader {
                 entries.push(("type", self.string("constant", &loc)));
                 entries.push(("radiance", self.vec3(l * scale, &loc)));
             }
-            other @ ("spot" | "goniometric" | "projection") => {
+            "spot" => {
+                let i = spectrum(self, &mut p, "I")?;
+                let mut scale = p.float("scale", 1.0)?;
+                let cone = p.float("coneangle", 30.0)?;
+                let delta = p.float("conedeltaangle", 5.0)?;
+                if !(cone > 0.0 && cone <= 90.0) {
+                    return Err(loc.error(
+                        &what,
+                        format!("\"coneangle\" {cone}: foton's spot lights take (0, 90] degrees"),
+                    ));
+                }
+                if !(0.0..=cone).contains(&delta) {
+                    return Err(loc.error(
+                        &what,
+                        format!(
+                            "\"conedeltaangle\" {delta}: expected within [0, coneangle = {cone}]"
+                        ),
+                    ));
+                }
+                let (cos_end, cos_start) =
+                    (cone.to_radians().cos(), (cone - delta).to_radians().cos());
+                if let Some((phi, _)) = p.float_opt("power")?
+                    && phi > 0.0
+                {
+                    scale *= phi / (2.0 * PI * ((1.0 - cos_start) + (cos_start - cos_end) / 2.0));
+                }
+                let from = point(&mut p, "from", DVec3::ZERO)?;
+                let to = point(&mut p, "to", DVec3::Z)?;
+                let axis = m.transform_vector3(to - from);
+                if axis.length_squared() == 0.0 {
+                    return Err(loc.error(&what, "\"from\" and \"to\" coincide: no direction"));
+                }
+                entries.push(("type", self.string("spot", &loc)));
+                entries.push(("position", self.vec3(m.transform_point3(from), &loc)));
+                entries.push(("direction", self.vec3(axis.normalize(), &loc)));
+                entries.push(("intensity", self.vec3(i * scale, &loc)));
+                entries.push(("cutoff_angle", self.num(cone, &loc)));
+                entries.push(("beam_width", self.num(cone - delta, &loc)));
+                entries.push(("falloff", self.string("smoothstep", &loc)));
+            }
+            other @ ("goniometric" | "projection") => {
                 return self.unsupported(
                     &loc,
                     &what,
@@ -90,6 +132,13 @@ impl Reader {
             }
         }
         self.finish(&mut p)?;
+        let positional = matches!(d.string(0), "point" | "spot");
+        if positional && !self.state.outside.is_empty() {
+            let outside = self.state.outside.clone();
+            let at = self.state.interface.clone().unwrap_or(loc.clone());
+            let key = self.medium_ref(&outside, &at);
+            entries.push(("medium", self.string(&key, &loc)));
+        }
         let light = self.table(entries, &loc);
         self.lights.push(light);
         Ok(())

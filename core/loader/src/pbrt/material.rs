@@ -7,6 +7,7 @@
 use super::params::Bag;
 use super::parse::{Directive, Type, Values};
 use super::spectra::{Kind, rgb};
+use super::texture::Tex;
 use super::{Loc, Reader, table_mut};
 use foton_core::error::Result;
 use foton_core::value::Node;
@@ -40,8 +41,8 @@ impl Reader {
             "diffuse" => {
                 let c = self.colour(&mut p, "reflectance", Kind::Albedo, &what)?;
                 entries.push(("type", self.string("diffuse", &loc)));
-                if let Some((c, l)) = c {
-                    entries.push(("reflectance", self.vec3(c, &l)));
+                if let Some(c) = c {
+                    entries.push(("reflectance", c));
                 } else {
                     entries.push(("reflectance", self.vec3(glam::DVec3::splat(0.5), &loc)));
                 }
@@ -162,29 +163,22 @@ impl Reader {
         Ok(true)
     }
 
-    /// A colour parameter: a spectrum, an rgb or a float grey; a texture is refused.
-    fn colour(
-        &mut self,
-        p: &mut Bag,
-        name: &str,
-        kind: Kind,
-        what: &str,
-    ) -> Result<Option<(glam::DVec3, Loc)>> {
+    /// A colour parameter that may vary: a spectrum, an rgb or a float grey as an RGB
+    /// array, or a texture (`"texture NAME" "tex"`) as its constant or its foton texture
+    /// table. None: absent, or a texture left out (`lenient`).
+    fn colour(&mut self, p: &mut Bag, name: &str, kind: Kind, what: &str) -> Result<Option<Node>> {
         let Some(q) = p.take(name) else {
             return Ok(None);
         };
         if q.ty == Type::Texture {
-            self.unsupported(
-                &q.loc,
-                what,
-                &format!(
-                    "{}: textures are not read yet (--lenient: the default colour)",
-                    q.decl()
-                ),
-            )?;
-            return Ok(None);
+            return Ok(match self.named_texture(&q, false, what)? {
+                Some(Tex::Constant(c)) => Some(self.vec3(c, &q.loc)),
+                Some(Tex::Table(t)) => Some(t),
+                None => None,
+            });
         }
-        Ok(Some((rgb(&q, kind, what, &self.dir)?, q.loc)))
+        let c = rgb(&q, kind, what, &self.dir)?;
+        Ok(Some(self.vec3(c, &q.loc)))
     }
 
     /// pbrt-v4's roughness parameters as GGX alphas (None: smooth).

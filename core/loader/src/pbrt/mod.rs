@@ -28,12 +28,14 @@ mod camera;
 mod lexer;
 mod light;
 mod material;
+mod medium;
 mod params;
 mod parse;
 mod shape;
 mod spectra;
 #[cfg(test)]
 mod tests;
+mod texture;
 
 use crate::reader::{Options, Report};
 use foton_core::error::{Error, Location, Result};
@@ -104,6 +106,12 @@ struct State {
     material: Option<String>,
     /// The current `AreaLightSource`, given to the shapes that follow.
     area_light: Option<Directive>,
+    /// The current `MediumInterface`: the media inside and outside the shapes that follow
+    /// (`""`: vacuum); the outside one is where the camera and the lights sit.
+    inside: String,
+    outside: String,
+    /// Where that `MediumInterface` was written.
+    interface: Option<Loc>,
 }
 
 /// A shape statement of an `ObjectBegin` block, with the state it was read in.
@@ -141,6 +149,16 @@ struct Reader {
     object: Option<(String, Vec<Recorded>)>,
     /// Whether the note on plymesh orientation was given (once a scene).
     ply_noted: bool,
+    /// `Texture` names (spectrum and float textures are named apart, as in pbrt-v4).
+    textures: HashMap<String, texture::Tex>,
+    float_textures: HashMap<String, texture::Tex>,
+    /// `MakeNamedMedium` names to their keys in `[media]`; those left out (`lenient`); the
+    /// names used, checked at the end (a medium may be made after its use).
+    named_media: HashMap<String, String>,
+    left_out_media: std::collections::HashSet<String>,
+    medium_refs: Vec<(String, Loc)>,
+    /// The outside medium at `Camera`.
+    camera_medium: Option<(String, Loc)>,
 }
 
 impl Reader {
@@ -158,6 +176,9 @@ impl Reader {
                 reverse_orientation: false,
                 material: None,
                 area_light: None,
+                inside: String::new(),
+                outside: String::new(),
+                interface: None,
             },
             stack: Vec::new(),
             transforms: Vec::new(),
@@ -173,6 +194,12 @@ impl Reader {
             objects: HashMap::new(),
             object: None,
             ply_noted: false,
+            textures: HashMap::new(),
+            float_textures: HashMap::new(),
+            named_media: HashMap::new(),
+            left_out_media: Default::default(),
+            medium_refs: Vec::new(),
+            camera_medium: None,
         }
     }
 
@@ -343,6 +370,10 @@ impl Reader {
                 self.named_coordinates
                     .insert("camera".into(), ctm.inverse());
                 self.camera = Some((d.clone(), ctm));
+                self.camera_medium = (!self.state.outside.is_empty()).then(|| {
+                    let at = self.state.interface.clone().unwrap_or(d.loc.clone());
+                    (self.state.outside.clone(), at)
+                });
             }
             "Film" => self.film = Some(d.clone()),
             "Sampler" => self.sampler = Some(d.clone()),
@@ -450,22 +481,17 @@ impl Reader {
                     self.shape(&shape, &state)?;
                 }
             }
-            "Texture" => self.unsupported(
-                &d.loc,
-                &format!("Texture {:?} {:?}", d.string(0), d.string(2)),
-                "textures are not read yet",
-            )?,
-            "MakeNamedMedium" => {
-                self.unsupported(&d.loc, &d.what(), "participating media are not read yet")?
-            }
+            "Texture" => self.texture(d)?,
+            "MakeNamedMedium" => self.medium(d)?,
             "MediumInterface" => {
-                if d.args.iter().any(|a| *a != parse::Arg::Str(String::new())) {
-                    self.unsupported(
-                        &d.loc,
-                        "MediumInterface",
-                        "participating media are not read yet",
-                    )?;
-                }
+                // One name: the same medium on both sides.
+                self.state.inside = d.string(0).to_string();
+                self.state.outside = if d.args.len() > 1 {
+                    d.string(1).to_string()
+                } else {
+                    d.string(0).to_string()
+                };
+                self.state.interface = Some(d.loc.clone());
             }
             "Attribute" => {
                 self.unsupported(&d.loc, &d.what(), "attribute defaults are not read yet")?
@@ -543,6 +569,12 @@ impl Reader {
             ));
         }
         self.scene_wide()?;
+        if let Some((name, loc)) = self.camera_medium.take() {
+            let key = self.medium_ref(&name, &loc);
+            let node = self.string(&key, &loc);
+            table_mut(&mut self.root, "camera").insert("medium", node);
+        }
+        self.check_medium_refs()?;
         let mut root = std::mem::take(&mut self.root);
         if !self.shapes.is_empty() {
             root.insert(

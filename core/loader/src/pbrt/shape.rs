@@ -152,6 +152,7 @@ impl Reader {
         }
         let material = self.current_material(state);
         entries.push(("material", self.string(&material, &loc)));
+        entries.extend(self.medium_sides(state, &loc));
         let shape = self.table(entries, &loc);
         self.shapes.push(shape);
         Ok(())

@@ -301,6 +301,35 @@ fn lights_point_distant_infinite() {
 }
 
 #[test]
+fn spot_lights_keep_pbrts_cone_and_smoothstep_and_power() {
+    let t = doc(
+        "WorldBegin\nTranslate 0 1 0\nLightSource \"spot\" \"rgb I\" [1 2 3] \"point3 from\" [0 2 0] \"point3 to\" [1 2 0] \"float coneangle\" 40 \"float conedeltaangle\" 10\n\
+         LightSource \"spot\" \"float power\" 50\n",
+    );
+    assert_eq!(text(&t, "lights.0.type"), "spot");
+    assert_eq!(text(&t, "lights.0.falloff"), "smoothstep");
+    assert!(close(&nums(&t, "lights.0.position"), &[0.0, 3.0, 0.0]));
+    assert!(close(&nums(&t, "lights.0.direction"), &[1.0, 0.0, 0.0]));
+    assert!(close(&nums(&t, "lights.0.intensity"), &[1.0, 2.0, 3.0]));
+    assert_eq!(num(&t, "lights.0.cutoff_angle"), 40.0);
+    assert_eq!(num(&t, "lights.0.beam_width"), 30.0);
+    // pbrt-v4's defaults (cone 30, delta 5, along +z) and `power` over the smoothstep cone.
+    assert!(close(&nums(&t, "lights.1.direction"), &[0.0, 0.0, 1.0]));
+    let (e, s) = (30f64.to_radians().cos(), 25f64.to_radians().cos());
+    let i = 50.0 / (2.0 * std::f64::consts::PI * ((1.0 - s) + (s - e) / 2.0));
+    assert!(close(&nums(&t, "lights.1.intensity"), &[i, i, i]));
+    let e = read(
+        "WorldBegin\nLightSource \"spot\" \"float coneangle\" 120\n",
+        false,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:2:1") && e.contains("coneangle"),
+        "{e}"
+    );
+}
+
+#[test]
 fn unsupported_is_an_error_or_left_out_with_lenient() {
     let text = format!(
         "{WORLD}Shape \"curve\" \"point3 P\" [0 0 0 1 1 1 2 2 2 3 3 3]\nShape \"sphere\" \"float radius\" 1 \"float bogus\" 2\n"
@@ -369,4 +398,157 @@ fn plymesh_reads_ply_and_ply_gz_and_inline_meshes_build() {
     let near = |a: f32, b: f32| (a - b).abs() < 1e-3;
     assert!(near(lo.z, 2.0) && near(hi.z, 4.0), "{lo} {hi}");
     assert!(near(hi.x, 3.0) && near(hi.y, 3.0), "{lo} {hi}");
+}
+
+#[test]
+fn textures_map_to_foton_textures_with_pbrts_uv_conventions() {
+    let t = doc(&format!(
+        "{WORLD}Texture \"wood\" \"spectrum\" \"imagemap\" \"string filename\" \"wood.png\" \"float uscale\" 2 \"float vscale\" 3 \"float udelta\" 0.5 \"float vdelta\" 0.25 \"string filter\" \"point\" \"string wrap\" \"clamp\"\n\
+         Texture \"bright\" \"spectrum\" \"scale\" \"texture tex\" \"wood\" \"float scale\" 2\n\
+         Texture \"lin\" \"spectrum\" \"imagemap\" \"string filename\" \"a.exr\"\n\
+         Texture \"checks\" \"spectrum\" \"checkerboard\" \"float uscale\" 4 \"float vscale\" 8 \"rgb tex1\" [1 0 0] \"rgb tex2\" [0 0 1]\n\
+         Texture \"k\" \"spectrum\" \"constant\" \"rgb value\" [0.1 0.2 0.3]\n\
+         Texture \"half\" \"float\" \"constant\" \"float value\" 0.25\n\
+         Texture \"m\" \"spectrum\" \"mix\" \"texture tex1\" \"k\" \"rgb tex2\" [1 1 1] \"texture amount\" \"half\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"wood\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"bright\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"lin\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"checks\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"k\"\nShape \"sphere\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"m\"\nShape \"sphere\"\n"
+    ));
+    let r = |i: usize| format!("materials.material_{i}.reflectance");
+    assert_eq!(text(&t, &format!("{}.type", r(1))), "bitmap");
+    assert_eq!(text(&t, &format!("{}.filename", r(1))), "wood.png");
+    assert_eq!(text(&t, &format!("{}.filter_type", r(1))), "nearest");
+    assert_eq!(text(&t, &format!("{}.wrap_mode", r(1))), "clamp");
+    assert!(!has(&t, &format!("{}.raw", r(1))), "PNG: sRGB-decoded");
+    // st = (2u + 0.5, 3v + 0.25), read at (s, 1 - t).
+    assert!(close(
+        &nums(&t, &format!("{}.to_uv.matrix", r(1))),
+        &[2.0, 0.0, 0.5, 0.0, -3.0, 0.75, 0.0, 0.0, 1.0]
+    ));
+    assert!(close(
+        &nums(&t, &format!("{}.scale", r(2))),
+        &[2.0, 2.0, 2.0]
+    ));
+    assert!(
+        matches!(node(&t, &format!("{}.raw", r(3))).value, Value::Bool(true)),
+        "EXR: linear"
+    );
+    assert_eq!(text(&t, &format!("{}.type", r(4))), "checkerboard");
+    assert!(close(
+        &nums(&t, &format!("{}.color0", r(4))),
+        &[1.0, 0.0, 0.0]
+    ));
+    assert!(close(
+        &nums(&t, &format!("{}.to_uv.matrix", r(4))),
+        &[2.0, 0.0, 0.0, 0.0, 4.0, 0.0, 0.0, 0.0, 1.0]
+    ));
+    assert!(close(&nums(&t, &r(5)), &[0.1, 0.2, 0.3]));
+    assert!(close(&nums(&t, &r(6)), &[0.325, 0.4, 0.475]));
+}
+
+#[test]
+fn textures_foton_cannot_render_are_errors_or_left_out() {
+    let text = format!(
+        "{WORLD}Texture \"r\" \"float\" \"imagemap\" \"string filename\" \"r.png\"\n\
+         Texture \"n\" \"spectrum\" \"fbm\"\n\
+         Material \"diffuse\" \"texture reflectance\" \"n\"\nShape \"sphere\"\n"
+    );
+    let e = read(&text, false).unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3:1") && e.contains("float imagemap"),
+        "{e}"
+    );
+    let (d, report) = read(&text, true).unwrap();
+    assert_eq!(report.left_out.len(), 3, "{:?}", report.left_out);
+    assert!(
+        report.left_out[2].contains("no spectrum texture named \"n\""),
+        "{:?}",
+        report.left_out
+    );
+    // The material stands, with its default reflectance.
+    assert!(close(
+        &nums(&d.root, "materials.material_1.reflectance"),
+        &[0.5, 0.5, 0.5]
+    ));
+    let e = read(
+        &format!("{WORLD}Texture \"x\" \"spectrum\" \"plaid\"\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("unknown texture class \"plaid\""), "{e}");
+    let e = read(
+        &format!("{WORLD}Material \"diffuse\" \"texture reflectance\" \"nope\"\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3") && e.contains("no spectrum texture named \"nope\""),
+        "{e}"
+    );
+}
+
+#[test]
+fn media_and_medium_interfaces() {
+    let t = doc(
+        "MakeNamedMedium \"air\" \"string type\" \"homogeneous\" \"rgb sigma_a\" [0.1 0.2 0.3] \"float scale\" 2 \"float g\" 0.5\n\
+         MediumInterface \"\" \"air\"\nLookAt 0 0 5  0 0 0  0 1 0\nCamera \"perspective\"\nWorldBegin\n\
+         LightSource \"point\" \"rgb I\" [1 1 1]\n\
+         MakeNamedMedium \"smoke\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"integer ny\" 1 \"integer nz\" 1 \"float density\" [1 3] \"point3 p0\" [0 0 0] \"point3 p1\" [2 1 1] \"rgb sigma_a\" [1 1 1] \"rgb sigma_s\" [3 3 3]\n\
+         AttributeBegin\nMediumInterface \"smoke\" \"air\"\nMaterial \"interface\"\nShape \"sphere\"\nAttributeEnd\n\
+         Shape \"sphere\"\nMediumInterface \"air\"\nShape \"sphere\"\n",
+    );
+    assert_eq!(text(&t, "camera.medium"), "air");
+    assert_eq!(text(&t, "lights.0.medium"), "air");
+    assert_eq!(text(&t, "media.air.type"), "homogeneous");
+    assert!(close(&nums(&t, "media.air.sigma_a"), &[0.2, 0.4, 0.6]));
+    assert!(close(&nums(&t, "media.air.sigma_s"), &[2.0, 2.0, 2.0]));
+    assert_eq!(num(&t, "media.air.phase.g"), 0.5);
+    assert_eq!(text(&t, "shapes.0.interior"), "smoke");
+    assert_eq!(text(&t, "shapes.0.exterior"), "air");
+    // The interface in effect at the camera (vacuum inside, air outside) is a transition
+    // too; a single name is none.
+    assert_eq!(text(&t, "shapes.1.interior"), "vacuum");
+    assert!(!has(&t, "shapes.2.interior"));
+    assert_eq!(text(&t, "media.smoke.type"), "heterogeneous");
+    assert!(close(&nums(&t, "media.smoke.sigma_t"), &[4.0, 4.0, 4.0]));
+    assert!(close(&nums(&t, "media.smoke.albedo"), &[0.75, 0.75, 0.75]));
+    // A border of zeros, one cell wide: 4 x 3 x 3 samples, the two given in the middle.
+    assert!(close(
+        &nums(&t, "media.smoke.density.resolution"),
+        &[4.0, 3.0, 3.0]
+    ));
+    let v = nums(&t, "media.smoke.density.values");
+    assert_eq!(v.len(), 36);
+    assert_eq!((v[12 + 4 + 1], v[12 + 4 + 2]), (1.0, 3.0));
+    assert_eq!(v.iter().sum::<f64>(), 4.0);
+    // The unit cube onto [-1, 3] x [-1, 2] x [-1, 2]: the box grown by one cell per side.
+    assert!(close(
+        &nums(&t, "media.smoke.density.transform.matrix"),
+        &[
+            4.0, 0.0, 0.0, -1.0, 0.0, 3.0, 0.0, -1.0, 0.0, 0.0, 3.0, -1.0, 0.0, 0.0, 0.0, 1.0
+        ]
+    ));
+    let e = read(
+        &format!("{WORLD}MediumInterface \"fog\" \"\"\nShape \"sphere\"\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(
+        e.contains("scene.pbrt:3:1") && e.contains("no medium named \"fog\""),
+        "{e}"
+    );
+    let cloud = format!(
+        "{WORLD}MakeNamedMedium \"c\" \"string type\" \"cloud\"\nMediumInterface \"c\" \"\"\nShape \"sphere\"\n"
+    );
+    assert!(
+        read(&cloud, false)
+            .unwrap_err()
+            .contains("the cloud medium")
+    );
+    let (d, report) = read(&cloud, true).unwrap();
+    assert_eq!(report.left_out.len(), 1, "{:?}", report.left_out);
+    assert_eq!(text(&d.root, "shapes.0.interior"), "vacuum");
 }

@@ -1,0 +1,295 @@
+//! `MakeNamedMedium` into `[media.NAME]` and `MediumInterface` into the media on either side
+//! of the shapes that follow, the camera's and the lights' media (media.cpp, scene.cpp).
+//!
+//! `homogeneous` (`sigma_a`, `sigma_s`, default 1 each, times `scale`; `g`) is foton's
+//! `homogeneous` medium with a Henyey-Greenstein phase function. `uniformgrid` (`density`,
+//! `nx`, `ny`, `nz`, `p0`, `p1`, `sigma_a`, `sigma_s`, `scale`, `g`) is foton's
+//! `heterogeneous` medium: sigma_t = (sigma_a + sigma_s) scale, albedo = sigma_s /
+//! (sigma_a + sigma_s), and the density grid placed by the medium's transform (the current transform
+//! at `MakeNamedMedium`) over the box [p0, p1]. pbrt-v4's `SampledGrid` has its samples at
+//! the cells' centres and reads zero beyond them (a lookup between the outermost samples and
+//! the box's faces falls towards zero), so the grid is written with a border of zero samples
+//! one cell wide: inside the box it reads as pbrt-v4's does. (pbrt-v4 also clips the medium
+//! to the box; here the half cell outside it keeps what the border interpolates to, which
+//! matters only where the medium's boundary shape is larger than its box.)
+//!
+//! A shape whose `MediumInterface` names two different media (inside, outside; `""` is
+//! vacuum) is a medium transition: its `interior` and `exterior`. pbrt-v4 ignores an
+//! interface that is no transition (a ray keeps the medium it is in), and so does foton: such
+//! a shape has no media of its own. The camera and the point and spot lights sit in the
+//! outside medium current at their statement.
+
+use super::params::Bag;
+use super::parse::{Directive, Type, Values};
+use super::spectra::{Kind, rgb};
+use super::{Loc, Reader, table_mut, vec};
+use foton_core::error::Result;
+use foton_core::value::{Node, Value};
+use glam::{DMat4, DVec3};
+
+impl Reader {
+    /// `MakeNamedMedium "name" "string type" ...`.
+    pub(super) fn medium(&mut self, d: &Directive) -> Result<()> {
+        let name = d.string(0).to_string();
+        let mut p = Bag::new(d);
+        let loc = d.loc.clone();
+        let (ty, tloc) = p
+            .string_opt("type")?
+            .ok_or_else(|| loc.error(&d.what(), "missing \"string type\""))?;
+        let what = format!("MakeNamedMedium {name:?} (type {ty:?})");
+        p.what = what.clone();
+        let key = medium_key(&name);
+        if let Some(other) = self
+            .named_media
+            .iter()
+            .find(|(n, k)| **k == key && **n != name)
+        {
+            return Err(loc.error(
+                &what,
+                format!(
+                    "its name and {:?} are the same TOML key {key:?}: rename one",
+                    other.0
+                ),
+            ));
+        }
+        let coefficients = |r: &Reader, p: &mut Bag| -> Result<(DVec3, DVec3, f64)> {
+            let mut sigma = |n: &str| -> Result<DVec3> {
+                match p.take(n) {
+                    Some(q) => rgb(&q, Kind::Unbounded, &what, &r.dir),
+                    None => Ok(DVec3::ONE),
+                }
+            };
+            let (sa, ss) = (sigma("sigma_a")?, sigma("sigma_s")?);
+            let scale = p.float("scale", 1.0)?;
+            if scale < 0.0 {
+                return Err(loc.error(&what, format!("\"scale\" {scale}: must not be negative")));
+            }
+            let g = p.float("g", 0.0)?;
+            if g.abs() >= 1.0 {
+                return Err(loc.error(&what, format!("\"g\" {g}: must be within (-1, 1)")));
+            }
+            Ok((sa * scale, ss * scale, g))
+        };
+        let mut entries: Vec<(&str, Node)> = Vec::new();
+        match ty.as_str() {
+            "homogeneous" => {
+                if let Some((preset, l)) = p.string_opt("preset")? {
+                    // pbrt-v4 warns and goes on with the coefficients given (or 1) when it
+                    // does not know a preset; foton does not carry the measured tables yet.
+                    self.unsupported(&l, &what, &format!("\"preset\" {preset:?}: the measured media (GetMediumScatteringProperties) are not carried yet (--lenient: sigma_a and sigma_s as given, 1 by default)"))?;
+                }
+                self.emission(&mut p, &what, &["Le", "Lescale"])?;
+                let (sa, ss, g) = coefficients(self, &mut p)?;
+                entries.push(("type", self.string("homogeneous", &loc)));
+                entries.push(("sigma_a", self.vec3(sa, &loc)));
+                entries.push(("sigma_s", self.vec3(ss, &loc)));
+                if g != 0.0 {
+                    entries.push(("phase", self.phase(g, &loc)));
+                }
+            }
+            "uniformgrid" => {
+                let (density, dloc) = p.numbers("density", &[Type::Float])?.ok_or_else(|| {
+                    loc.error(&what, "missing \"float density\" (nx ny nz values)")
+                })?;
+                let n = [p.int("nx", 1)?, p.int("ny", 1)?, p.int("nz", 1)?];
+                if n.iter().any(|x| *x < 1) {
+                    return Err(loc.error(
+                        &what,
+                        format!("\"nx\", \"ny\", \"nz\" {n:?}: must be positive"),
+                    ));
+                }
+                let n = n.map(|x| x as usize);
+                if density.len() != n[0] * n[1] * n[2] {
+                    return Err(dloc.error(
+                        &what,
+                        format!(
+                            "\"density\" has {} values; expected nx ny nz = {} x {} x {} = {}",
+                            density.len(),
+                            n[0],
+                            n[1],
+                            n[2],
+                            n[0] * n[1] * n[2]
+                        ),
+                    ));
+                }
+                self.emission(
+                    &mut p,
+                    &what,
+                    &[
+                        "Le",
+                        "Lescale",
+                        "temperature",
+                        "temperatureoffset",
+                        "temperaturecutoff",
+                        "temperaturescale",
+                    ],
+                )?;
+                let corner = |p: &mut Bag, k: &str, default: DVec3| -> Result<DVec3> {
+                    Ok(p.numbers(k, &[Type::Point3])?
+                        .map_or(default, |(v, _)| vec(&v)))
+                };
+                let p0 = corner(&mut p, "p0", DVec3::ZERO)?;
+                let p1 = corner(&mut p, "p1", DVec3::ONE)?;
+                let size = p1 - p0;
+                if size.min_element() <= 0.0 {
+                    return Err(loc.error(&what, "\"p1\" must exceed \"p0\" on every axis"));
+                }
+                let (sa, ss, g) = coefficients(self, &mut p)?;
+                let sigma_t = sa + ss;
+                let albedo = DVec3::select(sigma_t.cmpgt(DVec3::ZERO), ss / sigma_t, DVec3::ZERO);
+                // The grid with a border of zeros: (n + 2) samples per axis at the centres
+                // of cells of the same size, the first one a cell before p0.
+                let padded = n.map(|x| x + 2);
+                let mut values = vec![0.0; padded[0] * padded[1] * padded[2]];
+                for z in 0..n[2] {
+                    for y in 0..n[1] {
+                        for x in 0..n[0] {
+                            let to = ((z + 1) * padded[1] + y + 1) * padded[0] + x + 1;
+                            values[to] = density[(z * n[1] + y) * n[0] + x];
+                        }
+                    }
+                }
+                let cell = size / DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
+                let grid_box =
+                    DMat4::from_translation(p0 - cell) * DMat4::from_scale(size + 2.0 * cell);
+                let medium_from_unit = self.state.ctm * grid_box;
+                let resolution = padded.iter().map(|x| self.num(*x as f64, &loc)).collect();
+                let values = values.iter().map(|x| self.num(*x, &dloc)).collect();
+                let grid = self.table(
+                    vec![
+                        ("resolution", self.node(Value::Array(resolution), &loc)),
+                        ("values", self.node(Value::Array(values), &dloc)),
+                        ("transform", self.matrix(medium_from_unit, &loc)),
+                        ("samples", self.string("centres", &loc)),
+                        ("outside", self.string("zero", &loc)),
+                    ],
+                    &loc,
+                );
+                entries.push(("type", self.string("heterogeneous", &loc)));
+                entries.push(("sigma_t", self.vec3(sigma_t, &loc)));
+                entries.push(("albedo", self.vec3(albedo, &loc)));
+                entries.push(("density", grid));
+                if g != 0.0 {
+                    entries.push(("phase", self.phase(g, &loc)));
+                }
+            }
+            other @ ("rgbgrid" | "cloud" | "nanovdb") => {
+                self.unsupported(
+                    &tloc,
+                    &what,
+                    &format!(
+                        "the {other} medium is not read yet (--lenient: vacuum where it is named)"
+                    ),
+                )?;
+                self.left_out_media.insert(name);
+                p.rest();
+                return Ok(());
+            }
+            other => {
+                return Err(tloc.error(&what, format!("unknown medium type {other:?}; pbrt-v4 has homogeneous, uniformgrid, rgbgrid, cloud and nanovdb")));
+            }
+        }
+        self.finish(&mut p)?;
+        let t = self.table(entries, &loc);
+        table_mut(&mut self.root, "media").insert(&key, t);
+        self.named_media.insert(name, key);
+        Ok(())
+    }
+
+    /// Emission parameters of a medium: refused (foton's media do not emit yet), unless zero.
+    fn emission(&mut self, p: &mut Bag, what: &str, names: &[&str]) -> Result<()> {
+        for n in names {
+            if let Some(q) = p.take(n) {
+                let zero = matches!(&q.values, Values::Nums(v) if v.iter().all(|x| *x == 0.0));
+                let scale_only =
+                    n.ends_with("scale") || n.ends_with("offset") || n.ends_with("cutoff");
+                if !zero && !scale_only {
+                    self.unsupported(
+                        &q.loc,
+                        what,
+                        &format!("{}: emitting media are not read yet", q.decl()),
+                    )?;
+                }
+            }
+        }
+        Ok(())
+    }
+
+    fn phase(&self, g: f64, loc: &Loc) -> Node {
+        self.table(
+            vec![("type", self.string("hg", loc)), ("g", self.num(g, loc))],
+            loc,
+        )
+    }
+
+    /// The `[media]` key of a medium named in a `MediumInterface` (`""`: vacuum), the
+    /// reference kept to be checked once the whole scene is read.
+    pub(super) fn medium_ref(&mut self, name: &str, loc: &Loc) -> String {
+        if name.is_empty() || self.left_out_media.contains(name) {
+            return "vacuum".into();
+        }
+        self.medium_refs.push((name.to_string(), loc.clone()));
+        medium_key(name)
+    }
+
+    /// Every medium named was made (pbrt-v4 allows a `MakeNamedMedium` after its use).
+    pub(super) fn check_medium_refs(&mut self) -> Result<()> {
+        for (name, loc) in std::mem::take(&mut self.medium_refs) {
+            if !self.named_media.contains_key(&name) {
+                let mut made: Vec<&str> = self.named_media.keys().map(String::as_str).collect();
+                made.sort_unstable();
+                return Err(loc.error(
+                    "MediumInterface",
+                    format!(
+                        "no medium named {name:?} (MakeNamedMedium makes one); made: {}",
+                        if made.is_empty() {
+                            "none".into()
+                        } else {
+                            made.join(", ")
+                        }
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+
+    /// A shape's `interior` and `exterior` when its medium interface is a transition.
+    pub(super) fn medium_sides(
+        &mut self,
+        state: &super::State,
+        loc: &Loc,
+    ) -> Vec<(&'static str, Node)> {
+        if state.inside == state.outside {
+            return Vec::new();
+        }
+        let (inside, outside) = (state.inside.clone(), state.outside.clone());
+        let at = state.interface.as_ref().unwrap_or(loc);
+        let i = self.medium_ref(&inside, at);
+        let o = self.medium_ref(&outside, at);
+        vec![
+            ("interior", self.string(&i, loc)),
+            ("exterior", self.string(&o, loc)),
+        ]
+    }
+}
+
+/// A medium's key in `[media]`: its name made a plain TOML key (`vacuum` is foton's name for
+/// no medium).
+fn medium_key(name: &str) -> String {
+    let key: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    match key.as_str() {
+        "" => "medium".into(),
+        "vacuum" => "vacuum_".into(),
+        _ => key,
+    }
+}
