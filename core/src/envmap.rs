@@ -22,6 +22,13 @@
 //! of non-zero radiance lies in a cell of non-zero weight, so light sampling alone (photons)
 //! is unbiased. Mitsuba samples the same cells with a piecewise-bilinear density in (u, v)
 //! instead; the images agree, the noise differs a little.
+//!
+//! pbrt-v4's layout ([`EnvironmentMap::equal_area`], its `ImageInfiniteLight`): the image
+//! is Clarberg's equal-area octahedral map of the sphere, a direction d in the map's frame
+//! at ([`sphere_to_square`]) (u, v) in [0, 1]^2 with row 0 the image's top row, the radiance
+//! that of the texel the point falls in (no interpolation: pbrt-v4's `LookupNearest`). Every
+//! texel covers the same solid angle, 4 pi / (width height), so a texel drawn by luminance
+//! and a point uniform in it give the density p(texel) width height / (4 pi).
 
 use crate::Rgb;
 use crate::sampling::Distribution2D;
@@ -41,8 +48,10 @@ pub struct EnvironmentMap {
     /// Over the (u - 1/(2 width), v) square, cell (i, j) between texel centres (i, j) and
     /// (i + 1, j + 1).
     distribution: Distribution2D,
-    /// cos theta of the rows of texel centres, top to bottom.
+    /// cos theta of the rows of texel centres, top to bottom (latitude-longitude); empty
+    /// for the equal-area layout, whose distribution is over its texels.
     cos_rows: Vec<f32>,
+    equal_area: bool,
     /// The integral of the radiance over the sphere of directions (W/m^2).
     integral: Rgb,
 }
@@ -114,6 +123,7 @@ impl EnvironmentMap {
         Ok(EnvironmentMap {
             distribution: Distribution2D::new(&weights, w, h - 1),
             cos_rows: (0..h).map(|j| cos_row(j) as f32).collect(),
+            equal_area: false,
             bitmap,
             scale,
             to_world,
@@ -122,15 +132,51 @@ impl EnvironmentMap {
         })
     }
 
+    /// The map of an image in pbrt-v4's equal-area octahedral layout, as [`Self::new`]
+    /// otherwise.
+    pub fn equal_area(
+        bitmap: &Bitmap,
+        scale: f32,
+        to_world: Mat3,
+    ) -> Result<EnvironmentMap, String> {
+        let mut map = EnvironmentMap::new(
+            &Bitmap::new(1, 1, vec![Rgb::ONE]).expect("1 x 1"),
+            scale,
+            to_world,
+        )?;
+        let texels: Vec<Rgb> = bitmap.texels().iter().map(|c| c.max(Rgb::ZERO)).collect();
+        let (w, h) = (bitmap.width(), bitmap.height());
+        let weights: Vec<f32> = texels.iter().map(|&c| luminance(c)).collect();
+        let sum: glam::DVec3 = texels.iter().map(|c| c.as_dvec3()).sum();
+        map.integral = (sum * (4.0 * PI64 / (w * h) as f64) * scale as f64).as_vec3();
+        map.distribution = Distribution2D::new(&weights, w, h);
+        map.bitmap = Bitmap::new(w, h, texels).expect("same size");
+        map.cos_rows = Vec::new();
+        map.equal_area = true;
+        Ok(map)
+    }
+
     /// Radiance arriving from direction `dir` (towards the environment, world space).
     #[inline]
     pub fn eval(&self, dir: Vec3) -> Rgb {
         let d = (self.from_world * dir).normalize_or_zero();
+        if self.equal_area {
+            return self.eval_texel(sphere_to_square(d));
+        }
         let uv = Vec2::new(
             d.x.atan2(-d.z) * (0.5 / PI),
             d.y.clamp(-1.0, 1.0).acos() * (1.0 / PI),
         );
         self.eval_uv(uv)
+    }
+
+    /// The texel the point `uv` of the equal-area square falls in.
+    #[inline]
+    fn eval_texel(&self, uv: Vec2) -> Rgb {
+        let (w, h) = (self.bitmap.width(), self.bitmap.height());
+        let x = ((uv.x * w as f32) as usize).min(w - 1);
+        let y = ((uv.y * h as f32) as usize).min(h - 1);
+        self.scale * self.bitmap.texel(x, y)
     }
 
     #[inline]
@@ -148,6 +194,11 @@ impl EnvironmentMap {
     /// and its solid-angle density; None for a black map.
     pub fn sample(&self, u: Vec2) -> Option<(Vec3, Rgb, f32)> {
         let (p, _) = self.distribution.sample(u)?;
+        if self.equal_area {
+            let dir = self.to_world * square_to_sphere(p);
+            let pdf = self.pdf(dir);
+            return (pdf > 0.0).then(|| (dir, self.eval_texel(p), pdf));
+        }
         let (row, t) = self.row(p.y);
         // Uniform in cos theta across the row of cells: uniform in solid angle.
         let (c0, c1) = (self.cos_rows[row], self.cos_rows[row + 1]);
@@ -191,6 +242,10 @@ impl EnvironmentMap {
         if d == Vec3::ZERO {
             return 0.0;
         }
+        if self.equal_area {
+            let p = sphere_to_square(d).clamp(Vec2::ZERO, Vec2::splat(1.0 - f32::EPSILON));
+            return self.distribution.pdf(p) / (4.0 * PI);
+        }
         let u = d.x.atan2(-d.z) * (0.5 / PI) - 0.5 / self.bitmap.width() as f32;
         let v = d.y.clamp(-1.0, 1.0).acos() * (1.0 / PI);
         let (row, _) = self.row(v);
@@ -212,6 +267,45 @@ impl EnvironmentMap {
     pub fn bitmap(&self) -> &Bitmap {
         &self.bitmap
     }
+}
+
+/// Clarberg's equal-area map of the unit square onto the sphere (pbrt-v4's
+/// `EqualAreaSquareToSphere`): the square's centre is +z, its corners -z; the square folded
+/// as an octahedron, each of its four quadrants one of the hemisphere's quarters, the
+/// triangles nearer the corners the southern hemisphere's.
+pub fn square_to_sphere(p: Vec2) -> Vec3 {
+    let (u, v) = (2.0 * p.x - 1.0, 2.0 * p.y - 1.0);
+    let (up, vp) = (u.abs(), v.abs());
+    // Signed distance from the diagonal |u| + |v| = 1 (the equator).
+    let signed = 1.0 - (up + vp);
+    let r = 1.0 - signed.abs();
+    let phi = if r == 0.0 { 1.0 } else { (vp - up) / r + 1.0 } * (PI / 4.0);
+    let z = (1.0 - r * r).copysign(signed);
+    let (sin_phi, cos_phi) = phi.sin_cos();
+    let s = r * (2.0 - r * r).max(0.0).sqrt();
+    Vec3::new(cos_phi.copysign(u) * s, sin_phi.copysign(v) * s, z)
+}
+
+/// The inverse of [`square_to_sphere`] for a unit direction (pbrt-v4's
+/// `EqualAreaSphereToSquare`, with the arctangent its polynomial approximates).
+pub fn sphere_to_square(d: Vec3) -> Vec2 {
+    let (x, y, z) = (d.x.abs(), d.y.abs(), d.z.abs());
+    let r = (1.0 - z).max(0.0).sqrt();
+    let (a, b) = (x.max(y), x.min(y));
+    let t = if a == 0.0 { 0.0 } else { b / a };
+    let mut phi = t.atan() * (2.0 / PI);
+    if x < y {
+        phi = 1.0 - phi;
+    }
+    let mut v = phi * r;
+    let mut u = r - v;
+    if d.z < 0.0 {
+        // The southern hemisphere: the triangles towards the corners.
+        std::mem::swap(&mut u, &mut v);
+        u = 1.0 - u;
+        v = 1.0 - v;
+    }
+    Vec2::new(0.5 * (u.copysign(d.x) + 1.0), 0.5 * (v.copysign(d.y) + 1.0))
 }
 
 #[cfg(test)]
@@ -336,5 +430,96 @@ mod tests {
                 .is_err()
         );
         assert!(EnvironmentMap::new(&image(), -1.0, Mat3::IDENTITY).is_err());
+    }
+
+    /// Clarberg's map: the square's centre is +z, its corners -z, its edges' midpoints the
+    /// equator's +-x and +-y; the inverse inverts it; and it preserves area: uniform points
+    /// of the square give directions uniform on the sphere (chi-square over 8 bands of z of
+    /// equal solid angle times 8 sectors of phi, 63 degrees of freedom).
+    #[test]
+    fn equal_area_map_is_inverse_and_preserves_area() {
+        let close = |a: Vec3, b: Vec3| (a - b).length() < 1e-5;
+        assert!(close(square_to_sphere(Vec2::splat(0.5)), Vec3::Z));
+        assert!(close(square_to_sphere(Vec2::ZERO), -Vec3::Z));
+        assert!(close(square_to_sphere(Vec2::new(1.0, 0.5)), Vec3::X));
+        assert!(close(square_to_sphere(Vec2::new(0.5, 1.0)), Vec3::Y));
+        assert!(close(square_to_sphere(Vec2::new(0.0, 0.5)), -Vec3::X));
+        let mut rng = Rng::new(&[9]);
+        let (bands, sectors, n) = (8usize, 8usize, 200_000usize);
+        let mut counts = vec![0u32; bands * sectors];
+        for _ in 0..n {
+            let p = rng.next_2d();
+            let d = square_to_sphere(p);
+            assert!((d.length() - 1.0).abs() < 1e-5, "{p} -> {d}");
+            let back = sphere_to_square(d);
+            assert!(
+                (back - p).abs().max_element() < 1e-4,
+                "{p} -> {d} -> {back}"
+            );
+            let band = (((d.z + 1.0) / 2.0 * bands as f32) as usize).min(bands - 1);
+            let phi = d.y.atan2(d.x) + PI;
+            let sector = ((phi / (2.0 * PI) * sectors as f32) as usize).min(sectors - 1);
+            counts[band * sectors + sector] += 1;
+        }
+        let expected = n as f64 / (bands * sectors) as f64;
+        let chi2: f64 = counts
+            .iter()
+            .map(|&c| (c as f64 - expected).powi(2) / expected)
+            .sum();
+        // 63 degrees of freedom: the 99.9th percentile is about 103.4.
+        assert!(chi2 < 103.4, "chi-square {chi2}");
+    }
+
+    /// An equal-area map reads the texel a direction falls in, integrates to 4 pi times its
+    /// mean, and its samples' density is its pdf, which integrates to one.
+    #[test]
+    fn equal_area_map_lookup_integral_and_pdf() {
+        let (w, h) = (8, 8);
+        let mut texels = vec![Rgb::new(0.2, 0.3, 0.5); w * h];
+        texels[3 * w + 5] = Rgb::new(40.0, 30.0, 20.0);
+        let img = Bitmap::new(w, h, texels.clone()).unwrap();
+        let map = EnvironmentMap::equal_area(&img, 2.0, Mat3::from_rotation_x(0.3)).unwrap();
+        let centre = |i: usize, j: usize| {
+            Mat3::from_rotation_x(0.3)
+                * square_to_sphere(Vec2::new(
+                    (i as f32 + 0.5) / w as f32,
+                    (j as f32 + 0.5) / h as f32,
+                ))
+        };
+        assert_eq!(map.eval(centre(5, 3)), 2.0 * texels[3 * w + 5]);
+        assert_eq!(map.eval(centre(1, 6)), 2.0 * texels[6 * w + 1]);
+        let mean: Rgb = texels.iter().copied().sum::<Rgb>() / (w * h) as f32;
+        assert!(
+            (map.integral() - 2.0 * 4.0 * PI * mean).abs().max_element()
+                < 1e-3 * map.integral().max_element()
+        );
+        let (n_cos, n_phi) = (400, 800);
+        let mut total = 0.0f64;
+        for a in 0..n_cos {
+            let z = -1.0 + 2.0 * (a as f32 + 0.5) / n_cos as f32;
+            let r = (1.0 - z * z).sqrt();
+            for b in 0..n_phi {
+                let phi = 2.0 * PI * (b as f32 + 0.5) / n_phi as f32;
+                total += map.pdf(Vec3::new(r * phi.cos(), r * phi.sin(), z)) as f64;
+            }
+        }
+        let cell = 4.0 * PI64 / (n_cos * n_phi) as f64;
+        assert!((total * cell - 1.0).abs() < 2e-3, "{}", total * cell);
+        let mut rng = Rng::new(&[8]);
+        let mut bright = 0;
+        for _ in 0..10_000 {
+            let (d, l, pdf) = map.sample(rng.next_2d()).unwrap();
+            assert!(((map.pdf(d) - pdf) / pdf).abs() < 1e-3);
+            assert_eq!(map.eval(d), l);
+            bright += (l.x > 10.0) as u32;
+        }
+        // The bright texel's share of the luminance.
+        let lum = |c: Rgb| luminance(c) as f64;
+        let share = lum(texels[3 * w + 5]) / texels.iter().map(|&c| lum(c)).sum::<f64>();
+        let sd = (share * (1.0 - share) / 10_000.0).sqrt();
+        assert!(
+            (bright as f64 / 10_000.0 - share).abs() < 4.0 * sd,
+            "{bright} against {share}"
+        );
     }
 }

@@ -1,5 +1,6 @@
 //! `envmap`: radiance from every direction at infinity read from a latitude-longitude image
-//! (Mitsuba's `envmap`), sampled by its luminance. Rays leaving the scene see it; a scene has
+//! (Mitsuba's `envmap`) or an equal-area octahedral one (pbrt-v4's image `infinite` light),
+//! sampled by its luminance. Rays leaving the scene see it; a scene has
 //! at most one such environment.
 //!
 //! | Parameter  | Type      | Meaning                                                          | Default  |
@@ -7,6 +8,7 @@
 //! | `filename` | string    | the image: OpenEXR or Radiance HDR (linear), PNG or JPEG (sRGB)  | required |
 //! | `scale`    | number    | radiance scale, >= 0                                             | `1`      |
 //! | `to_world` | transform | turns the map (only its rotation counts)                         | identity |
+//! | `mapping`  | string    | `"latlong"` (Mitsuba's) or `"equal_area"` (pbrt-v4's octahedral) | `"latlong"` |
 
 use super::{EmittedRay, LightSample, LightSource, LightType, SceneSphere};
 use crate::Rgb;
@@ -90,8 +92,12 @@ pub const FACTORY: Factory<EnvmapLight> = Factory {
         }
         let to_world = resources.transform(l, "to_world")?;
         let bitmap = resources.bitmap(l, "filename", false)?;
-        let map = EnvironmentMap::new(&bitmap, scale, glam::Mat3::from_mat4(to_world))
-            .map_err(|e| l.error("to_world", e))?;
+        let to_world = glam::Mat3::from_mat4(to_world);
+        let map = match l.choice("mapping", &["latlong", "equal_area"], "latlong")? {
+            "equal_area" => EnvironmentMap::equal_area(&bitmap, scale, to_world),
+            _ => EnvironmentMap::new(&bitmap, scale, to_world),
+        }
+        .map_err(|e| l.error("to_world", e))?;
         Ok(Box::new(EnvmapLight {
             map: Arc::new(map),
             sphere: SceneSphere::default(),

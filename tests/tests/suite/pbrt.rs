@@ -323,3 +323,53 @@ AttributeEnd
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// pbrt-v4's image `infinite` light is an equal-area octahedral map (`EqualAreaSphereToSquare`):
+/// the image's top half is the light's -y hemisphere, its bottom half +y. An image white on
+/// top and black below lights the underside of a white diffuse plane (reflectance 0.8) to
+/// 0.8 x `scale` and leaves its top black; `Rotate 180 1 0 0` on the light swaps them.
+#[test]
+fn image_infinite_lights_are_equal_area_octahedral_maps() {
+    let dir = temp_dir("pbrt-envmap");
+    let mut img = image::RgbImage::new(8, 8);
+    for y in 0..4 {
+        for x in 0..8 {
+            img.put_pixel(x, y, image::Rgb([255, 255, 255]));
+        }
+    }
+    img.save(dir.join("sky.png")).unwrap();
+    let scene = |eye_y: f64, rotate: &str| {
+        format!(
+            r#"
+LookAt 0 {eye_y} 0  0 0 0  0 0 1
+Camera "perspective" "float fov" 30
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8 "string filename" "e.exr"
+PixelFilter "box"
+Sampler "independent" "integer pixelsamples" 64
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+AttributeBegin
+{rotate}
+LightSource "infinite" "string filename" "sky.png" "float scale" 0.5
+AttributeEnd
+Material "diffuse" "rgb reflectance" [0.8 0.8 0.8]
+Shape "trianglemesh" "point3 P" [-5 0 -5  5 0 -5  5 0 5  -5 0 5] "integer indices" [0 1 2  0 2 3]
+"#
+        )
+    };
+    for (eye_y, rotate, want) in [
+        (-3.0, "", 0.4),
+        (3.0, "", 0.0),
+        (-3.0, "Rotate 180 1 0 0", 0.0),
+        (3.0, "Rotate 180 1 0 0", 0.4),
+    ] {
+        let file = write(&dir, "e.pbrt", &scene(eye_y, rotate));
+        let film = render_file(&file, &[], 2);
+        let (mean, se) = foton_tests::region_mean(&film, 0, 0, 8, 8);
+        assert!(
+            (mean.x - want).abs() < 4.0 * se.x + 2e-3,
+            "eye at y = {eye_y}, {rotate:?}: {mean} +- {se}, expected {want}"
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -64,11 +64,30 @@ impl Reader {
                 entries.push(("irradiance", self.vec3(l * scale, &loc)));
             }
             "infinite" => {
-                if let Some((f, l)) = p.string_opt("filename")? {
-                    return self.unsupported(&l, &what, &format!("\"filename\" {f:?}: environment maps (pbrt-v4's equal-area octahedral images) are not read yet"));
-                }
                 if let Some(q) = p.take("portal") {
                     self.unsupported(&q.loc, &what, "portals are not read yet")?;
+                }
+                if let Some((f, l)) = p.string_opt("filename")? {
+                    if p.has("L") {
+                        return Err(loc.error(&what, "both \"L\" and \"filename\": give one"));
+                    }
+                    if let Some(q) = p.take("illuminance") {
+                        self.unsupported(&q.loc, &what, "\"illuminance\" with an image is not read yet (--lenient: \"scale\" alone)")?;
+                    }
+                    let scale = p.float("scale", 1.0)?;
+                    let path = super::parse::resolve(&self.dir, &l.file, &f);
+                    let rel = path
+                        .strip_prefix(&self.dir)
+                        .map_or(path.clone(), std::path::Path::to_path_buf);
+                    entries.push(("type", self.string("envmap", &loc)));
+                    entries.push(("filename", self.string(&rel.to_string_lossy(), &l)));
+                    entries.push(("mapping", self.string("equal_area", &loc)));
+                    entries.push(("scale", self.num(scale, &loc)));
+                    entries.push(("to_world", self.matrix(m, &loc)));
+                    self.finish(&mut p)?;
+                    let light = self.table(entries, &loc);
+                    self.lights.push(light);
+                    return Ok(());
                 }
                 let l = spectrum(self, &mut p, "L")?;
                 let mut scale = p.float("scale", 1.0)?;
