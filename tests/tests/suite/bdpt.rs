@@ -271,14 +271,12 @@ fn splats_follow_the_pixel_filter() {
     use foton_core::filter::{Filter, FilterSampler};
     let scene = diffuse_box();
     for (filter, kind) in [
-        (
-            "{ type = \"tent\", radius = 1.5 }",
-            Filter::Tent { radius: 1.5 },
-        ),
+        ("{ type = \"tent\", radius = 1.5 }", Filter::tent(1.5)),
         (
             "{ type = \"gaussian\", stddev = 0.6 }",
-            Filter::Gaussian { stddev: 0.6 },
+            Filter::gaussian(0.6),
         ),
+        ("\"mitchell\"", Filter::mitchell(1.0 / 3.0, 1.0 / 3.0)),
     ] {
         let sampler = FilterSampler::new(kind);
         let mut inflation = 1.0f32;
@@ -286,7 +284,8 @@ fn splats_follow_the_pixel_filter() {
             for j in 0..=20 {
                 let film = glam::Vec2::new(10.0 + i as f32 * 0.05, 10.0 + j as f32 * 0.05);
                 let (mut sum, mut sum2) = (0.0f32, 0.0f32);
-                sampler.footprint(film, SIZE, SIZE, |_, _, h| {
+                sampler.footprint(film, SIZE, SIZE, |_, _, pdf, weight| {
+                    let h = pdf * weight;
                     sum += h;
                     sum2 += h * h;
                 });
