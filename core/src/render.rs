@@ -90,6 +90,11 @@ pub struct PixelSample {
     pub film: Vec2,
     /// The filter's density at `film` for this pixel ([`crate::filter::FilterSampler::pdf`]).
     pub filter_pdf: f32,
+    /// The weight the sample's estimate counts with ([`crate::filter::FilmSample::weight`]):
+    /// exactly 1.0 with a positive filter, sign(w) ∫|w| / ∫w with one that has negative
+    /// lobes. The pixel loop multiplies what the integrator's `radiance` returns (and its
+    /// techniques' shares) by it; an integrator with its own camera loop does the same.
+    pub filter_weight: f32,
 }
 
 /// Where a render's light paths add what they bring to the camera (see the module comment).
@@ -110,6 +115,15 @@ impl Splats<'_> {
     /// dropped (and counted in the render's warning).
     #[inline]
     pub fn add(&mut self, x: u32, y: u32, value: Rgb) {
+        self.add_weighted(x, y, value, 1.0)
+    }
+
+    /// [`Splats::add`] of `value` times `weight`, the filter's weight of the pixel at the
+    /// splat's film point ([`crate::filter::FilterSampler::footprint`]: negative in a
+    /// filter's negative lobes, exactly 1.0 for a positive filter): `value` itself must be
+    /// [`usable`].
+    #[inline]
+    pub fn add_weighted(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         if !usable(value) {
             self.bad += 1;
             return;
@@ -118,7 +132,7 @@ impl Splats<'_> {
             return;
         }
         let mut sum = RadianceSum::ZERO;
-        sum.add(value);
+        sum.add(value * weight);
         self.pending.push((y * self.width + x, sum));
         if self.pending.len() >= SPLAT_BATCH {
             self.flush();
@@ -166,11 +180,18 @@ impl Techniques<'_> {
     /// [`Splats::add`] (dropped, as there, when not [`usable`] or zero).
     #[inline]
     pub fn splat(&mut self, technique: usize, x: u32, y: u32, value: Rgb) {
+        self.splat_weighted(technique, x, y, value, 1.0)
+    }
+
+    /// [`Techniques::splat`] of `value` times the filter's `weight`, as
+    /// [`Splats::add_weighted`].
+    #[inline]
+    pub fn splat_weighted(&mut self, technique: usize, x: u32, y: u32, value: Rgb, weight: f32) {
         if !usable(value) || value == Rgb::ZERO {
             return;
         }
         let mut sum = RadianceSum::ZERO;
-        sum.add(value);
+        sum.add(value * weight);
         self.pending
             .push((technique as u32, y * self.width + x, sum));
         if self.pending.len() >= SPLAT_BATCH {
@@ -317,13 +338,14 @@ where
                                 let samplers = pixel_samplers(&scene.render, width, x, y);
                                 for s in s0..s1 {
                                     let mut sampler = samplers.sample(s);
-                                    let at = filter.film_position(x, y, sampler.next_2d());
+                                    let at = filter.sample(x, y, sampler.next_2d());
                                     let sample = PixelSample {
-                                        ray: scene.camera.generate_ray(at),
+                                        ray: scene.camera.generate_ray(at.film),
                                         x,
                                         y,
-                                        film: at,
-                                        filter_pdf: filter.pdf(x, y, at),
+                                        film: at.film,
+                                        filter_pdf: filter.pdf(x, y, at.film),
+                                        filter_weight: at.weight,
                                     };
                                     let mut l = radiance(
                                         &sample,
@@ -338,6 +360,12 @@ where
                                         if LAYERS {
                                             techniques.sample.fill(Rgb::ZERO);
                                         }
+                                    }
+                                    // The filter's weight, after the check (it may be
+                                    // negative); exactly 1.0 for a positive filter.
+                                    l *= at.weight;
+                                    if LAYERS {
+                                        techniques.sample.iter_mut().for_each(|v| *v *= at.weight);
                                     }
                                     sum.add(l);
                                     if LAYERS {

@@ -126,15 +126,15 @@ impl StrategyLayers<'_, '_, '_> {
 impl SplatSink for StrategyLayers<'_, '_, '_> {
     const SHARES: bool = true;
 
-    fn add(&mut self, x: u32, y: u32, value: Rgb) {
+    fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         // Every splat of the estimator comes with its strategy (add_strategy).
-        self.splats.add(x, y, value);
+        self.splats.add_weighted(x, y, value, weight);
     }
 
-    fn add_strategy(&mut self, s: u32, x: u32, y: u32, value: Rgb) {
-        self.splats.add(x, y, value);
+    fn add_strategy(&mut self, s: u32, x: u32, y: u32, value: Rgb, weight: f32) {
+        self.splats.add_weighted(x, y, value, weight);
         let k = self.layer(s, 1);
-        self.techniques.splat(k, x, y, value);
+        self.techniques.splat_weighted(k, x, y, value, weight);
     }
 
     fn share(&mut self, s: u32, t: u32, value: Rgb) {

@@ -49,11 +49,13 @@ impl Bidir {
         scene
             .film()
             .filter
-            .footprint(cs.film, width, height, |x, y, h| {
+            .footprint(cs.film, width, height, |x, y, pdf, weight| {
+                // The camera samples this point with density pdf; the pixel weights it by the
+                // normalised filter pdf * weight (pdf itself for a positive filter).
                 let w = self.weight(s, 1, || {
-                    weight_to_camera(&self.factors, &v.running, h * pdf_camera, pdf_rev)
+                    weight_to_camera(&self.factors, &v.running, pdf * pdf_camera, pdf_rev)
                 });
-                splats.add_strategy(s, x, y, base * (h * w));
+                splats.add_strategy(s, x, y, base * (pdf * w), weight);
             });
     }
 
@@ -99,11 +101,11 @@ impl Bidir {
         scene
             .film()
             .filter
-            .footprint(cs.film, width, height, |x, y, h| {
+            .footprint(cs.film, width, height, |x, y, pdf, weight| {
                 let w = self.weight(1, 1, || {
-                    weight_to_camera(&Factors::CONNECT, &running, h * pdf_camera, 0.0)
+                    weight_to_camera(&Factors::CONNECT, &running, pdf * pdf_camera, 0.0)
                 });
-                splats.add_strategy(1, x, y, base * (h * w));
+                splats.add_strategy(1, x, y, base * (pdf * w), weight);
             });
     }
 

@@ -60,13 +60,16 @@ pub trait SplatSink {
     /// subpath is traced without reporting them.
     const SHARES: bool = false;
 
-    /// Adds `value` to pixel (x, y).
-    fn add(&mut self, x: u32, y: u32, value: Rgb);
+    /// Adds `value` times `weight` to pixel (x, y): `value` must be usable (finite, not
+    /// negative; [`Splats::add_weighted`]), `weight` is the filter's weight of the pixel at the
+    /// splat's film point (negative in a negative lobe, exactly 1.0 for a positive filter).
+    fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32);
 
-    /// Adds `value`, the (MIS-weighted) contribution of strategy (s, t = 1), to pixel (x, y).
+    /// Adds `value` times `weight`, the (MIS-weighted) contribution of strategy (s, t = 1), to
+    /// pixel (x, y), as [`SplatSink::add`].
     #[inline(always)]
-    fn add_strategy(&mut self, _s: u32, x: u32, y: u32, value: Rgb) {
-        self.add(x, y, value)
+    fn add_strategy(&mut self, _s: u32, x: u32, y: u32, value: Rgb, weight: f32) {
+        self.add(x, y, value, weight)
     }
 
     /// Strategy (s, t)'s (t >= 2) MIS-weighted share of the camera sample's own estimate,
@@ -77,8 +80,8 @@ pub trait SplatSink {
 
 impl SplatSink for Splats<'_> {
     #[inline]
-    fn add(&mut self, x: u32, y: u32, value: Rgb) {
-        Splats::add(self, x, y, value)
+    fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
+        Splats::add_weighted(self, x, y, value, weight)
     }
 }
 

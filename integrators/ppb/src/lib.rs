@@ -225,7 +225,10 @@ impl Ppb {
 
     /// Pass `iteration`'s estimate of the radiance through pixel `pixel` at (x, y); `share`
     /// gets each term with its technique (`EMISSION`, `BEAM`, `DIRECT`, `SURFACE`), weighted
-    /// by the camera path's throughput (their sum is the estimate, to float rounding).
+    /// by the camera path's throughput (their sum is the estimate, to float rounding). Also
+    /// returns the camera sample's filter weight, by which the caller multiplies the estimate
+    /// and its shares once it has found the estimate usable (exactly 1.0 for a positive
+    /// filter).
     #[allow(clippy::too_many_arguments)]
     fn estimate(
         &self,
@@ -236,7 +239,7 @@ impl Ppb {
         rays: &mut u64,
         bad_photons: &mut u64,
         mut share: impl FnMut(usize, Rgb),
-    ) -> Rgb {
+    ) -> (Rgb, f32) {
         let seed = scene.render().seed;
         let pixel = y as u64 * scene.film().width as u64 + x as u64;
         let mut sampler = Sampler::with_keys(
@@ -247,7 +250,9 @@ impl Ppb {
             iteration as u32,
             self.passes.iterations.unwrap_or(1) as u32,
         );
-        let film = scene.film().filter.film_position(x, y, sampler.next_2d());
+        let placed = scene.film().filter.sample(x, y, sampler.next_2d());
+        let film = placed.film;
+
         let ray = scene.camera().generate_ray(film);
         let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
         // A segment that leaves the scene in a medium (unbounded fog, a camera in it) meets
@@ -337,7 +342,7 @@ impl Ppb {
             share(SURFACE, vp.beta * gathered);
             l += vp.beta * lv;
         }
-        l
+        (l, placed.weight)
     }
 }
 
@@ -432,7 +437,7 @@ impl CameraPass<'_> {
         for (x, sum) in row.iter_mut().enumerate() {
             let mut shares = [Rgb::ZERO; 4];
             let keep = layers.is_some();
-            let l = self.ppb.estimate(
+            let (l, weight) = self.ppb.estimate(
                 self.scene,
                 self.pass,
                 self.iteration,
@@ -446,10 +451,12 @@ impl CameraPass<'_> {
                 },
             );
             if usable(l) {
-                sum.add(l);
+                // The camera sample's filter weight, after the check (it may be negative):
+                // exactly 1.0 for a positive filter.
+                sum.add(l * weight);
                 if let Some(layers) = layers.as_deref_mut() {
                     for (layer, v) in layers[x].iter_mut().zip(shares) {
-                        layer.add(v);
+                        layer.add(v * weight);
                     }
                 }
             } else {

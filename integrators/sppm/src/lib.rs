@@ -172,6 +172,10 @@ struct CameraSample {
     /// Emission and shadow-ray direct light, weighted by the path throughput.
     ld: Rgb,
     visible: Option<VisiblePoint>,
+    /// The camera sample's filter weight, which scales all it brings (its direct light and
+    /// its visible point's gathers), once they are found usable: exactly 1.0 for a positive
+    /// filter.
+    weight: f32,
 }
 
 impl CameraSample {
@@ -203,8 +207,8 @@ impl Sppm {
                             iteration as u32,
                             self.passes.iterations.unwrap_or(1) as u32,
                         );
-                        let film = scene.film().filter.film_position(x, y, sampler.next_2d());
-                        let ray = scene.camera().generate_ray(film);
+                        let at = scene.film().filter.sample(x, y, sampler.next_2d());
+                        let ray = scene.camera().generate_ray(at.film);
                         let path =
                             trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
                         let mut ld = path.emitted;
@@ -227,6 +231,7 @@ impl Sppm {
                         CameraSample {
                             ld,
                             visible: path.visible,
+                            weight: at.weight,
                         }
                     })
                     .collect();
@@ -323,7 +328,7 @@ impl Passes for SppmPasses<'_> {
                 .zip(camera.par_iter())
                 .for_each(|(st, cs)| {
                     let ld = if usable(cs.ld) {
-                        cs.ld
+                        cs.ld * cs.weight
                     } else {
                         Tally::add(&tally.bad_samples, 1);
                         Rgb::ZERO
@@ -355,7 +360,7 @@ impl Passes for SppmPasses<'_> {
                     let depth = sppm.max_depth - vp.bounces;
                     let g = gather_disc(&map, vp, r, depth, &sppm.kernel);
                     Tally::add(&tally.bad_photons, g.bad);
-                    let (m, phi) = (g.m, g.phi * vp.beta.as_dvec3());
+                    let (m, phi) = (g.m, g.phi * (vp.beta * cs.weight).as_dvec3());
                     match sppm.schedule {
                         RadiusSchedule::Pixel => {
                             st.ld += ld.as_dvec3();

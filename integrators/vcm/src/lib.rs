@@ -197,7 +197,7 @@ impl RowSplats {
 
 impl SplatSink for RowSplats {
     #[inline]
-    fn add(&mut self, x: u32, y: u32, value: Rgb) {
+    fn add(&mut self, x: u32, y: u32, value: Rgb, weight: f32) {
         if !usable(value) {
             self.bad += 1;
             return;
@@ -206,7 +206,7 @@ impl SplatSink for RowSplats {
             return;
         }
         let mut s = RadianceSum::ZERO;
-        s.add(value);
+        s.add(value * weight);
         self.bands[(y / self.band_rows) as usize].push((y * self.width + x, s));
     }
 }
@@ -391,14 +391,16 @@ impl Vcm {
                 let mut l = Rgb::ZERO;
                 // The techniques' shares of l (LAYERS only).
                 let mut shares = [Rgb::ZERO; 3];
+                let mut weight = 1.0f32;
                 if self.mode != Mode::Lt {
-                    let at = filter.film_position(x, y, sampler.next_2d());
+                    let at = filter.sample(x, y, sampler.next_2d());
                     let ps = PixelSample {
-                        ray: scene.camera().generate_ray(at),
+                        ray: scene.camera().generate_ray(at.film),
                         x,
                         y,
-                        film: at,
-                        filter_pdf: filter.pdf(x, y, at),
+                        film: at.film,
+                        filter_pdf: filter.pdf(x, y, at.film),
+                        filter_weight: at.weight,
                     };
                     camera.clear();
                     l = bidir.camera_subpath(scene, &ps, &mut sampler, &mut camera, rays);
@@ -430,11 +432,18 @@ impl Vcm {
                             }
                         }
                     }
+                    weight = at.weight;
                 }
                 if !usable(l) {
                     row.bad += 1;
                     l = Rgb::ZERO;
                     shares = [Rgb::ZERO; 3];
+                }
+                // The camera sample's filter weight, after the check (it may be negative):
+                // exactly 1.0 for a positive filter.
+                l *= weight;
+                if LAYERS {
+                    shares.iter_mut().for_each(|v| *v *= weight);
                 }
                 let mut sum = RadianceSum::ZERO;
                 sum.add(l);

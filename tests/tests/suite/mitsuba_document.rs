@@ -387,24 +387,65 @@ fn crop_windows_and_film_parameters() {
     assert!((a - b).length() < 1e-5, "{a} against {b}");
 }
 
-/// Mitsuba's mitchell, catmullrom and lanczos filters: foton has none, so the file is
-/// refused, or with `--lenient` filtered by Mitsuba's default gaussian, which it says.
+/// Mitsuba's mitchell (`B`, `C`), catmullrom and lanczos (`lobes`) filters, in 3.x and 0.6
+/// files, read with their parameters and loaded as foton's filters of the same profile; a
+/// parameter they do not have is refused as any other.
 #[test]
-fn filters_foton_lacks_are_replaced_with_a_note() {
+fn mitchell_catmullrom_and_lanczos_are_read() {
+    use foton_core::filter::Filter;
     let dir = temp_dir("mitsuba-filters");
-    for ty in ["mitchell", "catmullrom", "lanczos"] {
-        let body = SENSOR.replace(
-            "</film>",
-            &format!("<rfilter type=\"{ty}\"><float name=\"B\" value=\"0.3\"/></rfilter></film>"),
-        );
-        let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
-        let e = read(&xml, false).unwrap_err();
-        assert!(e.contains(ty) && e.contains("gaussian"), "{e}");
-        let (doc, report) = read(&xml, true).unwrap();
-        assert_eq!(text(&doc.root, "film.filter.type"), "gaussian");
-        assert_eq!(number(&doc.root, "film.filter.stddev"), 0.5);
-        assert!(report.left_out.iter().any(|l| l.contains(ty)), "{ty}");
+    for version in ["3.0.0", "0.6.0"] {
+        for (rf, ty, want) in [
+            (
+                "<rfilter type=\"mitchell\"><float name=\"B\" value=\"0.25\"/><float name=\"C\" value=\"0.375\"/></rfilter>",
+                "mitchell",
+                Filter::mitchell(0.25, 0.375),
+            ),
+            (
+                "<rfilter type=\"mitchell\"/>",
+                "mitchell",
+                Filter::mitchell(1.0 / 3.0, 1.0 / 3.0),
+            ),
+            (
+                "<rfilter type=\"catmullrom\"/>",
+                "catmullrom",
+                Filter::catmull_rom(),
+            ),
+            (
+                "<rfilter type=\"lanczos\"><integer name=\"lobes\" value=\"2\"/></rfilter>",
+                "lanczos",
+                Filter::lanczos(2),
+            ),
+            ("<rfilter type=\"lanczos\"/>", "lanczos", Filter::lanczos(3)),
+        ] {
+            let body = SENSOR.replace("</film>", &format!("{rf}</film>"));
+            let xml = write(&dir, "scene.xml", &scene(version, &body));
+            let (doc, report) = read(&xml, false).unwrap_or_else(|e| panic!("{version} {rf}: {e}"));
+            assert_eq!(text(&doc.root, "film.filter.type"), ty);
+            assert!(report.left_out.is_empty(), "{:?}", report.left_out);
+            let loaded = foton_loader::load(&xml, &[]).unwrap_or_else(|e| panic!("{rf}: {e}"));
+            let got = loaded.film().filter.filter().clone();
+            let same = match (&got, &want) {
+                (
+                    Filter::Mitchell { b, c, radius },
+                    Filter::Mitchell {
+                        b: b2,
+                        c: c2,
+                        radius: r2,
+                    },
+                ) => (b - b2).abs() < 1e-6 && (c - c2).abs() < 1e-6 && radius == r2,
+                _ => got == want,
+            };
+            assert!(same, "{version} {rf}: {got:?} against {want:?}");
+        }
     }
+    let body = SENSOR.replace(
+        "</film>",
+        "<rfilter type=\"catmullrom\"><float name=\"B\" value=\"0.3\"/></rfilter></film>",
+    );
+    let xml = write(&dir, "scene.xml", &scene("3.0.0", &body));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("B"), "{e}");
 }
 
 /// Mitsuba 2.0 to 2.2 files are read as 3.x files are (the same names), and their sample

@@ -114,15 +114,27 @@ pub(super) fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSe
     Ok(film)
 }
 
-/// `[film] filter`: "box" (the default), "tent", "gaussian", or a table with `type` and the
-/// filter's parameter (`radius` of the tent, default 1; `stddev` of the gaussian, default
-/// 0.5), in pixels.
+/// `[film] filter`: a name ("box", the default, "tent", "gaussian", "mitchell",
+/// "catmullrom", "lanczos", "sinc": each with its defaults) or a table with `type` and the
+/// filter's parameters, in pixels: `radius` (a number, or `[x, y]` for two radii) of the tent
+/// (default 1), the gaussian (default 4 `stddev`; `stddev` default 0.5), mitchell and
+/// catmullrom (default 2) and sinc (default 4); mitchell's `b` and `c` (default 1/3 each);
+/// lanczos's `lobes` (default 3: the sinc windowed by sinc(x / lobes), radius `lobes`); sinc's
+/// `tau` (default 3).
 fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
-    const TYPES: [&str; 3] = ["box", "tent", "gaussian"];
-    let expected = "expected \"box\", \"tent\", \"gaussian\" or a table such as { type = \"tent\", radius = 1.0 }";
-    let ty = match t.node("filter").map(|n| &n.value) {
+    const TYPES: [&str; 7] = [
+        "box",
+        "tent",
+        "gaussian",
+        "mitchell",
+        "catmullrom",
+        "lanczos",
+        "sinc",
+    ];
+    let expected = "expected \"box\", \"tent\", \"gaussian\", \"mitchell\", \"catmullrom\", \"lanczos\", \"sinc\" or a table such as { type = \"tent\", radius = 1.0 }";
+    let filter = match t.node("filter").map(|n| &n.value) {
         None => return Ok(Filter::Box),
-        Some(Value::Str(s)) if TYPES.contains(&s.as_str()) => s.as_str(),
+        Some(Value::Str(s)) if TYPES.contains(&s.as_str()) => default_filter(s),
         Some(Value::Str(s)) => {
             return Err(t.error("filter", format!("unknown filter {s:?}; {expected}")));
         }
@@ -136,15 +148,60 @@ fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
                 }
                 Ok(x)
             };
+            // A radius: one number for both axes or [x, y].
+            let radius = |default: f32| -> Result<Vec2> {
+                let r = match f.node("radius").map(|n| &n.value) {
+                    Some(Value::Array(_)) => {
+                        let r = f.floats_opt("radius", 2)?.unwrap();
+                        Vec2::new(r[0], r[1])
+                    }
+                    _ => Vec2::splat(f.f32("radius", default)?),
+                };
+                if !(r.x > 0.0 && r.x <= 256.0 && r.y > 0.0 && r.y <= 256.0) {
+                    return Err(f.error(
+                        "radius",
+                        format!("each radius must be in (0, 256] pixels, found {r}"),
+                    ));
+                }
+                Ok(r)
+            };
             let filter = match ty {
                 "tent" => Filter::Tent {
-                    radius: positive("radius", 1.0)?,
+                    radius: radius(1.0)?,
                 },
-                "gaussian" => Filter::Gaussian {
-                    stddev: positive("stddev", 0.5)?,
+                "gaussian" => {
+                    let stddev = positive("stddev", 0.5)?;
+                    Filter::Gaussian {
+                        stddev,
+                        radius: radius(4.0 * stddev)?,
+                    }
+                }
+                "mitchell" => Filter::Mitchell {
+                    b: f.f32("b", 1.0 / 3.0)?,
+                    c: f.f32("c", 1.0 / 3.0)?,
+                    radius: radius(2.0)?,
+                },
+                "catmullrom" => Filter::Mitchell {
+                    b: 0.0,
+                    c: 0.5,
+                    radius: radius(2.0)?,
+                },
+                "lanczos" => {
+                    let lobes = f.u32("lobes", 3)?;
+                    if !(1..=64).contains(&lobes) {
+                        return Err(f.error("lobes", format!("must be 1 to 64, found {lobes}")));
+                    }
+                    Filter::lanczos(lobes)
+                }
+                "sinc" => Filter::Sinc {
+                    radius: radius(4.0)?,
+                    tau: positive("tau", 3.0)?,
                 },
                 _ => Filter::Box,
             };
+            if let Some(problem) = filter.problem() {
+                return Err(f.error("type", problem));
+            }
             ld.done(&f);
             return Ok(filter);
         }
@@ -155,11 +212,23 @@ fn read_filter(t: &Properties<'_>, ld: &mut Loader) -> Result<Filter> {
             ));
         }
     };
-    Ok(match ty {
-        "tent" => Filter::Tent { radius: 1.0 },
-        "gaussian" => Filter::Gaussian { stddev: 0.5 },
+    Ok(filter)
+}
+
+/// A filter by its name alone, with its defaults.
+fn default_filter(name: &str) -> Filter {
+    match name {
+        "tent" => Filter::tent(1.0),
+        "gaussian" => Filter::gaussian(0.5),
+        "mitchell" => Filter::mitchell(1.0 / 3.0, 1.0 / 3.0),
+        "catmullrom" => Filter::catmull_rom(),
+        "lanczos" => Filter::lanczos(3),
+        "sinc" => Filter::Sinc {
+            radius: Vec2::splat(4.0),
+            tau: 3.0,
+        },
         _ => Filter::Box,
-    })
+    }
 }
 
 /// The camera, and the medium the file puts it in (None: found from where it stands).

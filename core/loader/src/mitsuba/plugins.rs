@@ -489,7 +489,7 @@ const MITSUBA06_PARAMETERS: &[(&str, &str, &[&str])] = &[
     ("rfilter", "box", &["radius"]),
     ("rfilter", "gaussian", &["stddev"]),
     ("rfilter", "lanczos", &["lobes"]),
-    ("rfilter", "mitchell", &["b", "c"]),
+    ("rfilter", "mitchell", &["B", "C"]),
     ("sampler", "", &["sample_count"]),
     ("sampler", "halton", &["scramble"]),
     ("sampler", "hammersley", &["scramble"]),

@@ -367,24 +367,28 @@ impl Reader {
                         let s = rf.float("stddev", 0.5)?;
                         filter.insert("stddev", at(Value::Float(s), l));
                     }
-                    // Filters with negative lobes foton does not have: the Gaussian of
-                    // Mitsuba's default, whose main lobe is about as wide, stands in.
-                    "mitchell" | "catmullrom" | "lanczos" => {
-                        rf.props.clear();
-                        self.unsupported(
-                            &rf,
-                            "foton has no such filter; it filters with a gaussian (stddev 0.5) instead",
-                        )?;
-                        filter = Table::default();
-                        filter.insert("type", at(Value::Str("gaussian".into()), l));
-                        filter.insert("stddev", at(Value::Float(0.5), l));
+                    // Filters with negative lobes: Mitsuba's `B` and `C` (0.6 writes them so
+                    // too; radius 2) and `lobes` (radius = lobes).
+                    "mitchell" => {
+                        let b = rf.float("B", 1.0 / 3.0)?;
+                        let c = rf.float("C", 1.0 / 3.0)?;
+                        filter.insert("b", at(Value::Float(b), l));
+                        filter.insert("c", at(Value::Float(c), l));
+                    }
+                    "catmullrom" => {}
+                    "lanczos" => {
+                        let lobes = rf.int("lobes", 3)?;
+                        if !(1..=64).contains(&lobes) {
+                            return Err(rf.error(format!("`lobes` {lobes}: must be 1 to 64")));
+                        }
+                        filter.insert("lobes", at(Value::Int(lobes), l));
                     }
                     _ => {
                         rf.props.clear();
                         let m = not_read(
                             "rfilter",
                             &rf.ty,
-                            "foton's filters are box, tent and gaussian",
+                            "foton's filters are box, tent, gaussian, mitchell, catmullrom and lanczos",
                         );
                         self.unsupported(&rf, &m)?;
                         filter = Table::default();

@@ -211,71 +211,79 @@ impl Reader {
     /// pbrt-v4's filters (filters.cpp) as foton's: `box` (radius 0.5: the pixel) and
     /// `gaussian` as they are, `triangle` as `tent`; the default gaussian of sigma 0.5 and
     /// radius 1.5 as foton's gaussian of that standard deviation (support 2).
+    /// `PixelFilter`: each of pbrt-v4's filters with its `xradius` and `yradius` (filters.cpp's
+    /// defaults), as foton's filter of the same profile.
     fn filter(&mut self, d: &Directive, given: bool) -> Result<()> {
         let mut p = Bag::new(d);
         let loc = &d.loc;
-        let filter = match d.string(0) {
+        let radius = |p: &mut Bag, default: f64| -> Result<(f64, f64)> {
+            Ok((p.float("xradius", default)?, p.float("yradius", default)?))
+        };
+        let (ty, mut entries) = match d.string(0) {
             "box" => {
-                let r = p.numbers("radius", &[super::parse::Type::Vector2])?;
-                if let Some((r, l)) = r
-                    && r.iter().any(|x| (x - 0.5).abs() > 1e-9)
-                {
+                let (rx, ry) = radius(&mut p, 0.5)?;
+                if (rx - 0.5).abs() > 1e-9 || (ry - 0.5).abs() > 1e-9 {
                     self.unsupported(
-                        &l,
+                        loc,
                         &d.what(),
                         "a box of another radius than 0.5 (the pixel) is not read yet",
                     )?;
                 }
-                self.string("box", loc)
+                self.finish(&mut p)?;
+                let filter = self.string("box", loc);
+                table_mut(&mut self.root, "film").insert("filter", filter);
+                return Ok(());
             }
             "gaussian" => {
+                let (rx, ry) = radius(&mut p, 1.5)?;
                 let sigma = p.float("sigma", 0.5)?;
-                if let Some((r, l)) = p.numbers("radius", &[super::parse::Type::Vector2])? {
-                    self.note(
-                        &l,
-                        &d.what(),
-                        &format!("radius {r:?}: foton's gaussian has support 4 sigma"),
-                    );
-                }
                 if given {
-                    self.note(loc, &d.what(), "rendered by foton's gaussian filter of the same sigma (support 4 sigma, pbrt-v4's 3 sigma by default)");
+                    self.note(loc, &d.what(), "rendered by foton's gaussian filter of the same sigma and radius (pbrt-v4's profile, sampled with the filter's density)");
                 }
-                let entries = vec![
-                    ("type", self.string("gaussian", loc)),
-                    ("stddev", self.num(sigma, loc)),
-                ];
-                self.table(entries, loc)
+                (
+                    "gaussian",
+                    vec![("stddev", sigma), ("radius", rx), ("radius", ry)],
+                )
             }
+            // pbrt-v4's triangle, max(0, r - |x|) per axis, is foton's tent of the same radii.
             "triangle" => {
-                let r = p.numbers("radius", &[super::parse::Type::Vector2])?;
-                let radius = match r {
-                    Some((r, l)) => {
-                        if (r[0] - r[1]).abs() > 1e-12 {
-                            self.unsupported(
-                                &l,
-                                &d.what(),
-                                "a triangle filter of two radii is not read yet",
-                            )?;
-                        }
-                        r[0]
-                    }
-                    None => 2.0,
-                };
-                let entries = vec![
-                    ("type", self.string("tent", loc)),
-                    ("radius", self.num(radius, loc)),
-                ];
-                self.table(entries, loc)
+                let (rx, ry) = radius(&mut p, 2.0)?;
+                ("tent", vec![("radius", rx), ("radius", ry)])
             }
-            "mitchell" | "sinc" => {
-                self.unsupported(loc, &d.what(), "foton has box, tent and gaussian filters")?;
-                return Ok(());
+            "mitchell" => {
+                let (rx, ry) = radius(&mut p, 2.0)?;
+                let b = p.float("B", 1.0 / 3.0)?;
+                let c = p.float("C", 1.0 / 3.0)?;
+                (
+                    "mitchell",
+                    vec![("b", b), ("c", c), ("radius", rx), ("radius", ry)],
+                )
+            }
+            "sinc" => {
+                let (rx, ry) = radius(&mut p, 4.0)?;
+                let tau = p.float("tau", 3.0)?;
+                ("sinc", vec![("tau", tau), ("radius", rx), ("radius", ry)])
             }
             other => {
                 return Err(loc.error(&d.what(), format!("unknown filter {other:?}; pbrt-v4 has box, gaussian, mitchell, sinc and triangle")));
             }
         };
         self.finish(&mut p)?;
+        // The two radii become one `radius = [x, y]`.
+        let ry = entries.pop().expect("radius y").1;
+        let rx = entries.pop().expect("radius x").1;
+        let mut table = vec![("type", self.string(ty, loc))];
+        for (k, v) in entries {
+            table.push((k, self.num(v, loc)));
+        }
+        let radius = if rx == ry {
+            self.num(rx, loc)
+        } else {
+            let items = vec![self.num(rx, loc), self.num(ry, loc)];
+            self.node(Value::Array(items), loc)
+        };
+        table.push(("radius", radius));
+        let filter = self.table(table, loc);
         table_mut(&mut self.root, "film").insert("filter", filter);
         Ok(())
     }

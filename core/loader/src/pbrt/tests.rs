@@ -552,3 +552,51 @@ fn media_and_medium_interfaces() {
     assert_eq!(report.left_out.len(), 1, "{:?}", report.left_out);
     assert_eq!(text(&d.root, "shapes.0.interior"), "vacuum");
 }
+
+#[test]
+fn pixel_filters_with_their_radii_and_parameters() {
+    let filter = |line: &str| doc(&format!("{line}\nCamera \"perspective\"\n{WORLD}"));
+    // The default: pbrt-v4's gaussian, sigma 0.5, radius 1.5.
+    let t = doc(&format!("Camera \"perspective\"\n{WORLD}"));
+    assert_eq!(text(&t, "film.filter.type"), "gaussian");
+    assert_eq!(num(&t, "film.filter.stddev"), 0.5);
+    assert_eq!(num(&t, "film.filter.radius"), 1.5);
+    let t = filter(
+        "PixelFilter \"gaussian\" \"float sigma\" 0.7 \"float xradius\" 2 \"float yradius\" 1",
+    );
+    assert_eq!(num(&t, "film.filter.stddev"), 0.7);
+    assert!(close(&nums(&t, "film.filter.radius"), &[2.0, 1.0]));
+    let t = filter("PixelFilter \"triangle\" \"float yradius\" 1");
+    assert_eq!(text(&t, "film.filter.type"), "tent");
+    assert!(close(&nums(&t, "film.filter.radius"), &[2.0, 1.0]));
+    let t = filter("PixelFilter \"mitchell\"");
+    assert_eq!(text(&t, "film.filter.type"), "mitchell");
+    assert!((num(&t, "film.filter.b") - 1.0 / 3.0).abs() < 1e-12);
+    assert!((num(&t, "film.filter.c") - 1.0 / 3.0).abs() < 1e-12);
+    assert_eq!(num(&t, "film.filter.radius"), 2.0);
+    let t = filter("PixelFilter \"mitchell\" \"float B\" 0 \"float C\" 0.5 \"float xradius\" 3");
+    assert_eq!(num(&t, "film.filter.b"), 0.0);
+    assert_eq!(num(&t, "film.filter.c"), 0.5);
+    assert!(close(&nums(&t, "film.filter.radius"), &[3.0, 2.0]));
+    let t = filter("PixelFilter \"sinc\"");
+    assert_eq!(text(&t, "film.filter.type"), "sinc");
+    assert_eq!(num(&t, "film.filter.tau"), 3.0);
+    assert_eq!(num(&t, "film.filter.radius"), 4.0);
+    let t = filter("PixelFilter \"sinc\" \"float tau\" 2 \"float xradius\" 2 \"float yradius\" 2");
+    assert_eq!(num(&t, "film.filter.tau"), 2.0);
+    assert_eq!(num(&t, "film.filter.radius"), 2.0);
+    let t = filter("PixelFilter \"box\"");
+    assert_eq!(text(&t, "film.filter"), "box");
+    let e = read(
+        &format!("PixelFilter \"box\" \"float xradius\" 1\nCamera \"perspective\"\n{WORLD}"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("another radius"), "{e}");
+    let e = read(
+        &format!("PixelFilter \"mitchell\" \"float bogus\" 1\nCamera \"perspective\"\n{WORLD}"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("bogus"), "{e}");
+}
