@@ -10,7 +10,7 @@ use super::spectra::{Kind, rgb};
 use super::texture::Tex;
 use super::{Loc, Reader, table_mut};
 use foton_core::error::Result;
-use foton_core::value::Node;
+use foton_core::value::{Node, Value};
 
 /// pbrt-v4's named metals (`metal-X-eta`, `metal-X-k`) that Mitsuba's measured data, which
 /// foton carries, also has.
@@ -138,14 +138,170 @@ impl Reader {
                 }
             }
             "interface" => entries.push(("type", self.string("null", &loc))),
-            other @ ("coateddiffuse"
-            | "coatedconductor"
-            | "thindielectric"
-            | "diffusetransmission"
-            | "mix"
-            | "measured"
-            | "subsurface"
-            | "hair") => {
+            "thindielectric" => {
+                let eta = match p.take("eta") {
+                    None => 1.5,
+                    Some(q) => match (&q.ty, &q.values) {
+                        (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
+                        _ => {
+                            self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float eta\"", q.decl()))?;
+                            return Ok(false);
+                        }
+                    },
+                };
+                if eta <= 0.0 {
+                    return Err(loc.error(&what, format!("\"eta\" {eta}: must be positive")));
+                }
+                entries.push(("type", self.string("thindielectric", &loc)));
+                entries.push(("ior", self.num(eta, &loc)));
+            }
+            "diffusetransmission" => {
+                // f = R / pi on the side light comes from, T / pi through: foton's blend of a
+                // diffuse reflector R / w_R and a diffuse transmitter T / w_T, taken with
+                // probabilities w_R and w_T (the largest channels; the rest is absorbed).
+                let constant =
+                    |r: &mut Reader, p: &mut Bag, name: &str| -> Result<Option<glam::DVec3>> {
+                        match r.colour(p, name, Kind::Albedo, &what)? {
+                            None => Ok(Some(glam::DVec3::splat(0.25))),
+                            Some(Node {
+                                value: Value::Array(a),
+                                ..
+                            }) => Ok(Some(glam::DVec3::new(
+                                a[0].value.as_f64().unwrap_or(0.0),
+                                a[1].value.as_f64().unwrap_or(0.0),
+                                a[2].value.as_f64().unwrap_or(0.0),
+                            ))),
+                            Some(_) => {
+                                r.unsupported(
+                                    &loc,
+                                    &what,
+                                    &format!("a textured \"{name}\" is not read yet"),
+                                )?;
+                                Ok(None)
+                            }
+                        }
+                    };
+                let (Some(rr), Some(tt)) = (
+                    constant(self, &mut p, "reflectance")?,
+                    constant(self, &mut p, "transmittance")?,
+                ) else {
+                    return Ok(false);
+                };
+                let scale = p.float("scale", 1.0)?;
+                let (rr, tt) = (rr * scale, tt * scale);
+                let (wr, wt) = (rr.max_element(), tt.max_element());
+                if wr + wt > 1.0 + 1e-9 {
+                    self.unsupported(&loc, &what, &format!("reflectance and transmittance whose largest channels sum to {} > 1 are not read yet", wr + wt))?;
+                    return Ok(false);
+                }
+                let mut parts = Vec::new();
+                let mut weights = Vec::new();
+                if wr > 0.0 {
+                    let d = self.table(
+                        vec![
+                            ("type", self.string("diffuse", &loc)),
+                            ("reflectance", self.vec3(rr / wr, &loc)),
+                        ],
+                        &loc,
+                    );
+                    parts.push(d);
+                    weights.push(self.num(wr, &loc));
+                }
+                if wt > 0.0 {
+                    let t = self.table(
+                        vec![
+                            ("type", self.string("difftrans", &loc)),
+                            ("transmittance", self.vec3(tt / wt, &loc)),
+                        ],
+                        &loc,
+                    );
+                    parts.push(t);
+                    weights.push(self.num(wt, &loc));
+                }
+                if parts.is_empty() {
+                    entries.push(("type", self.string("diffuse", &loc)));
+                    entries.push(("reflectance", self.vec3(glam::DVec3::ZERO, &loc)));
+                } else {
+                    entries.push(("type", self.string("blend", &loc)));
+                    entries.push(("materials", self.node(Value::Array(parts), &loc)));
+                    entries.push(("weights", self.node(Value::Array(weights), &loc)));
+                }
+            }
+            "mix" => {
+                let names = match p.take("materials") {
+                    Some(q) => match &q.values {
+                        Values::Strs(s) if q.ty == Type::String && s.len() == 2 => s.clone(),
+                        _ => {
+                            return Err(q.loc.error(
+                                &what,
+                                format!("{}: expected two material names", q.decl()),
+                            ));
+                        }
+                    },
+                    None => {
+                        return Err(
+                            loc.error(&what, "missing \"string materials\" (two named materials)")
+                        );
+                    }
+                };
+                let mut parts = Vec::new();
+                for n in &names {
+                    let table = self.named_materials.get(n).and_then(|key| {
+                        match self.root.get("materials") {
+                            Some(Node {
+                                value: Value::Table(t),
+                                ..
+                            }) => t.get(key).cloned(),
+                            _ => None,
+                        }
+                    });
+                    match table {
+                        Some(t) if !matches!(&t.value, Value::Table(tt) if matches!(tt.get("type"), Some(Node { value: Value::Str(k), .. }) if k == "null")) => {
+                            parts.push(t)
+                        }
+                        Some(_) => {
+                            return Err(loc.error(
+                                &what,
+                                format!("{n:?}: an \"interface\" material cannot be part of a mix"),
+                            ));
+                        }
+                        None => {
+                            self.unsupported(&loc, &what, &format!("no named material {n:?} (made by MakeNamedMaterial before the mix; one left out leaves the mix out)"))?;
+                            return Ok(false);
+                        }
+                    }
+                }
+                let amount = match p.take("amount") {
+                    None => Some(self.num(0.5, &loc)),
+                    Some(q) if q.ty == Type::Texture => {
+                        match self.named_texture(&q, true, &what)? {
+                            Some(Tex::Constant(c)) => Some(self.num(c.x, &q.loc)),
+                            Some(Tex::Table(t)) => Some(t),
+                            None => None,
+                        }
+                    }
+                    Some(q) => match (&q.ty, &q.values) {
+                        (Type::Float, Values::Nums(v)) if v.len() == 1 => {
+                            Some(self.num(v[0].clamp(0.0, 1.0), &q.loc))
+                        }
+                        _ => {
+                            return Err(q.loc.error(
+                                &what,
+                                format!(
+                                    "{}: expected \"float amount\" or a float texture",
+                                    q.decl()
+                                ),
+                            ));
+                        }
+                    },
+                };
+                entries.push(("type", self.string("blend", &loc)));
+                entries.push(("materials", self.node(Value::Array(parts), &loc)));
+                if let Some(a) = amount {
+                    entries.push(("weight", a));
+                }
+            }
+            other @ ("coateddiffuse" | "coatedconductor" | "measured" | "subsurface" | "hair") => {
                 self.unsupported(
                     &loc,
                     &what,

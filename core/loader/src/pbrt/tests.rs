@@ -600,3 +600,46 @@ fn pixel_filters_with_their_radii_and_parameters() {
     .unwrap_err();
     assert!(e.contains("bogus"), "{e}");
 }
+
+#[test]
+fn thin_dielectric_diffuse_transmission_and_mix() {
+    let t = doc(&format!(
+        "{WORLD}Material \"thindielectric\" \"float eta\" 1.33\nShape \"sphere\"\n\
+         Material \"diffusetransmission\" \"rgb reflectance\" [0.2 0.4 0.1] \"rgb transmittance\" [0.3 0.1 0.5]\nShape \"sphere\"\n\
+         MakeNamedMaterial \"a\" \"string type\" \"diffuse\"\n\
+         MakeNamedMaterial \"b\" \"string type\" \"dielectric\"\n\
+         MakeNamedMaterial \"m\" \"string type\" \"mix\" \"string materials\" [\"a\" \"b\"] \"float amount\" 0.3\n\
+         NamedMaterial \"m\"\nShape \"sphere\"\n"
+    ));
+    assert_eq!(text(&t, "materials.material_1.type"), "thindielectric");
+    assert_eq!(num(&t, "materials.material_1.ior"), 1.33);
+    // R / pi + T / pi as a blend of R / 0.4 and T / 0.5 taken with probabilities 0.4 and 0.5.
+    assert_eq!(text(&t, "materials.material_2.type"), "blend");
+    assert!(close(
+        &nums(&t, "materials.material_2.weights"),
+        &[0.4, 0.5]
+    ));
+    assert_eq!(text(&t, "materials.material_2.materials.0.type"), "diffuse");
+    assert!(close(
+        &nums(&t, "materials.material_2.materials.0.reflectance"),
+        &[0.5, 1.0, 0.25]
+    ));
+    assert_eq!(
+        text(&t, "materials.material_2.materials.1.type"),
+        "difftrans"
+    );
+    assert!(close(
+        &nums(&t, "materials.material_2.materials.1.transmittance"),
+        &[0.6, 0.2, 1.0]
+    ));
+    assert_eq!(text(&t, "materials.m.type"), "blend");
+    assert_eq!(text(&t, "materials.m.materials.0.type"), "diffuse");
+    assert_eq!(text(&t, "materials.m.materials.1.type"), "dielectric");
+    assert_eq!(num(&t, "materials.m.weight"), 0.3);
+    let e = read(
+        &format!("{WORLD}Material \"mix\" \"string materials\" [\"x\" \"y\"]\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("no named material \"x\""), "{e}");
+}
