@@ -13,6 +13,7 @@
 //! one-sided: black seen from behind).
 
 pub mod blend;
+pub mod layered;
 mod principled_common;
 
 use crate::Rgb;
@@ -53,6 +54,8 @@ materials! {
         Principled(principled::PrincipledMaterial, principled::PrincipledBxdf),
         PrincipledThin(principledthin::PrincipledThinMaterial, principledthin::PrincipledThinBxdf),
         DiffTrans(difftrans::DiffTransMaterial, difftrans::DiffTransBxdf),
+        CoatedDiffuse(coateddiffuse::CoatedDiffuseMaterial, coateddiffuse::CoatedDiffuseBxdf),
+        CoatedConductor(coatedconductor::CoatedConductorMaterial, coatedconductor::CoatedConductorBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

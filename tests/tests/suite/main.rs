@@ -18,6 +18,7 @@ mod bitterli;
 mod blend;
 mod build_id;
 mod capabilities;
+mod coated;
 mod conductor;
 mod consistency;
 mod crossing_limit;
