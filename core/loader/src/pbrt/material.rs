@@ -301,7 +301,108 @@ impl Reader {
                     entries.push(("weight", a));
                 }
             }
-            other @ ("coateddiffuse" | "coatedconductor" | "measured" | "subsurface" | "hair") => {
+            "coateddiffuse" | "coatedconductor" => {
+                entries.push(("type", self.string(&ty, &loc)));
+                let diffuse = ty == "coateddiffuse";
+                // pbrt-v4's names, a dot made an underscore (foton's TOML keys).
+                let floats: &[(&str, &str)] = if diffuse {
+                    &[
+                        ("roughness", "roughness"),
+                        ("uroughness", "uroughness"),
+                        ("vroughness", "vroughness"),
+                        ("eta", "eta"),
+                        ("thickness", "thickness"),
+                        ("g", "g"),
+                    ]
+                } else {
+                    &[
+                        ("interface.roughness", "interface_roughness"),
+                        ("interface.uroughness", "interface_uroughness"),
+                        ("interface.vroughness", "interface_vroughness"),
+                        ("interface.eta", "interface_eta"),
+                        ("conductor.roughness", "conductor_roughness"),
+                        ("conductor.uroughness", "conductor_uroughness"),
+                        ("conductor.vroughness", "conductor_vroughness"),
+                        ("thickness", "thickness"),
+                        ("g", "g"),
+                    ]
+                };
+                for &(name, key) in floats {
+                    let Some(q) = p.take(name) else { continue };
+                    let x = match (&q.ty, &q.values) {
+                        (Type::Float, Values::Nums(v)) if v.len() == 1 => Some(v[0]),
+                        (Type::Texture, _) => match self.named_texture(&q, true, &what)? {
+                            Some(Tex::Constant(c)) => Some(c.x),
+                            _ => None,
+                        },
+                        (Type::Spectrum, _) if name.ends_with("eta") => {
+                            self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float {name}\"", q.decl()))?;
+                            None
+                        }
+                        _ => {
+                            return Err(q.loc.error(
+                                &what,
+                                format!("{}: expected one \"float {name}\"", q.decl()),
+                            ));
+                        }
+                    };
+                    if let Some(x) = x {
+                        entries.push((key, self.num(x, &q.loc)));
+                    }
+                }
+                for name in ["maxdepth", "nsamples"] {
+                    if let Some((n, l)) = p.int_opt(name)? {
+                        entries.push((name, self.num(n as f64, &l)));
+                    }
+                }
+                let remap = p.bool("remaproughness", true)?;
+                entries.push(("remaproughness", self.node(Value::Bool(remap), &loc)));
+                if let Some(c) = self.colour(&mut p, "albedo", Kind::Albedo, &what)? {
+                    entries.push(("albedo", c));
+                }
+                if let Some(c) = self.colour(&mut p, "reflectance", Kind::Albedo, &what)? {
+                    entries.push(("reflectance", c));
+                } else if !diffuse {
+                    let (eta, k) = (p.take("conductor.eta"), p.take("conductor.k"));
+                    let named = |q: &Option<super::parse::Param>, suffix: &str| match q {
+                        Some(q) => match (&q.ty, &q.values) {
+                            (Type::Spectrum, Values::Strs(s)) => s[0]
+                                .strip_prefix("metal-")
+                                .and_then(|m| m.strip_suffix(suffix))
+                                .map(str::to_string),
+                            _ => None,
+                        },
+                        None => None,
+                    };
+                    match (named(&eta, "-eta"), named(&k, "-k"), eta, k) {
+                        (Some(a), Some(b), _, _) if a == b => {
+                            if !METALS.contains(&a.as_str())
+                                || foton_core::material::conductor_ior(&a).is_none()
+                            {
+                                self.unsupported(
+                                    &loc,
+                                    &what,
+                                    &format!("the metal {a:?}: foton has no data for it"),
+                                )?;
+                                return Ok(false);
+                            }
+                            self.note(&loc, &what, &format!("metal-{a}: Mitsuba's measured index of {a} reduced to RGB as Mitsuba 3 does, not pbrt-v4's spectral rendering of it (colours may differ slightly)"));
+                            entries.push(("conductor_material", self.string(&a, &loc)));
+                        }
+                        (_, _, None, None) => {}
+                        (_, _, Some(eta), Some(k)) => {
+                            let e = rgb(&eta, Kind::Unbounded, &what, &self.dir)?;
+                            let kk = rgb(&k, Kind::Unbounded, &what, &self.dir)?;
+                            entries.push(("conductor_eta", self.vec3(e, &eta.loc)));
+                            entries.push(("conductor_k", self.vec3(kk, &k.loc)));
+                        }
+                        _ => {
+                            return Err(loc.error(&what, "give both \"conductor.eta\" and \"conductor.k\" (or neither: copper)"));
+                        }
+                    }
+                }
+            }
+            other @ ("measured" | "subsurface" | "hair") => {
                 self.unsupported(
                     &loc,
                     &what,

@@ -643,3 +643,36 @@ fn thin_dielectric_diffuse_transmission_and_mix() {
     .unwrap_err();
     assert!(e.contains("no named material \"x\""), "{e}");
 }
+
+#[test]
+fn coated_materials_keep_pbrts_names() {
+    let t = doc(&format!(
+        "{WORLD}Material \"coateddiffuse\" \"rgb reflectance\" [0.7 0.3 0.1] \"float roughness\" 0.1 \"float thickness\" 0.05 \"rgb albedo\" [0.5 0.5 0.5] \"integer maxdepth\" 20\nShape \"sphere\"\n\
+         Material \"coatedconductor\" \"spectrum conductor.eta\" \"metal-Au-eta\" \"spectrum conductor.k\" \"metal-Au-k\" \"float interface.roughness\" 0.05 \"float conductor.roughness\" 0.2 \"float interface.eta\" 1.4\nShape \"sphere\"\n\
+         Material \"coatedconductor\" \"rgb conductor.eta\" [0.2 0.3 0.4] \"rgb conductor.k\" [3 3 3] \"bool remaproughness\" false\nShape \"sphere\"\n"
+    ));
+    assert_eq!(text(&t, "materials.material_1.type"), "coateddiffuse");
+    assert!(close(
+        &nums(&t, "materials.material_1.reflectance"),
+        &[0.7, 0.3, 0.1]
+    ));
+    assert_eq!(num(&t, "materials.material_1.roughness"), 0.1);
+    assert_eq!(num(&t, "materials.material_1.thickness"), 0.05);
+    assert_eq!(num(&t, "materials.material_1.maxdepth"), 20.0);
+    assert!(close(
+        &nums(&t, "materials.material_1.albedo"),
+        &[0.5, 0.5, 0.5]
+    ));
+    assert_eq!(text(&t, "materials.material_2.conductor_material"), "Au");
+    assert_eq!(num(&t, "materials.material_2.interface_roughness"), 0.05);
+    assert_eq!(num(&t, "materials.material_2.conductor_roughness"), 0.2);
+    assert_eq!(num(&t, "materials.material_2.interface_eta"), 1.4);
+    assert!(close(
+        &nums(&t, "materials.material_3.conductor_eta"),
+        &[0.2, 0.3, 0.4]
+    ));
+    assert!(matches!(
+        node(&t, "materials.material_3.remaproughness").value,
+        Value::Bool(false)
+    ));
+}
