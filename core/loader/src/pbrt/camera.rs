@@ -4,7 +4,7 @@
 //! samplers.cpp, integrators.cpp, filters.cpp).
 
 use super::params::Bag;
-use super::parse::{Arg, Directive};
+use super::parse::{Arg, Directive, Type};
 use super::{Loc, Reader, table_mut};
 use foton_core::error::Result;
 use foton_core::value::{Node, Value};
@@ -13,12 +13,14 @@ use glam::{DMat4, DVec3};
 impl Reader {
     pub(super) fn scene_wide(&mut self) -> Result<()> {
         let (camera, camera_from_world) = self.camera.clone().expect("set at WorldBegin");
-        self.camera(&camera, camera_from_world)?;
+        // The film first: the camera's window on the image plane depends on its resolution
+        // and crop window.
         let film = self
             .film
             .clone()
             .unwrap_or_else(|| default("Film", "rgb", &camera.loc));
-        self.film(&film)?;
+        let window = self.film(&film)?;
+        self.camera(&camera, camera_from_world, window)?;
         let filter = self
             .filter
             .clone()
@@ -36,7 +38,7 @@ impl Reader {
         self.integrator(&integrator)
     }
 
-    fn camera(&mut self, d: &Directive, camera_from_world: DMat4) -> Result<()> {
+    fn camera(&mut self, d: &Directive, camera_from_world: DMat4, film: FilmWindow) -> Result<()> {
         let mut p = Bag::new(d);
         let loc = &d.loc;
         match d.string(0) {
@@ -81,11 +83,43 @@ impl Reader {
             )?;
         }
         p.float_opt("focaldistance")?;
-        for name in ["screenwindow", "frameaspectratio"] {
-            if let Some(q) = p.take(name) {
-                self.unsupported(&q.loc, &d.what(), &format!("{} is not read yet", q.decl()))?;
-            }
+        // pbrt-v4's screen window (cameras.cpp): [-frame, frame] x [-1, 1] for a frame wider
+        // than tall, else [-1, 1] x [-1/frame, 1/frame], in units of tan(fov / 2) on the
+        // plane at distance 1; the image spans it, row 0 at its top.
+        let (xres, yres) = (film.full.0 as f64, film.full.1 as f64);
+        let frame_given = p.float_opt("frameaspectratio")?;
+        let frame = frame_given.as_ref().map_or(xres / yres, |(f, _)| *f);
+        if !(frame > 0.0 && frame.is_finite()) {
+            return Err(loc.error(
+                &d.what(),
+                format!("\"frameaspectratio\" {frame}: must be positive"),
+            ));
         }
+        let mut screen = if frame > 1.0 {
+            [-frame, frame, -1.0, 1.0]
+        } else {
+            [-1.0, 1.0, -1.0 / frame, 1.0 / frame]
+        };
+        let custom = match p.numbers("screenwindow", &[Type::Float])? {
+            Some((v, l)) if v.len() == 4 => {
+                if v[1] <= v[0] || v[3] <= v[2] {
+                    return Err(l.error(
+                        &d.what(),
+                        "\"screenwindow\" [x0 x1 y0 y1] must have x0 < x1 and y0 < y1",
+                    ));
+                }
+                screen = [v[0], v[1], v[2], v[3]];
+                true
+            }
+            Some((v, l)) => {
+                return Err(l.error(
+                    &d.what(),
+                    format!("\"screenwindow\": expected 4 values, found {}", v.len()),
+                ));
+            }
+            None => false,
+        };
+        let custom = custom || frame_given.is_some() || film.crop.is_some();
         // Times only matter with motion.
         p.float_opt("shutteropen")?;
         p.float_opt("shutterclose")?;
@@ -94,9 +128,31 @@ impl Reader {
             ("position", self.vec3(position, loc)),
             ("look_at", self.vec3(position + forward.normalize(), loc)),
             ("up", self.vec3(up.normalize(), loc)),
-            ("fov", self.num(fov, loc)),
-            ("fov_axis", self.string("smaller", loc)),
         ];
+        if custom {
+            // The part of the image plane the (cropped) film sees: foton's vertical field of
+            // view and the window's centre (`shift`), both in units of the plane at
+            // distance 1. Pixels must stay square.
+            let t = (fov.to_radians() / 2.0).tan();
+            let [x0, x1, y0, y1] = screen;
+            if ((x1 - x0) / xres - (y1 - y0) / yres).abs() > 1e-6 * (x1 - x0) / xres {
+                self.unsupported(loc, &d.what(), "a screen window whose pixels are not square is not supported (foton's pixels are square)")?;
+            }
+            let (px0, px1, py0, py1) = film.crop.unwrap_or((0, film.full.0, 0, film.full.1));
+            let sx = |px: i64| x0 + px as f64 / xres * (x1 - x0);
+            let sy = |py: i64| y1 - py as f64 / yres * (y1 - y0);
+            let half = (sy(py0) - sy(py1)) / 2.0 * t;
+            let centre = [(sx(px0) + sx(px1)) / 2.0 * t, (sy(py0) + sy(py1)) / 2.0 * t];
+            entries.push(("fov", self.num(2.0 * half.atan().to_degrees(), loc)));
+            entries.push(("fov_axis", self.string("y", loc)));
+            if centre != [0.0, 0.0] {
+                let items = centre.iter().map(|c| self.num(*c, loc)).collect();
+                entries.push(("shift", self.node(Value::Array(items), loc)));
+            }
+        } else {
+            entries.push(("fov", self.num(fov, loc)));
+            entries.push(("fov_axis", self.string("smaller", loc)));
+        }
         if mirror {
             entries.push(("mirror", self.node(Value::Bool(true), loc)));
         }
@@ -105,7 +161,7 @@ impl Reader {
         Ok(())
     }
 
-    fn film(&mut self, d: &Directive) -> Result<()> {
+    fn film(&mut self, d: &Directive) -> Result<FilmWindow> {
         let mut p = Bag::new(d);
         let loc = &d.loc;
         match d.string(0) {
@@ -167,9 +223,52 @@ impl Reader {
         {
             self.unsupported(&l, &d.what(), "\"whitebalance\" is not read yet")?;
         }
-        if let Some(q) = p.take("cropwindow").or_else(|| p.take("pixelbounds")) {
-            self.unsupported(&q.loc, &d.what(), &format!("{} is not read yet", q.decl()))?;
+        // The pixels rendered (film.cpp): `pixelbounds` [x0 x1 y0 y1], or `cropwindow` in
+        // [0, 1] (which wins), x0 = ceil(xres min(c0, c1)) and so on; the image written is
+        // that window alone.
+        let mut crop = None;
+        if let Some((v, l)) = p.numbers("pixelbounds", &[Type::Integer])? {
+            if v.len() != 4 {
+                return Err(l.error(
+                    &d.what(),
+                    format!("\"pixelbounds\": expected 4 values, found {}", v.len()),
+                ));
+            }
+            let b = (
+                (v[0] as i64).clamp(0, width),
+                (v[1] as i64).clamp(0, width),
+                (v[2] as i64).clamp(0, height),
+                (v[3] as i64).clamp(0, height),
+            );
+            crop = Some((b, l));
         }
+        if let Some((v, l)) = p.numbers("cropwindow", &[Type::Float])? {
+            if v.len() != 4 {
+                return Err(l.error(
+                    &d.what(),
+                    format!("\"cropwindow\": expected 4 values, found {}", v.len()),
+                ));
+            }
+            let c = |a: f64, b: f64| (a.min(b).clamp(0.0, 1.0), a.max(b).clamp(0.0, 1.0));
+            let ((cx0, cx1), (cy0, cy1)) = (c(v[0], v[1]), c(v[2], v[3]));
+            let px = |f: f64, n: i64| (n as f64 * f).ceil() as i64;
+            crop = Some((
+                (
+                    px(cx0, width),
+                    px(cx1, width),
+                    px(cy0, height),
+                    px(cy1, height),
+                ),
+                l,
+            ));
+        }
+        let crop = match crop {
+            Some(((x0, x1, y0, y1), l)) if x1 <= x0 || y1 <= y0 => {
+                return Err(l.error(&d.what(), "the crop window holds no pixel"));
+            }
+            Some((b, _)) if b != (0, width, 0, height) => Some(b),
+            _ => None,
+        };
         if let Some((m, l)) = p.float_opt("maxcomponentvalue")?
             && m.is_finite()
         {
@@ -205,7 +304,28 @@ impl Reader {
         film.insert("width", w);
         film.insert("height", h);
         film.insert("output", o);
-        Ok(())
+        if let Some((x0, x1, y0, y1)) = crop {
+            film.insert(
+                "width",
+                Node {
+                    value: Value::Int(x1 - x0),
+                    line: 0,
+                    column: 0,
+                },
+            );
+            film.insert(
+                "height",
+                Node {
+                    value: Value::Int(y1 - y0),
+                    line: 0,
+                    column: 0,
+                },
+            );
+        }
+        Ok(FilmWindow {
+            full: (width, height),
+            crop,
+        })
     }
 
     /// pbrt-v4's filters (filters.cpp) as foton's: `box` (radius 0.5: the pixel) and
@@ -441,6 +561,13 @@ impl Reader {
 }
 
 /// A statement the file does not have, with pbrt-v4's default type.
+/// The film's full resolution and the pixels it renders of it (x0, x1, y0, y1; None: all).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct FilmWindow {
+    full: (i64, i64),
+    crop: Option<(i64, i64, i64, i64)>,
+}
+
 fn default(name: &str, ty: &str, loc: &Loc) -> Directive {
     Directive {
         name: name.into(),

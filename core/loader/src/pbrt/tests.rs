@@ -676,3 +676,25 @@ fn coated_materials_keep_pbrts_names() {
         Value::Bool(false)
     ));
 }
+
+#[test]
+fn crop_windows_and_screen_windows_are_a_narrower_shifted_camera() {
+    let t = doc(&format!(
+        "Camera \"perspective\" \"float fov\" 30\nFilm \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 48 \"float cropwindow\" [0.75 0.25 0.1 0.6]\n{WORLD}"
+    ));
+    // Pixels ceil(64 x 0.25) = 16 to 48 and ceil(48 x 0.1) = 5 to ceil(48 x 0.6) = 29.
+    assert_eq!(num(&t, "film.width"), 32.0);
+    assert_eq!(num(&t, "film.height"), 24.0);
+    let tan = 15f64.to_radians().tan();
+    // Screen y from 1 - 2 x 5/48 down to 1 - 2 x 29/48: half of 1, centred at 7/24.
+    assert!((num(&t, "camera.fov") - 2.0 * (0.5 * tan).atan().to_degrees()).abs() < 1e-9);
+    assert_eq!(text(&t, "camera.fov_axis"), "y");
+    assert!(close(&nums(&t, "camera.shift"), &[0.0, 7.0 / 24.0 * tan]));
+    let t = doc(&format!(
+        "Camera \"perspective\" \"float fov\" 30 \"float screenwindow\" [-0.5 1.5 -0.5 1]\nFilm \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 48\n{WORLD}"
+    ));
+    assert!((num(&t, "camera.fov") - 2.0 * (0.75 * tan).atan().to_degrees()).abs() < 1e-9);
+    assert!(close(&nums(&t, "camera.shift"), &[0.5 * tan, 0.25 * tan]));
+    let e = read(&format!("Camera \"perspective\" \"float screenwindow\" [-1 1 -1 1]\nFilm \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 48\n{WORLD}"), false).unwrap_err();
+    assert!(e.contains("not square"), "{e}");
+}
