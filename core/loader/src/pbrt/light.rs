@@ -16,7 +16,7 @@ use std::f64::consts::PI;
 
 impl Reader {
     pub(super) fn light(&mut self, d: &Directive) -> Result<()> {
-        let mut p = Bag::new(d);
+        let mut p = Bag::new(d).with_defaults(&self.state.attributes.light);
         let loc = d.loc.clone();
         let what = d.what();
         let m = self.state.ctm;

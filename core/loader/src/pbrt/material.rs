@@ -19,7 +19,7 @@ const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"];
 impl Reader {
     /// Reads the material `d` into `[materials.name]`. false: left out (`lenient`).
     pub(super) fn material(&mut self, d: &Directive, name: &str) -> Result<bool> {
-        let mut p = Bag::new(d);
+        let mut p = Bag::new(d).with_defaults(&self.state.attributes.material);
         let loc = d.loc.clone();
         // MakeNamedMaterial gives the type as a parameter.
         let (ty, what) = if d.name == "MakeNamedMaterial" {

@@ -31,7 +31,7 @@ impl Reader {
     /// `MakeNamedMedium "name" "string type" ...`.
     pub(super) fn medium(&mut self, d: &Directive) -> Result<()> {
         let name = d.string(0).to_string();
-        let mut p = Bag::new(d);
+        let mut p = Bag::new(d).with_defaults(&self.state.attributes.medium);
         let loc = d.loc.clone();
         let (ty, tloc) = p
             .string_opt("type")?

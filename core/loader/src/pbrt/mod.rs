@@ -112,6 +112,19 @@ struct State {
     outside: String,
     /// Where that `MediumInterface` was written.
     interface: Option<Loc>,
+    /// `Attribute` defaults per target, in the order written.
+    attributes: Attributes,
+}
+
+/// The parameters `Attribute` gives the shapes, lights, materials, media and textures that
+/// follow in its attribute block.
+#[derive(Clone, Debug, Default)]
+struct Attributes {
+    shape: Vec<parse::Param>,
+    light: Vec<parse::Param>,
+    material: Vec<parse::Param>,
+    medium: Vec<parse::Param>,
+    texture: Vec<parse::Param>,
 }
 
 /// A shape statement of an `ObjectBegin` block, with the state it was read in.
@@ -179,6 +192,7 @@ impl Reader {
                 inside: String::new(),
                 outside: String::new(),
                 interface: None,
+                attributes: Attributes::default(),
             },
             stack: Vec::new(),
             transforms: Vec::new(),
@@ -494,7 +508,21 @@ impl Reader {
                 self.state.interface = Some(d.loc.clone());
             }
             "Attribute" => {
-                self.unsupported(&d.loc, &d.what(), "attribute defaults are not read yet")?
+                let a = &mut self.state.attributes;
+                let target = match d.string(0) {
+                    "shape" => &mut a.shape,
+                    "light" => &mut a.light,
+                    "material" => &mut a.material,
+                    "medium" => &mut a.medium,
+                    "texture" => &mut a.texture,
+                    other => {
+                        return Err(d.loc.error(
+                            "Attribute",
+                            format!("unknown target {other:?}; expected shape, light, material, medium or texture"),
+                        ));
+                    }
+                };
+                target.extend(d.params.iter().cloned());
             }
             other => unreachable!("the parser knows no directive `{other}`"),
         }

@@ -11,6 +11,9 @@ pub struct Bag {
     pub what: String,
     pub loc: Loc,
     params: Vec<Option<Param>>,
+    /// `Attribute` defaults, the latest first (pbrt-v4 looks them up after the directive's
+    /// own parameters, and never reports one unused).
+    defaults: Vec<Option<Param>>,
 }
 
 impl Bag {
@@ -19,19 +22,37 @@ impl Bag {
             what: d.what(),
             loc: d.loc.clone(),
             params: d.params.iter().cloned().map(Some).collect(),
+            defaults: Vec::new(),
         }
+    }
+
+    /// The bag with `Attribute` defaults (in the order written) behind its own parameters.
+    pub fn with_defaults(mut self, defaults: &[Param]) -> Bag {
+        self.defaults = defaults.iter().rev().cloned().map(Some).collect();
+        self
     }
 
     /// The first parameter called `name` (pbrt-v4's lookups take the first), taken.
     pub fn take(&mut self, name: &str) -> Option<Param> {
-        self.params
+        let own = self
+            .params
             .iter_mut()
             .find(|p| p.as_ref().is_some_and(|p| p.name == name))
-            .and_then(Option::take)
+            .and_then(Option::take);
+        own.or_else(|| {
+            self.defaults
+                .iter_mut()
+                .find(|p| p.as_ref().is_some_and(|p| p.name == name))
+                .and_then(Option::take)
+        })
     }
 
     pub fn has(&self, name: &str) -> bool {
-        self.params.iter().flatten().any(|p| p.name == name)
+        self.params
+            .iter()
+            .chain(&self.defaults)
+            .flatten()
+            .any(|p| p.name == name)
     }
 
     /// The parameters nobody took.

@@ -19,7 +19,7 @@ use glam::{DMat3, DMat4, DVec3};
 
 impl Reader {
     pub(super) fn shape(&mut self, d: &Directive, state: &State) -> Result<()> {
-        let mut p = Bag::new(d);
+        let mut p = Bag::new(d).with_defaults(&state.attributes.shape);
         let loc = d.loc.clone();
         let what = d.what();
         let m = state.ctm;

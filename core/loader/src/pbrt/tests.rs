@@ -698,3 +698,26 @@ fn crop_windows_and_screen_windows_are_a_narrower_shifted_camera() {
     let e = read(&format!("Camera \"perspective\" \"float screenwindow\" [-1 1 -1 1]\nFilm \"rgb\" \"integer xresolution\" 64 \"integer yresolution\" 48\n{WORLD}"), false).unwrap_err();
     assert!(e.contains("not square"), "{e}");
 }
+
+#[test]
+fn attribute_gives_defaults_within_its_attribute_block() {
+    let t = doc(&format!(
+        "{WORLD}AttributeBegin\nAttribute \"shape\" \"float radius\" 0.25 \"float bogus\" 1\nAttribute \"shape\" \"float radius\" 0.5\n\
+         Attribute \"material\" \"rgb reflectance\" [0.1 0.2 0.3]\nMaterial \"diffuse\"\nShape \"sphere\"\nShape \"sphere\" \"float radius\" 2\nAttributeEnd\nShape \"sphere\"\n"
+    ));
+    // The latest Attribute wins, the shape's own parameter over both, none after the block;
+    // an attribute nobody reads is no error.
+    assert_eq!(num(&t, "shapes.0.radius"), 0.5);
+    assert_eq!(num(&t, "shapes.1.radius"), 2.0);
+    assert_eq!(num(&t, "shapes.2.radius"), 1.0);
+    assert!(close(
+        &nums(&t, "materials.material_1.reflectance"),
+        &[0.1, 0.2, 0.3]
+    ));
+    let e = read(
+        &format!("{WORLD}Attribute \"camera\" \"float fov\" 3\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("unknown target \"camera\""), "{e}");
+}

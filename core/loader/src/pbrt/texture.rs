@@ -61,7 +61,7 @@ impl Reader {
                 ));
             }
         };
-        let mut p = Bag::new(d);
+        let mut p = Bag::new(d).with_defaults(&self.state.attributes.texture);
         p.what = what.clone();
         let loc = d.loc.clone();
         let tex = match class {
