@@ -120,7 +120,21 @@ impl Reader {
                     self.note(&loc, &what, "a PLY mesh's triangles keep their winding's side; pbrt-v4 turns a triangle with vertex normals towards them (the same for consistently oriented meshes)");
                 }
             }
-            other @ ("bilinearmesh" | "cylinder" | "loopsubdiv" | "curve") => {
+            "bilinearmesh" | "cylinder" => {
+                let mesh = if d.string(0) == "cylinder" {
+                    self.cylinder(&mut p, &what, &loc)?
+                } else {
+                    self.bilinear_mesh(&mut p, &what, &loc)?
+                };
+                let Some(mesh) = mesh else {
+                    return Ok(());
+                };
+                area = Some(mesh.area(m));
+                entries.push(("type", self.string("mesh", &loc)));
+                entries.extend(mesh.entries(self, &loc));
+                entries.push(("transform", self.matrix(m, &loc)));
+            }
+            other @ ("loopsubdiv" | "curve") => {
                 return self.unsupported(
                     &loc,
                     &what,
@@ -167,6 +181,163 @@ impl Reader {
         let mut t = Table::default();
         t.insert("matrix", self.node(Value::Array(rows), loc));
         self.node(Value::Table(t), loc)
+    }
+
+    /// A `cylinder` (`radius` 1, `zmin` -1, `zmax` 1, `phimax` 360) as its prism of
+    /// [`CYLINDER_FACETS`] facets per full turn with the cylinder's normals at the vertices
+    /// (smooth shading), facing out (pbrt-v4's dp/du x dp/dv), uv = (phi / phimax, (z -
+    /// zmin) / (zmax - zmin)).
+    fn cylinder(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
+        let r = p.float("radius", 1.0)?;
+        let (z0, z1) = (p.float("zmin", -1.0)?, p.float("zmax", 1.0)?);
+        let (z0, z1) = (z0.min(z1), z0.max(z1));
+        let phimax = p.float("phimax", 360.0)?.clamp(0.0, 360.0).to_radians();
+        if r <= 0.0 || z1 <= z0 || phimax <= 0.0 {
+            return Err(loc.error(what, "a cylinder of zero radius, height or angle"));
+        }
+        let segments =
+            ((CYLINDER_FACETS as f64 * phimax / std::f64::consts::TAU).ceil() as usize).max(1);
+        let (mut positions, mut normals, mut uvs, mut indices) = (vec![], vec![], vec![], vec![]);
+        for i in 0..=segments {
+            let u = i as f64 / segments as f64;
+            let (sin, cos) = (u * phimax).sin_cos();
+            for (v, z) in [(0.0, z0), (1.0, z1)] {
+                positions.extend([r * cos, r * sin, z]);
+                normals.extend([cos, sin, 0.0]);
+                uvs.extend([u, v]);
+            }
+        }
+        for i in 0..segments as u32 {
+            let (a, d, b, c) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            indices.extend([a, b, c, a, c, d]);
+        }
+        self.note(
+            loc,
+            what,
+            &format!("a cylinder as its prism of {CYLINDER_FACETS} facets a turn, shaded smooth"),
+        );
+        Ok(Some(InlineMesh {
+            positions,
+            indices,
+            normals: Some(normals),
+            uvs: Some(uvs),
+        }))
+    }
+
+    /// A `bilinearmesh` (`P`, `indices` four a patch: p00 p10 p01 p11; `uv`, `N`): a planar
+    /// patch is two triangles, exactly; a curved one is tessellated into
+    /// [`PATCH_STEPS`]^2 quads of two triangles, vertices on the patch (a note). Its side
+    /// is pbrt-v4's dp/du x dp/dv, turned towards `N` when given; uv is `uv` interpolated,
+    /// or the patch's (u, v).
+    fn bilinear_mesh(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
+        let (positions, ploc) = p
+            .numbers("P", &[Type::Point3])?
+            .ok_or_else(|| loc.error(what, "missing \"point3 P\" (the vertices)"))?;
+        let n = positions.len() / 3;
+        let patches = match p.numbers("indices", &[Type::Integer])? {
+            Some((v, l)) => {
+                if v.len() % 4 != 0 {
+                    return Err(l.error(what, format!("\"indices\": {} values, not a multiple of 4", v.len())));
+                }
+                if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i as usize >= n) {
+                    return Err(l.error(what, format!("\"indices\": {bad} is out of range: there are {n} vertices")));
+                }
+                v.iter().map(|&i| i as usize).collect::<Vec<_>>()
+            }
+            None if n == 4 => vec![0, 1, 2, 3],
+            None => return Err(ploc.error(what, "missing \"integer indices\" (only a mesh of exactly 4 vertices may leave them out)")),
+        };
+        let per_vertex =
+            |name: &str, v: Option<(Vec<f64>, Loc)>, width: usize| -> Result<Option<Vec<f64>>> {
+                match v {
+                    Some((v, l)) if v.len() != n * width => Err(l.error(
+                        what,
+                        format!(
+                            "\"{name}\": {} values for {n} vertices, expected {}",
+                            v.len(),
+                            n * width
+                        ),
+                    )),
+                    v => Ok(v.map(|(v, _)| v)),
+                }
+            };
+        let given_n = p.numbers("N", &[Type::Normal])?;
+        let given_n = per_vertex("N", given_n, 3)?;
+        let given_uv = p.numbers("uv", &[Type::Point2])?;
+        let given_uv = per_vertex("uv", given_uv, 2)?;
+        if let Some(q) = p.take("emissionfilename") {
+            self.unsupported(
+                &q.loc,
+                what,
+                &format!("{}: textured emission is not read yet", q.decl()),
+            )?;
+        }
+        let at = |v: &[f64], w: usize, i: usize| -> DVec3 {
+            DVec3::new(
+                v[i * w],
+                v[i * w + 1],
+                if w == 3 { v[i * w + 2] } else { 0.0 },
+            )
+        };
+        let bilerp = |c: [DVec3; 4], u: f64, v: f64| {
+            (1.0 - u) * (1.0 - v) * c[0]
+                + u * (1.0 - v) * c[1]
+                + (1.0 - u) * v * c[2]
+                + u * v * c[3]
+        };
+        let mut mesh = InlineMesh {
+            positions: Vec::new(),
+            indices: Vec::new(),
+            normals: given_n.as_ref().map(|_| Vec::new()),
+            uvs: Some(Vec::new()),
+        };
+        let mut curved = false;
+        for q in patches.chunks(4) {
+            let corners = [0, 1, 2, 3].map(|k| at(&positions, 3, q[k]));
+            let uv = [0, 1, 2, 3].map(|k| match &given_uv {
+                Some(uv) => at(uv, 2, q[k]),
+                None => DVec3::new((k % 2) as f64, (k / 2) as f64, 0.0),
+            });
+            let normal = (corners[1] - corners[0]).cross(corners[2] - corners[0]);
+            let size = (corners[1] - corners[0])
+                .length()
+                .max((corners[2] - corners[0]).length());
+            let off_plane = (corners[3] - corners[0])
+                .dot(normal.normalize_or_zero())
+                .abs();
+            let steps = if off_plane <= 1e-6 * size {
+                1
+            } else {
+                curved = true;
+                PATCH_STEPS
+            };
+            let base = (mesh.positions.len() / 3) as u32;
+            for j in 0..=steps {
+                for i in 0..=steps {
+                    let (u, v) = (i as f64 / steps as f64, j as f64 / steps as f64);
+                    mesh.positions.extend(bilerp(corners, u, v).to_array());
+                    let t = bilerp(uv, u, v);
+                    mesh.uvs.as_mut().expect("set").extend([t.x, t.y]);
+                    if let (Some(nn), Some(out)) = (&given_n, &mut mesh.normals) {
+                        let c = [0, 1, 2, 3].map(|k| at(nn, 3, q[k]));
+                        out.extend(bilerp(c, u, v).normalize_or_zero().to_array());
+                    }
+                }
+            }
+            let row = steps as u32 + 1;
+            for j in 0..steps as u32 {
+                for i in 0..steps as u32 {
+                    let a = base + j * row + i;
+                    let (b, c, d) = (a + 1, a + row + 1, a + row);
+                    mesh.indices.extend([a, b, c, a, c, d]);
+                }
+            }
+        }
+        if curved {
+            self.note(loc, what, &format!("curved bilinear patches tessellated into {PATCH_STEPS} x {PATCH_STEPS} quads each"));
+        }
+        mesh.orient_to_normals();
+        Ok(Some(mesh))
     }
 
     /// A `trianglemesh`'s data, checked (None: left out, `lenient`).
@@ -226,6 +397,12 @@ impl Reader {
         Ok(Some(mesh))
     }
 }
+
+/// Facets of a cylinder per full turn (as the Mitsuba reader's cylinders).
+const CYLINDER_FACETS: usize = 64;
+
+/// Quads per side of a curved bilinear patch.
+const PATCH_STEPS: usize = 8;
 
 /// A `trianglemesh` as the document's inline mesh: flat lists, 3 numbers a vertex, 3 indices
 /// a triangle.

@@ -721,3 +721,34 @@ fn attribute_gives_defaults_within_its_attribute_block() {
     .unwrap_err();
     assert!(e.contains("unknown target \"camera\""), "{e}");
 }
+
+#[test]
+fn bilinear_patches_and_cylinders_become_meshes() {
+    let t = doc(&format!(
+        "{WORLD}Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 0]\n\
+         Shape \"bilinearmesh\" \"point3 P\" [0 0 0  1 0 0  0 1 0  1 1 1]\n\
+         Shape \"cylinder\" \"float radius\" 2 \"float phimax\" 180\n"
+    ));
+    // Planar: two triangles wound as dp/du x dp/dv = +z; uv the patch's.
+    let idx = nums(&t, "shapes.0.indices");
+    assert_eq!(idx.len(), 6);
+    let p = nums(&t, "shapes.0.positions");
+    let v = |i: f64| {
+        glam::DVec3::new(
+            p[3 * i as usize],
+            p[3 * i as usize + 1],
+            p[3 * i as usize + 2],
+        )
+    };
+    assert!((v(idx[1]) - v(idx[0])).cross(v(idx[2]) - v(idx[0])).z > 0.0);
+    assert_eq!(nums(&t, "shapes.0.uvs").len(), 8);
+    // Curved: 8 x 8 quads, vertices on the patch.
+    assert_eq!(nums(&t, "shapes.1.indices").len(), 8 * 8 * 6);
+    // Half a cylinder: 32 facets, vertices at radius 2 with outward normals.
+    assert_eq!(nums(&t, "shapes.2.indices").len(), 32 * 6);
+    let (p, n) = (nums(&t, "shapes.2.positions"), nums(&t, "shapes.2.normals"));
+    for (q, m) in p.chunks(3).zip(n.chunks(3)) {
+        assert!(((q[0] * q[0] + q[1] * q[1]).sqrt() - 2.0).abs() < 1e-9 && q[1] >= -1e-9);
+        assert!((q[0] * m[0] + q[1] * m[1]) > 0.0);
+    }
+}
