@@ -12,7 +12,7 @@ use foton_core::light::area_light;
 use foton_core::material::Material;
 use foton_core::props::Properties;
 use foton_core::scene::{Named, Object};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
 
@@ -131,6 +131,25 @@ pub(super) fn read_shapes(
                 // The mesh reader reversed its triangles itself.
                 shapes.iter_mut().for_each(Shape::flip);
             }
+        }
+        // The BVH is built in f32: coordinates beyond 1e15 overflow its cost estimates (and
+        // any renderer's precision long before).
+        if let Some(b) = shapes.iter().map(Shape::aabb).find(|b| {
+            let (lo, hi) = (Vec3::from(b.min), Vec3::from(b.max));
+            !(lo.is_finite() && hi.is_finite() && lo.abs().max(hi.abs()).max_element() <= 1e15)
+        }) {
+            let key = ["positions", "file", "center", "origin"]
+                .into_iter()
+                .find(|k| s.has(k))
+                .unwrap_or("type");
+            return Err(s.error(
+                key,
+                format!(
+                    "the shape reaches from {} to {}: coordinates must be finite and within 1e15",
+                    Vec3::from(b.min),
+                    Vec3::from(b.max)
+                ),
+            ));
         }
         let material_name = s.string_required("material")?;
         let material = *materials

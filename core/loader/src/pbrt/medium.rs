@@ -99,16 +99,16 @@ impl Reader {
                     ));
                 }
                 let n = n.map(|x| x as usize);
-                if density.len() != n[0] * n[1] * n[2] {
+                let count = n[0].checked_mul(n[1]).and_then(|c| c.checked_mul(n[2]));
+                if count != Some(density.len()) {
                     return Err(dloc.error(
                         &what,
                         format!(
-                            "\"density\" has {} values; expected nx ny nz = {} x {} x {} = {}",
+                            "\"density\" has {} values; expected nx ny nz = {} x {} x {}",
                             density.len(),
                             n[0],
                             n[1],
                             n[2],
-                            n[0] * n[1] * n[2]
                         ),
                     ));
                 }

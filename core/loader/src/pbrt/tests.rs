@@ -752,3 +752,208 @@ fn bilinear_patches_and_cylinders_become_meshes() {
         assert!((q[0] * m[0] + q[1] * m[1]) > 0.0);
     }
 }
+
+/// A scene using most of what the reader maps, for the mutation test.
+const RICH: &str = r#"Scale -1 1 1
+LookAt 0 1 4  0 0.5 0  0 1 0
+Camera "perspective" "float fov" 40 "float screenwindow" [-1 1 -0.75 0.75]
+Film "rgb" "integer xresolution" 16 "integer yresolution" 12 "float cropwindow" [0.1 0.9 0 1] "string filename" "x.exr"
+PixelFilter "mitchell" "float xradius" 2
+Sampler "stratified" "integer xsamples" 2 "integer ysamples" 2
+Integrator "volpath" "integer maxdepth" 5
+MakeNamedMedium "air" "string type" "homogeneous" "rgb sigma_a" [0.01 0.01 0.01] "rgb sigma_s" [0.1 0.1 0.1] "float g" 0.3
+MediumInterface "" "air"
+WorldBegin
+Attribute "shape" "float radius" 0.5
+Texture "img" "spectrum" "imagemap" "string filename" "t.png" "float uscale" 2 "string filter" "point"
+Texture "chk" "spectrum" "checkerboard" "rgb tex1" [1 0 0] "rgb tex2" [0 0 1] "float uscale" 4
+Texture "k" "float" "constant" "float value" 0.3
+Texture "s" "spectrum" "scale" "texture tex" "img" "float scale" 0.5
+LightSource "point" "rgb I" [1 1 1] "point3 from" [0 2 0]
+LightSource "spot" "rgb I" [2 2 2] "point3 from" [1 2 1] "point3 to" [0 0 0] "float coneangle" 40
+LightSource "distant" "point3 from" [0 1 1] "point3 to" [0 0 0] "rgb L" [1 1 1]
+LightSource "infinite" "string filename" "t.png" "float scale" 0.5
+MakeNamedMaterial "a" "string type" "diffuse" "texture reflectance" "chk"
+MakeNamedMaterial "b" "string type" "conductor" "spectrum eta" "metal-Au-eta" "spectrum k" "metal-Au-k" "float roughness" 0.1
+MakeNamedMaterial "m" "string type" "mix" "string materials" ["a" "b"] "texture amount" "k"
+MakeNamedMedium "smoke" "string type" "uniformgrid" "integer nx" 2 "integer ny" 2 "integer nz" 1 "float density" [1 2 3 4] "point3 p0" [-1 0 -1] "point3 p1" [1 1 1]
+AttributeBegin
+  NamedMaterial "m"
+  Shape "sphere"
+  Translate 1 0 0
+  Material "coateddiffuse" "texture reflectance" "s" "float roughness" 0.05
+  Shape "disk" "float radius" 0.3
+AttributeEnd
+AttributeBegin
+  AreaLightSource "diffuse" "rgb L" [3 3 3] "float power" 10
+  Shape "bilinearmesh" "point3 P" [-0.5 2 -0.5  0.5 2 -0.5  -0.5 2 0.5  0.5 2 0.5] "integer indices" [0 2 1 3]
+AttributeEnd
+AttributeBegin
+  MediumInterface "smoke" "air"
+  Material "interface"
+  Shape "trianglemesh" "point3 P" [-1 0 -1  1 0 -1  1 1 -1  -1 1 -1] "integer indices" [0 1 2  0 2 3] "point2 uv" [0 0 1 0 1 1 0 1]
+AttributeEnd
+ObjectBegin "o"
+  Material "diffusetransmission"
+  Shape "cylinder" "float radius" 0.2 "float zmin" 0 "float zmax" 0.5
+ObjectEnd
+ObjectInstance "o"
+Material "thindielectric" "float eta" 1.4
+Shape "trianglemesh" "point3 P" [0 0 0  1 0 0  0 1 0]
+"#;
+
+/// Mutated scenes (bytes flipped, inserted, removed; numbers replaced by extreme ones; lines
+/// dropped or repeated) read and built by the whole loader, leniently and not: errors or
+/// scenes, never a panic. `FOTON_FUZZ_PBRT=N` runs N instead of 1,500.
+#[test]
+fn mutated_pbrt_scenes_are_errors_or_scenes_never_panics() {
+    let n: usize = std::env::var("FOTON_FUZZ_PBRT")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(1_500);
+    let dir = std::env::temp_dir().join(format!("foton-pbrt-fuzz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // A 2 x 2 PNG for the image texture and the environment map.
+    let png = {
+        let mut img = image::RgbImage::new(2, 2);
+        img.put_pixel(1, 0, image::Rgb([200, 100, 50]));
+        let mut bytes = std::io::Cursor::new(Vec::new());
+        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
+        bytes.into_inner()
+    };
+    std::fs::write(dir.join("t.png"), png).unwrap();
+    let path = dir.join("scene.pbrt");
+    std::fs::write(&path, RICH).unwrap();
+    crate::load::load_with(&path, &[], &[], false)
+        .unwrap_or_else(|e| panic!("the base scene: {e}"));
+    let mut state = 0x9e37_79b9_7f4a_7c15u64;
+    let mut next = |m: usize| {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        (state % m.max(1) as u64) as usize
+    };
+    const NUMBERS: &[&str] = &[
+        "0",
+        "-1",
+        "1e30",
+        "-1e30",
+        "nan",
+        "inf",
+        "3.5",
+        "100000",
+        "2147483648",
+        "-0",
+    ];
+    let mut outcomes = [0usize; 2];
+    for _ in 0..n {
+        let mut text = RICH.to_string();
+        for _ in 0..1 + next(3) {
+            match next(4) {
+                0 => {
+                    // A byte changed, inserted or removed.
+                    let mut b = text.into_bytes();
+                    let at = next(b.len());
+                    match next(3) {
+                        0 => {
+                            let pool = b" []\"#\n01-.ex";
+                            b[at] = pool[next(pool.len())];
+                        }
+                        1 => {
+                            let pool = b"[]\"0 \n";
+                            b.insert(at, pool[next(pool.len())]);
+                        }
+                        _ => {
+                            b.remove(at);
+                        }
+                    }
+                    text = String::from_utf8_lossy(&b).into_owned();
+                }
+                1 => {
+                    // A number replaced.
+                    let spans: Vec<(usize, usize)> = {
+                        let b = text.as_bytes();
+                        let mut out = Vec::new();
+                        let mut i = 0;
+                        while i < b.len() {
+                            if b[i].is_ascii_digit() {
+                                let s = i;
+                                while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.') {
+                                    i += 1;
+                                }
+                                out.push((s, i));
+                            }
+                            i += 1;
+                        }
+                        out
+                    };
+                    if let Some(&(s, e)) = spans.get(next(spans.len())) {
+                        text.replace_range(s..e, NUMBERS[next(NUMBERS.len())]);
+                    }
+                }
+                2 => {
+                    let mut lines: Vec<&str> = text.lines().collect();
+                    let at = next(lines.len());
+                    if next(2) == 0 {
+                        lines.remove(at);
+                    } else {
+                        let l = lines[at];
+                        lines.insert(next(lines.len()), l);
+                    }
+                    text = lines.join("\n");
+                }
+                _ => {
+                    // Two lines swapped.
+                    let mut lines: Vec<&str> = text.lines().collect();
+                    let (a, b) = (next(lines.len()), next(lines.len()));
+                    lines.swap(a, b);
+                    text = lines.join("\n");
+                }
+            }
+        }
+        std::fs::write(&path, &text).unwrap();
+        let lenient = next(2) == 0;
+        let result = std::panic::catch_unwind(|| crate::load::load_with(&path, &[], &[], lenient));
+        match result {
+            Ok(r) => outcomes[r.is_ok() as usize] += 1,
+            Err(_) => panic!("the loader panicked on:\n{text}"),
+        }
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    // Both outcomes happen: the mutations neither always break the scene nor never do.
+    assert!(
+        outcomes[0] > n / 10 && outcomes[1] > n / 10,
+        "errors, scenes: {outcomes:?}"
+    );
+}
+
+/// Geometry beyond what f32 holds (found by the mutation test: obvhs' build overflowed on a
+/// cylinder 1e30 long) is an error naming the shape, for every format.
+#[test]
+fn geometry_beyond_1e15_is_an_error_not_a_panic() {
+    let dir = std::env::temp_dir().join(format!("foton-pbrt-huge-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let pbrt = dir.join("huge.pbrt");
+    std::fs::write(
+        &pbrt,
+        format!("{WORLD}Shape \"cylinder\" \"float zmax\" 1e30\n"),
+    )
+    .unwrap();
+    let e = crate::load::load_with(&pbrt, &[], &[], false)
+        .err()
+        .expect("an error")
+        .to_string();
+    assert!(e.contains("within 1e15") && e.contains("shapes[0]"), "{e}");
+    let toml = dir.join("huge.toml");
+    std::fs::write(
+        &toml,
+        "[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n[materials.m]\ntype = \"diffuse\"\n[[shapes]]\ntype = \"sphere\"\ncenter = [0.0, 0.0, 0.0]\nradius = 1e30\nmaterial = \"m\"\n",
+    )
+    .unwrap();
+    let e = crate::load::load_with(&toml, &[], &[], false)
+        .err()
+        .expect("an error")
+        .to_string();
+    assert!(e.contains("huge.toml:") && e.contains("within 1e15"), "{e}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
