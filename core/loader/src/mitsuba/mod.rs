@@ -32,6 +32,8 @@ mod object;
 mod plugins;
 mod sensor;
 mod shape;
+#[cfg(test)]
+mod tests;
 mod texture;
 mod upgrade;
 
