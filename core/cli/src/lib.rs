@@ -40,9 +40,9 @@ use std::io::Write;
     name = "foton",
     version,
     about = "foton: a physically based renderer whose integrators are plugins",
-    long_about = "foton renders a scene described in one TOML file or Mitsuba XML file (0.5, 0.6 or \
-                  3; see docs/scene-format.md) with the integrator plugin the file, or \
-                  --integrator, names."
+    long_about = "foton renders a scene described in one TOML file, Mitsuba XML file (0.4 to 3.x) \
+                  or pbrt-v4 file (see docs/scene-format.md, docs/pbrt.md) with the integrator \
+                  plugin the file, or --integrator, names."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -64,8 +64,8 @@ enum Command {
     /// The merged image equals the render done in one process with the same seed, bit for
     /// bit. Nothing is written if a check fails.
     Merge(merge::MergeArgs),
-    /// Write a Mitsuba 3 XML scene as the equivalent TOML scene (the same image for the same
-    /// seed); lists what --lenient left out.
+    /// Write a Mitsuba XML or pbrt-v4 scene as the equivalent TOML scene (the same image for
+    /// the same seed); lists what --lenient left out.
     Convert(convert::ConvertArgs),
     /// List the plugins found on the plugin search path.
     Plugins(common::PluginArgs),
