@@ -134,7 +134,16 @@ impl Reader {
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
             }
-            other @ ("loopsubdiv" | "curve") => {
+            "loopsubdiv" => {
+                let Some(mesh) = self.loop_subdivision(&mut p, &what, &loc)? else {
+                    return Ok(());
+                };
+                area = Some(mesh.area(m));
+                entries.push(("type", self.string("mesh", &loc)));
+                entries.extend(mesh.entries(self, &loc));
+                entries.push(("transform", self.matrix(m, &loc)));
+            }
+            other @ "curve" => {
                 return self.unsupported(
                     &loc,
                     &what,
@@ -340,6 +349,60 @@ impl Reader {
         Ok(Some(mesh))
     }
 
+    /// A `loopsubdiv` (`levels` 3, `P`, `indices`): Loop's subdivision surface refined at
+    /// load, as pbrt-v4's `LoopSubdivide` does: `levels` rounds of splitting every triangle
+    /// in four, then every vertex moved to its limit position; vertex normals the
+    /// area-weighted normals of the refined triangles (pbrt-v4 takes the limit surface's
+    /// tangents: the same to within the refinement).
+    fn loop_subdivision(
+        &mut self,
+        p: &mut Bag,
+        what: &str,
+        loc: &Loc,
+    ) -> Result<Option<InlineMesh>> {
+        let levels = p.int("levels", 3)?;
+        p.string_opt("scheme")?;
+        let Some(base) = self.triangle_mesh(p, what, loc)? else {
+            return Ok(None);
+        };
+        if !(0..=10).contains(&levels) {
+            return Err(loc.error(what, format!("\"levels\" {levels}: expected 0 to 10")));
+        }
+        let triangles = (base.indices.len() / 3) << (2 * levels);
+        if triangles > 50_000_000 {
+            return Err(loc.error(
+                what,
+                format!("{levels} levels make {triangles} triangles: more than 50 million"),
+            ));
+        }
+        let points = base
+            .positions
+            .chunks(3)
+            .map(|v| DVec3::new(v[0], v[1], v[2]))
+            .collect();
+        let tris = base.indices.chunks(3).map(|t| [t[0], t[1], t[2]]).collect();
+        let (points, tris) = loop_subdivide(points, tris, levels as usize);
+        let mut normals = vec![DVec3::ZERO; points.len()];
+        for t in &tris {
+            let [a, b, c] = t.map(|i| points[i as usize]);
+            let n = (b - a).cross(c - a);
+            for &i in t {
+                normals[i as usize] += n;
+            }
+        }
+        Ok(Some(InlineMesh {
+            positions: points.iter().flat_map(|v| v.to_array()).collect(),
+            indices: tris.iter().flatten().copied().collect(),
+            normals: Some(
+                normals
+                    .iter()
+                    .flat_map(|n| n.normalize_or_zero().to_array())
+                    .collect(),
+            ),
+            uvs: None,
+        }))
+    }
+
     /// A `trianglemesh`'s data, checked (None: left out, `lenient`).
     fn triangle_mesh(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
         let (positions, ploc) = p
@@ -396,6 +459,112 @@ impl Reader {
         mesh.orient_to_normals();
         Ok(Some(mesh))
     }
+}
+
+/// Loop's subdivision: `levels` rounds of Loop's rules, then the limit positions.
+///
+/// Each round keeps the triangles' winding and splits each in four at new vertices on its
+/// edges. An edge shared by two triangles puts its vertex at 3/8 of each end and 1/8 of each
+/// opposite vertex, a boundary edge at its middle; an old vertex of valence n inside the
+/// mesh moves to (1 - n beta) v + beta (sum of its neighbours), beta = 3/16 for n = 3 and
+/// 3 / (8 n) otherwise, one on the boundary to 3/4 v + 1/8 of each of its two boundary
+/// neighbours. At the end each vertex goes to its limit: inside, the same rule with gamma =
+/// 1 / (n + 3 / (8 beta)); on the boundary, 3/5 v + 1/5 of each boundary neighbour.
+fn loop_subdivide(
+    mut p: Vec<DVec3>,
+    mut tris: Vec<[u32; 3]>,
+    levels: usize,
+) -> (Vec<DVec3>, Vec<[u32; 3]>) {
+    use std::collections::HashMap;
+    let key = |a: u32, b: u32| (a.min(b), a.max(b));
+    let beta = |n: usize| {
+        if n == 3 {
+            3.0 / 16.0
+        } else {
+            3.0 / (8.0 * n as f64)
+        }
+    };
+    // Per vertex: its neighbours, and those along boundary edges.
+    let rings = |p: &[DVec3], tris: &[[u32; 3]]| {
+        let mut opposite: HashMap<(u32, u32), Vec<u32>> = HashMap::new();
+        for t in tris {
+            for k in 0..3 {
+                opposite
+                    .entry(key(t[k], t[(k + 1) % 3]))
+                    .or_default()
+                    .push(t[(k + 2) % 3]);
+            }
+        }
+        let mut ring = vec![Vec::new(); p.len()];
+        let mut boundary = vec![Vec::new(); p.len()];
+        let mut edges: Vec<_> = opposite.iter().collect();
+        edges.sort_unstable_by_key(|(k, _)| **k);
+        for &(&(a, b), o) in &edges {
+            ring[a as usize].push(b);
+            ring[b as usize].push(a);
+            if o.len() == 1 {
+                boundary[a as usize].push(b);
+                boundary[b as usize].push(a);
+            }
+        }
+        (opposite, ring, boundary)
+    };
+    let moved =
+        |p: &[DVec3], ring: &[Vec<u32>], boundary: &[Vec<u32>], limit: bool| -> Vec<DVec3> {
+            (0..p.len())
+                .map(|i| {
+                    let v = p[i];
+                    if boundary[i].is_empty() {
+                        let n = ring[i].len();
+                        if n == 0 {
+                            return v;
+                        }
+                        let w = if limit {
+                            1.0 / (n as f64 + 3.0 / (8.0 * beta(n)))
+                        } else {
+                            beta(n)
+                        };
+                        let sum: DVec3 = ring[i].iter().map(|&j| p[j as usize]).sum();
+                        (1.0 - n as f64 * w) * v + w * sum
+                    } else if boundary[i].len() == 2 {
+                        let w = if limit { 1.0 / 5.0 } else { 1.0 / 8.0 };
+                        let [a, b] = [boundary[i][0], boundary[i][1]].map(|j| p[j as usize]);
+                        (1.0 - 2.0 * w) * v + w * (a + b)
+                    } else {
+                        // A non-manifold corner: kept where it is.
+                        v
+                    }
+                })
+                .collect()
+        };
+    for _ in 0..levels {
+        let (opposite, ring, boundary) = rings(&p, &tris);
+        let mut next = moved(&p, &ring, &boundary, false);
+        let mut edge_vertex: HashMap<(u32, u32), u32> = HashMap::new();
+        let mut split = Vec::with_capacity(tris.len() * 4);
+        for t in &tris {
+            let mut mid = [0u32; 3];
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                mid[k] = *edge_vertex.entry(key(a, b)).or_insert_with(|| {
+                    let o = &opposite[&key(a, b)];
+                    let (pa, pb) = (p[a as usize], p[b as usize]);
+                    next.push(if o.len() == 2 {
+                        3.0 / 8.0 * (pa + pb) + 1.0 / 8.0 * (p[o[0] as usize] + p[o[1] as usize])
+                    } else {
+                        0.5 * (pa + pb)
+                    });
+                    next.len() as u32 - 1
+                });
+            }
+            let [ab, bc, ca] = mid;
+            split.extend([[t[0], ab, ca], [t[1], bc, ab], [t[2], ca, bc], [ab, bc, ca]]);
+        }
+        p = next;
+        tris = split;
+    }
+    let (_, ring, boundary) = rings(&p, &tris);
+    (moved(&p, &ring, &boundary, true), tris)
 }
 
 /// Facets of a cylinder per full turn (as the Mitsuba reader's cylinders).

@@ -957,3 +957,38 @@ fn geometry_beyond_1e15_is_an_error_not_a_panic() {
     assert!(e.contains("huge.toml:") && e.contains("within 1e15"), "{e}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+#[test]
+fn loop_subdivision_refines_at_load() {
+    let t = doc(&format!(
+        "{WORLD}Shape \"loopsubdiv\" \"integer levels\" 2 \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"integer indices\" [0 1 2  0 2 3]\n\
+         Shape \"loopsubdiv\" \"point3 P\" [1 1 1  -1 -1 1  -1 1 -1  1 -1 -1] \"integer indices\" [0 1 2  0 3 1  0 2 3  1 3 2]\n"
+    ));
+    // A flat quad stays flat: 2 x 4^2 triangles, normals +z as wound.
+    assert_eq!(nums(&t, "shapes.0.indices").len(), 32 * 3);
+    assert!(
+        nums(&t, "shapes.0.positions")
+            .chunks(3)
+            .all(|v| v[2].abs() < 1e-12)
+    );
+    assert!(
+        nums(&t, "shapes.0.normals")
+            .chunks(3)
+            .all(|n| (n[2] - 1.0).abs() < 1e-9)
+    );
+    // A tetrahedron, 3 levels by default: 4 x 64 triangles, its limit surface strictly inside
+    // the tetrahedron's circumsphere and around its centre.
+    assert_eq!(nums(&t, "shapes.1.indices").len(), 256 * 3);
+    for v in nums(&t, "shapes.1.positions").chunks(3) {
+        let r = (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        assert!(r > 0.2 && r < 3f64.sqrt(), "{v:?}");
+    }
+    let e = read(
+        &format!(
+            "{WORLD}Shape \"loopsubdiv\" \"integer levels\" 12 \"point3 P\" [0 0 0 1 0 0 0 1 0]\n"
+        ),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("\"levels\" 12"), "{e}");
+}
