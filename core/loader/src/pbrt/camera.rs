@@ -496,20 +496,18 @@ impl Reader {
                 "bdpt"
             }
             "sppm" => {
-                let iterations = p.int("iterations", 64)?;
+                // pbrt-v4 runs as many iterations as the sampler has samples per pixel.
                 let photons = p.int("photonsperiteration", -1)?;
                 let radius = p.float("radius", 1.0)?;
                 p.int_opt("seed")?;
-                let render = table_mut(&mut self.root, "render");
-                render.insert(
-                    "spp",
-                    Node {
-                        value: Value::Int(iterations.max(1)),
-                        line: 0,
-                        column: 0,
-                    },
-                );
-                let mut entries = vec![("initial_radius", self.num(radius, loc))];
+                let iterations = match table_mut(&mut self.root, "render").get("spp") {
+                    Some(n) => n.value.as_f64().unwrap_or(16.0) as i64,
+                    None => 16,
+                };
+                let mut entries = vec![
+                    ("initial_radius", self.num(radius, loc)),
+                    ("iterations", self.node(Value::Int(iterations.max(1)), loc)),
+                ];
                 if photons > 0 {
                     entries.push(("photons_per_iteration", self.node(Value::Int(photons), loc)));
                 } else {

@@ -6,7 +6,7 @@
 
 use super::params::Bag;
 use super::parse::{Directive, Type, Values};
-use super::spectra::{Kind, rgb};
+use super::spectra::{ETA_WAVELENGTH, Kind, eta_at_550, rgb};
 use super::texture::Tex;
 use super::{Loc, Reader, table_mut};
 use foton_core::error::Result;
@@ -55,10 +55,21 @@ impl Reader {
                         None => 1.5,
                         Some(q) => match (&q.ty, &q.values) {
                             (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
-                            _ => {
-                                self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float eta\"", q.decl()))?;
-                                return Ok(false);
-                            }
+                            _ => match eta_at_550(&q, &what, &self.dir)? {
+                                Some(eta) => {
+                                    self.warn(&q.loc, &what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
+                                    eta
+                                }
+                                None => {
+                                    return Err(q.loc.error(
+                                        &what,
+                                        format!(
+                                            "{}: expected \"float eta\" or \"spectrum eta\"",
+                                            q.decl()
+                                        ),
+                                    ));
+                                }
+                            },
                         },
                     };
                     if eta <= 0.0 {
@@ -138,15 +149,37 @@ impl Reader {
                 }
             }
             "interface" => entries.push(("type", self.string("null", &loc))),
+            // pbrt-v4 still takes these for `interface`, with a warning (materials.cpp).
+            "" | "none" => {
+                self.warn(
+                    &loc,
+                    &what,
+                    &format!(
+                        "material {ty:?} is pbrt-v3's name of \"interface\": read as interface"
+                    ),
+                );
+                entries.push(("type", self.string("null", &loc)));
+            }
             "thindielectric" => {
                 let eta = match p.take("eta") {
                     None => 1.5,
                     Some(q) => match (&q.ty, &q.values) {
                         (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
-                        _ => {
-                            self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float eta\"", q.decl()))?;
-                            return Ok(false);
-                        }
+                        _ => match eta_at_550(&q, &what, &self.dir)? {
+                            Some(eta) => {
+                                self.warn(&q.loc, &what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
+                                eta
+                            }
+                            None => {
+                                return Err(q.loc.error(
+                                    &what,
+                                    format!(
+                                        "{}: expected \"float eta\" or \"spectrum eta\"",
+                                        q.decl()
+                                    ),
+                                ));
+                            }
+                        },
                     },
                 };
                 if eta <= 0.0 {
@@ -336,8 +369,11 @@ impl Reader {
                             _ => None,
                         },
                         (Type::Spectrum, _) if name.ends_with("eta") => {
-                            self.unsupported(&q.loc, &what, &format!("{}: a dispersive index of refraction (a spectrum) is not read yet; only \"float {name}\"", q.decl()))?;
-                            None
+                            let eta = eta_at_550(&q, &what, &self.dir)?;
+                            if let Some(eta) = eta {
+                                self.warn(&q.loc, &what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
+                            }
+                            eta
                         }
                         _ => {
                             return Err(q.loc.error(

@@ -603,6 +603,7 @@ impl Reader {
             table_mut(&mut self.root, "camera").insert("medium", node);
         }
         self.check_medium_refs()?;
+        self.without_media_unless_volumetric();
         let mut root = std::mem::take(&mut self.root);
         if !self.shapes.is_empty() {
             root.insert(
@@ -631,6 +632,47 @@ impl Reader {
             },
             self.report,
         ))
+    }
+}
+
+impl Reader {
+    /// pbrt-v4's integrators other than `volpath`, `simplevolpath`, `bdpt` and `mlt` ignore
+    /// participating media (render.cpp warns): the scene renders as without them, so the
+    /// media are dropped, with a warning.
+    fn without_media_unless_volumetric(&mut self) {
+        let integrator = self
+            .integrator
+            .as_ref()
+            .map_or("volpath", |d| d.string(0))
+            .to_string();
+        if matches!(
+            integrator.as_str(),
+            "volpath" | "simplevolpath" | "bdpt" | "mlt"
+        ) || self.root.get("media").is_none()
+        {
+            return;
+        }
+        let loc = self
+            .integrator
+            .as_ref()
+            .map(|d| d.loc.clone())
+            .expect("not volpath");
+        self.warn(&loc, &format!("Integrator {integrator:?}"), "pbrt-v4's integrator ignores participating media (use volpath to render them): the scene is read without them");
+        self.root.0.retain(|(k, _)| k != "media");
+        let strip = |t: &mut Node, keys: &[&str]| {
+            if let Value::Table(t) = &mut t.value {
+                t.0.retain(|(k, _)| !keys.contains(&k.as_str()));
+            }
+        };
+        if let Some(c) = self.root.get_mut("camera") {
+            strip(c, &["medium"]);
+        }
+        for s in &mut self.shapes {
+            strip(s, &["interior", "exterior"]);
+        }
+        for l in &mut self.lights {
+            strip(l, &["medium"]);
+        }
     }
 }
 

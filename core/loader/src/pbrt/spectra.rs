@@ -95,6 +95,59 @@ pub fn rgb(p: &Param, kind: Kind, what: &str, scene_dir: &Path) -> Result<DVec3>
     }
 }
 
+/// pbrt-v4's named glasses (`glass-BK7`...) as their index at 550 nm, interpolated in the
+/// measured tables pbrt-v4 carries (src/pbrt/util/spectrum.cpp, from refractiveindex.info):
+/// foton's dielectrics are not dispersive.
+pub const GLASSES: &[(&str, f64)] = &[
+    ("glass-BK7", 1.51854),
+    ("glass-BAF10", 1.67305),
+    ("glass-FK51A", 1.4878),
+    ("glass-LASF9", 1.85581),
+    ("glass-F5", 1.67709),
+    ("glass-F10", 1.73357),
+    ("glass-F11", 1.79112),
+];
+
+/// The wavelength at which a spectral index of refraction is read.
+pub const ETA_WAVELENGTH: f64 = 550.0;
+
+/// An index of refraction given as a spectrum (a named glass, wavelength-value pairs or a
+/// file): its value at [`ETA_WAVELENGTH`]. None: a float or not a spectrum.
+pub fn eta_at_550(p: &Param, what: &str, scene_dir: &Path) -> Result<Option<f64>> {
+    let err = |m: String| p.loc.error(what, format!("{}: {m}", p.decl()));
+    let spectrum = match (&p.ty, &p.values) {
+        (Type::Spectrum, Values::Nums(v)) => {
+            let (w, x): (Vec<f64>, Vec<f64>) = v.chunks(2).map(|c| (c[0], c[1])).unzip();
+            Spectrum::new(w, x).map_err(err)?
+        }
+        (Type::Spectrum, Values::Strs(names)) => {
+            if let Some((_, eta)) = GLASSES.iter().find(|(n, _)| *n == names[0]) {
+                return Ok(Some(*eta));
+            }
+            let path = super::parse::resolve(scene_dir, &p.loc.file, &names[0]);
+            if !path.is_file() {
+                return Err(err(format!(
+                    "{:?}: not a glass foton knows ({}) nor a spectrum file",
+                    names[0],
+                    GLASSES
+                        .iter()
+                        .map(|(n, _)| *n)
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )));
+            }
+            let text = std::fs::read_to_string(&path)
+                .map_err(|e| err(format!("{}: {e}", path.display())))?;
+            Spectrum::parse_spd(&text).map_err(|m| err(format!("{}: {m}", path.display())))?
+        }
+        _ => return Ok(None),
+    };
+    match spectrum.eval(ETA_WAVELENGTH) {
+        Some(eta) if eta > 0.0 => Ok(Some(eta)),
+        _ => Err(err(format!("no positive value at {ETA_WAVELENGTH} nm"))),
+    }
+}
+
 fn reduce(s: &dyn Fn(f64) -> Option<f64>, kind: Kind) -> DVec3 {
     match kind {
         Kind::Albedo => to_srgb(s, Quantity::Reflectance),

@@ -134,10 +134,21 @@ fn film_sampler_integrator_and_their_defaults() {
     assert_eq!(text(&t, "render.sampler"), "independent");
     assert_eq!(text(&t, "render.integrator"), "bdpt");
     assert_eq!(node(&t, "render.max_depth").value, Value::Int(7));
+    // pbrt-v4's SPPM runs as many iterations as the sampler has samples per pixel (it has no
+    // "iterations" parameter: an error there).
     let t = doc(&format!(
-        "Integrator \"sppm\" \"integer iterations\" 10 \"integer photonsperiteration\" 1000 \"float radius\" 0.1\n{WORLD}"
+        "Sampler \"halton\" \"integer pixelsamples\" 10\nIntegrator \"sppm\" \"integer photonsperiteration\" 1000 \"float radius\" 0.1\n{WORLD}"
     ));
-    assert_eq!(node(&t, "render.spp").value, Value::Int(10));
+    assert_eq!(
+        node(&t, "integrators.sppm.iterations").value,
+        Value::Int(10)
+    );
+    let e = read(
+        &format!("Integrator \"sppm\" \"integer iterations\" 10\n{WORLD}"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("\"integer iterations\""), "{e}");
     assert_eq!(num(&t, "integrators.sppm.initial_radius"), 0.1);
     assert_eq!(
         node(&t, "integrators.sppm.photons_per_iteration").value,
@@ -991,4 +1002,71 @@ fn loop_subdivision_refines_at_load() {
     )
     .unwrap_err();
     assert!(e.contains("\"levels\" 12"), "{e}");
+}
+
+#[test]
+fn spectral_indices_are_read_at_550_nm() {
+    let (d, report) = read(
+        &format!(
+            "{WORLD}Material \"dielectric\" \"spectrum eta\" \"glass-BK7\"\nShape \"sphere\"\n\
+             Material \"thindielectric\" \"spectrum eta\" [400 1.6 700 1.3]\nShape \"sphere\"\n\
+             Material \"coateddiffuse\" \"spectrum eta\" \"glass-F11\"\nShape \"sphere\"\n"
+        ),
+        false,
+    )
+    .unwrap();
+    let t = d.root;
+    assert_eq!(num(&t, "materials.material_1.ior"), 1.51854);
+    // Linear between 400 and 700 nm: 1.6 - 0.3 x 150 / 300.
+    assert!((num(&t, "materials.material_2.ior") - 1.45).abs() < 1e-9);
+    assert_eq!(num(&t, "materials.material_3.eta"), 1.79112);
+    assert_eq!(
+        report
+            .warnings
+            .iter()
+            .filter(|w| w.contains("dispersion ignored"))
+            .count(),
+        3,
+        "{:?}",
+        report.warnings
+    );
+    let e = read(
+        &format!("{WORLD}Material \"dielectric\" \"spectrum eta\" \"glass-XYZ\"\n"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("glass-XYZ") && e.contains("glass-BK7"), "{e}");
+}
+
+#[test]
+fn media_are_dropped_for_integrators_that_ignore_them_and_material_none_is_interface() {
+    let scene = |integrator: &str| {
+        format!(
+            "Integrator \"{integrator}\"\nMakeNamedMedium \"fog\" \"string type\" \"homogeneous\"\nMediumInterface \"\" \"fog\"\nCamera \"perspective\"\n{WORLD}\
+             MediumInterface \"fog\" \"\"\nMaterial \"none\"\nShape \"sphere\"\n"
+        )
+    };
+    let (d, report) = read(&scene("path"), false).unwrap();
+    assert!(!has(&d.root, "camera.medium") && d.root.get("media").is_none());
+    assert!(!has(&d.root, "shapes.0.interior"));
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("ignores participating media")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("\"none\" is pbrt-v3's name")),
+        "{:?}",
+        report.warnings
+    );
+    assert_eq!(text(&d.root, "materials.material_1.type"), "null");
+    let t = doc(&scene("volpath"));
+    assert_eq!(text(&t, "camera.medium"), "fog");
+    assert_eq!(text(&t, "shapes.0.interior"), "fog");
 }
