@@ -199,16 +199,30 @@ impl Reader {
             );
             out
         };
-        // The sensor's imaging ratio (film.cpp): exposure time x ISO / 100, 1 by default.
+        // The sensor's imaging ratio (film.cpp's PixelSensor): the camera's exposure time
+        // (shutterclose - shutteropen, scene.cpp) x ISO / 100, 1 by default; the image
+        // scales with it, as with every light's emission (`Reader::imaging_ratio`).
         let iso = p.float("iso", 100.0)?;
-        let exposure = p.float("exposuretime", 1.0)?;
-        if (iso * exposure / 100.0 - 1.0).abs() > 1e-9 {
-            self.unsupported(
-                loc,
-                &d.what(),
-                "\"iso\" and \"exposuretime\" that scale the image are not read yet",
-            )?;
+        let shutter = |name: &str, default: f64| {
+            self.camera
+                .as_ref()
+                .and_then(|(c, _)| {
+                    c.params
+                        .iter()
+                        .find(|q| q.name == name)
+                        .and_then(|q| match &q.values {
+                            super::parse::Values::Nums(v) if v.len() == 1 => Some(v[0]),
+                            _ => None,
+                        })
+                })
+                .unwrap_or(default)
+        };
+        let exposure = shutter("shutterclose", 1.0) - shutter("shutteropen", 0.0);
+        let ratio = exposure * iso / 100.0;
+        if !(ratio > 0.0 && ratio.is_finite()) {
+            return Err(loc.error(&d.what(), format!("the imaging ratio (exposure time {exposure} x iso {iso} / 100) must be positive")));
         }
+        self.imaging_ratio = ratio;
         if let Some((s, l)) = p.string_opt("sensor")?
             && s != "cie1931"
         {

@@ -172,6 +172,8 @@ struct Reader {
     medium_refs: Vec<(String, Loc)>,
     /// The outside medium at `Camera`.
     camera_medium: Option<(String, Loc)>,
+    /// The film's imaging ratio (exposure time x ISO / 100): the factor of every light.
+    imaging_ratio: f64,
 }
 
 impl Reader {
@@ -214,6 +216,7 @@ impl Reader {
             left_out_media: Default::default(),
             medium_refs: Vec::new(),
             camera_medium: None,
+            imaging_ratio: 1.0,
         }
     }
 
@@ -604,6 +607,7 @@ impl Reader {
         }
         self.check_medium_refs()?;
         self.without_media_unless_volumetric();
+        self.scale_emission(self.imaging_ratio);
         let mut root = std::mem::take(&mut self.root);
         if !self.shapes.is_empty() {
             root.insert(
@@ -636,6 +640,40 @@ impl Reader {
 }
 
 impl Reader {
+    /// Every light's emission times `k` (the film's imaging ratio, by which pbrt-v4 scales
+    /// the image: light transport is linear in the emission).
+    fn scale_emission(&mut self, k: f64) {
+        if k == 1.0 {
+            return;
+        }
+        let scale = |node: &mut Node| match &mut node.value {
+            Value::Float(x) => *x *= k,
+            Value::Int(i) => node.value = Value::Float(*i as f64 * k),
+            Value::Array(a) => a.iter_mut().for_each(|n| {
+                if let Some(x) = n.value.as_f64() {
+                    n.value = Value::Float(x * k);
+                }
+            }),
+            _ => {}
+        };
+        for l in &mut self.lights {
+            if let Value::Table(t) = &mut l.value {
+                for key in ["intensity", "irradiance", "radiance", "scale"] {
+                    if let Some(n) = t.get_mut(key) {
+                        scale(n);
+                    }
+                }
+            }
+        }
+        for s in &mut self.shapes {
+            if let Value::Table(t) = &mut s.value
+                && let Some(n) = t.get_mut("emission")
+            {
+                scale(n);
+            }
+        }
+    }
+
     /// pbrt-v4's integrators other than `volpath`, `simplevolpath`, `bdpt` and `mlt` ignore
     /// participating media (render.cpp warns): the scene renders as without them, so the
     /// media are dropped, with a warning.

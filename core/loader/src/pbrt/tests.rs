@@ -1070,3 +1070,16 @@ fn media_are_dropped_for_integrators_that_ignore_them_and_material_none_is_inter
     assert_eq!(text(&t, "camera.medium"), "fog");
     assert_eq!(text(&t, "shapes.0.interior"), "fog");
 }
+
+#[test]
+fn iso_and_shutter_scale_every_light() {
+    let t = doc(
+        "Camera \"perspective\" \"float shutteropen\" 0 \"float shutterclose\" 0.5\nFilm \"rgb\" \"float iso\" 400\nWorldBegin\n\
+         LightSource \"point\" \"rgb I\" [1 2 3]\nLightSource \"infinite\" \"rgb L\" [0.5 0.5 0.5]\n\
+         AttributeBegin\nAreaLightSource \"diffuse\" \"rgb L\" [4 4 4]\nShape \"sphere\"\nAttributeEnd\n",
+    );
+    // 0.5 s x ISO 400 / 100 = 2.
+    assert!(close(&nums(&t, "lights.0.intensity"), &[2.0, 4.0, 6.0]));
+    assert!(close(&nums(&t, "lights.1.radiance"), &[1.0, 1.0, 1.0]));
+    assert!(close(&nums(&t, "shapes.0.emission"), &[8.0, 8.0, 8.0]));
+}
