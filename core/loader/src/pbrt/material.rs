@@ -6,7 +6,7 @@
 
 use super::params::Bag;
 use super::parse::{Directive, Type, Values};
-use super::spectra::{ETA_WAVELENGTH, Kind, eta_at_550, rgb};
+use super::spectra::{ETA_WAVELENGTH, Kind, eta_at_550, metal_rgb_ior, rgb};
 use super::texture::Tex;
 use super::{Loc, Reader, table_mut};
 use foton_core::error::Result;
@@ -119,10 +119,9 @@ impl Reader {
                                 )?;
                                 return Ok(false);
                             }
-                            if eta.is_some() {
-                                self.note(&loc, &what, &format!("metal-{a}: Mitsuba's measured index of {a} reduced to RGB as Mitsuba 3 does, not pbrt-v4's spectral rendering of it (colours may differ slightly)"));
-                            }
-                            entries.push(("material", self.string(&a, &loc)));
+                            let (e, kk) = metal_rgb_ior(&a, 1.0).expect("checked above");
+                            entries.push(("eta", self.vec3(e, &loc)));
+                            entries.push(("k", self.vec3(kk, &loc)));
                         }
                         _ => {
                             let (Some(eta), Some(k)) = (eta, k) else {
@@ -422,8 +421,16 @@ impl Reader {
                                 )?;
                                 return Ok(false);
                             }
-                            self.note(&loc, &what, &format!("metal-{a}: Mitsuba's measured index of {a} reduced to RGB as Mitsuba 3 does, not pbrt-v4's spectral rendering of it (colours may differ slightly)"));
-                            entries.push(("conductor_material", self.string(&a, &loc)));
+                            // Under the coat the metal's index is relative to the coat's.
+                            let outside = entries
+                                .iter()
+                                .find(|(k, _)| *k == "interface_eta")
+                                .and_then(|(_, n)| n.value.as_f64())
+                                .filter(|x| *x > 0.0)
+                                .unwrap_or(1.5);
+                            let (e, kk) = metal_rgb_ior(&a, outside).expect("checked above");
+                            entries.push(("conductor_eta", self.vec3(e, &loc)));
+                            entries.push(("conductor_k", self.vec3(kk, &loc)));
                         }
                         (_, _, None, None) => {}
                         (_, _, Some(eta), Some(k)) => {

@@ -276,7 +276,16 @@ fn materials_named_and_anonymous() {
         text(&t, &format!("materials.{}.type", m(2))),
         "roughconductor"
     );
-    assert_eq!(text(&t, &format!("materials.{}.material", m(2))), "Au");
+    // Gold's RGB index fitted to pbrt-v4's spectral Fresnel reflectance (spectra.rs).
+    let (eta, k) = super::spectra::metal_rgb_ior("Au", 1.0).unwrap();
+    assert!(close(
+        &nums(&t, &format!("materials.{}.eta", m(2))),
+        &eta.to_array()
+    ));
+    assert!(close(
+        &nums(&t, &format!("materials.{}.k", m(2))),
+        &k.to_array()
+    ));
     assert_eq!(text(&t, &format!("materials.{}.distribution", m(2))), "ggx");
     assert!((num(&t, &format!("materials.{}.alpha", m(2))) - 0.2).abs() < 1e-12);
     assert_eq!(text(&t, &format!("materials.{}.type", m(3))), "conductor");
@@ -674,7 +683,12 @@ fn coated_materials_keep_pbrts_names() {
         &nums(&t, "materials.material_1.albedo"),
         &[0.5, 0.5, 0.5]
     ));
-    assert_eq!(text(&t, "materials.material_2.conductor_material"), "Au");
+    // Relative to the coat's index 1.4, then given back in the outside's units.
+    let (eta, _) = super::spectra::metal_rgb_ior("Au", 1.4).unwrap();
+    assert!(close(
+        &nums(&t, "materials.material_2.conductor_eta"),
+        &eta.to_array()
+    ));
     assert_eq!(num(&t, "materials.material_2.interface_roughness"), 0.05);
     assert_eq!(num(&t, "materials.material_2.conductor_roughness"), 0.2);
     assert_eq!(num(&t, "materials.material_2.interface_eta"), 1.4);
