@@ -1,7 +1,8 @@
 //! `MakeNamedMedium` into `[media.NAME]` and `MediumInterface` into the media on either side
 //! of the shapes that follow, the camera's and the lights' media (media.cpp, scene.cpp).
 //!
-//! `homogeneous` (`sigma_a`, `sigma_s`, default 1 each, times `scale`; `g`) is foton's
+//! `homogeneous` (`sigma_a`, `sigma_s`, default 1 each, or a measured `preset`, times
+//! `scale`; `g`) is foton's
 //! `homogeneous` medium with a Henyey-Greenstein phase function. `uniformgrid` (`density`,
 //! `nx`, `ny`, `nz`, `p0`, `p1`, `sigma_a`, `sigma_s`, `scale`, `g`) is foton's
 //! `heterogeneous` medium: sigma_t = (sigma_a + sigma_s) scale, albedo = sigma_s /
@@ -52,14 +53,21 @@ impl Reader {
                 ),
             ));
         }
-        let coefficients = |r: &Reader, p: &mut Bag| -> Result<(DVec3, DVec3, f64)> {
+        // sigma_a and sigma_s (default 1, or a preset's), times `scale`; g.
+        let coefficients = |r: &Reader,
+                            p: &mut Bag,
+                            preset: Option<(DVec3, DVec3)>|
+         -> Result<(DVec3, DVec3, f64)> {
             let mut sigma = |n: &str| -> Result<DVec3> {
                 match p.take(n) {
                     Some(q) => rgb(&q, Kind::Unbounded, &what, &r.dir),
                     None => Ok(DVec3::ONE),
                 }
             };
-            let (sa, ss) = (sigma("sigma_a")?, sigma("sigma_s")?);
+            let (sa, ss) = match preset {
+                Some((s_s, s_a)) => (s_a, s_s),
+                None => (sigma("sigma_a")?, sigma("sigma_s")?),
+            };
             let scale = p.float("scale", 1.0)?;
             if scale < 0.0 {
                 return Err(loc.error(&what, format!("\"scale\" {scale}: must not be negative")));
@@ -73,13 +81,19 @@ impl Reader {
         let mut entries: Vec<(&str, Node)> = Vec::new();
         match ty.as_str() {
             "homogeneous" => {
-                if let Some((preset, l)) = p.string_opt("preset")? {
-                    // pbrt-v4 warns and goes on with the coefficients given (or 1) when it
-                    // does not know a preset; foton does not carry the measured tables yet.
-                    self.unsupported(&l, &what, &format!("\"preset\" {preset:?}: the measured media (GetMediumScatteringProperties) are not carried yet (--lenient: sigma_a and sigma_s as given, 1 by default)"))?;
-                }
+                let preset = match p.string_opt("preset")? {
+                    Some((name, l)) => match measured(&name) {
+                        Some(c) => Some(c),
+                        None => {
+                            // pbrt-v4 warns and goes on with the coefficients given.
+                            self.warn(&l, &what, &format!("no measured medium named {name:?}: sigma_a and sigma_s as given (see core/data/media/measured.csv)"));
+                            None
+                        }
+                    },
+                    None => None,
+                };
                 self.emission(&mut p, &what, &["Le", "Lescale"])?;
-                let (sa, ss, g) = coefficients(self, &mut p)?;
+                let (sa, ss, g) = coefficients(self, &mut p, preset)?;
                 entries.push(("type", self.string("homogeneous", &loc)));
                 entries.push(("sigma_a", self.vec3(sa, &loc)));
                 entries.push(("sigma_s", self.vec3(ss, &loc)));
@@ -134,7 +148,7 @@ impl Reader {
                 if size.min_element() <= 0.0 {
                     return Err(loc.error(&what, "\"p1\" must exceed \"p0\" on every axis"));
                 }
-                let (sa, ss, g) = coefficients(self, &mut p)?;
+                let (sa, ss, g) = coefficients(self, &mut p, None)?;
                 let sigma_t = sa + ss;
                 let albedo = DVec3::select(sigma_t.cmpgt(DVec3::ZERO), ss / sigma_t, DVec3::ZERO);
                 // The grid with a border of zeros: (n + 2) samples per axis at the centres
@@ -272,6 +286,25 @@ impl Reader {
             ("exterior", self.string(&o, loc)),
         ]
     }
+}
+
+/// A measured medium (`core/data/media/measured.csv`, pbrt-v4's presets): sigma_s and
+/// sigma_a in 1/mm.
+fn measured(name: &str) -> Option<(DVec3, DVec3)> {
+    include_str!("../../../data/media/measured.csv")
+        .lines()
+        .filter(|l| !l.starts_with('#') && !l.starts_with("name,"))
+        .find_map(|l| {
+            let (n, rest) = l.split_once(',')?;
+            if n != name {
+                return None;
+            }
+            let v: Vec<f64> = rest
+                .split(',')
+                .filter_map(|x| x.trim().parse().ok())
+                .collect();
+            (v.len() == 6).then(|| (DVec3::new(v[0], v[1], v[2]), DVec3::new(v[3], v[4], v[5])))
+        })
 }
 
 /// A medium's key in `[media]`: its name made a plain TOML key (`vacuum` is foton's name for

@@ -1097,3 +1097,32 @@ fn iso_and_shutter_scale_every_light() {
     assert!(close(&nums(&t, "lights.1.radiance"), &[1.0, 1.0, 1.0]));
     assert!(close(&nums(&t, "shapes.0.emission"), &[8.0, 8.0, 8.0]));
 }
+
+#[test]
+fn measured_media_presets() {
+    let (d, report) = read(
+        &format!(
+            "{WORLD}MakeNamedMedium \"milk\" \"string type\" \"homogeneous\" \"string preset\" \"Wholemilk\" \"float scale\" 10\n\
+             MakeNamedMedium \"x\" \"string type\" \"homogeneous\" \"string preset\" \"Unobtainium\" \"rgb sigma_a\" [1 2 3]\n"
+        ),
+        false,
+    )
+    .unwrap();
+    // Jensen et al. 2001: whole milk, sigma_s' = (2.55, 3.21, 3.77), sigma_a = (0.0011,
+    // 0.0024, 0.014) per mm; times scale.
+    assert!(close(
+        &nums(&d.root, "media.milk.sigma_s"),
+        &[25.5, 32.1, 37.7]
+    ));
+    assert!(close(
+        &nums(&d.root, "media.milk.sigma_a"),
+        &[0.011, 0.024, 0.14]
+    ));
+    // An unknown preset: a warning, the coefficients as given (pbrt-v4 does the same).
+    assert!(close(&nums(&d.root, "media.x.sigma_a"), &[1.0, 2.0, 3.0]));
+    assert!(
+        report.warnings.iter().any(|w| w.contains("Unobtainium")),
+        "{:?}",
+        report.warnings
+    );
+}
