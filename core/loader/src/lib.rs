@@ -22,6 +22,8 @@ pub mod image;
 mod load;
 pub mod mesh;
 pub mod mitsuba;
+#[cfg(test)]
+mod mutations;
 pub mod pbrt;
 pub mod reader;
 pub mod texture;

@@ -40,107 +40,19 @@ const RICH: &str = r#"<scene version="3.0.0">
 </scene>
 "#;
 
-/// Bytes changed, numbers replaced by extreme ones, lines dropped, repeated or swapped; read
-/// strictly and leniently. `FOTON_FUZZ_XML=N` runs N instead of 1,500.
+/// The mutation test (`crate::mutations`) on that scene. `FOTON_FUZZ_XML=N` runs N cases
+/// instead of 1,500.
 #[test]
 fn mutated_mitsuba_scenes_are_errors_or_scenes_never_panics() {
-    let n: usize = std::env::var("FOTON_FUZZ_XML")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1_500);
+    let n = crate::mutations::count("FOTON_FUZZ_XML", 1_500);
     let dir = std::env::temp_dir().join(format!("foton-xml-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let path = dir.join("scene.xml");
-    std::fs::write(&path, RICH).unwrap();
-    crate::load::load_with(&path, &[], &[], false)
-        .unwrap_or_else(|e| panic!("the base scene: {e}"));
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = |m: usize| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % m.max(1) as u64) as usize
-    };
-    const NUMBERS: &[&str] = &[
-        "0",
-        "-1",
-        "1e30",
-        "-1e30",
-        "nan",
-        "inf",
-        "3.5",
-        "100000",
-        "2147483648",
-        "-0",
-    ];
-    let mut outcomes = [0usize; 2];
-    for _ in 0..n {
-        let mut text = RICH.to_string();
-        for _ in 0..1 + next(3) {
-            match next(4) {
-                0 => {
-                    let mut b = text.into_bytes();
-                    let at = next(b.len());
-                    let pool = b"<>/\"= ,$0-.ex";
-                    match next(3) {
-                        0 => b[at] = pool[next(pool.len())],
-                        1 => b.insert(at, pool[next(pool.len())]),
-                        _ => {
-                            b.remove(at);
-                        }
-                    }
-                    text = String::from_utf8_lossy(&b).into_owned();
-                }
-                1 => {
-                    let spans: Vec<(usize, usize)> = {
-                        let b = text.as_bytes();
-                        let mut out = Vec::new();
-                        let mut i = 0;
-                        while i < b.len() {
-                            if b[i].is_ascii_digit() {
-                                let s = i;
-                                while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.') {
-                                    i += 1;
-                                }
-                                out.push((s, i));
-                            }
-                            i += 1;
-                        }
-                        out
-                    };
-                    if let Some(&(s, e)) = spans.get(next(spans.len())) {
-                        text.replace_range(s..e, NUMBERS[next(NUMBERS.len())]);
-                    }
-                }
-                2 => {
-                    let mut lines: Vec<&str> = text.lines().collect();
-                    let at = next(lines.len());
-                    if next(2) == 0 {
-                        lines.remove(at);
-                    } else {
-                        let l = lines[at];
-                        lines.insert(next(lines.len()), l);
-                    }
-                    text = lines.join("\n");
-                }
-                _ => {
-                    let mut lines: Vec<&str> = text.lines().collect();
-                    let (a, b) = (next(lines.len()), next(lines.len()));
-                    lines.swap(a, b);
-                    text = lines.join("\n");
-                }
-            }
-        }
-        std::fs::write(&path, &text).unwrap();
-        let lenient = next(2) == 0;
-        match std::panic::catch_unwind(|| crate::load::load_with(&path, &[], &[], lenient)) {
-            Ok(r) => outcomes[r.is_ok() as usize] += 1,
-            Err(_) => panic!("the loader panicked on:\n{text}"),
-        }
-    }
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(
-        outcomes[0] > n / 10 && outcomes[1] > n / 10,
-        "errors, scenes: {outcomes:?}"
+    crate::mutations::check(
+        &dir.join("scene.xml"),
+        RICH,
+        b"<>/\"= ,$0-.ex",
+        n,
+        0x2545_f491_4f6c_dd1d,
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }

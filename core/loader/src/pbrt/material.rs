@@ -51,27 +51,7 @@ impl Reader {
                 let alpha = self.roughness(&mut p, &what)?;
                 let rough = alpha.is_some();
                 if ty == "dielectric" {
-                    let eta = match p.take("eta") {
-                        None => 1.5,
-                        Some(q) => match (&q.ty, &q.values) {
-                            (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
-                            _ => match eta_at_550(&q, &what, &self.dir)? {
-                                Some(eta) => {
-                                    self.warn(&q.loc, &what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
-                                    eta
-                                }
-                                None => {
-                                    return Err(q.loc.error(
-                                        &what,
-                                        format!(
-                                            "{}: expected \"float eta\" or \"spectrum eta\"",
-                                            q.decl()
-                                        ),
-                                    ));
-                                }
-                            },
-                        },
-                    };
+                    let eta = self.eta(&mut p, &what)?;
                     if eta <= 0.0 {
                         return Err(loc.error(&what, format!("\"eta\" {eta}: must be positive")));
                     }
@@ -160,27 +140,7 @@ impl Reader {
                 entries.push(("type", self.string("null", &loc)));
             }
             "thindielectric" => {
-                let eta = match p.take("eta") {
-                    None => 1.5,
-                    Some(q) => match (&q.ty, &q.values) {
-                        (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
-                        _ => match eta_at_550(&q, &what, &self.dir)? {
-                            Some(eta) => {
-                                self.warn(&q.loc, &what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
-                                eta
-                            }
-                            None => {
-                                return Err(q.loc.error(
-                                    &what,
-                                    format!(
-                                        "{}: expected \"float eta\" or \"spectrum eta\"",
-                                        q.decl()
-                                    ),
-                                ));
-                            }
-                        },
-                    },
-                };
+                let eta = self.eta(&mut p, &what)?;
                 if eta <= 0.0 {
                     return Err(loc.error(&what, format!("\"eta\" {eta}: must be positive")));
                 }
@@ -228,27 +188,18 @@ impl Reader {
                 }
                 let mut parts = Vec::new();
                 let mut weights = Vec::new();
-                if wr > 0.0 {
-                    let d = self.table(
-                        vec![
-                            ("type", self.string("diffuse", &loc)),
-                            ("reflectance", self.vec3(rr / wr, &loc)),
-                        ],
-                        &loc,
-                    );
-                    parts.push(d);
-                    weights.push(self.num(wr, &loc));
-                }
-                if wt > 0.0 {
-                    let t = self.table(
-                        vec![
-                            ("type", self.string("difftrans", &loc)),
-                            ("transmittance", self.vec3(tt / wt, &loc)),
-                        ],
-                        &loc,
-                    );
-                    parts.push(t);
-                    weights.push(self.num(wt, &loc));
+                for (w, ty, key, c) in [
+                    (wr, "diffuse", "reflectance", rr),
+                    (wt, "difftrans", "transmittance", tt),
+                ] {
+                    if w > 0.0 {
+                        let part = vec![
+                            ("type", self.string(ty, &loc)),
+                            (key, self.vec3(c / w, &loc)),
+                        ];
+                        parts.push(self.table(part, &loc));
+                        weights.push(self.num(w, &loc));
+                    }
                 }
                 if parts.is_empty() {
                     entries.push(("type", self.string("diffuse", &loc)));
@@ -479,6 +430,29 @@ impl Reader {
         }
         let c = rgb(&q, kind, what, &self.dir)?;
         Ok(Some(self.vec3(c, &q.loc)))
+    }
+
+    /// A dielectric's `eta` (default 1.5): a float, or a spectrum read at 550 nm (foton's
+    /// dielectrics are not dispersive: a warning).
+    fn eta(&mut self, p: &mut Bag, what: &str) -> Result<f64> {
+        let Some(q) = p.take("eta") else {
+            return Ok(1.5);
+        };
+        if let (Type::Float, Values::Nums(v)) = (&q.ty, &q.values)
+            && v.len() == 1
+        {
+            return Ok(v[0]);
+        }
+        match eta_at_550(&q, what, &self.dir)? {
+            Some(eta) => {
+                self.warn(&q.loc, what, &format!("{}: dispersion ignored, the index at {ETA_WAVELENGTH} nm ({eta}) everywhere", q.decl()));
+                Ok(eta)
+            }
+            None => Err(q.loc.error(
+                what,
+                format!("{}: expected \"float eta\" or \"spectrum eta\"", q.decl()),
+            )),
+        }
     }
 
     /// pbrt-v4's roughness parameters as GGX alphas (None: smooth).

@@ -310,19 +310,8 @@ fn measured(name: &str) -> Option<(DVec3, DVec3)> {
 /// A medium's key in `[media]`: its name made a plain TOML key (`vacuum` is foton's name for
 /// no medium).
 fn medium_key(name: &str) -> String {
-    let key: String = name
-        .chars()
-        .map(|c| {
-            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                c
-            } else {
-                '_'
-            }
-        })
-        .collect();
-    match key.as_str() {
-        "" => "medium".into(),
-        "vacuum" => "vacuum_".into(),
-        _ => key,
+    match super::plain_key(name, "medium") {
+        key if key == "vacuum" => "vacuum_".into(),
+        key => key,
     }
 }

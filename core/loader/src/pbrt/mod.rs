@@ -535,21 +535,7 @@ impl Reader {
     /// A `[materials]` key for a pbrt-v4 material name: the name itself when it is a plain
     /// TOML key, else made one (and unique).
     fn material_key(&mut self, name: &str) -> String {
-        let plain: String = name
-            .chars()
-            .map(|c| {
-                if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
-                    c
-                } else {
-                    '_'
-                }
-            })
-            .collect();
-        let plain = if plain.is_empty() {
-            "material".into()
-        } else {
-            plain
-        };
+        let plain = plain_key(name, "material");
         let taken = |k: &str| matches!(self.root.get("materials"), Some(Node { value: Value::Table(t), .. }) if t.get(k).is_some());
         if !taken(&plain) && plain == name {
             return plain;
@@ -712,6 +698,22 @@ impl Reader {
             strip(l, &["medium"]);
         }
     }
+}
+
+/// `name` made a plain TOML key (other characters than letters, digits, `_` and `-` made
+/// `_`; `empty` for an empty name).
+fn plain_key(name: &str, empty: &str) -> String {
+    let key: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if key.is_empty() { empty.into() } else { key }
 }
 
 fn vec(n: &[f64]) -> DVec3 {

@@ -239,41 +239,13 @@ impl Reader {
     /// is pbrt-v4's dp/du x dp/dv, turned towards `N` when given; uv is `uv` interpolated,
     /// or the patch's (u, v).
     fn bilinear_mesh(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
-        let (positions, ploc) = p
-            .numbers("P", &[Type::Point3])?
-            .ok_or_else(|| loc.error(what, "missing \"point3 P\" (the vertices)"))?;
-        let n = positions.len() / 3;
-        let patches = match p.numbers("indices", &[Type::Integer])? {
-            Some((v, l)) => {
-                if v.len() % 4 != 0 {
-                    return Err(l.error(what, format!("\"indices\": {} values, not a multiple of 4", v.len())));
-                }
-                if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i as usize >= n) {
-                    return Err(l.error(what, format!("\"indices\": {bad} is out of range: there are {n} vertices")));
-                }
-                v.iter().map(|&i| i as usize).collect::<Vec<_>>()
-            }
-            None if n == 4 => vec![0, 1, 2, 3],
-            None => return Err(ploc.error(what, "missing \"integer indices\" (only a mesh of exactly 4 vertices may leave them out)")),
-        };
-        let per_vertex =
-            |name: &str, v: Option<(Vec<f64>, Loc)>, width: usize| -> Result<Option<Vec<f64>>> {
-                match v {
-                    Some((v, l)) if v.len() != n * width => Err(l.error(
-                        what,
-                        format!(
-                            "\"{name}\": {} values for {n} vertices, expected {}",
-                            v.len(),
-                            n * width
-                        ),
-                    )),
-                    v => Ok(v.map(|(v, _)| v)),
-                }
-            };
-        let given_n = p.numbers("N", &[Type::Normal])?;
-        let given_n = per_vertex("N", given_n, 3)?;
-        let given_uv = p.numbers("uv", &[Type::Point2])?;
-        let given_uv = per_vertex("uv", given_uv, 2)?;
+        let MeshData {
+            positions,
+            indices,
+            normals: given_n,
+            uvs: given_uv,
+        } = mesh_data(p, what, loc, 4)?;
+        let patches: Vec<usize> = indices.iter().map(|&i| i as usize).collect();
         if let Some(q) = p.take("emissionfilename") {
             self.unsupported(
                 &q.loc,
@@ -405,41 +377,12 @@ impl Reader {
 
     /// A `trianglemesh`'s data, checked (None: left out, `lenient`).
     fn triangle_mesh(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<InlineMesh>> {
-        let (positions, ploc) = p
-            .numbers("P", &[Type::Point3])?
-            .ok_or_else(|| loc.error(what, "missing \"point3 P\" (the vertices)"))?;
-        let n = positions.len() / 3;
-        let indices = match p.numbers("indices", &[Type::Integer])? {
-            Some((v, l)) => {
-                if v.len() % 3 != 0 {
-                    return Err(l.error(what, format!("\"indices\": {} values, not a multiple of 3", v.len())));
-                }
-                if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i as usize >= n) {
-                    return Err(l.error(what, format!("\"indices\": {bad} is out of range: there are {n} vertices")));
-                }
-                v.iter().map(|&i| i as u32).collect::<Vec<_>>()
-            }
-            None if n == 3 => vec![0, 1, 2],
-            None => return Err(ploc.error(what, "missing \"integer indices\" (only a mesh of exactly 3 vertices may leave them out)")),
-        };
-        let per_vertex =
-            |name: &str, v: Option<(Vec<f64>, Loc)>, width: usize| -> Result<Option<Vec<f64>>> {
-                match v {
-                    Some((v, l)) if v.len() != n * width => Err(l.error(
-                        what,
-                        format!(
-                            "\"{name}\": {} values for {n} vertices, expected {}",
-                            v.len(),
-                            n * width
-                        ),
-                    )),
-                    v => Ok(v.map(|(v, _)| v)),
-                }
-            };
-        let normals = p.numbers("N", &[Type::Normal])?;
-        let normals = per_vertex("N", normals, 3)?;
-        let uvs = p.numbers("uv", &[Type::Point2])?;
-        let uvs = per_vertex("uv", uvs, 2)?;
+        let MeshData {
+            positions,
+            indices,
+            normals,
+            uvs,
+        } = mesh_data(p, what, loc, 3)?;
         if let Some(q) = p.take("S") {
             self.warn(
                 &q.loc,
@@ -459,6 +402,70 @@ impl Reader {
         mesh.orient_to_normals();
         Ok(Some(mesh))
     }
+}
+
+/// A mesh's vertices (`P`), its elements' vertex indices (`indices`, `corners` a face; they
+/// may be left out for a single face), and per-vertex `N` and `uv`, checked.
+struct MeshData {
+    positions: Vec<f64>,
+    indices: Vec<u32>,
+    normals: Option<Vec<f64>>,
+    uvs: Option<Vec<f64>>,
+}
+
+fn mesh_data(p: &mut Bag, what: &str, loc: &Loc, corners: usize) -> Result<MeshData> {
+    let (positions, ploc) = p
+        .numbers("P", &[Type::Point3])?
+        .ok_or_else(|| loc.error(what, "missing \"point3 P\" (the vertices)"))?;
+    let n = positions.len() / 3;
+    let indices = match p.numbers("indices", &[Type::Integer])? {
+        Some((v, l)) => {
+            if v.len() % corners != 0 {
+                return Err(l.error(
+                    what,
+                    format!(
+                        "\"indices\": {} values, not a multiple of {corners}",
+                        v.len()
+                    ),
+                ));
+            }
+            if let Some(bad) = v.iter().find(|&&i| i < 0.0 || i as usize >= n) {
+                return Err(l.error(
+                    what,
+                    format!("\"indices\": {bad} is out of range: there are {n} vertices"),
+                ));
+            }
+            v.iter().map(|&i| i as u32).collect()
+        }
+        None if n == corners => (0..corners as u32).collect(),
+        None => {
+            return Err(ploc.error(
+                what,
+                format!("missing \"integer indices\" (only a mesh of exactly {corners} vertices may leave them out)"),
+            ));
+        }
+    };
+    let mut per_vertex = |name: &str, ty: Type, width: usize| -> Result<Option<Vec<f64>>> {
+        match p.numbers(name, &[ty])? {
+            Some((v, l)) if v.len() != n * width => Err(l.error(
+                what,
+                format!(
+                    "\"{name}\": {} values for {n} vertices, expected {}",
+                    v.len(),
+                    n * width
+                ),
+            )),
+            v => Ok(v.map(|(v, _)| v)),
+        }
+    };
+    let normals = per_vertex("N", Type::Normal, 3)?;
+    let uvs = per_vertex("uv", Type::Point2, 2)?;
+    Ok(MeshData {
+        positions,
+        indices,
+        normals,
+        uvs,
+    })
 }
 
 /// Loop's subdivision: `levels` rounds of Loop's rules, then the limit positions.

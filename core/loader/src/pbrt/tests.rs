@@ -827,129 +827,25 @@ Material "thindielectric" "float eta" 1.4
 Shape "trianglemesh" "point3 P" [0 0 0  1 0 0  0 1 0]
 "#;
 
-/// Mutated scenes (bytes flipped, inserted, removed; numbers replaced by extreme ones; lines
-/// dropped or repeated) read and built by the whole loader, leniently and not: errors or
-/// scenes, never a panic. `FOTON_FUZZ_PBRT=N` runs N instead of 1,500.
+/// The mutation test (`crate::mutations`) on that scene. `FOTON_FUZZ_PBRT=N` runs N cases
+/// instead of 1,500.
 #[test]
 fn mutated_pbrt_scenes_are_errors_or_scenes_never_panics() {
-    let n: usize = std::env::var("FOTON_FUZZ_PBRT")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(1_500);
+    let n = crate::mutations::count("FOTON_FUZZ_PBRT", 1_500);
     let dir = std::env::temp_dir().join(format!("foton-pbrt-fuzz-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     // A 2 x 2 PNG for the image texture and the environment map.
-    let png = {
-        let mut img = image::RgbImage::new(2, 2);
-        img.put_pixel(1, 0, image::Rgb([200, 100, 50]));
-        let mut bytes = std::io::Cursor::new(Vec::new());
-        img.write_to(&mut bytes, image::ImageFormat::Png).unwrap();
-        bytes.into_inner()
-    };
-    std::fs::write(dir.join("t.png"), png).unwrap();
-    let path = dir.join("scene.pbrt");
-    std::fs::write(&path, RICH).unwrap();
-    crate::load::load_with(&path, &[], &[], false)
-        .unwrap_or_else(|e| panic!("the base scene: {e}"));
-    let mut state = 0x9e37_79b9_7f4a_7c15u64;
-    let mut next = |m: usize| {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        (state % m.max(1) as u64) as usize
-    };
-    const NUMBERS: &[&str] = &[
-        "0",
-        "-1",
-        "1e30",
-        "-1e30",
-        "nan",
-        "inf",
-        "3.5",
-        "100000",
-        "2147483648",
-        "-0",
-    ];
-    let mut outcomes = [0usize; 2];
-    for _ in 0..n {
-        let mut text = RICH.to_string();
-        for _ in 0..1 + next(3) {
-            match next(4) {
-                0 => {
-                    // A byte changed, inserted or removed.
-                    let mut b = text.into_bytes();
-                    let at = next(b.len());
-                    match next(3) {
-                        0 => {
-                            let pool = b" []\"#\n01-.ex";
-                            b[at] = pool[next(pool.len())];
-                        }
-                        1 => {
-                            let pool = b"[]\"0 \n";
-                            b.insert(at, pool[next(pool.len())]);
-                        }
-                        _ => {
-                            b.remove(at);
-                        }
-                    }
-                    text = String::from_utf8_lossy(&b).into_owned();
-                }
-                1 => {
-                    // A number replaced.
-                    let spans: Vec<(usize, usize)> = {
-                        let b = text.as_bytes();
-                        let mut out = Vec::new();
-                        let mut i = 0;
-                        while i < b.len() {
-                            if b[i].is_ascii_digit() {
-                                let s = i;
-                                while i < b.len() && (b[i].is_ascii_digit() || b[i] == b'.') {
-                                    i += 1;
-                                }
-                                out.push((s, i));
-                            }
-                            i += 1;
-                        }
-                        out
-                    };
-                    if let Some(&(s, e)) = spans.get(next(spans.len())) {
-                        text.replace_range(s..e, NUMBERS[next(NUMBERS.len())]);
-                    }
-                }
-                2 => {
-                    let mut lines: Vec<&str> = text.lines().collect();
-                    let at = next(lines.len());
-                    if next(2) == 0 {
-                        lines.remove(at);
-                    } else {
-                        let l = lines[at];
-                        lines.insert(next(lines.len()), l);
-                    }
-                    text = lines.join("\n");
-                }
-                _ => {
-                    // Two lines swapped.
-                    let mut lines: Vec<&str> = text.lines().collect();
-                    let (a, b) = (next(lines.len()), next(lines.len()));
-                    lines.swap(a, b);
-                    text = lines.join("\n");
-                }
-            }
-        }
-        std::fs::write(&path, &text).unwrap();
-        let lenient = next(2) == 0;
-        let result = std::panic::catch_unwind(|| crate::load::load_with(&path, &[], &[], lenient));
-        match result {
-            Ok(r) => outcomes[r.is_ok() as usize] += 1,
-            Err(_) => panic!("the loader panicked on:\n{text}"),
-        }
-    }
-    let _ = std::fs::remove_dir_all(&dir);
-    // Both outcomes happen: the mutations neither always break the scene nor never do.
-    assert!(
-        outcomes[0] > n / 10 && outcomes[1] > n / 10,
-        "errors, scenes: {outcomes:?}"
+    let mut img = image::RgbImage::new(2, 2);
+    img.put_pixel(1, 0, image::Rgb([200, 100, 50]));
+    img.save(dir.join("t.png")).unwrap();
+    crate::mutations::check(
+        &dir.join("scene.pbrt"),
+        RICH,
+        b" []\"#\n01-.ex",
+        n,
+        0x9e37_79b9_7f4a_7c15,
     );
+    let _ = std::fs::remove_dir_all(&dir);
 }
 
 /// Geometry beyond what f32 holds (found by the mutation test: obvhs' build overflowed on a
