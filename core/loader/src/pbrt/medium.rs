@@ -101,10 +101,8 @@ impl Reader {
                     entries.push(("phase", self.phase(g, &loc)));
                 }
             }
-            "uniformgrid" => {
-                let (density, dloc) = p.numbers("density", &[Type::Float])?.ok_or_else(|| {
-                    loc.error(&what, "missing \"float density\" (nx ny nz values)")
-                })?;
+            "uniformgrid" | "rgbgrid" => {
+                let rgb_grid = ty == "rgbgrid";
                 let n = [p.int("nx", 1)?, p.int("ny", 1)?, p.int("nz", 1)?];
                 if n.iter().any(|x| *x < 1) {
                     return Err(loc.error(
@@ -114,18 +112,44 @@ impl Reader {
                 }
                 let n = n.map(|x| x as usize);
                 let count = n[0].checked_mul(n[1]).and_then(|c| c.checked_mul(n[2]));
-                if count != Some(density.len()) {
-                    return Err(dloc.error(
-                        &what,
-                        format!(
-                            "\"density\" has {} values; expected nx ny nz = {} x {} x {}",
-                            density.len(),
-                            n[0],
-                            n[1],
-                            n[2],
-                        ),
-                    ));
-                }
+                // Per sample: the extinction (1 or 3 channels) and, for an RGB grid, the albedo.
+                let grid = |p: &mut Bag,
+                            name: &str,
+                            ty: Type,
+                            width: usize|
+                 -> Result<Option<(Vec<f64>, Loc)>> {
+                    match p.numbers(name, &[ty])? {
+                        Some((v, l)) if count.and_then(|c| c.checked_mul(width)) != Some(v.len()) => Err(l.error(
+                            &what,
+                            format!("\"{name}\" has {} values; expected nx ny nz = {} x {} x {} of {width}", v.len(), n[0], n[1], n[2]),
+                        )),
+                        v => Ok(v),
+                    }
+                };
+                let (extinction, albedo_grid, dloc) = if rgb_grid {
+                    let sa = grid(&mut p, "sigma_a", Type::Rgb, 3)?;
+                    let ss = grid(&mut p, "sigma_s", Type::Rgb, 3)?;
+                    let dloc = match (&sa, &ss) {
+                        (Some((_, l)), _) | (None, Some((_, l))) => l.clone(),
+                        (None, None) => return Err(loc.error(&what, "an RGB grid needs \"rgb sigma_a\" or \"rgb sigma_s\" (nx ny nz colours)")),
+                    };
+                    let len = 3 * count.unwrap_or(0);
+                    let sa = sa.map_or(vec![0.0; len], |(v, _)| v);
+                    let ss = ss.map_or(vec![0.0; len], |(v, _)| v);
+                    let st: Vec<f64> = sa.iter().zip(&ss).map(|(a, s)| a + s).collect();
+                    let albedo: Vec<f64> = st
+                        .iter()
+                        .zip(&ss)
+                        .map(|(t, s)| if *t > 0.0 { s / t } else { 0.0 })
+                        .collect();
+                    (st, Some(albedo), dloc)
+                } else {
+                    let (d, l) = grid(&mut p, "density", Type::Float, 1)?.ok_or_else(|| {
+                        loc.error(&what, "missing \"float density\" (nx ny nz values)")
+                    })?;
+                    (d, None, l)
+                };
+                let channels = if rgb_grid { 3 } else { 1 };
                 self.emission(
                     &mut p,
                     &what,
@@ -148,46 +172,68 @@ impl Reader {
                 if size.min_element() <= 0.0 {
                     return Err(loc.error(&what, "\"p1\" must exceed \"p0\" on every axis"));
                 }
-                let (sa, ss, g) = coefficients(self, &mut p, None)?;
-                let sigma_t = sa + ss;
-                let albedo = DVec3::select(sigma_t.cmpgt(DVec3::ZERO), ss / sigma_t, DVec3::ZERO);
-                // The grid with a border of zeros: (n + 2) samples per axis at the centres
-                // of cells of the same size, the first one a cell before p0.
+                // An RGB grid's coefficients are its grids, times `scale`; a density grid's
+                // multiply sigma_a and sigma_s.
+                let (sigma_t, albedo) = if rgb_grid {
+                    let scale = p.float("scale", 1.0)?;
+                    if scale < 0.0 {
+                        return Err(
+                            loc.error(&what, format!("\"scale\" {scale}: must not be negative"))
+                        );
+                    }
+                    (DVec3::splat(scale), DVec3::ONE)
+                } else {
+                    let (sa, ss, _) = coefficients(self, &mut p, None)?;
+                    let st = sa + ss;
+                    (
+                        st,
+                        DVec3::select(st.cmpgt(DVec3::ZERO), ss / st, DVec3::ZERO),
+                    )
+                };
+                let g = p.float("g", 0.0)?;
+                if g.abs() >= 1.0 {
+                    return Err(loc.error(&what, format!("\"g\" {g}: must be within (-1, 1)")));
+                }
+                // The extinction with a border of zeros: (n + 2) samples per axis at the
+                // centres of cells of the same size, the first one a cell before p0.
                 let padded = n.map(|x| x + 2);
-                let mut values = vec![0.0; padded[0] * padded[1] * padded[2]];
+                let mut values = vec![0.0; padded[0] * padded[1] * padded[2] * channels];
                 for z in 0..n[2] {
                     for y in 0..n[1] {
                         for x in 0..n[0] {
                             let to = ((z + 1) * padded[1] + y + 1) * padded[0] + x + 1;
-                            values[to] = density[(z * n[1] + y) * n[0] + x];
+                            let from = (z * n[1] + y) * n[0] + x;
+                            values[to * channels..(to + 1) * channels].copy_from_slice(
+                                &extinction[from * channels..(from + 1) * channels],
+                            );
                         }
                     }
                 }
                 let cell = size / DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
-                let grid_box =
-                    DMat4::from_translation(p0 - cell) * DMat4::from_scale(size + 2.0 * cell);
-                let medium_from_unit = self.state.ctm * grid_box;
-                let resolution = padded.iter().map(|x| self.num(*x as f64, &loc)).collect();
-                let values = values.iter().map(|x| self.num(*x, &dloc)).collect();
-                let grid = self.table(
-                    vec![
-                        ("resolution", self.node(Value::Array(resolution), &loc)),
-                        ("values", self.node(Value::Array(values), &dloc)),
-                        ("transform", self.matrix(medium_from_unit, &loc)),
-                        ("samples", self.string("centres", &loc)),
-                        ("outside", self.string("zero", &loc)),
-                    ],
-                    &loc,
-                );
+                let padded_box = self.state.ctm
+                    * DMat4::from_translation(p0 - cell)
+                    * DMat4::from_scale(size + 2.0 * cell);
                 entries.push(("type", self.string("heterogeneous", &loc)));
                 entries.push(("sigma_t", self.vec3(sigma_t, &loc)));
-                entries.push(("albedo", self.vec3(albedo, &loc)));
-                entries.push(("density", grid));
+                match albedo_grid {
+                    // Per sample, clamped beyond the outermost ones: sigma_s = albedo x
+                    // sigma_t then follows pbrt-v4's interpolated sigma_s where the albedo
+                    // varies slowly, also at the faces.
+                    Some(a) => {
+                        let unpadded =
+                            self.state.ctm * DMat4::from_translation(p0) * DMat4::from_scale(size);
+                        let t = self.grid_table(n, &a, unpadded, "clamp", &dloc);
+                        entries.push(("albedo", t));
+                    }
+                    None => entries.push(("albedo", self.vec3(albedo, &loc))),
+                }
+                let density = self.grid_table(padded, &values, padded_box, "zero", &dloc);
+                entries.push(("density", density));
                 if g != 0.0 {
                     entries.push(("phase", self.phase(g, &loc)));
                 }
             }
-            other @ ("rgbgrid" | "cloud" | "nanovdb") => {
+            other @ ("cloud" | "nanovdb") => {
                 self.unsupported(
                     &tloc,
                     &what,
@@ -227,6 +273,30 @@ impl Reader {
             }
         }
         Ok(())
+    }
+
+    /// A volume table of `values` on `res` samples at the cells' centres of the unit cube
+    /// placed by `unit_to_world`, read as `outside` beyond them.
+    fn grid_table(
+        &self,
+        res: [usize; 3],
+        values: &[f64],
+        unit_to_world: DMat4,
+        outside: &str,
+        loc: &Loc,
+    ) -> Node {
+        let resolution = res.iter().map(|x| self.num(*x as f64, loc)).collect();
+        let values = values.iter().map(|x| self.num(*x, loc)).collect();
+        self.table(
+            vec![
+                ("resolution", self.node(Value::Array(resolution), loc)),
+                ("values", self.node(Value::Array(values), loc)),
+                ("transform", self.matrix(unit_to_world, loc)),
+                ("samples", self.string("centres", loc)),
+                ("outside", self.string(outside, loc)),
+            ],
+            loc,
+        )
     }
 
     fn phase(&self, g: f64, loc: &Loc) -> Node {

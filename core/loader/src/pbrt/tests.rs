@@ -1022,3 +1022,28 @@ fn measured_media_presets() {
         report.warnings
     );
 }
+
+#[test]
+fn rgb_grid_media_are_an_rgb_extinction_and_albedo() {
+    let t = doc(&format!(
+        "{WORLD}MakeNamedMedium \"m\" \"string type\" \"rgbgrid\" \"integer nx\" 2 \"rgb sigma_a\" [1 0 0  0 0 0] \"rgb sigma_s\" [1 2 3  0 4 0] \"float scale\" 2\n"
+    ));
+    assert!(close(&nums(&t, "media.m.sigma_t"), &[2.0, 2.0, 2.0]));
+    // Extinction sigma_a + sigma_s per sample (3 channels) with a border of zeros.
+    assert!(close(
+        &nums(&t, "media.m.density.resolution"),
+        &[4.0, 3.0, 3.0]
+    ));
+    let v = nums(&t, "media.m.density.values");
+    assert_eq!(v.len(), 36 * 3);
+    assert_eq!(
+        &v[(12 + 4 + 1) * 3..(12 + 4 + 3) * 3],
+        &[2.0, 2.0, 3.0, 0.0, 4.0, 0.0]
+    );
+    // The albedo per sample, unpadded, clamped beyond (0 where nothing is there).
+    assert_eq!(
+        nums(&t, "media.m.albedo.values"),
+        vec![0.5, 1.0, 1.0, 0.0, 1.0, 0.0]
+    );
+    assert_eq!(text(&t, "media.m.albedo.outside"), "clamp");
+}
