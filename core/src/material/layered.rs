@@ -577,8 +577,9 @@ fn rng_of(a: Vec3, b: [f32; 3]) -> Rng {
 ///
 /// pbrt-v4 weighs these with the coat's pdf the other way round, `top.PDF(-w, wi)`, a
 /// density over the outside direction wi: the two techniques' weights then do not sum to
-/// one and a rough coat's f is biased (by about 8% on a white base under roughness 0.1; the
-/// mismatch between `f` and `Sample_f` of pbrt-v4's issue #187). This is the one place the
+/// one and a rough coat's f is biased (by about 8% on a white base under roughness 0.1: pbrt-v4's
+/// own renders of a rough coat by BSDF sampling alone and by light sampling alone disagree,
+/// docs/pbrt.md). This is the one place the
 /// walk departs from pbrt's.
 fn exit_pdf(top: &Dielectric, wi: Vec3, w: Vec3) -> f32 {
     top.pdf(wi, -w, Flags::Transmission)

@@ -74,8 +74,8 @@ fn bdpt_agrees_with_path_on_coated_materials() {
 /// strategies alone (unweighted): (0, 3), the camera path's sampled direction hitting the
 /// light (the lobe's `sample`, its walk's weights), and (1, 2), the connection to a point on
 /// the light (its `eval`). They agree only if the walk's samples and the estimated f do:
-/// pbrt-v4's own weighting of the exits the walk finds through a rough coat (its issue #187)
-/// makes f 8% too bright on a white base under roughness 0.1, which this test sees.
+/// pbrt-v4's own weighting of the exits the walk finds through a rough coat (its BSDF-sampled
+/// and light-sampled renders disagree: docs/pbrt.md) makes f 8% too bright on a white base under roughness 0.1, which this test sees.
 #[test]
 fn sampled_and_evaluated_direct_lighting_agree_on_rough_coats() {
     let scene = foton_tests::header("bdpt", 1, 1, 24, 24)

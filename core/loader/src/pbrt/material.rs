@@ -76,46 +76,12 @@ impl Reader {
                         self.unsupported(&q.loc, &what, "a conductor given by its \"reflectance\" is not read yet (eta and k are)")?;
                         return Ok(false);
                     }
-                    let (eta, k) = (p.take("eta"), p.take("k"));
-                    let named = |q: &Option<super::parse::Param>, suffix: &str| match q {
-                        None => Some("Cu".to_string()),
-                        Some(q) => match (&q.ty, &q.values) {
-                            (Type::Spectrum, Values::Strs(s)) => s[0]
-                                .strip_prefix("metal-")
-                                .and_then(|m| m.strip_suffix(suffix))
-                                .map(str::to_string),
-                            _ => None,
-                        },
+                    let Some((e, kk)) = self.metal_index(&mut p, ["eta", "k"], 1.0, &what, &loc)?
+                    else {
+                        return Ok(false);
                     };
-                    match (named(&eta, "-eta"), named(&k, "-k")) {
-                        (Some(a), Some(b)) if a == b => {
-                            if !METALS.contains(&a.as_str())
-                                || foton_core::material::conductor_ior(&a).is_none()
-                            {
-                                self.unsupported(
-                                    &loc,
-                                    &what,
-                                    &format!("the metal {a:?}: foton has no data for it"),
-                                )?;
-                                return Ok(false);
-                            }
-                            let (e, kk) = metal_rgb_ior(&a, 1.0).expect("checked above");
-                            entries.push(("eta", self.vec3(e, &loc)));
-                            entries.push(("k", self.vec3(kk, &loc)));
-                        }
-                        _ => {
-                            let (Some(eta), Some(k)) = (eta, k) else {
-                                return Err(loc.error(
-                                    &what,
-                                    "give both \"eta\" and \"k\" (or neither: copper)",
-                                ));
-                            };
-                            let e = rgb(&eta, Kind::Unbounded, &what, &self.dir)?;
-                            let kk = rgb(&k, Kind::Unbounded, &what, &self.dir)?;
-                            entries.push(("eta", self.vec3(e, &eta.loc)));
-                            entries.push(("k", self.vec3(kk, &k.loc)));
-                        }
-                    }
+                    entries.push(("eta", self.vec3(e, &loc)));
+                    entries.push(("k", self.vec3(kk, &loc)));
                 }
                 if let Some((au, av)) = alpha {
                     entries.push(("distribution", self.string("ggx", &loc)));
@@ -349,51 +315,20 @@ impl Reader {
                 if let Some(c) = self.colour(&mut p, "reflectance", Kind::Albedo, &what)? {
                     entries.push(("reflectance", c));
                 } else if !diffuse {
-                    let (eta, k) = (p.take("conductor.eta"), p.take("conductor.k"));
-                    let named = |q: &Option<super::parse::Param>, suffix: &str| match q {
-                        Some(q) => match (&q.ty, &q.values) {
-                            (Type::Spectrum, Values::Strs(s)) => s[0]
-                                .strip_prefix("metal-")
-                                .and_then(|m| m.strip_suffix(suffix))
-                                .map(str::to_string),
-                            _ => None,
-                        },
-                        None => None,
+                    // Under the coat the metal's index is relative to the coat's.
+                    let outside = entries
+                        .iter()
+                        .find(|(k, _)| *k == "interface_eta")
+                        .and_then(|(_, n)| n.value.as_f64())
+                        .filter(|x| *x > 0.0)
+                        .unwrap_or(1.5);
+                    let names = ["conductor.eta", "conductor.k"];
+                    let Some((e, kk)) = self.metal_index(&mut p, names, outside, &what, &loc)?
+                    else {
+                        return Ok(false);
                     };
-                    match (named(&eta, "-eta"), named(&k, "-k"), eta, k) {
-                        (Some(a), Some(b), _, _) if a == b => {
-                            if !METALS.contains(&a.as_str())
-                                || foton_core::material::conductor_ior(&a).is_none()
-                            {
-                                self.unsupported(
-                                    &loc,
-                                    &what,
-                                    &format!("the metal {a:?}: foton has no data for it"),
-                                )?;
-                                return Ok(false);
-                            }
-                            // Under the coat the metal's index is relative to the coat's.
-                            let outside = entries
-                                .iter()
-                                .find(|(k, _)| *k == "interface_eta")
-                                .and_then(|(_, n)| n.value.as_f64())
-                                .filter(|x| *x > 0.0)
-                                .unwrap_or(1.5);
-                            let (e, kk) = metal_rgb_ior(&a, outside).expect("checked above");
-                            entries.push(("conductor_eta", self.vec3(e, &loc)));
-                            entries.push(("conductor_k", self.vec3(kk, &loc)));
-                        }
-                        (_, _, None, None) => {}
-                        (_, _, Some(eta), Some(k)) => {
-                            let e = rgb(&eta, Kind::Unbounded, &what, &self.dir)?;
-                            let kk = rgb(&k, Kind::Unbounded, &what, &self.dir)?;
-                            entries.push(("conductor_eta", self.vec3(e, &eta.loc)));
-                            entries.push(("conductor_k", self.vec3(kk, &k.loc)));
-                        }
-                        _ => {
-                            return Err(loc.error(&what, "give both \"conductor.eta\" and \"conductor.k\" (or neither: copper)"));
-                        }
-                    }
+                    entries.push(("conductor_eta", self.vec3(e, &loc)));
+                    entries.push(("conductor_k", self.vec3(kk, &loc)));
                 }
             }
             other @ ("measured" | "subsurface" | "hair") => {
@@ -430,6 +365,58 @@ impl Reader {
         }
         let c = rgb(&q, kind, what, &self.dir)?;
         Ok(Some(self.vec3(c, &q.loc)))
+    }
+
+    /// A metal's complex index from the parameters `names` (eta, k; neither: copper, pbrt-v4's
+    /// default): a named metal (`metal-X-eta` with `metal-X-k`) as RGB fitted to its spectral
+    /// reflectance relative to a medium of index `outside` ([`metal_rgb_ior`]), or two
+    /// spectra reduced to RGB. None: left out (`lenient`).
+    fn metal_index(
+        &mut self,
+        p: &mut Bag,
+        names: [&str; 2],
+        outside: f64,
+        what: &str,
+        loc: &Loc,
+    ) -> Result<Option<(glam::DVec3, glam::DVec3)>> {
+        let (eta, k) = (p.take(names[0]), p.take(names[1]));
+        let named = |q: &Option<super::parse::Param>, suffix: &str| match q {
+            None => Some("Cu".to_string()),
+            Some(q) => match (&q.ty, &q.values) {
+                (Type::Spectrum, Values::Strs(s)) => s[0]
+                    .strip_prefix("metal-")
+                    .and_then(|m| m.strip_suffix(suffix))
+                    .map(str::to_string),
+                _ => None,
+            },
+        };
+        match (named(&eta, "-eta"), named(&k, "-k"), eta, k) {
+            (Some(a), Some(b), _, _) if a == b => {
+                let fitted = METALS
+                    .contains(&a.as_str())
+                    .then(|| metal_rgb_ior(&a, outside))
+                    .flatten();
+                if fitted.is_none() {
+                    self.unsupported(
+                        loc,
+                        what,
+                        &format!("the metal {a:?}: foton has no data for it"),
+                    )?;
+                }
+                Ok(fitted)
+            }
+            (_, _, Some(eta), Some(k)) => Ok(Some((
+                rgb(&eta, Kind::Unbounded, what, &self.dir)?,
+                rgb(&k, Kind::Unbounded, what, &self.dir)?,
+            ))),
+            _ => Err(loc.error(
+                what,
+                format!(
+                    "give both \"{}\" and \"{}\" (or neither: copper)",
+                    names[0], names[1]
+                ),
+            )),
+        }
     }
 
     /// A dielectric's `eta` (default 1.5): a float, or a spectrum read at 550 nm (foton's
