@@ -50,10 +50,14 @@ pub fn load_bitmap(path: &Path, raw: bool) -> Result<Bitmap> {
     Bitmap::new(width, height, texels).ok_or_else(|| Error::io(path, "the image is empty"))
 }
 
+/// The images a load has decoded, by file and `raw`: a file that many materials' textures
+/// name is read once.
+pub type Bitmaps = std::collections::HashMap<(std::path::PathBuf, bool), Arc<Bitmap>>;
+
 /// A texture table (`type = "bitmap"` or `"checkerboard"` and its parameters, see
 /// docs/scene-format.md); `filename` is relative to `base_dir`. Every error names the
 /// scene file, line and key; an image that cannot be read also names the image file.
-pub fn read_texture(t: &Properties<'_>, base_dir: &Path) -> Result<Texture> {
+pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) -> Result<Texture> {
     let ty = t.string_opt("type")?.ok_or_else(|| {
         t.error(
             "type",
@@ -82,14 +86,25 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path) -> Result<Texture> {
             if scale.min_element() < 0.0 {
                 return Err(t.error("scale", "must not be negative"));
             }
-            let mut bitmap = load_bitmap(&base_dir.join(filename), raw)
-                .map_err(|e| t.error("filename", e.to_string()))?;
+            let path = base_dir.join(filename);
+            let mut bitmap = match bitmaps.get(&(path.clone(), raw)) {
+                Some(b) => b.clone(),
+                None => {
+                    let b = Arc::new(
+                        load_bitmap(&path, raw).map_err(|e| t.error("filename", e.to_string()))?,
+                    );
+                    bitmaps.insert((path, raw), b.clone());
+                    b
+                }
+            };
             if scale != Rgb::ONE {
                 let texels = bitmap.texels().iter().map(|c| *c * scale).collect();
-                bitmap = Bitmap::new(bitmap.width(), bitmap.height(), texels).expect("same size");
+                bitmap = Arc::new(
+                    Bitmap::new(bitmap.width(), bitmap.height(), texels).expect("same size"),
+                );
             }
             Ok(Texture::Bitmap {
-                bitmap: Arc::new(bitmap),
+                bitmap,
                 filter,
                 wrap,
                 to_uv,
@@ -119,13 +134,14 @@ pub fn read_texture_param<'a>(
     name: &str,
     default: Rgb,
     base_dir: &Path,
+    bitmaps: &mut Bitmaps,
 ) -> Result<(Texture, Option<Properties<'a>>)> {
     let is_table = bag
         .node(name)
         .is_some_and(|n| matches!(n.value, Value::Table(_)));
     if is_table {
         let t = bag.table(name)?.expect("present");
-        let texture = read_texture(&t, base_dir)?;
+        let texture = read_texture(&t, base_dir, bitmaps)?;
         Ok((texture, Some(t)))
     } else {
         Ok((Texture::Constant(bag.rgb(name, default)?), None))
@@ -203,7 +219,7 @@ mod tests {
         let doc = Document::parse(text, &file)?;
         let root = Properties::root(&file, &doc.root);
         let t = root.table("t")?.unwrap();
-        read_texture(&t, dir)
+        read_texture(&t, dir, &mut Bitmaps::new())
     }
 
     fn close(a: Rgb, b: Rgb) -> bool {
@@ -229,6 +245,32 @@ mod tests {
 
     fn linear(i: usize) -> Rgb {
         Rgb::from_array(PIXELS[i].map(|b| srgb_to_linear(b as f32 / 255.0)))
+    }
+
+    /// A file named by several textures of a load is decoded once and shared; a `scale`
+    /// makes its own scaled copy.
+    #[test]
+    fn a_load_decodes_each_image_once() {
+        let dir = temp_dir("shared");
+        write_png(&dir);
+        let file = dir.join("scene.toml");
+        let text = "[a]\ntype = \"bitmap\"\nfilename = \"t.png\"\n[b]\ntype = \"bitmap\"\nfilename = \"t.png\"\n[c]\ntype = \"bitmap\"\nfilename = \"t.png\"\nscale = 2.0\n";
+        let doc = Document::parse(text, &file).unwrap();
+        let root = Properties::root(&file, &doc.root);
+        let mut bitmaps = Bitmaps::new();
+        let mut read =
+            |k: &str| match read_texture(&root.table(k).unwrap().unwrap(), &dir, &mut bitmaps)
+                .unwrap()
+            {
+                Texture::Bitmap { bitmap, .. } => bitmap,
+                other => panic!("{other:?}"),
+            };
+        let (a, b, c) = (read("a"), read("b"), read("c"));
+        assert!(Arc::ptr_eq(&a, &b));
+        assert!(!Arc::ptr_eq(&a, &c));
+        assert_eq!(c.texel(0, 0), a.texel(0, 0) * 2.0);
+        assert_eq!(bitmaps.len(), 1);
+        let _ = std::fs::remove_dir_all(&dir);
     }
 
     #[test]

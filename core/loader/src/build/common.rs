@@ -2,7 +2,7 @@
 //! shapes and lights fill, names defined in a section, a table's `type`, arrays of tables and
 //! transform tables.
 
-use crate::texture::{load_bitmap, read_texture_param};
+use crate::texture::{Bitmaps, load_bitmap, read_texture_param};
 use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::geometry::{Primitive, TriangleAttrs};
@@ -22,6 +22,7 @@ pub(super) struct Loader {
     pub(super) sources: Vec<PathBuf>,
     pub(super) bags: Vec<Vec<Unused>>,
     pub(super) warnings: Vec<String>,
+    pub(super) bitmaps: Bitmaps,
 }
 
 impl Loader {
@@ -52,7 +53,7 @@ impl Resources for Loader {
     }
 
     fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture> {
-        let (texture, table) = read_texture_param(bag, key, default, &self.dir)?;
+        let (texture, table) = read_texture_param(bag, key, default, &self.dir, &mut self.bitmaps)?;
         if let Some(table) = table {
             self.done(&table);
         }

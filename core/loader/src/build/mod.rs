@@ -50,6 +50,7 @@ pub fn from_document(doc: Document) -> Result<Scene> {
         sources: Vec::new(),
         bags: Vec::new(),
         warnings: Vec::new(),
+        bitmaps: Default::default(),
     };
     let root = Properties::root(&file, &doc.root);
     for key in root.keys() {
