@@ -385,12 +385,13 @@ impl FilterSampler {
             for x in range(film.x, r.x, width) {
                 let pdf = self.pdf(x as u32, y as u32, film);
                 if pdf > 0.0 {
-                    f(
-                        x as u32,
-                        y as u32,
-                        pdf,
-                        self.weight(x as u32, y as u32, film),
-                    );
+                    // A positive filter's weight is 1 wherever its pdf is not 0.
+                    let weight = if self.signed {
+                        self.weight(x as u32, y as u32, film)
+                    } else {
+                        1.0
+                    };
+                    f(x as u32, y as u32, pdf, weight);
                 }
             }
         }
