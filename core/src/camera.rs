@@ -1,5 +1,12 @@
-//! A pinhole camera with a vertical field of view, and its importance for estimators that
-//! trace paths from the lights (pbrt-v4's `PerspectiveCamera::We`, `PDF_We`, `SampleWi`).
+//! A perspective camera with a vertical field of view, a pinhole or a thin lens, and its
+//! importance for estimators that trace paths from the lights (pbrt-v4's
+//! `PerspectiveCamera::We`, `PDF_We`, `SampleWi`).
+//!
+//! **Thin lens.** With a lens of radius r focused at distance f (along the optical axis),
+//! a camera ray starts at a uniform point of the lens disc and goes through the point of the
+//! plane of focus that the pinhole's ray through the same film point reaches: points on that
+//! plane are sharp, others blur. A point projects onto the film through the lens's centre
+//! from where the ray crosses the plane of focus.
 //!
 //! **Importance.** The importance is normalised over the whole image, as pbrt-v4's is: a
 //! camera ray's direction w, at angle theta from the optical axis, has the density
@@ -17,18 +24,20 @@ use glam::{Vec2, Vec3};
 /// A connection from a point to the camera ([`Camera::sample_wi`]).
 #[derive(Clone, Copy, Debug)]
 pub struct CameraSample {
-    /// Unit direction from the point towards the pinhole.
+    /// The point on the lens (the pinhole's position without one).
+    pub p: Vec3,
+    /// Unit direction from the point towards `p`.
     pub wi: Vec3,
-    /// Distance from the point to the pinhole.
+    /// Distance from the point to `p`.
     pub dist: f32,
-    /// The camera's importance We of the ray from the pinhole through the point.
+    /// The camera's importance We of the ray from `p` through the point.
     pub we: f32,
-    /// The solid-angle density at the point of having sampled this direction: the pinhole is
-    /// a delta in position, so dist^2 / cos theta (pbrt-v4's pinhole: a lens of area one).
+    /// The solid-angle density at the point of having sampled this direction:
+    /// dist^2 / (cos theta  lens area), a pinhole's lens area taken as one (as pbrt-v4's is).
     pub pdf: f32,
     /// Where on the film the point lands (pixel units, (0, 0) the top-left corner).
     pub film: Vec2,
-    /// cos theta: between the optical axis and the ray from the pinhole.
+    /// cos theta: between the optical axis and the ray from `p`.
     pub cos: f32,
 }
 
@@ -45,6 +54,10 @@ pub struct Camera {
     shift: Vec2,
     width: u32,
     height: u32,
+    /// The lens's radius: zero for a pinhole.
+    lens_radius: f32,
+    /// Distance from the lens to the plane of focus, along the optical axis.
+    focal_distance: f32,
 }
 
 impl Camera {
@@ -69,7 +82,41 @@ impl Camera {
             shift: Vec2::ZERO,
             width,
             height,
+            lens_radius: 0.0,
+            focal_distance: 1.0,
         }
+    }
+
+    /// The camera with a thin lens of radius `lens_radius` focused at `focal_distance` (both
+    /// positive; a zero radius keeps the pinhole).
+    pub fn with_lens(mut self, lens_radius: f32, focal_distance: f32) -> Camera {
+        if lens_radius > 0.0 {
+            self.lens_radius = lens_radius;
+            self.focal_distance = focal_distance;
+        }
+        self
+    }
+
+    /// The lens's radius (zero for a pinhole) and the distance it focuses at.
+    pub fn lens(&self) -> (f32, f32) {
+        (self.lens_radius, self.focal_distance)
+    }
+
+    /// Area of the lens: one for a pinhole (a delta in position, pbrt-v4's convention).
+    #[inline]
+    fn lens_area(&self) -> f32 {
+        if self.lens_radius > 0.0 {
+            std::f32::consts::PI * self.lens_radius * self.lens_radius
+        } else {
+            1.0
+        }
+    }
+
+    /// The point of the lens for a uniform sample `u` of the unit square.
+    #[inline]
+    fn lens_point(&self, u: Vec2) -> Vec3 {
+        let d = crate::sampling::concentric_disc(u) * self.lens_radius;
+        self.position + d.x * self.right + d.y * self.up
     }
 
     /// The camera with its image mirrored left to right (a camera transform whose
@@ -92,17 +139,34 @@ impl Camera {
         (self.width, self.height)
     }
 
-    /// The ray through a point on the film in pixel units: (0, 0) is the top-left corner.
+    /// The ray from the pinhole (the lens's centre) through a point on the film in pixel
+    /// units: (0, 0) is the top-left corner.
     pub fn generate_ray(&self, film: Vec2) -> Ray {
+        Ray::new(self.position, self.towards(film).normalize())
+    }
+
+    /// The camera ray through a point on the film: from the lens point that `lens` (a uniform
+    /// sample of the unit square, drawn only if the camera has a lens) gives, through the
+    /// point of the plane of focus [`Camera::generate_ray`]'s ray reaches.
+    pub fn generate_ray_lens(&self, film: Vec2, lens: impl FnOnce() -> Vec2) -> Ray {
+        if self.lens_radius <= 0.0 {
+            return self.generate_ray(film);
+        }
+        let focus = self.position + self.focal_distance * self.towards(film);
+        let origin = self.lens_point(lens());
+        Ray::new(origin, (focus - origin).normalize())
+    }
+
+    /// The direction from the pinhole through a film point, its component along the optical
+    /// axis one.
+    #[inline]
+    fn towards(&self, film: Vec2) -> Vec3 {
         let aspect = self.width as f32 / self.height as f32;
         // The shift is +0 for a centred window, and x + 0 is x (never -0 here): a centred
         // camera's rays are those of the plain formula, bit for bit.
         let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect + self.shift.x;
         let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half + self.shift.y;
-        Ray::new(
-            self.position,
-            (self.forward + sx * self.right + sy * self.up).normalize(),
-        )
+        self.forward + sx * self.right + sy * self.up
     }
 
     /// Area of the image on the plane at distance 1 in front of the pinhole.
@@ -118,51 +182,83 @@ impl Camera {
         self.forward
     }
 
-    /// The importance We of a ray leaving the pinhole along `dir` (unit) and the film point it
-    /// goes through; None outside the image widened by `margin` pixels on every side (see the
-    /// module comment: the reach of the reconstruction filter, [`FilterSampler::margin`]).
+    /// The importance We of a camera ray (from the pinhole, or from a point of the lens) and
+    /// the film point it goes through; None outside the image widened by `margin` pixels on
+    /// every side (see the module comment: the reach of the reconstruction filter,
+    /// [`FilterSampler::margin`]).
     ///
     /// [`FilterSampler::margin`]: crate::filter::FilterSampler::margin
-    pub fn we(&self, dir: Vec3, margin: f32) -> Option<(f32, Vec2)> {
-        let cos = dir.dot(self.forward);
+    #[inline]
+    pub fn we(&self, ray: &Ray, margin: f32) -> Option<(f32, Vec2)> {
+        let cos = ray.dir.dot(self.forward);
         if cos <= 0.0 {
             return None;
         }
-        let film = self.project_within(self.position + dir, margin)?;
+        let film = self.film_of(ray, cos, margin)?;
         let cos2 = cos * cos;
-        Some((1.0 / (self.image_area() * cos2 * cos2), film))
+        Some((
+            1.0 / (self.image_area() * self.lens_area() * cos2 * cos2),
+            film,
+        ))
     }
 
-    /// The densities with which camera rays leave the pinhole along `dir` (unit): in position
-    /// 1 (a delta: the pinhole), in direction 1 / (A cos^3 theta) (A the image's area at
-    /// distance 1), zero outside the image widened by `margin` pixels. pbrt-v4's `PDF_We`.
-    pub fn pdf_we(&self, dir: Vec3, margin: f32) -> (f32, f32) {
-        let cos = dir.dot(self.forward);
-        if cos <= 0.0 || self.project_within(self.position + dir, margin).is_none() {
-            return (1.0, 0.0);
+    /// Where a camera ray crosses the film, widened by `margin` pixels: the pinhole's
+    /// projection of the point where it crosses the plane of focus (`cos`, its direction's
+    /// component along the optical axis, positive).
+    #[inline]
+    fn film_of(&self, ray: &Ray, cos: f32, margin: f32) -> Option<Vec2> {
+        if self.lens_radius <= 0.0 {
+            return self.project_within(self.position + ray.dir, margin);
         }
-        (1.0, 1.0 / (self.image_area() * cos * cos * cos))
+        let focus = ray.origin + (self.focal_distance / cos) * ray.dir;
+        self.project_within(focus, margin)
     }
 
-    /// The connection from the point `p` to the pinhole (pbrt-v4's `SampleWi`): the direction,
-    /// the importance of the ray through `p`, its density at `p`, and where on the film `p`
-    /// lands; None if `p` is behind the camera or projects outside the image widened by
-    /// `margin` pixels.
-    pub fn sample_wi(&self, p: Vec3, margin: f32) -> Option<CameraSample> {
-        let d = self.position - p;
+    /// The densities with which camera rays leave the camera along `ray`: in position 1 / the
+    /// lens's area (1 for the pinhole, a delta), in direction 1 / (A cos^3 theta) (A the
+    /// image's area at distance 1), zero outside the image widened by `margin` pixels.
+    /// pbrt-v4's `PDF_We`.
+    #[inline]
+    pub fn pdf_we(&self, ray: &Ray, margin: f32) -> (f32, f32) {
+        let cos = ray.dir.dot(self.forward);
+        let pos = 1.0 / self.lens_area();
+        if cos <= 0.0 || self.film_of(ray, cos, margin).is_none() {
+            return (pos, 0.0);
+        }
+        (pos, 1.0 / (self.image_area() * cos * cos * cos))
+    }
+
+    /// The connection from the point `p` to the camera (pbrt-v4's `SampleWi`): a point of the
+    /// lens (from `lens`, a uniform sample of the unit square drawn only if the camera has a
+    /// lens), the direction towards it, the importance of the ray from there through `p`, its
+    /// density at `p`, and where on the film `p` lands; None if `p` is behind the camera or
+    /// lands outside the image widened by `margin` pixels.
+    pub fn sample_wi(
+        &self,
+        p: Vec3,
+        margin: f32,
+        lens: impl FnOnce() -> Vec2,
+    ) -> Option<CameraSample> {
+        let at = if self.lens_radius > 0.0 {
+            self.lens_point(lens())
+        } else {
+            self.position
+        };
+        let d = at - p;
         let dist2 = d.length_squared();
         if dist2 == 0.0 {
             return None;
         }
         let dist = dist2.sqrt();
         let wi = d / dist;
-        let (we, film) = self.we(-wi, margin)?;
+        let (we, film) = self.we(&Ray::new(at, -wi), margin)?;
         let cos = (-wi).dot(self.forward);
         Some(CameraSample {
+            p: at,
             wi,
             dist,
             we,
-            pdf: dist2 / cos,
+            pdf: dist2 / (cos * self.lens_area()),
             film,
             cos,
         })
@@ -288,9 +384,9 @@ mod tests {
         let (mut pdf_sum, mut we_sum) = (0.0f64, 0.0f64);
         for _ in 0..n {
             let w = crate::sampling::uniform_sphere(rng.next_2d());
-            let (_, pdf) = cam.pdf_we(w, 0.0);
+            let (_, pdf) = cam.pdf_we(&Ray::new(cam.position, w), 0.0);
             pdf_sum += pdf as f64;
-            if let Some((we, _)) = cam.we(w, 0.0) {
+            if let Some((we, _)) = cam.we(&Ray::new(cam.position, w), 0.0) {
                 we_sum += (we * w.dot(cam.forward)) as f64;
             }
         }
@@ -306,11 +402,11 @@ mod tests {
         ] {
             let ray = cam.generate_ray(film);
             let p = ray.at(2.5);
-            let s = cam.sample_wi(p, 0.0).unwrap();
+            let s = cam.sample_wi(p, 0.0, || Vec2::ZERO).unwrap();
             assert!((s.film - film).length() < 1e-3);
             assert!((s.wi + ray.dir).length() < 1e-5);
             assert!((s.dist - 2.5).abs() < 1e-4);
-            let (_, pdf_dir) = cam.pdf_we(ray.dir, 0.0);
+            let (_, pdf_dir) = cam.pdf_we(&ray, 0.0);
             assert!((s.we * s.cos / pdf_dir - 1.0).abs() < 1e-5);
             // Finite differences of the film position with the direction: the Jacobian.
             let h = 1e-3;
@@ -320,11 +416,14 @@ mod tests {
             let want = 1.0 / (64.0 * 48.0) / solid;
             assert!((pdf_dir / want - 1.0).abs() < 0.01, "{pdf_dir} vs {want}");
         }
-        assert!(cam.sample_wi(cam.position - cam.forward, 0.0).is_none());
+        assert!(
+            cam.sample_wi(cam.position - cam.forward, 0.0, || Vec2::ZERO)
+                .is_none()
+        );
         // Just outside the image: only within a margin.
         let outside = cam.generate_ray(Vec2::new(-0.7, 10.0)).at(2.0);
-        assert!(cam.sample_wi(outside, 0.0).is_none());
-        let s = cam.sample_wi(outside, 1.0).unwrap();
+        assert!(cam.sample_wi(outside, 0.0, || Vec2::ZERO).is_none());
+        let s = cam.sample_wi(outside, 1.0, || Vec2::ZERO).unwrap();
         assert!((s.film - Vec2::new(-0.7, 10.0)).length() < 1e-3);
     }
 
@@ -371,5 +470,77 @@ mod tests {
         let centred = oblique_camera().with_shift(Vec2::ZERO);
         let f = Vec2::new(11.3, 29.9);
         assert_eq!(centred.generate_ray(f).dir, full.generate_ray(f).dir);
+    }
+
+    /// The oblique camera with a lens of radius 0.2 focused at 3.
+    fn lens_camera() -> Camera {
+        oblique_camera().with_lens(0.2, 3.0)
+    }
+
+    /// A thin lens: every ray through a film point meets the pinhole's ray through it on the
+    /// plane of focus, and a point there lands on that film point from every lens point; the
+    /// importance integrates to one over the lens and the directions; and `sample_wi` is
+    /// consistent with `pdf_we` (We cos / pdf_dir = 1 / lens area).
+    #[test]
+    fn a_thin_lens_focuses_and_its_importance_is_normalised() {
+        for cam in [
+            lens_camera(),
+            lens_camera().mirrored().with_shift(Vec2::new(0.1, 0.2)),
+        ] {
+            let mut rng = crate::sampling::Rng::new(&[11]);
+            let lens_area = std::f32::consts::PI * 0.2 * 0.2;
+            for film in [
+                Vec2::new(3.5, 40.25),
+                Vec2::new(32.0, 24.0),
+                Vec2::new(60.0, 2.0),
+            ] {
+                let pinhole = cam.generate_ray(film);
+                let focus = pinhole.at(3.0 / pinhole.dir.dot(cam.forward));
+                for _ in 0..8 {
+                    let ray = cam.generate_ray_lens(film, || rng.next_2d());
+                    assert!((ray.origin - cam.position).length() <= 0.2 + 1e-6);
+                    assert!((ray.origin - cam.position).dot(cam.forward).abs() < 1e-6);
+                    let t = (focus - ray.origin).dot(ray.dir);
+                    assert!((ray.at(t) - focus).length() < 1e-4, "{film}");
+                    let (we, back) = cam.we(&ray, 0.0).expect("inside the image");
+                    assert!((back - film).length() < 1e-2, "{film} -> {back}");
+                    let (pos, dir) = cam.pdf_we(&ray, 0.0);
+                    assert!((pos * lens_area - 1.0).abs() < 1e-5);
+                    assert!((we * ray.dir.dot(cam.forward) / dir * lens_area - 1.0).abs() < 1e-4);
+                    let s = cam.sample_wi(focus, 0.0, || rng.next_2d()).unwrap();
+                    assert!((s.film - film).length() < 1e-2, "{film} -> {}", s.film);
+                    let cos = s.cos;
+                    let want = s.dist * s.dist / (cos * lens_area);
+                    assert!((s.pdf / want - 1.0).abs() < 1e-5);
+                }
+                // Off the plane of focus, the lens points spread a point over the film.
+                let near = pinhole.at(1.0);
+                let a = cam.sample_wi(near, 100.0, || Vec2::new(0.0, 0.5)).unwrap();
+                let b = cam.sample_wi(near, 100.0, || Vec2::new(1.0, 0.5)).unwrap();
+                assert!((a.film - b.film).length() > 1.0, "{} {}", a.film, b.film);
+            }
+            // Monte Carlo over the lens and the sphere of directions: the integral of We cos
+            // is one, and so is each lens point's integral of pdf_dir.
+            let n = 400_000;
+            let (mut pdf_sum, mut we_sum) = (0.0f64, 0.0f64);
+            for _ in 0..n {
+                let origin = cam.lens_point(rng.next_2d());
+                let w = crate::sampling::uniform_sphere(rng.next_2d());
+                let ray = Ray::new(origin, w);
+                pdf_sum += cam.pdf_we(&ray, 0.0).1 as f64;
+                if let Some((we, _)) = cam.we(&ray, 0.0) {
+                    we_sum += (we * w.dot(cam.forward)) as f64;
+                }
+            }
+            let scale = 4.0 * std::f64::consts::PI / n as f64;
+            assert!((pdf_sum * scale - 1.0).abs() < 0.02, "{}", pdf_sum * scale);
+            let we_total = we_sum * scale * lens_area as f64;
+            assert!((we_total - 1.0).abs() < 0.02, "{we_total}");
+        }
+        // A zero radius is the pinhole, bit for bit.
+        let pin = oblique_camera().with_lens(0.0, 3.0);
+        let f = Vec2::new(10.2, 33.3);
+        let ray = pin.generate_ray_lens(f, || unreachable!("a pinhole draws no lens sample"));
+        assert_eq!(ray.dir, oblique_camera().generate_ray(f).dir);
     }
 }

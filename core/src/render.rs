@@ -340,7 +340,9 @@ where
                                     let mut sampler = samplers.sample(s);
                                     let at = filter.sample(x, y, sampler.next_2d());
                                     let sample = PixelSample {
-                                        ray: scene.camera.generate_ray(at.film),
+                                        ray: scene
+                                            .camera
+                                            .generate_ray_lens(at.film, || sampler.next_2d()),
                                         x,
                                         y,
                                         film: at.film,

@@ -13,6 +13,7 @@ impl Bidir {
         &self,
         scene: &Scene,
         v: &Vertex,
+        sampler: &mut Sampler,
         splats: &mut impl SplatSink,
         rays: &mut u64,
     ) {
@@ -22,7 +23,7 @@ impl Bidir {
         }
         let camera = &scene.camera();
         let margin = scene.film().filter.margin();
-        let Some(cs) = camera.sample_wi(v.p, margin) else {
+        let Some(cs) = camera.sample_wi(v.p, margin, || sampler.next_2d()) else {
             return;
         };
         let f = v.f_light(cs.wi);
@@ -32,18 +33,19 @@ impl Bidir {
         let tr = if scene.render().hide_emitters {
             // Camera rays pass through emitters until they first scatter: so does this
             // connection, the camera subpath's first segment seen from its other end.
-            Rgb::splat(seen_past_emitters(scene, v, rays) as u8 as f32)
+            Rgb::splat(seen_past_emitters(scene, v, cs.p, rays) as u8 as f32)
         } else {
             *rays += 1;
             let medium = v.medium_towards(scene, cs.wi);
-            scene.transmittance(v.p, v.ng(), camera.position, Vec3::ZERO, medium)
+            scene.transmittance(v.p, v.ng(), cs.p, Vec3::ZERO, medium)
         };
         if tr == Rgb::ZERO {
             return;
         }
         let base = v.beta * f * tr * (cs.we / cs.pdf);
         // The camera's density of having sampled v, per unit area there (filter aside).
-        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
+        let pdf_camera =
+            camera.pdf_we(&Ray::new(cs.p, -cs.wi), margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
         let pdf_rev = v.pdf(cs.wi, v.wo);
         let (width, height) = (scene.film().width, scene.film().height);
         scene
@@ -65,6 +67,7 @@ impl Bidir {
         &self,
         scene: &Scene,
         o: &Origin,
+        sampler: &mut Sampler,
         splats: &mut impl SplatSink,
         rays: &mut u64,
     ) {
@@ -75,7 +78,7 @@ impl Bidir {
         }
         let camera = &scene.camera();
         let margin = scene.film().filter.margin();
-        let Some(cs) = camera.sample_wi(o.p, margin) else {
+        let Some(cs) = camera.sample_wi(o.p, margin, || sampler.next_2d()) else {
             return;
         };
         let le = scene.lights()[o.light].emitted(o.n, cs.wi);
@@ -83,13 +86,14 @@ impl Bidir {
             return;
         }
         *rays += 1;
-        let tr = scene.transmittance(o.p, o.n, camera.position, Vec3::ZERO, o.medium);
+        let tr = scene.transmittance(o.p, o.n, cs.p, Vec3::ZERO, o.medium);
         if tr == Rgb::ZERO {
             return;
         }
         let cos = o.n.dot(cs.wi).abs();
         let base = le * tr * (cos / o.pdf * cs.we / cs.pdf);
-        let pdf_camera = camera.pdf_we(-cs.wi, margin).1 * cos / (cs.dist * cs.dist);
+        let pdf_camera =
+            camera.pdf_we(&Ray::new(cs.p, -cs.wi), margin).1 * cos / (cs.dist * cs.dist);
         // The only other strategy is the camera ray that reaches the point (s = 0, t = 2): no
         // merge builds this path (a light's origin is no stored vertex).
         let running = Running {
@@ -206,18 +210,17 @@ impl Bidir {
     }
 }
 
-/// Whether light vertex `v` is seen from the pinhole by a camera ray that passes through
-/// emitters (`hide_emitters`, core's `RayWalk::camera`): what it meets before `v` is all null
-/// boundaries or emitters, and `v` is not on an emitter itself (the camera sees through those).
+/// Whether light vertex `v` is seen from `origin` (the pinhole or a point of the lens) by a
+/// camera ray that passes through emitters (`hide_emitters`, core's `RayWalk::camera`): what
+/// it meets before `v` is all null boundaries or emitters, and `v` is not on an emitter itself (the camera sees through those).
 /// Surfaces only: `hide_emitters` with media is refused.
-fn seen_past_emitters(scene: &Scene, v: &Vertex, rays: &mut u64) -> bool {
+fn seen_past_emitters(scene: &Scene, v: &Vertex, origin: Vec3, rays: &mut u64) -> bool {
     let At::Surface { hit: vh, .. } = &v.at else {
         return false;
     };
     if scene.object(vh).light.is_some() {
         return false;
     }
-    let origin = scene.camera().position;
     let to = v.p - origin;
     let dist = to.length();
     let mut walk = RayWalk::camera(scene, Ray::new(origin, to / dist));

@@ -228,10 +228,10 @@ impl Bidir {
 
         // ---- t = 1: light vertices connected to the pinhole, splatted ----
         if let Some(o) = origin {
-            self.splat_origin(scene, &o, splats, rays);
+            self.splat_origin(scene, &o, sampler, splats, rays);
         }
         for v in &light {
-            self.splat_vertex(scene, v, splats, rays);
+            self.splat_vertex(scene, v, sampler, splats, rays);
         }
 
         // ---- s >= 1, t >= 2: connections from each camera vertex ----
@@ -287,7 +287,7 @@ impl Bidir {
         emitted: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let margin = scene.film().filter.margin();
-        let (_, pdf_we) = scene.camera().pdf_we(ps.ray.dir, margin);
+        let (_, pdf_we) = scene.camera().pdf_we(&ps.ray, margin);
         let pdf_camera = ps.filter_pdf * pdf_we;
         if pdf_camera <= 0.0 {
             return Rgb::ZERO;

@@ -302,7 +302,7 @@ mod tests {
                 let dir = |a: usize, b: usize| (xs[b] - xs[a]).normalize();
                 let d2 = |a: usize, b: usize| xs[a].distance_squared(xs[b]);
                 let cos = |i: usize, w: Vec3| ns[i].dot(w).abs();
-                let (_, pdf_we) = camera.pdf_we(dir(0, 1), 0.0);
+                let (_, pdf_we) = camera.pdf_we(&foton_core::api::Ray::new(xs[0], dir(0, 1)), 0.0);
                 // Densities per unit area of each vertex sampled from the camera side (fwd)
                 // and from the light side (rev), as Veach writes them.
                 let mut fwd = vec![0.0f32; k + 1];

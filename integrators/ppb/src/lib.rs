@@ -253,7 +253,7 @@ impl Ppb {
         let placed = scene.film().filter.sample(x, y, sampler.next_2d());
         let film = placed.film;
 
-        let ray = scene.camera().generate_ray(film);
+        let ray = scene.camera().generate_ray_lens(film, || sampler.next_2d());
         let kernel = Kernel1d::with_norm(&self.kernel, self.kernel_1d);
         // A segment that leaves the scene in a medium (unbounded fog, a camera in it) meets
         // beams as far as photons went: the box around the scene and the pass's beams.

@@ -208,7 +208,9 @@ impl Sppm {
                             self.passes.iterations.unwrap_or(1) as u32,
                         );
                         let at = scene.film().filter.sample(x, y, sampler.next_2d());
-                        let ray = scene.camera().generate_ray(at.film);
+                        let ray = scene
+                            .camera()
+                            .generate_ray_lens(at.film, || sampler.next_2d());
                         let path =
                             trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
                         let mut ld = path.emitted;

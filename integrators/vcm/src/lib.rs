@@ -382,10 +382,10 @@ impl Vcm {
                 // ---- t = 1: this pixel's light subpath connected to the camera ----
                 if self.mode.connects() {
                     if let Some(o) = &lights.origins[pixel] {
-                        bidir.splat_origin(scene, o, &mut row.splats, rays);
+                        bidir.splat_origin(scene, o, &mut sampler, &mut row.splats, rays);
                     }
                     for v in lights.of(pixel) {
-                        bidir.splat_vertex(scene, v, &mut row.splats, rays);
+                        bidir.splat_vertex(scene, v, &mut sampler, &mut row.splats, rays);
                     }
                 }
                 let mut l = Rgb::ZERO;
@@ -395,7 +395,9 @@ impl Vcm {
                 if self.mode != Mode::Lt {
                     let at = filter.sample(x, y, sampler.next_2d());
                     let ps = PixelSample {
-                        ray: scene.camera().generate_ray(at.film),
+                        ray: scene
+                            .camera()
+                            .generate_ray_lens(at.film, || sampler.next_2d()),
                         x,
                         y,
                         film: at.film,

@@ -68,6 +68,7 @@ mod sppm;
 mod techniques;
 mod textures;
 mod thin_dielectric;
+mod thin_lens;
 mod tonemap;
 mod tools;
 mod tools_bad_input;

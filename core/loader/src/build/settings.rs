@@ -283,10 +283,26 @@ pub(super) fn read_camera(
         Some(s) => return Err(t.error("shift", format!("must be finite, found {s:?}"))),
         None => Vec2::ZERO,
     };
+    // A thin lens: focused by default on the look_at point (its distance along the view).
+    let lens_radius = t.f32("lens_radius", 0.0)?;
+    if !(lens_radius >= 0.0 && lens_radius.is_finite()) {
+        return Err(t.error(
+            "lens_radius",
+            format!("must be zero (a pinhole) or positive, found {lens_radius}"),
+        ));
+    }
+    let focus_distance = t.f32("focus_distance", forward.length())?;
+    if !(focus_distance > 0.0 && focus_distance.is_finite()) {
+        return Err(t.error(
+            "focus_distance",
+            format!("must be positive, found {focus_distance}"),
+        ));
+    }
     let medium = medium_ref(&t, "medium", media)?;
     ld.done(&t);
-    let mut camera =
-        Camera::new(position, look_at, up, fov, film.width, film.height).with_shift(shift);
+    let mut camera = Camera::new(position, look_at, up, fov, film.width, film.height)
+        .with_shift(shift)
+        .with_lens(lens_radius, focus_distance);
     if mirror {
         camera = camera.mirrored();
     }

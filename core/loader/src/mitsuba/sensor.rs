@@ -1,5 +1,5 @@
-//! `<sensor>` and what it holds: the camera (a perspective sensor's to_world, fov or focal
-//! length, medium), `<film>` (size, format, `ldrfilm`'s tone curve, a crop window) with its
+//! `<sensor>` and what it holds: the camera (a perspective or thinlens sensor's to_world, fov
+//! or focal length, aperture and focus distance, medium), `<film>` (size, format, `ldrfilm`'s tone curve, a crop window) with its
 //! `<rfilter>`, and `<sampler>` (which foton sampler renders Mitsuba's, sample count, seed);
 //! Mitsuba's defaults for a sensor without a film or a sampler, and for a file without a
 //! sensor.
@@ -27,9 +27,13 @@ impl Reader {
     }
 
     pub(super) fn sensor(&mut self, mut o: Obj) -> Result<()> {
-        if o.ty != "perspective" {
+        if o.ty != "perspective" && o.ty != "thinlens" {
             o.props.clear();
-            let m = not_read("sensor", &o.ty, "only the perspective sensor is supported");
+            let m = not_read(
+                "sensor",
+                &o.ty,
+                "only the perspective and thinlens sensors are supported",
+            );
             return self.unsupported(&o, &m);
         }
         let line = o.line;
@@ -74,10 +78,31 @@ impl Reader {
             o.take("fov_axis");
             (fov, "diagonal".to_string())
         };
-        // A pinhole: the clip planes and focus distance change nothing foton renders.
-        for ignored in ["near_clip", "far_clip", "focus_distance"] {
-            o.take(ignored);
-        }
+        // A thin lens focuses at `focus_distance` along the view, by default at the far clip
+        // plane (Mitsuba's ProjectiveCamera); the clip planes change nothing else foton
+        // renders, and a pinhole's focus distance nothing at all.
+        o.take("near_clip");
+        let far_clip = o.float("far_clip", 1e4)?;
+        let focus_distance = o.float("focus_distance", far_clip)?;
+        let lens = if o.ty == "thinlens" {
+            if !o.props.iter().any(|(n, _, _)| n == "aperture_radius") {
+                return Err(o.error("a thinlens sensor needs `aperture_radius` (as Mitsuba does)"));
+            }
+            let radius = o.float("aperture_radius", 0.0)?;
+            if !(radius >= 0.0 && radius.is_finite()) {
+                return Err(o.error(format!(
+                    "`aperture_radius` = {radius}: expected zero or a positive radius"
+                )));
+            }
+            if !(focus_distance > 0.0 && focus_distance.is_finite()) {
+                return Err(o.error(format!(
+                    "`focus_distance` = {focus_distance}: expected a positive distance"
+                )));
+            }
+            (radius > 0.0).then_some((radius, focus_distance))
+        } else {
+            None
+        };
         let camera = table_mut(&mut self.root, "camera");
         if mirror {
             camera.insert("mirror", at(Value::Bool(true), line));
@@ -87,6 +112,10 @@ impl Reader {
         camera.insert("up", vec3(up, line));
         camera.insert("fov", at(Value::Float(fov), line));
         camera.insert("fov_axis", at(Value::Str(fov_axis), line));
+        if let Some((radius, focus)) = lens {
+            camera.insert("lens_radius", at(Value::Float(radius), line));
+            camera.insert("focus_distance", at(Value::Float(focus), line));
+        }
         if let Some((Prop::Ref(id), l)) = o.take("medium") {
             let name = self
                 .media

@@ -73,16 +73,20 @@ impl Reader {
                 format!("\"float fov\" {fov}: must be in (0, 180) degrees"),
             ));
         }
-        if let Some((r, l)) = p.float_opt("lensradius")?
-            && r > 0.0
-        {
-            self.unsupported(
-                &l,
+        let lens_radius = p.float("lensradius", 0.0)?;
+        let focal_distance = p.float("focaldistance", 1e6)?;
+        if !(lens_radius >= 0.0 && lens_radius.is_finite()) {
+            return Err(loc.error(
                 &d.what(),
-                "a lens (\"float lensradius\" > 0): foton's camera is a pinhole",
-            )?;
+                format!("\"float lensradius\" {lens_radius}: must be zero or positive"),
+            ));
         }
-        p.float_opt("focaldistance")?;
+        if !(focal_distance > 0.0 && focal_distance.is_finite()) {
+            return Err(loc.error(
+                &d.what(),
+                format!("\"float focaldistance\" {focal_distance}: must be positive"),
+            ));
+        }
         // pbrt-v4's screen window (cameras.cpp): [-frame, frame] x [-1, 1] for a frame wider
         // than tall, else [-1, 1] x [-1/frame, 1/frame], in units of tan(fov / 2) on the
         // plane at distance 1; the image spans it, row 0 at its top.
@@ -155,6 +159,13 @@ impl Reader {
         }
         if mirror {
             entries.push(("mirror", self.node(Value::Bool(true), loc)));
+        }
+        if lens_radius > 0.0 {
+            // Camera-space lengths, in the world's units (a uniform scale of the camera
+            // transform scales them).
+            let scale = forward.length();
+            entries.push(("lens_radius", self.num(lens_radius * scale, loc)));
+            entries.push(("focus_distance", self.num(focal_distance * scale, loc)));
         }
         let camera = self.table(entries, loc);
         self.root.insert("camera", camera);
