@@ -1,6 +1,14 @@
-//! A perspective camera with a vertical field of view, a pinhole or a thin lens, and its
-//! importance for estimators that trace paths from the lights (pbrt-v4's
-//! `PerspectiveCamera::We`, `PDF_We`, `SampleWi`).
+//! A perspective camera with a vertical field of view, a pinhole or a thin lens, or an
+//! orthographic camera, and their importance for estimators that trace paths from the lights
+//! (pbrt-v4's `PerspectiveCamera::We`, `PDF_We`, `SampleWi`).
+//!
+//! **Orthographic.** Camera rays are parallel, along the optical axis, from the points of a
+//! rectangle through the camera's position perpendicular to it (the view, `view_height`
+//! world units tall). Its importance is a delta in direction and uniform in position,
+//! We = delta(w - forward) / A (A the view's area): a point p is seen along -forward only,
+//! from the point of the view it projects to, and the density per unit area at p of camera
+//! rays reaching it is |cos theta_p| / A, with no distance fall-off (as light arriving from a
+//! directional light).
 //!
 //! **Thin lens.** With a lens of radius r focused at distance f (along the optical axis),
 //! a camera ray starts at a uniform point of the lens disc and goes through the point of the
@@ -47,11 +55,15 @@ pub struct Camera {
     forward: Vec3,
     right: Vec3,
     up: Vec3,
-    /// tan(fov/2): half the height of the image plane at distance 1.
+    /// tan(fov/2): half the height of the image plane at distance 1; orthographic: half the
+    /// view's height (world units).
     tan_half: f32,
-    /// The image's centre on the plane at distance 1, along `right` and `up`: zero unless
-    /// the window is off the optical axis ([`Camera::with_shift`]).
+    /// The image's centre on the plane at distance 1 (orthographic: on the view's plane),
+    /// along `right` and `up`: zero unless the window is off the optical axis
+    /// ([`Camera::with_shift`]).
     shift: Vec2,
+    /// Parallel rays along `forward` ([`Camera::orthographic`]).
+    orthographic: bool,
     width: u32,
     height: u32,
     /// The lens's radius: zero for a pinhole.
@@ -80,6 +92,7 @@ impl Camera {
             up,
             tan_half: (fov_degrees.to_radians() * 0.5).tan(),
             shift: Vec2::ZERO,
+            orthographic: false,
             width,
             height,
             lens_radius: 0.0,
@@ -87,10 +100,40 @@ impl Camera {
         }
     }
 
+    /// An orthographic camera at `position` looking towards `look_at`: its view is
+    /// `view_height` world units tall (and as wide as the image's aspect makes it), centred
+    /// on the optical axis unless shifted ([`Camera::with_shift`], in world units).
+    pub fn orthographic(
+        position: Vec3,
+        look_at: Vec3,
+        up: Vec3,
+        view_height: f32,
+        width: u32,
+        height: u32,
+    ) -> Camera {
+        let mut camera = Camera::new(position, look_at, up, 90.0, width, height);
+        camera.tan_half = 0.5 * view_height;
+        camera.orthographic = true;
+        camera
+    }
+
+    /// Whether the camera's rays are parallel (its importance a delta in direction).
+    #[inline]
+    pub fn is_orthographic(&self) -> bool {
+        self.orthographic
+    }
+
+    /// The width of a pixel on the view of an orthographic camera (world units); None for a
+    /// perspective camera, whose pixels' footprints grow with distance.
+    pub fn orthographic_pixel(&self) -> Option<f32> {
+        self.orthographic
+            .then(|| 2.0 * self.tan_half / self.height as f32)
+    }
+
     /// The camera with a thin lens of radius `lens_radius` focused at `focal_distance` (both
     /// positive; a zero radius keeps the pinhole).
     pub fn with_lens(mut self, lens_radius: f32, focal_distance: f32) -> Camera {
-        if lens_radius > 0.0 {
+        if lens_radius > 0.0 && !self.orthographic {
             self.lens_radius = lens_radius;
             self.focal_distance = focal_distance;
         }
@@ -142,6 +185,10 @@ impl Camera {
     /// The ray from the pinhole (the lens's centre) through a point on the film in pixel
     /// units: (0, 0) is the top-left corner.
     pub fn generate_ray(&self, film: Vec2) -> Ray {
+        if self.orthographic {
+            let (sx, sy) = self.screen(film);
+            return Ray::new(self.position + sx * self.right + sy * self.up, self.forward);
+        }
         Ray::new(self.position, self.towards(film).normalize())
     }
 
@@ -161,15 +208,24 @@ impl Camera {
     /// axis one.
     #[inline]
     fn towards(&self, film: Vec2) -> Vec3 {
+        let (sx, sy) = self.screen(film);
+        self.forward + sx * self.right + sy * self.up
+    }
+
+    /// A film point's place on the image plane at distance 1 (orthographic: on the view),
+    /// along `right` and `up` from the optical axis.
+    #[inline]
+    fn screen(&self, film: Vec2) -> (f32, f32) {
         let aspect = self.width as f32 / self.height as f32;
         // The shift is +0 for a centred window, and x + 0 is x (never -0 here): a centred
         // camera's rays are those of the plain formula, bit for bit.
         let sx = (2.0 * film.x / self.width as f32 - 1.0) * self.tan_half * aspect + self.shift.x;
         let sy = (1.0 - 2.0 * film.y / self.height as f32) * self.tan_half + self.shift.y;
-        self.forward + sx * self.right + sy * self.up
+        (sx, sy)
     }
 
-    /// Area of the image on the plane at distance 1 in front of the pinhole.
+    /// Area of the image on the plane at distance 1 in front of the pinhole (orthographic:
+    /// of the view, in world units).
     #[inline]
     pub fn image_area(&self) -> f32 {
         let aspect = self.width as f32 / self.height as f32;
@@ -191,7 +247,7 @@ impl Camera {
     #[inline]
     pub fn we(&self, ray: &Ray, margin: f32) -> Option<(f32, Vec2)> {
         let cos = ray.dir.dot(self.forward);
-        if cos <= 0.0 {
+        if cos <= 0.0 || self.orthographic {
             return None;
         }
         let film = self.film_of(ray, cos, margin)?;
@@ -228,6 +284,34 @@ impl Camera {
         (pos, 1.0 / (self.image_area() * cos * cos * cos))
     }
 
+    /// The density with which the camera samples `ray`, in the measure its first segment
+    /// converts from: per solid angle for a perspective camera (`pdf_we`'s direction density),
+    /// per unit area of the view for an orthographic one (1 / its area: its direction is a
+    /// delta); zero outside the image widened by `margin` pixels. Per whole image, as
+    /// `pdf_we`.
+    #[inline]
+    pub fn pdf_ray(&self, ray: &Ray, margin: f32) -> f32 {
+        if self.orthographic {
+            let d = ray.origin - self.position;
+            let inside = self
+                .view_to_film(d.dot(self.right), d.dot(self.up), margin)
+                .is_some();
+            return if inside { 1.0 / self.image_area() } else { 0.0 };
+        }
+        self.pdf_we(ray, margin).1
+    }
+
+    /// The density per unit area (per unit volume in a medium, `cos` 1) at the point `dist`
+    /// along `ray` of the camera having sampled it: `pdf_ray` times `cos` (the cosine there)
+    /// over dist^2 for a perspective camera, with no distance for an orthographic one.
+    #[inline]
+    pub fn pdf_area(&self, ray: &Ray, margin: f32, cos: f32, dist: f32) -> f32 {
+        if self.orthographic {
+            return self.pdf_ray(ray, margin) * cos;
+        }
+        self.pdf_we(ray, margin).1 * cos / (dist * dist)
+    }
+
     /// The connection from the point `p` to the camera (pbrt-v4's `SampleWi`): a point of the
     /// lens (from `lens`, a uniform sample of the unit square drawn only if the camera has a
     /// lens), the direction towards it, the importance of the ray from there through `p`, its
@@ -239,6 +323,25 @@ impl Camera {
         margin: f32,
         lens: impl FnOnce() -> Vec2,
     ) -> Option<CameraSample> {
+        if self.orthographic {
+            // Seen along -forward only, from the point of the view p projects to.
+            let d = p - self.position;
+            let z = d.dot(self.forward);
+            let (x, y) = (d.dot(self.right), d.dot(self.up));
+            if z <= 0.0 {
+                return None;
+            }
+            let film = self.view_to_film(x, y, margin)?;
+            return Some(CameraSample {
+                p: self.position + x * self.right + y * self.up,
+                wi: -self.forward,
+                dist: z,
+                we: 1.0 / self.image_area(),
+                pdf: 1.0,
+                film,
+                cos: 1.0,
+            });
+        }
         let at = if self.lens_radius > 0.0 {
             self.lens_point(lens())
         } else {
@@ -277,9 +380,20 @@ impl Camera {
         if z <= 0.0 {
             return None;
         }
+        if self.orthographic {
+            return self.view_to_film(d.dot(self.right), d.dot(self.up), margin);
+        }
+        self.view_to_film(d.dot(self.right) / z, d.dot(self.up) / z, margin)
+    }
+
+    /// The film point of a point of the image plane at distance 1 (orthographic: of the
+    /// view), at `x` along `right` and `y` along `up` from the optical axis; None outside
+    /// the image widened by `margin` pixels.
+    #[inline]
+    fn view_to_film(&self, x: f32, y: f32, margin: f32) -> Option<Vec2> {
         let aspect = self.width as f32 / self.height as f32;
-        let sx = (d.dot(self.right) / z - self.shift.x) / (self.tan_half * aspect);
-        let sy = (d.dot(self.up) / z - self.shift.y) / self.tan_half;
+        let sx = (x - self.shift.x) / (self.tan_half * aspect);
+        let sy = (y - self.shift.y) / self.tan_half;
         let film = Vec2::new(
             (sx + 1.0) * 0.5 * self.width as f32,
             (1.0 - sy) * 0.5 * self.height as f32,
@@ -542,5 +656,55 @@ mod tests {
         let f = Vec2::new(10.2, 33.3);
         let ray = pin.generate_ray_lens(f, || unreachable!("a pinhole draws no lens sample"));
         assert_eq!(ray.dir, oblique_camera().generate_ray(f).dir);
+    }
+
+    /// An orthographic camera: its rays are parallel to the axis from the view's points, a
+    /// point lands where its ray started, `sample_wi` projects along the axis with the
+    /// importance 1 / A of a delta direction, and the density of a ray is 1 / A on the view.
+    #[test]
+    fn orthographic_rays_are_parallel_and_project_back() {
+        for cam in [
+            Camera::orthographic(Vec3::new(0.3, 1.2, 3.0), Vec3::ZERO, Vec3::Y, 2.5, 64, 48),
+            Camera::orthographic(Vec3::new(0.3, 1.2, 3.0), Vec3::ZERO, Vec3::Y, 2.5, 64, 48)
+                .mirrored()
+                .with_shift(Vec2::new(0.4, -0.1)),
+        ] {
+            let area = 2.5 * 2.5 * 64.0 / 48.0;
+            assert!((cam.image_area() - area).abs() < 1e-5);
+            assert_eq!(cam.orthographic_pixel(), Some(2.5 / 48.0));
+            for film in [
+                Vec2::new(0.5, 0.5),
+                Vec2::new(13.25, 40.75),
+                Vec2::new(63.5, 47.5),
+            ] {
+                let ray = cam.generate_ray(film);
+                assert!((ray.dir - cam.forward).length() < 1e-6);
+                assert!((ray.origin - cam.position).dot(cam.forward).abs() < 1e-5);
+                assert!((cam.pdf_ray(&ray, 0.0) * area - 1.0).abs() < 1e-5);
+                for t in [0.1, 5.0] {
+                    let p = ray.at(t);
+                    let back = cam.project(p).expect("in front and inside the view");
+                    assert!((back - film).length() < 1e-3, "{film} -> {back}");
+                    let s = cam.sample_wi(p, 0.0, || unreachable!()).unwrap();
+                    assert!((s.film - film).length() < 1e-3);
+                    assert!((s.p - ray.origin).length() < 1e-4);
+                    assert!((s.dist - t).abs() < 1e-4 && s.wi == -cam.forward);
+                    assert!((s.we / s.pdf * area - 1.0).abs() < 1e-5);
+                    let cos = 0.5;
+                    let pdf = cam.pdf_area(&Ray::new(s.p, -s.wi), 0.0, cos, s.dist);
+                    assert!((pdf * area - cos).abs() < 1e-5, "no distance fall-off");
+                }
+            }
+            // Behind the view's plane and outside the view: not seen.
+            assert!(
+                cam.sample_wi(cam.position - cam.forward, 0.0, || Vec2::ZERO)
+                    .is_none()
+            );
+            let outside = cam.generate_ray(Vec2::new(-3.0, 10.0));
+            assert_eq!(cam.pdf_ray(&outside, 0.0), 0.0);
+            assert!(cam.sample_wi(outside.at(1.0), 0.0, || Vec2::ZERO).is_none());
+            // A lens is not an orthographic camera's.
+            assert_eq!(cam.clone().with_lens(0.5, 2.0).lens().0, 0.0);
+        }
     }
 }

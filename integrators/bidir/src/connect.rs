@@ -44,8 +44,7 @@ impl Bidir {
         }
         let base = v.beta * f * tr * (cs.we / cs.pdf);
         // The camera's density of having sampled v, per unit area there (filter aside).
-        let pdf_camera =
-            camera.pdf_we(&Ray::new(cs.p, -cs.wi), margin).1 * v.cos(cs.wi) / (cs.dist * cs.dist);
+        let pdf_camera = camera.pdf_area(&Ray::new(cs.p, -cs.wi), margin, v.cos(cs.wi), cs.dist);
         let pdf_rev = v.pdf(cs.wi, v.wo);
         let (width, height) = (scene.film().width, scene.film().height);
         scene
@@ -92,8 +91,7 @@ impl Bidir {
         }
         let cos = o.n.dot(cs.wi).abs();
         let base = le * tr * (cos / o.pdf * cs.we / cs.pdf);
-        let pdf_camera =
-            camera.pdf_we(&Ray::new(cs.p, -cs.wi), margin).1 * cos / (cs.dist * cs.dist);
+        let pdf_camera = camera.pdf_area(&Ray::new(cs.p, -cs.wi), margin, cos, cs.dist);
         // The only other strategy is the camera ray that reaches the point (s = 0, t = 2): no
         // merge builds this path (a light's origin is no stored vertex).
         let running = Running {

@@ -287,8 +287,7 @@ impl Bidir {
         emitted: Option<&mut dyn FnMut(u32, Rgb)>,
     ) -> Rgb {
         let margin = scene.film().filter.margin();
-        let (_, pdf_we) = scene.camera().pdf_we(&ps.ray, margin);
-        let pdf_camera = ps.filter_pdf * pdf_we;
+        let pdf_camera = ps.filter_pdf * scene.camera().pdf_ray(&ps.ray, margin);
         if pdf_camera <= 0.0 {
             return Rgb::ZERO;
         }
@@ -393,7 +392,12 @@ impl Bidir {
             Side::Camera => TransportMode::Radiance,
             Side::Light => TransportMode::Importance,
         };
-        let infinite = emitted.is_some_and(|e| e.light.is_infinite());
+        // A first segment whose densities have no distance: from a light at infinity, or
+        // from an orthographic camera (parallel rays).
+        let infinite = match side {
+            Side::Light => emitted.is_some_and(|e| e.light.is_infinite()),
+            Side::Camera => scene.camera().is_orthographic(),
+        };
         let mut radiance = Rgb::ZERO;
         let mut prev = emitted.map_or(walk.ray.origin, |e| e.origin);
         let mut length = 0u32;

@@ -267,14 +267,19 @@ pub fn pixel_angle(scene: &Scene) -> f32 {
 }
 
 /// The automatic first gather radius of a pixel whose visible point lies `distance` along
-/// the camera path: `footprints` times the pixel's footprint there, kept within [1/1000, 1/50]
+/// the camera path: `footprints` times the pixel's footprint there (an orthographic camera's
+/// pixel width at any distance), kept within [1/1000, 1/50]
 /// of the scene's bounding-box diagonal (a few pixels wide, so that early iterations find
 /// photons, and small against the scene; an infinite distance gets the largest). `sppm` takes
 /// 3 footprints ([`SPPM_FOOTPRINTS`]); `ppb`, whose passes gather from many more surface
 /// photons, fewer (its README).
 pub fn auto_radius(scene: &Scene, pixel_angle: f32, distance: f32, footprints: f64) -> f64 {
     let diagonal = (scene.bounds().1 - scene.bounds().0).length().max(1e-6) as f64;
-    (footprints * pixel_angle as f64 * distance as f64).clamp(diagonal / 1000.0, diagonal / 50.0)
+    let footprint = match scene.camera().orthographic_pixel() {
+        Some(width) => footprints * width as f64,
+        None => footprints * pixel_angle as f64 * distance as f64,
+    };
+    footprint.clamp(diagonal / 1000.0, diagonal / 50.0)
 }
 
 /// `sppm`'s automatic first radius in pixel footprints.

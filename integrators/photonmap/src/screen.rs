@@ -78,6 +78,9 @@ pub struct ScreenBeams {
     near: Option<Accel>,
     /// The farthest a segment's line may pass from the pinhole and still use the bins.
     reach: f32,
+    /// Whether the camera is a pinhole: the bins hold rays from a point only (a lens's or an
+    /// orthographic camera's rays go through the BVH).
+    pinhole: bool,
     /// How far past the image film positions may lie and still use the bins (pixels).
     margin: f32,
 }
@@ -107,6 +110,7 @@ impl ScreenBeams {
             near: None,
             reach,
             margin,
+            pinhole: camera.lens().0 == 0.0 && !camera.is_orthographic(),
         };
         let pinhole = Pinhole::of(camera);
         let mut near = Vec::new();
@@ -203,7 +207,8 @@ impl ScreenBeams {
     fn answers(&self, film: Vec2, ray: &Ray) -> bool {
         let off = (ray.origin - self.position).cross(ray.dir);
         let (w, h, m) = (self.width as f32, self.height as f32, self.margin);
-        off.length_squared() <= self.reach * self.reach
+        self.pinhole
+            && off.length_squared() <= self.reach * self.reach
             && film.x >= -m
             && film.y >= -m
             && film.x <= w + m

@@ -44,6 +44,7 @@ mod mitsuba_fixtures;
 mod mitsuba_materials;
 mod mitsuba_shapes;
 mod one_sided;
+mod orthographic;
 mod parts;
 mod pbrt;
 mod photon;

@@ -247,6 +247,54 @@ pub(super) fn read_camera(
     let position = t.vec3_required("position")?;
     let look_at = t.vec3_required("look_at")?;
     let up = t.vec3("up", Vec3::Y)?;
+    let orthographic =
+        t.choice("type", &["perspective", "orthographic"], "perspective")? == "orthographic";
+    if orthographic {
+        for key in ["fov", "fov_axis", "lens_radius", "focus_distance"] {
+            if t.has(key) {
+                return Err(t.error(
+                    key,
+                    "has no meaning for an orthographic camera (its view is `view_height` tall)",
+                ));
+            }
+        }
+    } else {
+        for key in ["view_height", "view_width"] {
+            if t.has(key) {
+                return Err(t.error(
+                    key,
+                    "is an orthographic camera's (type = \"orthographic\"); a perspective camera takes `fov`",
+                ));
+            }
+        }
+    }
+    // An orthographic camera's view: its height, or its width (the height following from
+    // the image's aspect ratio), in world units.
+    let view_height = if orthographic {
+        let (key, size) = match (t.f32_opt("view_height")?, t.f32_opt("view_width")?) {
+            (Some(_), Some(_)) => {
+                return Err(t.error("view_width", "give `view_height` or `view_width`, not both"));
+            }
+            (Some(h), None) => ("view_height", h),
+            (None, Some(w)) => ("view_width", w),
+            (None, None) => {
+                return Err(t.error(
+                    "view_height",
+                    "an orthographic camera needs `view_height` (or `view_width`): the size of what it sees, in world units",
+                ));
+            }
+        };
+        if !(size > 0.0 && size.is_finite()) {
+            return Err(t.error(key, format!("must be positive, found {size}")));
+        }
+        if key == "view_width" {
+            size * film.height as f32 / film.width as f32
+        } else {
+            size
+        }
+    } else {
+        0.0
+    };
     let fov = t.f32("fov", 39.3)?;
     if !(fov > 0.0 && fov < 180.0) {
         return Err(t.error("fov", format!("must be in (0, 180) degrees, found {fov}")));
@@ -300,9 +348,14 @@ pub(super) fn read_camera(
     }
     let medium = medium_ref(&t, "medium", media)?;
     ld.done(&t);
-    let mut camera = Camera::new(position, look_at, up, fov, film.width, film.height)
-        .with_shift(shift)
-        .with_lens(lens_radius, focus_distance);
+    let mut camera = if orthographic {
+        Camera::orthographic(position, look_at, up, view_height, film.width, film.height)
+            .with_shift(shift)
+    } else {
+        Camera::new(position, look_at, up, fov, film.width, film.height)
+            .with_shift(shift)
+            .with_lens(lens_radius, focus_distance)
+    };
     if mirror {
         camera = camera.mirrored();
     }

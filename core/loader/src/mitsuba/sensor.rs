@@ -27,12 +27,12 @@ impl Reader {
     }
 
     pub(super) fn sensor(&mut self, mut o: Obj) -> Result<()> {
-        if o.ty != "perspective" && o.ty != "thinlens" {
+        if !["perspective", "thinlens", "orthographic"].contains(&o.ty.as_str()) {
             o.props.clear();
             let m = not_read(
                 "sensor",
                 &o.ty,
-                "only the perspective and thinlens sensors are supported",
+                "only the perspective, thinlens and orthographic sensors are supported",
             );
             return self.unsupported(&o, &m);
         }
@@ -50,6 +50,29 @@ impl Reader {
             );
         }
         let mirror = handedness < 0.0;
+        if o.ty == "orthographic" {
+            // Camera space's [-1, 1] spans the image's width (and [-1/aspect, 1/aspect] its
+            // height): the transform's scale sizes the view. Pixels stay square only if it
+            // scales x and y alike.
+            let (sx, sy) = (left.length(), m.transform_vector3(DVec3::Y).length());
+            if (sx - sy).abs() > 1e-6 * sx.max(sy) {
+                return Err(o.error(format!(
+                    "`to_world` scales the orthographic view by {sx} across and {sy} up: foton's pixels are square (give the same scale to x and y)"
+                )));
+            }
+            o.take("near_clip");
+            o.take("far_clip");
+            let camera = table_mut(&mut self.root, "camera");
+            camera.insert("type", at(Value::Str("orthographic".into()), line));
+            camera.insert("view_width", at(Value::Float(2.0 * sx), line));
+            if mirror {
+                camera.insert("mirror", at(Value::Bool(true), line));
+            }
+            camera.insert("position", vec3(position, line));
+            camera.insert("look_at", vec3(position + dir, line));
+            camera.insert("up", vec3(up, line));
+            return self.sensor_contents(o);
+        }
         let has_fov = o.props.iter().any(|(n, _, _)| n == "fov");
         let (fov, fov_axis) = if has_fov {
             if o.props.iter().any(|(n, _, _)| n == "focal_length") {
@@ -116,6 +139,12 @@ impl Reader {
             camera.insert("lens_radius", at(Value::Float(radius), line));
             camera.insert("focus_distance", at(Value::Float(focus), line));
         }
+        self.sensor_contents(o)
+    }
+
+    /// A sensor's medium, film, reconstruction filter and sampler.
+    fn sensor_contents(&mut self, mut o: Obj) -> Result<()> {
+        let line = o.line;
         if let Some((Prop::Ref(id), l)) = o.take("medium") {
             let name = self
                 .media
@@ -249,9 +278,9 @@ impl Reader {
     }
 
     /// A crop window (`crop_offset_x`, `crop_offset_y`, `crop_width`, `crop_height`, with
-    /// the film's full size), in the middle of the film: the camera of the window alone, a
-    /// narrower field of view on a smaller film; the same pixels. A window off the middle
-    /// needs an off-axis camera, which foton does not have: with `lenient` the whole film.
+    /// the film's full size): the camera of the window alone, a narrower field of view (an
+    /// orthographic camera: a narrower view) on a smaller film, shifted to the window's
+    /// centre; the same pixels.
     fn crop_camera(&mut self, sensor: &Obj, crop: Crop) -> Result<()> {
         let Crop {
             x,
@@ -265,6 +294,27 @@ impl Reader {
             return Ok(());
         }
         let camera = table_mut(&mut self.root, "camera");
+        if let Some(view_width) = camera.get("view_width").and_then(|n| n.value.as_f64()) {
+            // Orthographic: the window's part of the view, its centre in world units.
+            let (full_w, full_h) = (full.0 as f64, full.1 as f64);
+            let half = view_width / 2.0;
+            camera.insert(
+                "view_width",
+                at(Value::Float(view_width * width as f64 / full_w), line),
+            );
+            let shift = [
+                ((2 * x + width) as f64 / full_w - 1.0) * half,
+                (1.0 - (2 * y + height) as f64 / full_h) * half * full_h / full_w,
+            ];
+            if shift != [0.0, 0.0] {
+                let s = shift.map(|c| at(Value::Float(c), line)).to_vec();
+                camera.insert("shift", at(Value::Array(s), line));
+            }
+            let film = table_mut(&mut self.root, "film");
+            film.insert("width", at(Value::Int(width), line));
+            film.insert("height", at(Value::Int(height), line));
+            return Ok(());
+        }
         let fov = camera
             .get("fov")
             .and_then(|n| n.value.as_f64())

@@ -41,10 +41,15 @@ impl Reader {
     fn camera(&mut self, d: &Directive, camera_from_world: DMat4, film: FilmWindow) -> Result<()> {
         let mut p = Bag::new(d);
         let loc = &d.loc;
-        match d.string(0) {
-            "perspective" => {}
-            "orthographic" | "realistic" | "spherical" => {
-                return self.unsupported(loc, &d.what(), "only the perspective camera is read yet");
+        let orthographic = match d.string(0) {
+            "perspective" => false,
+            "orthographic" => true,
+            "realistic" | "spherical" => {
+                return self.unsupported(
+                    loc,
+                    &d.what(),
+                    "only the perspective and orthographic cameras are read",
+                );
             }
             other => {
                 return Err(loc.error(
@@ -52,7 +57,7 @@ impl Reader {
                     format!("unknown camera {other:?}; pbrt-v4 has perspective, orthographic, realistic and spherical"),
                 ));
             }
-        }
+        };
         let world_from_camera = camera_from_world.inverse();
         if !world_from_camera.is_finite() {
             return Err(loc.error(&d.what(), "the camera transform is singular"));
@@ -66,7 +71,12 @@ impl Reader {
         }
         // pbrt's image right is camera +x; foton's is forward x up.
         let mirror = forward.cross(up).dot(right) < 0.0;
-        let fov = p.float("fov", 90.0)?;
+        // An orthographic camera's screen window is in camera-space units: its `t` is 1.
+        let fov = if orthographic {
+            90.0
+        } else {
+            p.float("fov", 90.0)?
+        };
         if !(fov > 0.0 && fov < 180.0) {
             return Err(loc.error(
                 &d.what(),
@@ -87,6 +97,14 @@ impl Reader {
                 format!("\"float focaldistance\" {focal_distance}: must be positive"),
             ));
         }
+        if orthographic && lens_radius > 0.0 {
+            self.unsupported(
+                loc,
+                &d.what(),
+                "an orthographic camera with a lens (\"float lensradius\" > 0): rendered without the lens",
+            )?;
+        }
+        let lens_radius = if orthographic { 0.0 } else { lens_radius };
         // pbrt-v4's screen window (cameras.cpp): [-frame, frame] x [-1, 1] for a frame wider
         // than tall, else [-1, 1] x [-1/frame, 1/frame], in units of tan(fov / 2) on the
         // plane at distance 1; the image spans it, row 0 at its top.
@@ -123,7 +141,7 @@ impl Reader {
             }
             None => false,
         };
-        let custom = custom || frame_given.is_some() || film.crop.is_some();
+        let custom = custom || frame_given.is_some() || film.crop.is_some() || orthographic;
         // Times only matter with motion.
         p.float_opt("shutteropen")?;
         p.float_opt("shutterclose")?;
@@ -137,7 +155,13 @@ impl Reader {
             // The part of the image plane the (cropped) film sees: foton's vertical field of
             // view and the window's centre (`shift`), both in units of the plane at
             // distance 1. Pixels must stay square.
-            let t = (fov.to_radians() / 2.0).tan();
+            // Units of the plane at distance 1 (perspective), or world units (orthographic:
+            // camera-space lengths, scaled as the camera transform scales them).
+            let t = if orthographic {
+                forward.length()
+            } else {
+                (fov.to_radians() / 2.0).tan()
+            };
             let [x0, x1, y0, y1] = screen;
             if ((x1 - x0) / xres - (y1 - y0) / yres).abs() > 1e-6 * (x1 - x0) / xres {
                 self.unsupported(loc, &d.what(), "a screen window whose pixels are not square is not supported (foton's pixels are square)")?;
@@ -147,8 +171,13 @@ impl Reader {
             let sy = |py: i64| y1 - py as f64 / yres * (y1 - y0);
             let half = (sy(py0) - sy(py1)) / 2.0 * t;
             let centre = [(sx(px0) + sx(px1)) / 2.0 * t, (sy(py0) + sy(py1)) / 2.0 * t];
-            entries.push(("fov", self.num(2.0 * half.atan().to_degrees(), loc)));
-            entries.push(("fov_axis", self.string("y", loc)));
+            if orthographic {
+                entries.push(("type", self.string("orthographic", loc)));
+                entries.push(("view_height", self.num(2.0 * half, loc)));
+            } else {
+                entries.push(("fov", self.num(2.0 * half.atan().to_degrees(), loc)));
+                entries.push(("fov_axis", self.string("y", loc)));
+            }
             if centre != [0.0, 0.0] {
                 let items = centre.iter().map(|c| self.num(*c, loc)).collect();
                 entries.push(("shift", self.node(Value::Array(items), loc)));
