@@ -2,7 +2,7 @@
 # Renders every scene of this folder with pbrt-v4 and with foton, then compares them
 # (means and 8x8 blocks): docs/pbrt.md, "Checked against pbrt-v4".
 # Usage: scenes/pbrt-v4/compare.sh /path/to/pbrt [foton]
-#   pbrt: built as ../shared/peers/pbrt-v4/README.md describes; foton: target/release/foton.
+#   pbrt: a pbrt-v4 binary built from its public source (CPU); foton: target/release/foton.
 #   compare.py needs Python with numpy and OpenEXR (pip install numpy OpenEXR).
 set -euo pipefail
 PBRT=${1:?usage: compare.sh /path/to/pbrt [foton]}

@@ -4,6 +4,7 @@
 //! (shadow rays, through null boundaries and media). Reading scene files (TOML, Mitsuba XML,
 //! meshes, images) is not core's: foton-loader reads them and hands [`Scene::new`] the parts.
 
+mod alpha;
 mod visibility;
 mod volumes;
 
@@ -87,6 +88,10 @@ pub struct Object {
     /// loader finds it out only for a shape that may bound a medium (media named, a null or
     /// volume-enclosing material) and says false for the others, which bound no volume.
     pub closed: bool,
+    /// The shape's cut-out (pbrt-v4's `alpha`, Mitsuba's `mask`): where the texture's value
+    /// (a colour's luminance) is 0 the shape is absent, where it is 1 present, and between
+    /// present with that probability (see [`Scene::intersect`]). None: opaque everywhere.
+    pub alpha: Option<Texture>,
 }
 
 /// A medium of any kind.
@@ -126,6 +131,8 @@ pub struct Scene {
     pub(crate) camera_medium: Option<u32>,
     /// Whether any medium is used (see [`Scene::has_media`]).
     has_media: bool,
+    /// Whether any object has a cut-out (its `alpha`): only then do ray queries test them.
+    has_alpha: bool,
     /// Per light: the medium the file puts it in (a point or spot light's `medium`, an area
     /// light whose shape names its exterior); None: found from where it lies.
     light_media: Vec<Option<Option<u32>>>,
@@ -267,6 +274,7 @@ impl Scene {
                 camera.position,
             )?;
         }
+        let has_alpha = objects.iter().any(|o| o.alpha.is_some());
         Ok(Scene {
             file,
             render,
@@ -285,6 +293,7 @@ impl Scene {
             volumes,
             alone,
             has_media: uses_media,
+            has_alpha,
             light_media,
             camera_medium,
             bounds: (lo, hi),
@@ -365,10 +374,16 @@ impl Scene {
             .unwrap_or_else(|| Properties::empty(&self.file, &path)))
     }
 
-    /// Closest surface hit (null boundaries included) with t in (0, tmax).
+    /// Closest surface hit (null boundaries included) with t in (0, tmax), past the cut-out
+    /// parts of shapes with an `alpha` (at a fractional alpha a, a hit is kept with
+    /// probability a, decided by a hash of the ray: the same ray decides the same).
     #[inline]
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
-        self.accel.intersect(ray, tmax)
+        let hit = self.accel.intersect(ray, tmax)?;
+        if self.has_alpha {
+            return self.intersect_past_cut_outs(ray, tmax, hit);
+        }
+        Some(hit)
     }
 
     #[inline]

@@ -35,6 +35,9 @@ impl Scene {
         if dist <= 0.0 || seg.dot(d) <= 0.0 {
             return self.transmittance_between(medium, p0, p1);
         }
+        if self.has_alpha() {
+            return self.transmittance_walk(p0, p1, from, to, medium);
+        }
         // One traversal of the segment: it stops at the first blocker, and collects the null
         // boundaries crossed (a sphere may be crossed twice); they are then walked in order.
         let ray = Ray::new(from, seg / dist);
@@ -102,7 +105,7 @@ impl Scene {
     }
 
     /// [`Scene::transmittance`] by closest hits, one boundary after another: for segments
-    /// that cross more boundaries than one traversal collects.
+    /// that cross more boundaries than one traversal collects, and past cut-outs.
     fn transmittance_walk(
         &self,
         p0: Vec3,
@@ -142,7 +145,7 @@ impl Scene {
     }
 
     /// Whether the segment between two surface points is blocked by anything but null
-    /// boundaries. The ends are offset along their normals (a zero normal: no offset).
+    /// boundaries and cut-outs. The ends are offset along their normals (a zero normal: no offset).
     // Inlined: the shadow ray's set-up is a few vector operations on values the caller has in
     // registers, and a call per shadow ray cost 6 % of the path tracer's instructions.
     #[inline]
@@ -152,6 +155,9 @@ impl Scene {
         let dist = seg.length();
         if dist <= 0.0 {
             return false;
+        }
+        if self.has_alpha() {
+            return self.occluded_past_cut_outs(from, to);
         }
         let ray = Ray::new(from, seg / dist);
         let prims_objects = &self.objects;

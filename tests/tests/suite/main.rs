@@ -8,6 +8,7 @@
 //! sppm_interrupt.rs): they raise the process-wide interrupt flag that every in-process
 //! render watches, and would stop the renders of tests running beside them.
 
+mod alpha;
 mod bad_input;
 mod bad_input_output;
 mod bad_input_plugins;

@@ -6,12 +6,16 @@ use super::common::{
 };
 use super::medium::medium_ref;
 use crate::mesh::{MeshOptions, inline_mesh, load_mesh};
+use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
 use foton_core::light::area_light;
 use foton_core::material::Material;
 use foton_core::props::Properties;
+use foton_core::registry::Resources;
 use foton_core::scene::{Named, Object};
+use foton_core::texture::{Texture, luminance};
+use foton_core::value::Value;
 use glam::{Mat4, Vec3};
 
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
@@ -176,6 +180,13 @@ pub(super) fn read_shapes(
         }
         let explicit_media = exterior.is_some();
         let (interior, exterior) = (interior.flatten(), exterior.flatten());
+        let alpha = read_alpha(&s, ld)?;
+        if alpha.is_some() && (interior.is_some() || exterior.is_some()) {
+            return Err(s.error(
+                "alpha",
+                "a cut-out shape cannot bound a medium (a ray through its cut-out parts would leave the medium's volume undefined); give the medium to a shape without `alpha`",
+            ));
+        }
         let object = g.objects.len() as u32;
         let mut light = None;
         if let Some(emission) = s.rgb_opt("emission")?
@@ -185,6 +196,12 @@ pub(super) fn read_shapes(
                 return Err(s.error(
                     "emission",
                     "a shape with the null material is invisible and cannot emit; give it a real material (e.g. a black diffuse one)",
+                ));
+            }
+            if alpha.is_some() {
+                return Err(s.error(
+                    "alpha",
+                    "an emitting shape with a cut-out is not supported yet: give the emission to a shape without `alpha`",
                 ));
             }
             light = Some(g.lights.len() as u32);
@@ -200,6 +217,7 @@ pub(super) fn read_shapes(
             exterior,
             explicit_media,
             closed,
+            alpha,
         });
         let first_attrs = g.triangle_attrs.len() as u32;
         let with_attrs = !attrs.is_empty();
@@ -217,4 +235,43 @@ pub(super) fn read_shapes(
         ld.done(&s);
     }
     Ok(())
+}
+
+/// The shape's `alpha`: a number in [0, 1], an RGB or a texture table (its luminance); None
+/// where it is opaque everywhere (absent, or 1).
+fn read_alpha(s: &Properties<'_>, ld: &mut Loader) -> Result<Option<Texture>> {
+    let Some(node) = s.node("alpha") else {
+        return Ok(None);
+    };
+    if matches!(node.value, Value::Table(_)) {
+        let t = ld.texture(s, "alpha", Rgb::ONE)?;
+        if luminance(t.max()) > 1.0 + 1e-6 {
+            return Err(s.error(
+                "alpha",
+                "the texture's values must lie in [0, 1] (0: cut out, 1: opaque)",
+            ));
+        }
+        return Ok(Some(t));
+    }
+    if matches!(node.value, Value::Array(_)) {
+        let c = s.rgb("alpha", Rgb::ONE)?;
+        let a = luminance(c);
+        if c.min_element() < 0.0 || a > 1.0 + 1e-6 {
+            return Err(s.error(
+                "alpha",
+                format!(
+                    "expected a colour of luminance in [0, 1] (0: cut out, 1: opaque), found {c}"
+                ),
+            ));
+        }
+        return Ok((a < 1.0 - 1e-6).then_some(Texture::Constant(c)));
+    }
+    let a = s.f32("alpha", 1.0)?;
+    if !(0.0..=1.0).contains(&a) {
+        return Err(s.error(
+            "alpha",
+            format!("expected a number in [0, 1] (0: cut out, 1: opaque), found {a}"),
+        ));
+    }
+    Ok((a < 1.0).then(|| Texture::Constant(Rgb::splat(a))))
 }

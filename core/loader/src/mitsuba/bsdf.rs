@@ -1,6 +1,7 @@
 //! `<bsdf>`: a Mitsuba BSDF as a material of `[materials]` (diffuse, dielectrics, conductors,
 //! plastics, their rough variants, difftrans, phong, ward, roughdiffuse, principled,
-//! principledthin, twosided, null, blendbsdf and mixturebsdf as `blend`), with Mitsuba's
+//! principledthin, twosided, null, blendbsdf and mixturebsdf as `blend`, mask as its shapes'
+//! `alpha`), with Mitsuba's
 //! defaults written out and
 //! its named indices of refraction.
 
@@ -69,6 +70,46 @@ impl Reader {
                     .map(|n| &mut n.value)
                 {
                     make_twosided(t, line);
+                }
+                return Ok(name);
+            }
+            "mask" => {
+                // Mitsuba's mask blends the BSDF it wraps with a null one by `opacity`: as
+                // foton reads it, a cut-out of the shapes that use it (their `alpha`).
+                let Some(opacity) = self.texture(&mut o, "opacity", DVec3::splat(0.5))? else {
+                    return Ok(None);
+                };
+                let inner = o
+                    .props
+                    .iter()
+                    .position(|(_, p, _)| matches!(p, Prop::Object(_) | Prop::Ref(_)));
+                let Some(i) = inner else {
+                    return Err(o.error("a mask BSDF without the BSDF it wraps"));
+                };
+                let (_, inner, l) = o.props.remove(i);
+                self.leftovers(&o)?;
+                let name = match inner {
+                    Prop::Object(mut inner) if inner.tag == "bsdf" => {
+                        if inner.id.is_none() {
+                            inner.id = o.id.clone();
+                        }
+                        self.bsdf(inner)?
+                    }
+                    Prop::Ref(id) => match self.bsdfs.get(&id) {
+                        Some(name) => Some(name.clone()),
+                        None => {
+                            return Err(o.error(format!(
+                                "line {l}: no BSDF with id `{id}` for the mask to wrap"
+                            )));
+                        }
+                    },
+                    _ => return Err(o.error("a mask BSDF wraps a BSDF")),
+                };
+                if let Some(name) = &name {
+                    if let Some(id) = &o.id {
+                        self.bsdfs.insert(id.clone(), name.clone());
+                    }
+                    self.masks.insert(name.clone(), opacity);
                 }
                 return Ok(name);
             }
@@ -459,6 +500,14 @@ impl Reader {
             let Some(name) = name else {
                 return Ok(None);
             };
+            if self.masks.contains_key(&name) {
+                o.props.clear();
+                self.unsupported(
+                    o,
+                    "a mask BSDF inside a blend: a cut-out part of a blend is not rendered yet",
+                )?;
+                return Ok(None);
+            }
             names.push((name, l));
         }
         let mut out = Vec::new();

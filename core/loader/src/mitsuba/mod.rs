@@ -74,6 +74,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         shapes: Vec::new(),
         lights: Vec::new(),
         bsdfs: HashMap::new(),
+        masks: HashMap::new(),
         textures: HashMap::new(),
         media: HashMap::new(),
         sensor_medium: None,
@@ -243,6 +244,9 @@ struct Reader {
     lights: Vec<Node>,
     /// BSDF ids to their material names in `[materials]`.
     bsdfs: HashMap<String, String>,
+    /// Materials that a `mask` wraps, to their opacity: a shape with one takes it as its
+    /// `alpha`.
+    masks: HashMap<String, Node>,
     /// The sensor's medium (its name in `[media]`, line).
     sensor_medium: Option<(String, u32)>,
     /// Whether any shape names an interior or exterior medium.

@@ -382,8 +382,20 @@ impl Reader {
         // Only for differentiable rendering.
         self.ignored(&mut o, "silhouette_sampling_weight", &|_| true, "");
         self.leftovers(&o)?;
+        let mut alpha = self.masks.get(&material).cloned();
+        if alpha.is_some() && (emission.is_some() || interior.is_some() || exterior.is_some()) {
+            o.props.clear();
+            self.unsupported(
+                &o,
+                "a mask BSDF on a shape that emits or bounds a medium: a cut-out emitter or medium boundary is not rendered yet",
+            )?;
+            alpha = None;
+        }
         for mut t in shapes {
             t.insert("material", at(Value::Str(material.clone()), line));
+            if let Some(a) = &alpha {
+                t.insert("alpha", a.clone());
+            }
             if let Some(e) = emission {
                 t.insert("emission", vec3(e, line));
             }

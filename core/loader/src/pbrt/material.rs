@@ -5,7 +5,7 @@
 //! true (its default); an alpha below 1e-3 is smooth (`EffectivelySmooth`).
 
 use super::params::Bag;
-use super::parse::{Directive, Type, Values};
+use super::parse::{Directive, Param, Type, Values};
 use super::spectra::{ETA_WAVELENGTH, Kind, eta_at_550, metal_rgb_ior, rgb};
 use super::texture::Tex;
 use super::{Loc, Reader, table_mut};
@@ -16,7 +16,55 @@ use foton_core::value::{Node, Value};
 /// foton carries, also has.
 const METALS: &[&str] = &["Ag", "Al", "Au", "Cu", "CuZn", "MgO", "TiO2"];
 
+/// The numeric parameters of pbrt-v4's materials that take a float texture (besides `eta`
+/// where it is a dielectric's, and a mix's `amount`, which takes any).
+const FLOAT_TEXTURE_PARAMS: &[&str] = &[
+    "roughness",
+    "uroughness",
+    "vroughness",
+    "thickness",
+    "g",
+    "interface.roughness",
+    "interface.uroughness",
+    "interface.vroughness",
+    "interface.eta",
+    "conductor.roughness",
+    "conductor.uroughness",
+    "conductor.vroughness",
+];
+
 impl Reader {
+    /// Replaces the material's numeric parameters given as float textures by the textures'
+    /// values where they are constant; a varying one is refused (`lenient`: left out, the
+    /// parameter's default).
+    fn constant_float_textures(&mut self, p: &mut Bag, ty: &str, what: &str) -> Result<()> {
+        let eta = matches!(ty, "dielectric" | "thindielectric" | "coateddiffuse");
+        for &name in FLOAT_TEXTURE_PARAMS.iter().chain(eta.then_some(&"eta")) {
+            let Some(q) = p.take(name) else { continue };
+            if q.ty != Type::Texture {
+                p.put(q);
+                continue;
+            }
+            match self.named_texture(&q, true, what)? {
+                Some(Tex::Constant(c)) => p.put(Param {
+                    ty: Type::Float,
+                    values: Values::Nums(vec![c.x]),
+                    ..q
+                }),
+                Some(Tex::Table(_)) => self.unsupported(
+                    &q.loc,
+                    what,
+                    &format!(
+                        "{}: a {name} that varies over the surface is not read yet (--lenient: its default)",
+                        q.decl()
+                    ),
+                )?,
+                None => {}
+            }
+        }
+        Ok(())
+    }
+
     /// Reads the material `d` into `[materials.name]`. false: left out (`lenient`).
     pub(super) fn material(&mut self, d: &Directive, name: &str) -> Result<bool> {
         let mut p = Bag::new(d).with_defaults(&self.state.attributes.material);
@@ -36,6 +84,7 @@ impl Reader {
         if let Some(q) = p.take("normalmap").or_else(|| p.take("displacement")) {
             self.unsupported(&q.loc, &what, &format!("{} is not read yet", q.decl()))?;
         }
+        self.constant_float_textures(&mut p, &ty, &what)?;
         let mut entries: Vec<(&str, Node)> = Vec::new();
         match ty.as_str() {
             "diffuse" => {

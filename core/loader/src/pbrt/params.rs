@@ -55,6 +55,11 @@ impl Bag {
             .any(|p| p.name == name)
     }
 
+    /// Puts a parameter (back) among the bag's own, in front of the defaults.
+    pub fn put(&mut self, p: Param) {
+        self.params.push(Some(p));
+    }
+
     /// The parameters nobody took.
     pub fn rest(&mut self) -> Vec<Param> {
         self.params.iter_mut().filter_map(Option::take).collect()

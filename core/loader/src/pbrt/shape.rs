@@ -10,8 +10,9 @@
 //! a disk's u x v already carries the mirror. `ReverseOrientation` turns each of them.
 
 use super::params::Bag;
-use super::parse::{Directive, Type};
+use super::parse::{Directive, Param, Type, Values};
 use super::spectra::{Kind, rgb};
+use super::texture::Tex;
 use super::{Loc, Reader, State};
 use foton_core::error::Result;
 use foton_core::value::{Node, Table, Value};
@@ -154,16 +155,10 @@ impl Reader {
                 return Err(loc.error(&what, format!("unknown shape {other:?}; pbrt-v4 has sphere, disk, cylinder, trianglemesh, plymesh, bilinearmesh, loopsubdiv and curve")));
             }
         }
-        if let Some(q) = p.take("alpha") {
-            let opaque = q.ty == Type::Float && q.values == super::parse::Values::Nums(vec![1.0]);
-            if !opaque {
-                self.unsupported(
-                    &q.loc,
-                    &what,
-                    &format!("{}: cut-outs (alpha) are not read yet", q.decl()),
-                )?;
-            }
-        }
+        let alpha = match p.take("alpha") {
+            None => None,
+            Some(q) => self.alpha(&q, &what)?.map(|a| (a, q.loc.clone())),
+        };
         self.finish(&mut p)?;
         if flip {
             entries.push(("flip_normals", self.node(Value::Bool(true), &loc)));
@@ -175,10 +170,48 @@ impl Reader {
         }
         let material = self.current_material(state);
         entries.push(("material", self.string(&material, &loc)));
-        entries.extend(self.medium_sides(state, &loc));
+        let sides = self.medium_sides(state, &loc);
+        if let Some((alpha, aloc)) = alpha {
+            if entries.iter().any(|(k, _)| *k == "emission") {
+                self.unsupported(
+                    &aloc,
+                    &what,
+                    "\"alpha\" on an area light: an emitter with a cut-out is not rendered yet",
+                )?;
+            } else if !sides.is_empty() {
+                self.unsupported(&aloc, &what, "\"alpha\" on a shape between two media: a cut-out medium boundary is not rendered yet")?;
+            } else {
+                entries.push(("alpha", alpha));
+            }
+        }
+        entries.extend(sides);
         let shape = self.table(entries, &loc);
         self.shapes.push(shape);
         Ok(())
+    }
+
+    /// A shape's `alpha` (a float, or a float texture named) as a shape table's `alpha`; None
+    /// where it leaves the shape opaque everywhere (1) or was left out (`lenient`).
+    fn alpha(&mut self, q: &Param, what: &str) -> Result<Option<Node>> {
+        let a = match (&q.ty, &q.values) {
+            (Type::Float, Values::Nums(v)) if v.len() == 1 => v[0],
+            (Type::Texture, _) => match self.named_texture(q, true, what)? {
+                Some(Tex::Constant(c)) => c.x,
+                Some(Tex::Table(t)) => return Ok(Some(t)),
+                None => return Ok(None),
+            },
+            _ => {
+                return Err(q.loc.error(
+                    what,
+                    format!(
+                        "{}: expected one \"float alpha\" or a float texture",
+                        q.decl()
+                    ),
+                ));
+            }
+        };
+        // pbrt-v4 keeps a hit where alpha >= 1 and drops it where alpha <= 0.
+        Ok((a < 1.0).then(|| self.num(a.max(0.0), &q.loc)))
     }
 
     /// The 4x4 transform as the document's `{ matrix = [16 numbers, row-major] }`.

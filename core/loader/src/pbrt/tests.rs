@@ -472,13 +472,13 @@ fn textures_map_to_foton_textures_with_pbrts_uv_conventions() {
 #[test]
 fn textures_foton_cannot_render_are_errors_or_left_out() {
     let text = format!(
-        "{WORLD}Texture \"r\" \"float\" \"imagemap\" \"string filename\" \"r.png\"\n\
+        "{WORLD}Texture \"r\" \"float\" \"wrinkled\"\n\
          Texture \"n\" \"spectrum\" \"fbm\"\n\
          Material \"diffuse\" \"texture reflectance\" \"n\"\nShape \"sphere\"\n"
     );
     let e = read(&text, false).unwrap_err();
     assert!(
-        e.contains("scene.pbrt:3:1") && e.contains("float imagemap"),
+        e.contains("scene.pbrt:3:1") && e.contains("wrinkled texture is not read yet"),
         "{e}"
     );
     let (d, report) = read(&text, true).unwrap();
@@ -508,6 +508,53 @@ fn textures_foton_cannot_render_are_errors_or_left_out() {
         e.contains("scene.pbrt:3") && e.contains("no spectrum texture named \"nope\""),
         "{e}"
     );
+}
+
+/// A shape's `alpha`: a float below 1, or a float texture (an image, a checkerboard, a
+/// constant), becomes the shape's `alpha`; 1 leaves it out. A material's numeric parameter
+/// may name a constant float texture; one that varies is refused (`lenient`: its default).
+#[test]
+fn alpha_and_float_textures() {
+    let t = doc(&format!(
+        "{WORLD}Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
+         Texture \"half\" \"float\" \"constant\" \"float value\" 0.3\n\
+         Texture \"checks\" \"float\" \"checkerboard\" \"float tex1\" 1 \"float tex2\" 0\n\
+         Shape \"sphere\" \"float alpha\" 0.5\n\
+         Shape \"sphere\" \"float alpha\" 1\n\
+         Shape \"sphere\" \"texture alpha\" \"leaf\"\n\
+         Shape \"sphere\" \"texture alpha\" \"checks\"\n\
+         Shape \"sphere\" \"texture alpha\" \"half\"\n\
+         Material \"conductor\" \"texture roughness\" \"half\"\nShape \"sphere\"\n"
+    ));
+    assert_eq!(num(&t, "shapes.0.alpha"), 0.5);
+    assert!(!has(&t, "shapes.1.alpha"));
+    assert_eq!(text(&t, "shapes.2.alpha.type"), "bitmap");
+    assert_eq!(text(&t, "shapes.2.alpha.filename"), "leaf.png");
+    assert_eq!(text(&t, "shapes.3.alpha.type"), "checkerboard");
+    assert!(close(&nums(&t, "shapes.3.alpha.color0"), &[1.0, 1.0, 1.0]));
+    assert!((num(&t, "shapes.4.alpha") - 0.3).abs() < 1e-12);
+    let m = text(&t, "shapes.5.material");
+    assert_eq!(text(&t, &format!("materials.{m}.type")), "roughconductor");
+
+    for (scene, words) in [
+        (
+            "AttributeBegin\nAreaLightSource \"diffuse\"\nShape \"sphere\" \"float alpha\" 0.5\nAttributeEnd\n",
+            "an emitter with a cut-out",
+        ),
+        (
+            "Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
+             Material \"conductor\" \"texture roughness\" \"leaf\"\nShape \"sphere\"\n",
+            "a roughness that varies over the surface",
+        ),
+    ] {
+        let text = format!("{WORLD}{scene}");
+        let e = read(&text, false).unwrap_err();
+        assert!(e.contains(words), "{e}");
+        let (d, report) = read(&text, true).unwrap();
+        assert_eq!(report.left_out.len(), 1, "{:?}", report.left_out);
+        assert!(report.left_out[0].contains(words));
+        assert!(!has(&d.root, "shapes.0.alpha"));
+    }
 }
 
 #[test]

@@ -3,8 +3,9 @@
 //!
 //! Spectrum textures: `imagemap` as foton's `bitmap`, `checkerboard` (2-D) as foton's
 //! `checkerboard`, `constant`, and `scale` and `mix` where they reduce to one of those (a
-//! constant scale of an image, constants mixed by a constant amount). Float textures are read
-//! where they are constants. pbrt-v4's `uv` mapping, st = (su u + du, sv v + dv), becomes the
+//! constant scale of an image, constants mixed by a constant amount). Float textures the
+//! same, as grey tables: a shape's `alpha` and a mix's `amount` take any of them, the
+//! materials' numeric parameters (roughness, eta...) constants only. pbrt-v4's `uv` mapping, st = (su u + du, sv v + dv), becomes the
 //! texture's `to_uv`: an image texture reads its image at (s, 1 - t) (pbrt-v4 puts st = (0, 0)
 //! at the image's lower left, foton, as Mitsuba, at its upper left); pbrt-v4's checkerboard
 //! changes colour at every integer of s and t, foton's at every half, so its st is halved.
@@ -76,8 +77,8 @@ impl Reader {
                     Some(Tex::Constant(c))
                 }
             }
-            "imagemap" if !float => self.imagemap(&mut p, &what, &loc)?,
-            "checkerboard" if !float => self.checkerboard(&mut p, &what, &loc)?,
+            "imagemap" => self.imagemap(&mut p, &what, &loc)?,
+            "checkerboard" => self.checkerboard(&mut p, float, &what, &loc)?,
             "scale" => {
                 let t = self.texture_param(&mut p, "tex", DVec3::ONE, float, &what)?;
                 let s = self.texture_param(&mut p, "scale", DVec3::ONE, true, &what)?;
@@ -117,16 +118,6 @@ impl Reader {
                     }
                     _ => None,
                 }
-            }
-            "imagemap" | "checkerboard" => {
-                self.unsupported(
-                    &loc,
-                    &what,
-                    &format!(
-                        "a float {class} texture (a varying roughness, bump map or mix amount) is not read yet"
-                    ),
-                )?;
-                None
             }
             other if CLASSES.contains(&other) => {
                 self.unsupported(&loc, &what, &format!("the {other} texture is not read yet"))?;
@@ -244,7 +235,13 @@ impl Reader {
     }
 
     /// `checkerboard` (`dimension` 2): foton's `checkerboard` of half pbrt-v4's st.
-    fn checkerboard(&mut self, p: &mut Bag, what: &str, loc: &Loc) -> Result<Option<Tex>> {
+    fn checkerboard(
+        &mut self,
+        p: &mut Bag,
+        float: bool,
+        what: &str,
+        loc: &Loc,
+    ) -> Result<Option<Tex>> {
         let dimension = p.int("dimension", 2)?;
         if dimension != 2 {
             self.unsupported(loc, what, "a solid (3-D) checkerboard is not read yet")?;
@@ -253,8 +250,8 @@ impl Reader {
         let Some((su, sv, du, dv)) = self.uv_mapping(p, what, loc)? else {
             return Ok(None);
         };
-        let tex1 = self.texture_param(p, "tex1", DVec3::ONE, false, what)?;
-        let tex2 = self.texture_param(p, "tex2", DVec3::ZERO, false, what)?;
+        let tex1 = self.texture_param(p, "tex1", DVec3::ONE, float, what)?;
+        let tex2 = self.texture_param(p, "tex2", DVec3::ZERO, float, what)?;
         let (Some(Tex::Constant(a)), Some(Tex::Constant(b))) = (tex1, tex2) else {
             self.unsupported(
                 loc,
