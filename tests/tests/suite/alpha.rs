@@ -231,6 +231,24 @@ fn mitsubas_mask_is_a_cut_out() {
             file.display()
         );
     }
+    // A checkerboard opacity: Mitsuba 3 reads a texture as a number with its checkerboard's
+    // colours swapped (its `eval_1`; rendered by Mitsuba 3.9.1's volpath, the mask scene
+    // agrees with foton only so); Mitsuba 0.6 does not.
+    for (version, opaque_first) in [("3.0.0", false), ("0.6.0", true)] {
+        let checks = format!(
+            r#"<bsdf type="mask"><texture type="checkerboard" name="opacity"><rgb name="color0" value="1"/><rgb name="color1" value="0"/></texture>{black}</bsdf>"#
+        );
+        let file = write(
+            &dir,
+            &format!("checks-{version}.xml"),
+            &xml("", &checks).replace("3.0.0", version),
+        );
+        let scene = foton_loader::load(&file, &[]).unwrap();
+        let alpha = scene.objects()[1].alpha.as_ref().expect("a cut-out");
+        // uv (0.25, 0.25) lies in the check of color0.
+        let a = alpha.eval(glam::Vec2::splat(0.25)).x;
+        assert_eq!(a == 1.0, opaque_first, "{version}: alpha {a}");
+    }
     // On an emitter: refused, or (lenient) the mask left out.
     let emitter = xml(
         "",

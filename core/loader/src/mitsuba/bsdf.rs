@@ -79,6 +79,7 @@ impl Reader {
                 let Some(opacity) = self.texture(&mut o, "opacity", DVec3::splat(0.5))? else {
                     return Ok(None);
                 };
+                let opacity = self.as_eval_1(&o, "opacity", opacity);
                 let inner = o
                     .props
                     .iter()
@@ -449,9 +450,39 @@ impl Reader {
             Some((Prop::Int(i), _)) => Ok(Some(at(Value::Float(i as f64), line))),
             Some((p, l)) => {
                 o.props.push((name.to_string(), p, l));
-                self.texture(o, name, DVec3::splat(default))
+                let t = self.texture(o, name, DVec3::splat(default))?;
+                Ok(t.map(|t| self.as_eval_1(o, name, t)))
             }
         }
+    }
+
+    /// A texture Mitsuba 3 reads as a number (its `eval_1`: roughness, opacity, weights): a
+    /// checkerboard's colours swapped, since Mitsuba 3's checkerboard gives `color0` where
+    /// its `eval` gives `color1` (3.0 to 3.9; checked against 3.9.1).
+    fn as_eval_1(&mut self, o: &Obj, name: &str, mut node: Node) -> Node {
+        if o.v1 {
+            return node;
+        }
+        if let Value::Table(t) = &mut node.value
+            && matches!(t.get("type").map(|n| &n.value), Some(Value::Str(k)) if k == "checkerboard")
+        {
+            let line = node.line;
+            let c0 = t
+                .get("color0")
+                .cloned()
+                .unwrap_or_else(|| at(Value::Float(0.4), line));
+            let c1 = t
+                .get("color1")
+                .cloned()
+                .unwrap_or_else(|| at(Value::Float(0.2), line));
+            t.insert("color0", c1);
+            t.insert("color1", c0);
+            self.note(
+                o,
+                &format!("`{name}`: a checkerboard read as a number takes `color1` where its colour takes `color0`, as Mitsuba 3 reads it"),
+            );
+        }
+        node
     }
 }
 
@@ -635,7 +666,7 @@ impl Reader {
             Some((p @ (Prop::Object(_) | Prop::Ref(_)), l)) => {
                 o.props.push((name.to_string(), p, l));
                 Ok(match self.texture(o, name, DVec3::ZERO)? {
-                    Some(node) => Scalar::Given(node),
+                    Some(node) => Scalar::Given(self.as_eval_1(o, name, node)),
                     None => Scalar::LeftOut,
                 })
             }
