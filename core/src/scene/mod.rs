@@ -92,6 +92,10 @@ pub struct Object {
     /// (a colour's luminance) is 0 the shape is absent, where it is 1 present, and between
     /// present with that probability (see [`Scene::intersect`]). None: opaque everywhere.
     pub alpha: Option<Texture>,
+    /// The shading normals of its material's `normal_map` (Mitsuba's `normalmap`, pbrt-v4's
+    /// `normalmap`): a texture whose colour c gives the normal 2c - 1 in the surface's
+    /// shading frame (x along dp/du, z the normal). None: the surface's own normals.
+    pub normal_map: Option<Texture>,
 }
 
 /// A medium of any kind.
@@ -133,6 +137,8 @@ pub struct Scene {
     has_media: bool,
     /// Whether any object has a cut-out (its `alpha`): only then do ray queries test them.
     has_alpha: bool,
+    /// Whether any object has a normal map: only then does [`Scene::bsdf`] look for one.
+    has_normal_maps: bool,
     /// Per light: the medium the file puts it in (a point or spot light's `medium`, an area
     /// light whose shape names its exterior); None: found from where it lies.
     light_media: Vec<Option<Option<u32>>>,
@@ -275,6 +281,7 @@ impl Scene {
             )?;
         }
         let has_alpha = objects.iter().any(|o| o.alpha.is_some());
+        let has_normal_maps = objects.iter().any(|o| o.normal_map.is_some());
         Ok(Scene {
             file,
             render,
@@ -294,6 +301,7 @@ impl Scene {
             alone,
             has_media: uses_media,
             has_alpha,
+            has_normal_maps,
             light_media,
             camera_medium,
             bounds: (lo, hi),
@@ -429,6 +437,13 @@ impl Scene {
         if material.is_null() {
             return None;
         }
+        if self.has_normal_maps
+            && let Some(map) = &self.object(hit).normal_map
+        {
+            let mut sp = self.surface(hit);
+            sp.ns = normal_mapped(&sp, map);
+            return material.bsdf(&sp);
+        }
         let prim = self.primitive(hit);
         let attrs = self.triangle_attrs.get(prim.attrs as usize);
         let flat = attrs.is_none_or(|a| a.normals.is_none());
@@ -513,6 +528,20 @@ impl Scene {
     pub fn has_media(&self) -> bool {
         self.has_media
     }
+}
+
+/// The shading normal a normal map gives at a surface point: its colour c as 2c - 1 in the
+/// point's shading frame (Mitsuba 3's `normalmap`, pbrt-v4's `NormalMap`), turned to the
+/// geometric normal's side; the surface's own where the map gives no direction.
+fn normal_mapped(sp: &SurfacePoint, map: &Texture) -> Vec3 {
+    let local = 2.0 * map.eval(sp.uv) - Vec3::ONE;
+    let n = Frame::from_normal_tangent(sp.ns, sp.dpdu)
+        .to_world(local)
+        .normalize_or_zero();
+    if n == Vec3::ZERO {
+        return sp.ns;
+    }
+    if n.dot(sp.ng) < 0.0 { -n } else { n }
 }
 
 /// What the host (the loader, the tools, the tests) reads and changes of a scene besides what

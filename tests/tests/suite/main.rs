@@ -44,6 +44,7 @@ mod mitsuba_document;
 mod mitsuba_fixtures;
 mod mitsuba_materials;
 mod mitsuba_shapes;
+mod normal_map;
 mod one_sided;
 mod orthographic;
 mod parts;

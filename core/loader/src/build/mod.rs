@@ -65,7 +65,7 @@ pub fn from_document(doc: Document) -> Result<Scene> {
 
     let render = read_render(&root, &mut ld)?;
     let film = read_film(&root, &mut ld)?;
-    let (materials, material_index) = read_materials(&root, &mut ld)?;
+    let (materials, material_index, normal_maps) = read_materials(&root, &mut ld)?;
     let (media, medium_index) = read_media(&root, &mut ld)?;
     let (camera, camera_medium) = read_camera(&root, &film, &medium_index, &mut ld)?;
 
@@ -75,6 +75,7 @@ pub fn from_document(doc: Document) -> Result<Scene> {
         &mut ld,
         &materials,
         &material_index,
+        &normal_maps,
         &medium_index,
         &mut geometry,
     )?;

@@ -29,6 +29,7 @@ pub(super) fn read_shapes(
     ld: &mut Loader,
     material_defs: &[Named<Material>],
     materials: &Index,
+    normal_maps: &[Option<Texture>],
     media: &Index,
     g: &mut Geometry,
 ) -> Result<()> {
@@ -218,6 +219,7 @@ pub(super) fn read_shapes(
             explicit_media,
             closed,
             alpha,
+            normal_map: normal_maps[material as usize].clone(),
         });
         let first_attrs = g.triangle_attrs.len() as u32;
         let with_attrs = !attrs.is_empty();

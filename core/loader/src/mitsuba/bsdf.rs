@@ -1,7 +1,7 @@
 //! `<bsdf>`: a Mitsuba BSDF as a material of `[materials]` (diffuse, dielectrics, conductors,
 //! plastics, their rough variants, difftrans, phong, ward, roughdiffuse, principled,
 //! principledthin, twosided, null, blendbsdf and mixturebsdf as `blend`, mask as its shapes'
-//! `alpha`), with Mitsuba's
+//! `alpha`, normalmap as the wrapped material's `normal_map`), with Mitsuba's
 //! defaults written out and
 //! its named indices of refraction.
 
@@ -113,6 +113,67 @@ impl Reader {
                     self.masks.insert(name.clone(), opacity);
                 }
                 return Ok(name);
+            }
+            "normalmap" => {
+                // The BSDF it wraps, with the map as its `normal_map`: nested, it is read
+                // with the map; referenced, a copy of it gets the map (the original may be
+                // used without it elsewhere).
+                let Some(map) = self.texture(&mut o, "normalmap", DVec3::new(0.5, 0.5, 1.0))?
+                else {
+                    return Ok(None);
+                };
+                // Mitsuba 3.7 and later.
+                let shadowing = o.boolean("use_shadowing_function", true)?;
+                let flip = o.boolean("flip_invalid_normals", true)?;
+                if !o.v1 && (shadowing || flip) {
+                    self.note(
+                        &o,
+                        "the map's normals are used as given, as pbrt-v4 uses them: not Mitsuba 3's shadowing term (Estevez et al. 2019; `use_shadowing_function`, which darkens light arriving at grazing angles to a strongly tilted normal) nor its flip of normals facing away from the viewer (`flip_invalid_normals`)",
+                    );
+                }
+                let inner = o
+                    .props
+                    .iter()
+                    .position(|(_, p, _)| matches!(p, Prop::Object(_) | Prop::Ref(_)));
+                let Some(i) = inner else {
+                    return Err(o.error("a normalmap BSDF without the BSDF it wraps"));
+                };
+                let (_, inner, l) = o.props.remove(i);
+                self.leftovers(&o)?;
+                let name = match inner {
+                    Prop::Object(inner) if inner.tag == "bsdf" => self.bsdf(inner)?,
+                    Prop::Ref(id) => {
+                        let Some(original) = self.bsdfs.get(&id).cloned() else {
+                            return Err(o.error(format!(
+                                "line {l}: no BSDF with id `{id}` for the normal map to wrap"
+                            )));
+                        };
+                        let materials = table_mut(&mut self.root, "materials");
+                        let copy = materials.get(&original).cloned();
+                        let name = self.new_name("bsdf", &None);
+                        if let Some(copy) = copy {
+                            table_mut(&mut self.root, "materials").insert(&name, copy);
+                        }
+                        if let Some(mask) = self.masks.get(&original).cloned() {
+                            self.masks.insert(name.clone(), mask);
+                        }
+                        Some(name)
+                    }
+                    _ => return Err(o.error("a normalmap BSDF wraps a BSDF")),
+                };
+                let Some(name) = name else {
+                    return Ok(None);
+                };
+                if let Some(Value::Table(t)) = table_mut(&mut self.root, "materials")
+                    .get_mut(&name)
+                    .map(|n| &mut n.value)
+                {
+                    t.insert("normal_map", map);
+                }
+                if let Some(id) = &o.id {
+                    self.bsdfs.insert(id.clone(), name.clone());
+                }
+                return Ok(Some(name));
             }
             "diffuse" => {
                 put("type", Value::Str("diffuse".into()));

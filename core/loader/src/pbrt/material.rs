@@ -81,9 +81,25 @@ impl Reader {
         } else {
             (d.string(0).to_string(), d.what())
         };
-        if let Some(q) = p.take("normalmap").or_else(|| p.take("displacement")) {
-            self.unsupported(&q.loc, &what, &format!("{} is not read yet", q.decl()))?;
+        if let Some(q) = p.take("displacement") {
+            self.unsupported(
+                &q.loc,
+                &what,
+                &format!("{} (bump mapping) is not read yet", q.decl()),
+            )?;
         }
+        // pbrt-v4 reads the map as linear values at (u, 1 - v), repeated, bilinearly.
+        let normal_map = p.string_opt("normalmap")?.map(|(file, l)| {
+            self.table(
+                vec![
+                    ("type", self.string("bitmap", &l)),
+                    ("filename", self.string(&file, &l)),
+                    ("raw", self.node(Value::Bool(true), &l)),
+                    ("to_uv", self.to_uv([1.0, -1.0], [0.0, 1.0], &l)),
+                ],
+                &l,
+            )
+        });
         self.constant_float_textures(&mut p, &ty, &what)?;
         let mut entries: Vec<(&str, Node)> = Vec::new();
         match ty.as_str() {
@@ -393,6 +409,11 @@ impl Reader {
             }
         }
         self.finish(&mut p)?;
+        if let Some(map) = normal_map
+            && ty != "interface"
+        {
+            entries.push(("normal_map", map));
+        }
         let t = self.table(entries, &loc);
         table_mut(&mut self.root, "materials").insert(name, t);
         Ok(true)

@@ -310,7 +310,7 @@ impl Reader {
     }
 
     /// A `to_uv` table: uv' = scale uv + offset, as a row-major 3 x 3 matrix.
-    fn to_uv(&self, scale: [f64; 2], offset: [f64; 2], loc: &Loc) -> Node {
+    pub(super) fn to_uv(&self, scale: [f64; 2], offset: [f64; 2], loc: &Loc) -> Node {
         let m = [
             scale[0], 0.0, offset[0], 0.0, scale[1], offset[1], 0.0, 0.0, 1.0,
         ];
