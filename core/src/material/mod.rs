@@ -290,17 +290,111 @@ pub fn read_ior(m: &Properties<'_>, default: f32) -> Result<f32> {
 
 /// A microfacet distribution: `distribution` (`beckmann`, Mitsuba's default, or `ggx`) and
 /// `alpha` (default 0.1), or `alpha_u` and `alpha_v` where `anisotropic` lobes are allowed.
-pub fn read_microfacet(m: &Properties<'_>, anisotropic: bool) -> Result<Microfacet> {
-    let kind = match m.string("distribution", "beckmann")? {
-        "beckmann" => MicrofacetKind::Beckmann,
-        "ggx" => MicrofacetKind::Ggx,
-        other => {
+/// A microfacet roughness that varies over the surface: alpha_u and alpha_v from textures
+/// (a grey's value, a colour's luminance: Mitsuba's `eval_1`), optionally as the square
+/// root of the value (pbrt-v4's `remaproughness`).
+#[derive(Clone, Debug)]
+pub struct RoughnessTextures {
+    pub alpha_u: Texture,
+    pub alpha_v: Texture,
+    pub remap: bool,
+}
+
+impl RoughnessTextures {
+    /// The distribution at surface coordinates `uv`, of the kind of `d`.
+    #[inline]
+    pub fn at(&self, d: Microfacet, uv: Vec2) -> Microfacet {
+        Microfacet::new(
+            d.kind,
+            self.alpha(self.alpha_u.at(uv)),
+            self.alpha(self.alpha_v.at(uv)),
+        )
+    }
+
+    /// The roughness a texture's value gives.
+    #[inline]
+    fn alpha(&self, c: Rgb) -> f32 {
+        let x = if c.x == c.y && c.y == c.z {
+            c.x
+        } else {
+            crate::texture::luminance(c)
+        };
+        if self.remap { x.max(0.0).sqrt() } else { x }
+    }
+}
+
+/// The roughness of a microfacet material: [`read_microfacet`]'s distribution, and, where
+/// `alpha` (or `alpha_u`, `alpha_v`) is a texture table, the textures that replace its
+/// roughness at each point. `remaproughness` (default false) takes alpha as the square root
+/// of the values given, numbers and textures alike (pbrt-v4's `RoughnessToAlpha`).
+pub fn read_roughness(
+    m: &Properties<'_>,
+    anisotropic: bool,
+    resources: &mut dyn Resources,
+) -> Result<(Microfacet, Option<RoughnessTextures>)> {
+    let is_table = |k: &str| {
+        m.node(k)
+            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
+    };
+    let remap = m.bool("remaproughness", false)?;
+    if !is_table("alpha") && !is_table("alpha_u") && !is_table("alpha_v") {
+        let mut d = read_microfacet(m, anisotropic)?;
+        if remap {
+            d = Microfacet::new(d.kind, d.alpha_u.sqrt(), d.alpha_v.sqrt());
+        }
+        return Ok((d, None));
+    }
+    let kind = read_microfacet_kind(m)?;
+    let read = |key: &str, resources: &mut dyn Resources| -> Result<Texture> {
+        if is_table(key) {
+            return resources.texture(m, key, Rgb::splat(0.1));
+        }
+        let x = m.f32_required(key)?;
+        if !(x >= 0.0 && x.is_finite()) {
+            return Err(m.error(key, format!("must not be negative, found {x}")));
+        }
+        Ok(Texture::Constant(Rgb::splat(x)))
+    };
+    let (u, v) = if m.has("alpha_u") || m.has("alpha_v") {
+        if !anisotropic {
             return Err(m.error(
-                "distribution",
-                format!("unknown distribution {other:?}; expected beckmann or ggx"),
+                "alpha_u",
+                "this material's roughness is isotropic: give `alpha`",
             ));
         }
+        (read("alpha_u", resources)?, read("alpha_v", resources)?)
+    } else {
+        let t = read("alpha", resources)?;
+        (t.clone(), t)
     };
+    let textures = RoughnessTextures {
+        alpha_u: u,
+        alpha_v: v,
+        remap,
+    };
+    // The distribution's own roughness: the textures' means', for what asks of the
+    // material as a whole.
+    let d = Microfacet::new(
+        kind,
+        textures.alpha(textures.alpha_u.mean()),
+        textures.alpha(textures.alpha_v.mean()),
+    );
+    Ok((d, Some(textures)))
+}
+
+fn read_microfacet_kind(m: &Properties<'_>) -> Result<MicrofacetKind> {
+    match m.string("distribution", "beckmann")? {
+        "beckmann" => Ok(MicrofacetKind::Beckmann),
+        "ggx" => Ok(MicrofacetKind::Ggx),
+        other => Err(m.error(
+            "distribution",
+            format!("unknown distribution {other:?}; expected beckmann or ggx"),
+        )),
+    }
+}
+
+pub fn read_microfacet(m: &Properties<'_>, anisotropic: bool) -> Result<Microfacet> {
+    let kind = read_microfacet_kind(m)?;
     let positive = |key: &str, x: f32| {
         if x > 0.0 && x.is_finite() {
             Ok(x)

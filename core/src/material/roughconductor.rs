@@ -5,12 +5,13 @@
 //! |------------------------|---------------|------------------------------------------|----------------|
 //! | `material`, `eta`, `k` |               | the index of refraction, as `conductor`'s | a perfect mirror |
 //! | `distribution`         | string        | `beckmann` or `ggx`                      | `beckmann`     |
-//! | `alpha`                | number        | roughness (or `alpha_u` and `alpha_v`: anisotropic) | `0.1` |
+//! | `alpha`                | number / texture | roughness (or `alpha_u` and `alpha_v`: anisotropic); a texture's luminance | `0.1` |
+//! | `remaproughness`       | bool          | alpha is the square root of the values given (pbrt-v4's) | `false` |
 //! | `specular_reflectance` | RGB / texture | scales the reflection                    | `1`            |
 //! | `twosided`             | bool          | the same seen from behind                | `true`         |
 
 use super::conductor::read_conductor_ior;
-use super::{SurfaceMaterial, read_microfacet};
+use super::{RoughnessTextures, SurfaceMaterial, read_roughness};
 use crate::Rgb;
 use crate::glossy::RoughConductor;
 use crate::registry::Factory;
@@ -24,6 +25,8 @@ pub struct RoughConductorMaterial {
     pub lobe: RoughConductor,
     pub specular_reflectance: Texture,
     pub twosided: bool,
+    /// A roughness that varies over the surface (`alpha` a texture).
+    pub roughness: Option<RoughnessTextures>,
 }
 
 impl SurfaceMaterial for RoughConductorMaterial {
@@ -31,15 +34,22 @@ impl SurfaceMaterial for RoughConductorMaterial {
 
     #[inline(always)]
     fn bxdf(&self, uv: Vec2) -> RoughConductor {
+        let distribution = match &self.roughness {
+            Some(r) => r.at(self.lobe.distribution, uv),
+            None => self.lobe.distribution,
+        };
         RoughConductor {
             specular_reflectance: self.specular_reflectance.at(uv),
+            distribution,
             ..self.lobe
         }
     }
 
     #[inline]
     fn needs_coordinates(&self) -> bool {
-        !self.lobe.distribution.is_isotropic() || !self.specular_reflectance.is_constant()
+        !self.lobe.distribution.is_isotropic()
+            || !self.specular_reflectance.is_constant()
+            || self.roughness.is_some()
     }
 
     fn twosided(&self) -> bool {
@@ -76,9 +86,11 @@ pub const FACTORY: Factory<RoughConductorMaterial> = Factory {
         let specular_reflectance = resources.texture(m, "specular_reflectance", Rgb::ONE)?;
         // No named material and no eta, k: a perfect (rough) mirror, F = 1.
         let (eta, k) = read_conductor_ior(m)?.unwrap_or((Rgb::ZERO, Rgb::ZERO));
+        let (distribution, roughness) = read_roughness(m, true, resources)?;
         Ok(Box::new(RoughConductorMaterial {
+            roughness,
             lobe: RoughConductor {
-                distribution: read_microfacet(m, true)?,
+                distribution,
                 eta,
                 k,
                 specular_reflectance: Rgb::ONE,

@@ -6,11 +6,12 @@
 //! |--------------------------|---------------|----------------------------------------|------------|
 //! | `ior`                    | number        | inside relative to outside, as `dielectric`'s | `1.5` |
 //! | `distribution`           | string        | `beckmann` or `ggx`                    | `beckmann` |
-//! | `alpha`                  | number        | roughness (or `alpha_u` and `alpha_v`) | `0.1`      |
+//! | `alpha`                  | number / texture | roughness (or `alpha_u` and `alpha_v`); a texture's luminance | `0.1` |
+//! | `remaproughness`         | bool          | alpha is the square root of the values given (pbrt-v4's) | `false` |
 //! | `specular_reflectance`   | RGB / texture | scales the reflection                  | `1`        |
 //! | `specular_transmittance` | RGB / texture | scales the refraction                  | `1`        |
 
-use super::{SurfaceMaterial, read_ior, read_microfacet};
+use super::{RoughnessTextures, SurfaceMaterial, read_ior, read_roughness};
 use crate::Rgb;
 use crate::glossy::RoughDielectric;
 use crate::registry::Factory;
@@ -24,6 +25,8 @@ pub struct RoughDielectricMaterial {
     pub lobe: RoughDielectric,
     pub specular_reflectance: Texture,
     pub specular_transmittance: Texture,
+    /// A roughness that varies over the surface (`alpha` a texture).
+    pub roughness: Option<RoughnessTextures>,
 }
 
 impl SurfaceMaterial for RoughDielectricMaterial {
@@ -31,9 +34,14 @@ impl SurfaceMaterial for RoughDielectricMaterial {
 
     #[inline(always)]
     fn bxdf(&self, uv: Vec2) -> RoughDielectric {
+        let distribution = match &self.roughness {
+            Some(r) => r.at(self.lobe.distribution, uv),
+            None => self.lobe.distribution,
+        };
         RoughDielectric {
             specular_reflectance: self.specular_reflectance.at(uv),
             specular_transmittance: self.specular_transmittance.at(uv),
+            distribution,
             ..self.lobe
         }
     }
@@ -43,6 +51,7 @@ impl SurfaceMaterial for RoughDielectricMaterial {
         !self.lobe.distribution.is_isotropic()
             || !self.specular_reflectance.is_constant()
             || !self.specular_transmittance.is_constant()
+            || self.roughness.is_some()
     }
 
     fn encloses_volume(&self) -> bool {
@@ -80,8 +89,9 @@ pub const FACTORY: Factory<RoughDielectricMaterial> = Factory {
     name: "roughdielectric",
     description: "a rough dielectric interface: microfacet reflection and refraction",
     create: |m, _, resources| {
+        let (distribution, roughness) = read_roughness(m, true, resources)?;
         let lobe = RoughDielectric {
-            distribution: read_microfacet(m, true)?,
+            distribution,
             eta: read_ior(m, 1.5)?,
             specular_reflectance: Rgb::ONE,
             specular_transmittance: Rgb::ONE,
@@ -90,6 +100,7 @@ pub const FACTORY: Factory<RoughDielectricMaterial> = Factory {
             lobe,
             specular_reflectance: resources.texture(m, "specular_reflectance", Rgb::ONE)?,
             specular_transmittance: resources.texture(m, "specular_transmittance", Rgb::ONE)?,
+            roughness,
         }))
     },
 };

@@ -57,6 +57,7 @@ mod plugins;
 mod ply;
 mod ppb;
 mod principled;
+mod rough_texture;
 mod samplers;
 mod sampling;
 mod sampling_lights;

@@ -877,7 +877,7 @@ fn lenient_textures_where_foton_takes_constants_are_their_means() {
         )
     };
     let body = format!(
-        "<shape type=\"sphere\">\n<emitter type=\"area\">{}</emitter>\n<bsdf type=\"roughconductor\" id=\"metal\">{}</bsdf>\n</shape>\n{SENSOR}",
+        "<shape type=\"sphere\">\n<emitter type=\"area\">{}</emitter>\n<bsdf type=\"roughplastic\" id=\"metal\">{}</bsdf>\n</shape>\n{SENSOR}",
         checker("radiance", 2.0, 4.0),
         checker("alpha", 0.1, 0.3)
     );
@@ -897,4 +897,15 @@ fn lenient_textures_where_foton_takes_constants_are_their_means() {
     assert_eq!(vector(sphere, "emission"), Vec3::splat(3.0));
     assert!((number(&doc.root, "materials.metal.alpha") - 0.2).abs() < 1e-12);
     assert_eq!(report.left_out.len(), 2, "{:?}", report.left_out);
+    // roughconductor and roughdielectric take the texture itself.
+    let body = format!(
+        "<shape type=\"sphere\">\n<bsdf type=\"roughconductor\" id=\"metal\">{}</bsdf>\n</shape>\n{SENSOR}",
+        checker("alpha", 0.1, 0.3)
+    );
+    let xml = write(&dir, "textured-metal.xml", &scene("3.0.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    let Value::Table(alpha) = &node(&doc.root, "materials.metal.alpha").value else {
+        panic!("a texture table")
+    };
+    assert!(matches!(&alpha.get("type").unwrap().value, Value::Str(t) if t == "checkerboard"));
 }

@@ -450,7 +450,10 @@ impl Reader {
         t.insert("distribution", at(Value::Str(distribution), line));
         o.take("sample_visible");
         let has = |o: &Obj, k: &str| o.props.iter().any(|(n, _, _)| n == k);
-        // A textured roughness: its mean (lenient), as foton's roughness is a constant.
+        // A textured roughness: as a texture for the conductor and the dielectric (those that
+        // may be anisotropic), its mean (lenient) for roughplastic, whose roughness is a
+        // constant.
+        let mut textures = Vec::new();
         for k in ["alpha", "alpha_u", "alpha_v"] {
             let textured = o.props.iter().any(|(n, p, _)| {
                 n == k
@@ -460,20 +463,36 @@ impl Reader {
                         _ => false,
                     }
             });
-            if textured {
+            if textured && anisotropic {
+                if let Some(node) = self.texture(o, k, DVec3::splat(0.1))? {
+                    let node = self.as_eval_1(o, k, node);
+                    textures.push((k, node));
+                }
+            } else if textured {
                 let mean = self.constant(o, k, DVec3::splat(0.1))?;
                 let l = o.line;
                 o.props.push((k.to_string(), Prop::Float(mean.x), l));
             }
         }
-        if anisotropic && (has(o, "alpha_u") || has(o, "alpha_v")) {
-            let u = o.float("alpha_u", 0.1)?;
-            let v = o.float("alpha_v", 0.1)?;
-            t.insert("alpha_u", at(Value::Float(u), line));
-            t.insert("alpha_v", at(Value::Float(v), line));
-        } else {
+        let textured = |k: &str| textures.iter().any(|(n, _)| *n == k);
+        if anisotropic
+            && (has(o, "alpha_u")
+                || has(o, "alpha_v")
+                || textured("alpha_u")
+                || textured("alpha_v"))
+        {
+            for k in ["alpha_u", "alpha_v"] {
+                if !textured(k) {
+                    let a = o.float(k, 0.1)?;
+                    t.insert(k, at(Value::Float(a), line));
+                }
+            }
+        } else if !textured("alpha") {
             let a = o.float("alpha", 0.1)?;
             t.insert("alpha", at(Value::Float(a), line));
+        }
+        for (k, node) in textures {
+            t.insert(k, node);
         }
         Ok(())
     }

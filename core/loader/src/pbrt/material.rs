@@ -37,8 +37,16 @@ impl Reader {
     /// Replaces the material's numeric parameters given as float textures by the textures'
     /// values where they are constant; a varying one is refused (`lenient`: left out, the
     /// parameter's default).
-    fn constant_float_textures(&mut self, p: &mut Bag, ty: &str, what: &str) -> Result<()> {
+    fn constant_float_textures(
+        &mut self,
+        p: &mut Bag,
+        ty: &str,
+        what: &str,
+    ) -> Result<Vec<(&'static str, Node)>> {
         let eta = matches!(ty, "dielectric" | "thindielectric" | "coateddiffuse");
+        // foton's rough conductor and dielectric take a roughness texture.
+        let varying_roughness = matches!(ty, "dielectric" | "conductor");
+        let mut varying = Vec::new();
         for &name in FLOAT_TEXTURE_PARAMS.iter().chain(eta.then_some(&"eta")) {
             let Some(q) = p.take(name) else { continue };
             if q.ty != Type::Texture {
@@ -51,6 +59,12 @@ impl Reader {
                     values: Values::Nums(vec![c.x]),
                     ..q
                 }),
+                Some(Tex::Table(t))
+                    if varying_roughness
+                        && matches!(name, "roughness" | "uroughness" | "vroughness") =>
+                {
+                    varying.push((name, t));
+                }
                 Some(Tex::Table(_)) => self.unsupported(
                     &q.loc,
                     what,
@@ -62,7 +76,7 @@ impl Reader {
                 None => {}
             }
         }
-        Ok(())
+        Ok(varying)
     }
 
     /// Reads the material `d` into `[materials.name]`. false: left out (`lenient`).
@@ -100,7 +114,7 @@ impl Reader {
                 &l,
             )
         });
-        self.constant_float_textures(&mut p, &ty, &what)?;
+        let varying = self.constant_float_textures(&mut p, &ty, &what)?;
         let mut entries: Vec<(&str, Node)> = Vec::new();
         match ty.as_str() {
             "diffuse" => {
@@ -113,8 +127,16 @@ impl Reader {
                 }
             }
             "dielectric" | "conductor" => {
-                let alpha = self.roughness(&mut p, &what)?;
-                let rough = alpha.is_some();
+                let textured = if varying.is_empty() {
+                    None
+                } else {
+                    Some(self.roughness_textures(&mut p, varying, &what, &loc)?)
+                };
+                let alpha = match textured {
+                    Some(_) => None,
+                    None => self.roughness(&mut p, &what)?,
+                };
+                let rough = alpha.is_some() || textured.is_some();
                 if ty == "dielectric" {
                     let eta = self.eta(&mut p, &what)?;
                     if eta <= 0.0 {
@@ -147,6 +169,10 @@ impl Reader {
                     };
                     entries.push(("eta", self.vec3(e, &loc)));
                     entries.push(("k", self.vec3(kk, &loc)));
+                }
+                if let Some(t) = textured {
+                    entries.push(("distribution", self.string("ggx", &loc)));
+                    entries.extend(t);
                 }
                 if let Some((au, av)) = alpha {
                     entries.push(("distribution", self.string("ggx", &loc)));
@@ -513,6 +539,40 @@ impl Reader {
     }
 
     /// pbrt-v4's roughness parameters as GGX alphas (None: smooth).
+    /// A roughness given as textures (`varying`: the parameters that named a varying float
+    /// texture) as foton's `alpha_u`, `alpha_v` (tables, or numbers where given as such) and
+    /// `remaproughness` (pbrt-v4's default true: alpha = sqrt(roughness)).
+    fn roughness_textures(
+        &mut self,
+        p: &mut Bag,
+        varying: Vec<(&'static str, Node)>,
+        what: &str,
+        loc: &Loc,
+    ) -> Result<Vec<(&'static str, Node)>> {
+        let given = |name: &str, p: &mut Bag, r: &mut Reader| -> Result<Option<Node>> {
+            if let Some((_, t)) = varying.iter().find(|(n, _)| *n == name) {
+                return Ok(Some(t.clone()));
+            }
+            Ok(match p.float_opt(name)? {
+                Some((x, l)) if x >= 0.0 => Some(r.num(x, &l)),
+                Some((x, _)) => {
+                    return Err(loc.error(what, format!("{name} {x}: must not be negative")));
+                }
+                None => None,
+            })
+        };
+        let r = given("roughness", p, self)?;
+        let u = given("uroughness", p, self)?.or(r.clone());
+        let v = given("vroughness", p, self)?.or(r);
+        let remap = p.bool("remaproughness", true)?;
+        let zero = || self.num(0.0, loc);
+        Ok(vec![
+            ("alpha_u", u.unwrap_or_else(zero)),
+            ("alpha_v", v.unwrap_or_else(zero)),
+            ("remaproughness", self.node(Value::Bool(remap), loc)),
+        ])
+    }
+
     fn roughness(&mut self, p: &mut Bag, what: &str) -> Result<Option<(f64, f64)>> {
         let r = p.float_opt("roughness")?;
         let u = p.float_opt("uroughness")?.or(r.clone());

@@ -535,6 +535,19 @@ fn alpha_and_float_textures() {
     assert!((num(&t, "shapes.4.alpha") - 0.3).abs() < 1e-12);
     let m = text(&t, "shapes.5.material");
     assert_eq!(text(&t, &format!("materials.{m}.type")), "roughconductor");
+    // A varying roughness of a conductor or a dielectric: foton's textured alpha, remapped.
+    let t = doc(&format!(
+        "{WORLD}Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
+         Material \"dielectric\" \"texture roughness\" \"leaf\" \"float vroughness\" 0.2\nShape \"sphere\"\n"
+    ));
+    let m = text(&t, "shapes.0.material");
+    assert_eq!(text(&t, &format!("materials.{m}.type")), "roughdielectric");
+    assert_eq!(text(&t, &format!("materials.{m}.alpha_u.type")), "bitmap");
+    assert_eq!(num(&t, &format!("materials.{m}.alpha_v")), 0.2);
+    assert!(matches!(
+        node(&t, &format!("materials.{m}.remaproughness")).value,
+        Value::Bool(true)
+    ));
 
     for (scene, words) in [
         (
@@ -543,7 +556,7 @@ fn alpha_and_float_textures() {
         ),
         (
             "Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
-             Material \"conductor\" \"texture roughness\" \"leaf\"\nShape \"sphere\"\n",
+             Material \"coateddiffuse\" \"texture roughness\" \"leaf\"\nShape \"sphere\"\n",
             "a roughness that varies over the surface",
         ),
     ] {

@@ -1,0 +1,90 @@
+//! A microfacet roughness given as a texture (`alpha` a texture table of `roughconductor`
+//! and `roughdielectric`; pbrt-v4's `"texture roughness"`, Mitsuba's textured `alpha`): each
+//! point is the material of the roughness there.
+
+use foton_tests::{header, region_mean, render_toml};
+
+/// A copper quad seen from above, lit by a point light above each half; `alpha` as given.
+fn scene(material: &str, alpha: &str) -> String {
+    header("path", 64, 3, 32, 16)
+        + &format!(
+            r#"
+[camera]
+type = "orthographic"
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+view_height = 1.0
+
+[materials.metal]
+type = "{material}"
+distribution = "ggx"
+alpha = {alpha}
+{extra}
+
+[[lights]]
+type = "point"
+position = [-0.5, 0.0, 0.6]
+intensity = [1.0, 1.0, 1.0]
+
+[[lights]]
+type = "point"
+position = [0.5, 0.0, 0.6]
+intensity = [1.0, 1.0, 1.0]
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, -0.5, 0.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 1.0, 0.0]
+material = "metal"
+"#,
+            extra = if material == "roughconductor" {
+                "material = \"Cu\""
+            } else {
+                "ior = 1.5"
+            }
+        )
+}
+
+#[test]
+fn each_point_of_a_textured_roughness_is_the_material_of_its_roughness() {
+    // The checkerboard along u alone (v' = 0.25): alpha 0.05 on the left half, 0.4 on the
+    // right half; 0.05 and 0.4 as the square roots of 0.0025 and 0.16 with remaproughness.
+    let checks = |a: f32, b: f32| {
+        format!(
+            "{{ type = \"checkerboard\", color0 = [{a}, {a}, {a}], color1 = [{b}, {b}, {b}], to_uv = {{ matrix = [1, 0, 0, 0, 0, 0.25, 0, 0, 1] }} }}"
+        )
+    };
+    for material in ["roughconductor", "roughdielectric"] {
+        let smooth = render_toml("rough-tex", &scene(material, "0.05"), &[], 2);
+        let rough = render_toml("rough-tex", &scene(material, "0.4"), &[], 2);
+        for (alpha, sets) in [
+            (checks(0.05, 0.4), vec![]),
+            (
+                checks(0.0025, 0.16),
+                vec!["materials.metal.remaproughness=true"],
+            ),
+        ] {
+            let textured = render_toml("rough-tex", &scene(material, &alpha), &sets, 2);
+            for (half, x0, x1, want) in [("left", 2, 14, &smooth), ("right", 18, 30, &rough)] {
+                let (got, _) = region_mean(&textured, x0, 2, x1, 14);
+                let (expected, _) = region_mean(want, x0, 2, x1, 14);
+                assert!(
+                    (got.x / expected.x - 1.0).abs() < 0.02,
+                    "{material} {sets:?}, {half} half: {} against {}",
+                    got.x,
+                    expected.x
+                );
+            }
+        }
+        // The two roughnesses look different there (the test can fail).
+        let (a, _) = region_mean(&smooth, 2, 2, 14, 14);
+        let (b, _) = region_mean(&rough, 2, 2, 14, 14);
+        assert!(
+            (a.x / b.x - 1.0).abs() > 0.1,
+            "{material}: {} and {}",
+            a.x,
+            b.x
+        );
+    }
+}
