@@ -5,12 +5,12 @@
 //!
 //! | Parameter                  | Type          | Meaning                                  | Default |
 //! |----------------------------|---------------|------------------------------------------|---------|
-//! | `interface_roughness`      | number        | the coat's roughness (or `interface_uroughness`, `interface_vroughness`) | `0` |
+//! | `interface_roughness`      | number / texture | the coat's roughness (or `interface_uroughness`, `interface_vroughness`) | `0` |
 //! | `interface_eta`            | number        | the coat's index relative to the outside | `1.5`   |
 //! | `conductor_eta`, `conductor_k` | RGB       | the metal's complex index relative to the outside (divided by `interface_eta` under the coat, as pbrt does) | copper |
 //! | `conductor_material`       | string        | instead: a named conductor (`Cu`, `Au`, ...: `conductor`'s names) | |
 //! | `reflectance`              | RGB / texture | instead: the metal's normal reflectance r (eta 1, k = 2 sqrt(r) / sqrt(1 - r)) | |
-//! | `conductor_roughness`      | number        | the metal's roughness (or `conductor_uroughness`, `conductor_vroughness`) | `0` |
+//! | `conductor_roughness`      | number / texture | the metal's roughness (or `conductor_uroughness`, `conductor_vroughness`) | `0` |
 //! | `remaproughness`, `thickness`, `albedo`, `g`, `maxdepth`, `nsamples` | | as for `coateddiffuse` | |
 
 use super::SurfaceMaterial;
@@ -32,6 +32,8 @@ pub struct CoatedConductorMaterial {
     /// The metal's normal reflectance, when it is given that way.
     pub reflectance: Option<Texture>,
     pub albedo: Texture,
+    /// The coat's and the metal's roughness where they vary over the surface.
+    pub roughness: [Option<layered::GgxTextures>; 2],
 }
 
 /// pbrt's index of a metal of normal reflectance `r`: eta 1 and k = 2 sqrt(r) / sqrt(1 - r)
@@ -52,6 +54,12 @@ impl SurfaceMaterial for CoatedConductorMaterial {
         if let Some(r) = &self.reflectance {
             (lobe.base.eta, lobe.base.k) = index_of_reflectance(r.at(uv), lobe.top.eta);
         }
+        if let Some(r) = &self.roughness[0] {
+            lobe.top.ggx = r.at(uv);
+        }
+        if let Some(r) = &self.roughness[1] {
+            lobe.base.ggx = r.at(uv);
+        }
         lobe
     }
 
@@ -61,6 +69,7 @@ impl SurfaceMaterial for CoatedConductorMaterial {
             || !self.lobe.base.ggx.distribution.is_isotropic()
             || self.reflectance.as_ref().is_some_and(|r| !r.is_constant())
             || !self.albedo.is_constant()
+            || self.roughness.iter().any(Option::is_some)
     }
 }
 
@@ -103,13 +112,15 @@ pub const FACTORY: Factory<CoatedConductorMaterial> = Factory {
             None
         };
         let slab = layered::read_slab(m, resources)?;
+        let (top_ggx, top_roughness) = layered::read_ggx_textured(m, "interface_", resources)?;
+        let (base_ggx, base_roughness) = layered::read_ggx_textured(m, "conductor_", resources)?;
         let lobe = Layered {
             top: Dielectric {
-                ggx: layered::read_ggx(m, "interface_")?,
+                ggx: top_ggx,
                 eta: interface_eta,
             },
             base: Conductor {
-                ggx: layered::read_ggx(m, "conductor_")?,
+                ggx: base_ggx,
                 // Relative to the coat above it.
                 eta: eta / interface_eta,
                 k: k / interface_eta,
@@ -124,6 +135,7 @@ pub const FACTORY: Factory<CoatedConductorMaterial> = Factory {
             lobe,
             reflectance,
             albedo: slab.albedo,
+            roughness: [top_roughness, base_roughness],
         }))
     },
 };

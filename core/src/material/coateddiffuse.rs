@@ -5,7 +5,7 @@
 //! | Parameter        | Type          | Meaning                                          | Default |
 //! |------------------|---------------|--------------------------------------------------|---------|
 //! | `reflectance`    | RGB / texture | the base's albedo (clamped to [0, 1])            | `0.5`   |
-//! | `roughness`      | number        | the coat's roughness (or `uroughness`, `vroughness`) | `0` (smooth) |
+//! | `roughness`      | number / texture | the coat's roughness (or `uroughness`, `vroughness`) | `0` (smooth) |
 //! | `remaproughness` | bool          | alpha = sqrt(roughness), as pbrt's `RoughnessToAlpha` | `true` |
 //! | `eta`            | number        | the coat's index relative to the outside        | `1.5`   |
 //! | `thickness`      | number        | the slab's depth in mean free paths              | `0.01`  |
@@ -30,6 +30,8 @@ pub struct CoatedDiffuseMaterial {
     pub lobe: CoatedDiffuseBxdf,
     pub reflectance: Texture,
     pub albedo: Texture,
+    /// The coat's roughness where it varies over the surface.
+    pub roughness: Option<layered::GgxTextures>,
 }
 
 impl SurfaceMaterial for CoatedDiffuseMaterial {
@@ -38,7 +40,12 @@ impl SurfaceMaterial for CoatedDiffuseMaterial {
     #[inline(always)]
     fn bxdf(&self, uv: Vec2) -> CoatedDiffuseBxdf {
         let clamp = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
+        let mut top = self.lobe.top;
+        if let Some(r) = &self.roughness {
+            top.ggx = r.at(uv);
+        }
         Layered {
+            top,
             base: Diffuse {
                 reflectance: clamp(self.reflectance.at(uv)),
             },
@@ -52,6 +59,7 @@ impl SurfaceMaterial for CoatedDiffuseMaterial {
         !self.lobe.top.ggx.distribution.is_isotropic()
             || !self.reflectance.is_constant()
             || !self.albedo.is_constant()
+            || self.roughness.is_some()
     }
 }
 
@@ -61,9 +69,10 @@ pub const FACTORY: Factory<CoatedDiffuseMaterial> = Factory {
     create: |m, _, resources| {
         let reflectance = super::reflectance(m, "reflectance", Rgb::splat(0.5), resources)?;
         let slab = layered::read_slab(m, resources)?;
+        let (ggx, roughness) = layered::read_ggx_textured(m, "", resources)?;
         let lobe = Layered {
             top: Dielectric {
-                ggx: layered::read_ggx(m, "")?,
+                ggx,
                 eta: layered::read_eta(m, "eta")?,
             },
             base: Diffuse {
@@ -79,6 +88,7 @@ pub const FACTORY: Factory<CoatedDiffuseMaterial> = Factory {
             lobe,
             reflectance,
             albedo: slab.albedo,
+            roughness,
         }))
     },
 };

@@ -995,6 +995,74 @@ pub fn read_ggx(m: &Properties<'_>, prefix: &str) -> Result<Ggx> {
     Ok(Ggx::new(u, v, m.bool("remaproughness", true)?))
 }
 
+/// A coat's or a base's roughness that varies over the surface: `roughness` (or
+/// `uroughness`, `vroughness`) given as textures (a grey's value, a colour's luminance).
+#[derive(Clone, Debug)]
+pub struct GgxTextures {
+    pub u: Texture,
+    pub v: Texture,
+    pub remap: bool,
+}
+
+impl GgxTextures {
+    /// The distribution at surface coordinates `uv`.
+    #[inline]
+    pub fn at(&self, uv: Vec2) -> Ggx {
+        let value = |t: &Texture| {
+            let c = t.at(uv);
+            if c.x == c.y && c.y == c.z {
+                c.x
+            } else {
+                crate::texture::luminance(c)
+            }
+        };
+        Ggx::new(value(&self.u), value(&self.v), self.remap)
+    }
+}
+
+/// [`read_ggx`], and where `roughness` (`uroughness`, `vroughness`) is a texture table, the
+/// textures that give each point its own (the distribution then has their means).
+pub fn read_ggx_textured(
+    m: &Properties<'_>,
+    prefix: &str,
+    resources: &mut dyn Resources,
+) -> Result<(Ggx, Option<GgxTextures>)> {
+    let key = |name: &str| format!("{prefix}{name}");
+    let is_table = |k: &str| {
+        m.node(k)
+            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
+    };
+    if !["roughness", "uroughness", "vroughness"]
+        .iter()
+        .any(|n| is_table(&key(n)))
+    {
+        return Ok((read_ggx(m, prefix)?, None));
+    }
+    let read = |name: &str, default: Texture, resources: &mut dyn Resources| -> Result<Texture> {
+        let k = key(name);
+        if is_table(&k) {
+            return resources.texture(m, &k, Rgb::ZERO);
+        }
+        if !m.has(&k) {
+            return Ok(default);
+        }
+        let x = m.f32(&k, 0.0)?;
+        if !(x >= 0.0 && x.is_finite()) {
+            return Err(m.error(&k, format!("must be >= 0, found {x}")));
+        }
+        Ok(Texture::Constant(Rgb::splat(x)))
+    };
+    let r = read("roughness", Texture::Constant(Rgb::ZERO), resources)?;
+    let textures = GgxTextures {
+        u: read("uroughness", r.clone(), resources)?,
+        v: read("vroughness", r, resources)?,
+        remap: m.bool("remaproughness", true)?,
+    };
+    let mean = |t: &Texture| crate::texture::luminance(t.mean());
+    let ggx = Ggx::new(mean(&textures.u), mean(&textures.v), textures.remap);
+    Ok((ggx, Some(textures)))
+}
+
 /// A relative index of refraction `key` (default 1.5), positive; pbrt takes 0 as 1.
 pub fn read_eta(m: &Properties<'_>, key: &str) -> Result<f32> {
     let eta = m.f32(key, 1.5)?;

@@ -88,3 +88,46 @@ fn each_point_of_a_textured_roughness_is_the_material_of_its_roughness() {
         );
     }
 }
+
+/// The same for the coat of `coateddiffuse` and the metal of `coatedconductor` (pbrt-v4's
+/// `roughness` and `conductor.roughness`, remapped by default).
+#[test]
+fn a_coats_textured_roughness_is_the_coat_of_each_points_roughness() {
+    let checks = |a: f32, b: f32| {
+        format!(
+            "{{ type = \"checkerboard\", color0 = [{a}, {a}, {a}], color1 = [{b}, {b}, {b}], to_uv = {{ matrix = [1, 0, 0, 0, 0, 0.25, 0, 0, 1] }} }}"
+        )
+    };
+    for (material, key) in [
+        ("coateddiffuse", "roughness"),
+        ("coatedconductor", "conductor_roughness"),
+    ] {
+        let scene = |value: &str| {
+            scene("roughconductor", "0.1").replace(
+                "type = \"roughconductor\"\ndistribution = \"ggx\"\nalpha = 0.1\nmaterial = \"Cu\"",
+                &format!("type = \"{material}\"\n{key} = {value}"),
+            )
+        };
+        let smooth = render_toml("rough-coat", &scene("0.01"), &[], 2);
+        let rough = render_toml("rough-coat", &scene("0.3"), &[], 2);
+        let textured = render_toml("rough-coat", &scene(&checks(0.01, 0.3)), &[], 2);
+        for (half, x0, x1, want) in [("left", 2, 14, &smooth), ("right", 18, 30, &rough)] {
+            let (got, _) = region_mean(&textured, x0, 2, x1, 14);
+            let (expected, _) = region_mean(want, x0, 2, x1, 14);
+            assert!(
+                (got.x / expected.x - 1.0).abs() < 0.03,
+                "{material}, {half} half: {} against {}",
+                got.x,
+                expected.x
+            );
+        }
+        let (a, _) = region_mean(&smooth, 2, 2, 14, 14);
+        let (b, _) = region_mean(&rough, 2, 2, 14, 14);
+        assert!(
+            (a.x / b.x - 1.0).abs() > 0.1,
+            "{material}: {} and {}",
+            a.x,
+            b.x
+        );
+    }
+}

@@ -45,7 +45,10 @@ impl Reader {
     ) -> Result<Vec<(&'static str, Node)>> {
         let eta = matches!(ty, "dielectric" | "thindielectric" | "coateddiffuse");
         // foton's rough conductor and dielectric take a roughness texture.
-        let varying_roughness = matches!(ty, "dielectric" | "conductor");
+        let varying_roughness = matches!(
+            ty,
+            "dielectric" | "conductor" | "coateddiffuse" | "coatedconductor"
+        );
         let mut varying = Vec::new();
         for &name in FLOAT_TEXTURE_PARAMS.iter().chain(eta.then_some(&"eta")) {
             let Some(q) = p.take(name) else { continue };
@@ -60,8 +63,7 @@ impl Reader {
                     ..q
                 }),
                 Some(Tex::Table(t))
-                    if varying_roughness
-                        && matches!(name, "roughness" | "uroughness" | "vroughness") =>
+                    if varying_roughness && name.ends_with("roughness") =>
                 {
                     varying.push((name, t));
                 }
@@ -367,6 +369,11 @@ impl Reader {
                         ("g", "g"),
                     ]
                 };
+                for (name, table) in varying.iter().cloned() {
+                    if let Some(&(_, key)) = floats.iter().find(|(n, _)| *n == name) {
+                        entries.push((key, table));
+                    }
+                }
                 for &(name, key) in floats {
                     let Some(q) = p.take(name) else { continue };
                     let x = match (&q.ty, &q.values) {

@@ -548,6 +548,15 @@ fn alpha_and_float_textures() {
         node(&t, &format!("materials.{m}.remaproughness")).value,
         Value::Bool(true)
     ));
+    let t = doc(&format!(
+        "{WORLD}Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
+         Material \"coatedconductor\" \"texture conductor.roughness\" \"leaf\"\nShape \"sphere\"\n"
+    ));
+    let m = text(&t, "shapes.0.material");
+    assert_eq!(
+        text(&t, &format!("materials.{m}.conductor_roughness.type")),
+        "bitmap"
+    );
 
     for (scene, words) in [
         (
@@ -556,8 +565,8 @@ fn alpha_and_float_textures() {
         ),
         (
             "Texture \"leaf\" \"float\" \"imagemap\" \"string filename\" \"leaf.png\"\n\
-             Material \"coateddiffuse\" \"texture roughness\" \"leaf\"\nShape \"sphere\"\n",
-            "a roughness that varies over the surface",
+             Material \"coateddiffuse\" \"texture thickness\" \"leaf\"\nShape \"sphere\"\n",
+            "a thickness that varies over the surface",
         ),
     ] {
         let text = format!("{WORLD}{scene}");
