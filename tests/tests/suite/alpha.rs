@@ -264,3 +264,23 @@ fn mitsubas_mask_is_a_cut_out() {
     assert!(err.contains("cut-out emitter"), "{err}");
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The Mitsuba 3 comparison scenes (docs/scene-format.md) open as written: the mask's
+/// shapes carry their cut-outs, the rough materials their roughness textures.
+#[test]
+fn the_mitsuba3_comparison_scenes_open_as_written() {
+    let root = foton_tests::repo_root().join("scenes/mitsuba3");
+    let mask = foton_loader::load(&root.join("mask.xml"), &[]).unwrap();
+    let cut: Vec<bool> = mask.objects().iter().map(|o| o.alpha.is_some()).collect();
+    assert_eq!(cut, [false, true, true]);
+    let rough = foton_loader::load(&root.join("rough-texture.xml"), &[]).unwrap();
+    assert!(rough.unused().is_empty(), "{:?}", rough.unused());
+    for m in rough.materials() {
+        let textured = match &m.value {
+            foton_core::material::Material::RoughConductor(r) => r.roughness.is_some(),
+            foton_core::material::Material::RoughDielectric(r) => r.roughness.is_some(),
+            _ => continue,
+        };
+        assert!(textured, "{}", m.name);
+    }
+}
