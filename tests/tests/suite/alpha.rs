@@ -87,6 +87,31 @@ fn a_quarter_opaque_screen_passes_three_quarters_each_way_for_every_integrator()
     }
 }
 
+/// The same in an absorbing medium filling the scene (shadow rays then carry transmittance,
+/// walked past the cut-outs): the absorption is common to both images, so the ratio is
+/// still (3/4)^2.
+#[test]
+fn a_quarter_opaque_screen_in_an_absorbing_medium() {
+    let ink = "\n[media.ink]\ntype = \"homogeneous\"\nsigma_a = [0.3, 0.3, 0.3]\n\n[scene]\nmedium = \"ink\"\n";
+    for (integrator, spp) in [("path", 256), ("bdpt", 64), ("vpm", 64), ("ppb", 64)] {
+        let render = |screen| {
+            render_toml(
+                "alpha-ink",
+                &(screened_floor(integrator, spp, screen) + ink),
+                &[],
+                2,
+            )
+        };
+        let open = render(None).mean().x;
+        let screened = render(Some("0.25")).mean().x;
+        let ratio = screened / open;
+        assert!(
+            (ratio / 0.5625 - 1.0).abs() < 0.03,
+            "{integrator} in ink: screened {screened}, open {open}: ratio {ratio}, expected 0.5625"
+        );
+    }
+}
+
 /// A quad cut out by a checkerboard alpha (0 and 1) in front of a glowing one: each pixel
 /// shows the glow where the check is cut out and the black quad where it is not, so the
 /// image is the checkerboard itself, exactly (no noise: the test is binary).
