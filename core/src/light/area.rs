@@ -1,7 +1,8 @@
 //! Area lights: an emissive shape (any shape given an `emission`; in Mitsuba files, an
 //! `area` emitter inside a shape) emits `radiance` on the side its geometric normal points
-//! to, and nothing on the other side. They are made with their shapes, never from a
-//! `[[lights]]` entry: the factory's error says where they go.
+//! to, and nothing on the other side, unless it is two-sided (pbrt-v4's `twosided`: the
+//! same radiance on both sides, twice the power). They are made with their shapes, never
+//! from a `[[lights]]` entry: the factory's error says where they go.
 
 use super::{EmittedRay, Light, LightSample, LightSource, LightType};
 use crate::Rgb;
@@ -22,6 +23,8 @@ pub struct AreaLight {
     pub radiance: Rgb,
     /// The scene object that emits.
     pub object: u32,
+    /// Whether it emits on both sides.
+    pub twosided: bool,
 }
 
 impl AreaLight {
@@ -35,7 +38,19 @@ impl AreaLight {
             area,
             radiance,
             object,
+            twosided: false,
         }
+    }
+
+    /// The light emitting on both sides of its shapes when `twosided`.
+    pub fn with_twosided(self, twosided: bool) -> AreaLight {
+        AreaLight { twosided, ..self }
+    }
+
+    /// How many sides emit.
+    #[inline]
+    fn sides(&self) -> f32 {
+        if self.twosided { 2.0 } else { 1.0 }
     }
 }
 
@@ -105,9 +120,9 @@ impl LightSource for AreaLight {
         LightType::Area
     }
 
-    /// pi A L for a one-sided emitter.
+    /// pi A L per emitting side.
     fn power(&self) -> Rgb {
-        PI * self.area * self.radiance
+        self.sides() * PI * self.area * self.radiance
     }
 
     #[inline(never)]
@@ -133,7 +148,11 @@ impl LightSource for AreaLight {
             return Some(LightSample {
                 wi,
                 dist: x.distance(p),
-                li: if inward { Rgb::ZERO } else { self.radiance },
+                li: if inward && !self.twosided {
+                    Rgb::ZERO
+                } else {
+                    self.radiance
+                },
                 pdf: cone.pdf(),
                 delta: false,
                 p,
@@ -148,7 +167,10 @@ impl LightSource for AreaLight {
         }
         let dist = dist2.sqrt();
         let wi = d / dist;
-        let cos_l = n.dot(-wi);
+        let mut cos_l = n.dot(-wi);
+        if self.twosided {
+            cos_l = cos_l.abs();
+        }
         if cos_l <= 0.0 {
             return None;
         }
@@ -180,35 +202,47 @@ impl LightSource for AreaLight {
 
     #[inline]
     fn emitted(&self, n: Vec3, w: Vec3) -> Rgb {
-        if n.dot(w) > 0.0 {
+        if n.dot(w) > 0.0 || (self.twosided && n.dot(w) < 0.0) {
             self.radiance
         } else {
             Rgb::ZERO
         }
     }
 
-    /// A uniform point, a cosine-distributed direction on its normal side.
+    /// A uniform point, a cosine-distributed direction on its normal side (two-sided: on
+    /// either side with probability 1/2, the first direction number choosing it).
     fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2, uc: f32) -> EmittedRay {
         let (i, _) = self.by_area.sample(uc);
-        let (p, n) = self.shapes[i].sample_area(u_pos);
+        let (p, mut n) = self.shapes[i].sample_area(u_pos);
+        let mut u_dir = u_dir;
+        if self.twosided {
+            if u_dir.x < 0.5 {
+                u_dir.x *= 2.0;
+            } else {
+                u_dir.x = (2.0 * u_dir.x - 1.0).min(crate::sampling::ONE_MINUS_EPSILON);
+                n = -n;
+            }
+        }
         let local = cosine_hemisphere(u_dir);
         EmittedRay {
             origin: p,
             dir: to_world(local, n),
             n,
-            // L cos / (1/A * cos/pi) = pi A L
-            flux: PI * self.area * self.radiance,
+            // L cos / (1/A * cos/(sides pi)) = sides pi A L
+            flux: self.sides() * PI * self.area * self.radiance,
             le: self.radiance,
             pdf_pos: 1.0 / self.area,
-            pdf_dir: local.z * std::f32::consts::FRAC_1_PI,
+            pdf_dir: local.z * std::f32::consts::FRAC_1_PI / self.sides(),
         }
     }
 
     fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32) {
-        (
-            1.0 / self.area,
-            n.dot(dir).max(0.0) * std::f32::consts::FRAC_1_PI,
-        )
+        let cos = if self.twosided {
+            n.dot(dir).abs() / 2.0
+        } else {
+            n.dot(dir).max(0.0)
+        };
+        (1.0 / self.area, cos * std::f32::consts::FRAC_1_PI)
     }
 }
 

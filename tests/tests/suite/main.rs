@@ -76,6 +76,7 @@ mod thin_lens;
 mod tonemap;
 mod tools;
 mod tools_bad_input;
+mod twosided_emitter;
 mod vcm;
 mod volume_photons;
 mod vpm;

@@ -327,7 +327,8 @@ fn uv_sphere_obj(rows: usize, with_vt: bool) -> String {
 
 /// Smooth normals: a coarse tessellated sphere without normals is shaded with vertex normals
 /// computed from its faces (Mitsuba's default), so its normals are close to the true sphere's
-/// everywhere; with `face_normals` they are the facets' (off by up to half a facet's angle).
+/// everywhere; with `face_normals` they are the facets' (off by up to half a facet's angle),
+/// and with `compute_normals = false` too (the file has none).
 #[test]
 fn meshes_without_normals_are_shaded_smooth() {
     let dir = temp_dir("smooth-normals");
@@ -340,6 +341,8 @@ fn meshes_without_normals_are_shaded_smooth() {
         foton_loader::load(&write(&dir, "s.toml", &text), &[]).unwrap()
     };
     let (smooth, faceted) = (load(""), load("face_normals = true"));
+    // pbrt-v4's way: no normals computed where the file has none.
+    let uncomputed = load("compute_normals = false");
     let mut rng = foton_core::sampling::Rng::new(&[5]);
     let (mut worst_smooth, mut worst_faceted) = (0.0f32, 0.0f32);
     for _ in 0..2000 {
@@ -352,6 +355,12 @@ fn meshes_without_normals_are_shaded_smooth() {
         }
         let origin = target.normalize() * 3.0;
         let ray = foton_core::geometry::Ray::new(origin, (target - origin).normalize());
+        let hit = uncomputed.intersect(&ray, f32::INFINITY).unwrap();
+        assert_eq!(
+            uncomputed.surface(&hit).ns,
+            hit.ng,
+            "compute_normals = false: flat"
+        );
         for (scene, worst) in [(&smooth, &mut worst_smooth), (&faceted, &mut worst_faceted)] {
             let hit = scene.intersect(&ray, f32::INFINITY).unwrap();
             let sp = scene.surface(&hit);

@@ -9,7 +9,8 @@ use crate::mesh::{MeshOptions, inline_mesh, load_mesh};
 use foton_core::Rgb;
 use foton_core::error::Result;
 use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
-use foton_core::light::area_light;
+use foton_core::light::Light;
+use foton_core::light::area::AreaLight;
 use foton_core::material::Material;
 use foton_core::props::Properties;
 use foton_core::registry::Resources;
@@ -89,6 +90,7 @@ pub(super) fn read_shapes(
                     face_normals: s.bool("face_normals", false)?,
                     flip_tex_coords: s.bool("flip_tex_coords", true)?,
                     flip_normals: flip,
+                    compute_normals: s.bool("compute_normals", true)?,
                 };
                 // The triangles written in the scene (a pbrt-v4 trianglemesh), or a file.
                 let mesh = if s.has("positions") && !s.has("file") {
@@ -206,7 +208,10 @@ pub(super) fn read_shapes(
                 ));
             }
             light = Some(g.lights.len() as u32);
-            g.lights.push(area_light(shapes.clone(), emission, object));
+            let twosided = s.bool("emission_twosided", false)?;
+            g.lights.push(Light::Area(
+                AreaLight::new(shapes.clone(), emission, object).with_twosided(twosided),
+            ));
             // Mitsuba's area emitter emits into its shape's exterior.
             g.light_media.push(explicit_media.then_some(exterior));
         }

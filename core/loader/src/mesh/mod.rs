@@ -29,6 +29,9 @@ pub struct MeshOptions {
     pub flip_tex_coords: bool,
     /// Turn the mesh inside out: reversed triangles, negated vertex normals.
     pub flip_normals: bool,
+    /// Without vertex normals of its own (the file's, or `normals`), compute smooth ones
+    /// (Mitsuba's way); false: shade with the triangles' own normals (pbrt-v4's way).
+    pub compute_normals: bool,
 }
 
 /// A mesh in the scene: its triangles, their attributes (empty, or one per triangle) and
@@ -343,6 +346,8 @@ fn triangles(
             .map(|&n| (normal_matrix * n).normalize_or_zero())
             .collect();
         (n, &raw.normal_triangles[..])
+    } else if !options.compute_normals {
+        (Vec::new(), &[][..])
     } else {
         let mut n = vertex_normals(&positions, &raw.triangles);
         if mirrored {
@@ -675,6 +680,7 @@ mod tests {
             face_normals: false,
             flip_tex_coords: false,
             flip_normals: false,
+            compute_normals: true,
         };
         let raw = |triangles: Vec<[u32; 3]>| RawMesh {
             positions: vec![Vec3::ZERO, Vec3::X, Vec3::Y, 2.0 * Vec3::X],

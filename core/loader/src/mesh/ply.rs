@@ -799,6 +799,7 @@ mod tests {
                     face_normals: next(2) == 0,
                     flip_tex_coords: false,
                     flip_normals: next(2) == 0,
+                    compute_normals: true,
                 };
                 let crease = (next(2) == 0 && !options.face_normals).then_some(30.0);
                 let _ = super::super::triangles(raw, glam::Mat4::IDENTITY, options, crease);

@@ -87,10 +87,14 @@ impl Reader {
                 let Some(mesh) = self.triangle_mesh(&mut p, &what, &loc)? else {
                     return Ok(());
                 };
-                area = Some(mesh.area(m));
+                area = Some(mesh.triangle_area(m));
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
+                // pbrt-v4 shades a mesh without "N" with its triangles' own normals.
+                if mesh.normals.is_none() {
+                    entries.push(("compute_normals", self.node(Value::Bool(false), &loc)));
+                }
             }
             "plymesh" => {
                 let (name, l) = p
@@ -116,6 +120,8 @@ impl Reader {
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.push(("file", self.string(&rel.to_string_lossy(), &l)));
                 entries.push(("transform", self.matrix(m, &loc)));
+                // The file's vertex normals if it has them, else the triangles' own (pbrt-v4).
+                entries.push(("compute_normals", self.node(Value::Bool(false), &loc)));
                 if !self.ply_noted {
                     self.ply_noted = true;
                     self.note(&loc, &what, "a PLY mesh's triangles keep their winding's side; pbrt-v4 turns a triangle with vertex normals towards them (the same for consistently oriented meshes)");
@@ -139,7 +145,7 @@ impl Reader {
                 let Some(mesh) = self.loop_subdivision(&mut p, &what, &loc)? else {
                     return Ok(());
                 };
-                area = Some(mesh.area(m));
+                area = Some(mesh.triangle_area(m));
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
@@ -164,9 +170,15 @@ impl Reader {
             entries.push(("flip_normals", self.node(Value::Bool(true), &loc)));
         }
         if let Some(light) = state.area_light.clone()
-            && let Some(emission) = self.area_light(&light, area)?
+            && let Some((emission, twosided)) = self.area_light(&light, area)?
         {
             entries.push(("emission", self.vec3(emission, &light.loc)));
+            if twosided {
+                entries.push((
+                    "emission_twosided",
+                    self.node(Value::Bool(true), &light.loc),
+                ));
+            }
         }
         let material = self.current_material(state);
         entries.push(("material", self.string(&material, &loc)));
@@ -642,6 +654,15 @@ impl InlineMesh {
         }
     }
 
+    /// The area pbrt-v4 normalises an area light's `power` by on a triangle mesh: each
+    /// triangle is a light of its own, of its own area (so the mesh emits `power` per
+    /// triangle). foton gives the mesh one radiance: that of the mean triangle, which keeps
+    /// the total power and is exact where the triangles are of one area (a quad's two).
+    fn triangle_area(&self, m: DMat4) -> f64 {
+        let n = (self.indices.len() / 3).max(1);
+        self.area(m) / n as f64
+    }
+
     fn area(&self, m: DMat4) -> f64 {
         self.indices
             .chunks(3)
@@ -699,8 +720,9 @@ fn uniform_scale(m: DMat4) -> Option<f64> {
 impl Reader {
     /// The emission of a shape under the `AreaLightSource` `d` (pbrt-v4's `DiffuseAreaLight`):
     /// `L` (default: the colour space's illuminant, white) times `scale`; `power` sets the
-    /// emitted power (with the shape's `area`). None: nothing emitted (left out, `lenient`).
-    fn area_light(&mut self, d: &Directive, area: Option<f64>) -> Result<Option<DVec3>> {
+    /// emitted power (with the shape's `area`, over both sides when `twosided`); and whether
+    /// it is two-sided. None: nothing emitted (left out, `lenient`).
+    fn area_light(&mut self, d: &Directive, area: Option<f64>) -> Result<Option<(DVec3, bool)>> {
         let mut p = Bag::new(d);
         let what = d.what();
         if d.string(0) != "diffuse" {
@@ -721,15 +743,14 @@ impl Reader {
             )?;
             return Ok(None);
         }
-        if p.bool("twosided", false)? {
-            self.unsupported(&d.loc, &what, "\"twosided\" true: foton's area lights emit on one side (--lenient: on the normal's side only)")?;
-        }
+        let twosided = p.bool("twosided", false)?;
+        let sides = if twosided { 2.0 } else { 1.0 };
         if let Some((phi, pl)) = p.float_opt("power")?
             && phi > 0.0
         {
             match area {
                 // k_e: the power of unit radiance (pbrt-v4 does not count the rgb's colour).
-                Some(a) if a > 0.0 => scale *= phi / (std::f64::consts::PI * a),
+                Some(a) if a > 0.0 => scale *= phi / (sides * std::f64::consts::PI * a),
                 _ => {
                     self.unsupported(
                         &pl,
@@ -740,6 +761,6 @@ impl Reader {
             }
         }
         self.finish(&mut p)?;
-        Ok(Some(l * scale))
+        Ok(Some((l * scale, twosided)))
     }
 }

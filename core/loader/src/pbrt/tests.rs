@@ -243,15 +243,24 @@ fn area_lights_attach_to_the_shapes_that_follow_in_their_attribute_block() {
     let e = nums(&t, "shapes.2.emission");
     let want = 10.0 / (std::f64::consts::PI * 2.0);
     assert!(close(&e, &[want, want, want]), "{e:?}");
-    let e = read(
-        &format!("{WORLD}AreaLightSource \"diffuse\" \"bool twosided\" true\nShape \"sphere\"\n"),
-        false,
-    )
-    .unwrap_err();
-    assert!(
-        e.contains("scene.pbrt:3:1") && e.contains("twosided") && e.contains("--lenient"),
-        "{e}"
-    );
+    // Two-sided: `emission_twosided`, and `power` shared by the two sides; on a mesh, per
+    // triangle (pbrt-v4 makes each triangle a light of its own).
+    let t = doc(&format!(
+        "{WORLD}AreaLightSource \"diffuse\" \"bool twosided\" true \"float power\" 10\n\
+         Shape \"trianglemesh\" \"point3 P\" [0 0 0  1 0 0  1 1 0  0 1 0] \"integer indices\" [0 1 2  0 2 3]\n"
+    ));
+    assert!(matches!(
+        node(&t, "shapes.0.emission_twosided").value,
+        Value::Bool(true)
+    ));
+    let e = nums(&t, "shapes.0.emission");
+    let want = 10.0 / (2.0 * std::f64::consts::PI * 0.5);
+    assert!(close(&e, &[want, want, want]), "{e:?}");
+    // A mesh without "N" is shaded flat, as pbrt-v4 shades it.
+    assert!(matches!(
+        node(&t, "shapes.0.compute_normals").value,
+        Value::Bool(false)
+    ));
 }
 
 #[test]
