@@ -87,7 +87,7 @@ impl Reader {
                 let Some(mesh) = self.triangle_mesh(&mut p, &what, &loc)? else {
                     return Ok(());
                 };
-                area = Some(mesh.triangle_area(m));
+                area = Some(mesh.light_area(m));
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
@@ -136,7 +136,7 @@ impl Reader {
                 let Some(mesh) = mesh else {
                     return Ok(());
                 };
-                area = Some(mesh.area(m));
+                area = Some(mesh.light_area(m));
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
@@ -145,7 +145,7 @@ impl Reader {
                 let Some(mesh) = self.loop_subdivision(&mut p, &what, &loc)? else {
                     return Ok(());
                 };
-                area = Some(mesh.triangle_area(m));
+                area = Some(mesh.light_area(m));
                 entries.push(("type", self.string("mesh", &loc)));
                 entries.extend(mesh.entries(self, &loc));
                 entries.push(("transform", self.matrix(m, &loc)));
@@ -275,6 +275,7 @@ impl Reader {
             indices,
             normals: Some(normals),
             uvs: Some(uvs),
+            lights: Some(1),
         }))
     }
 
@@ -316,6 +317,7 @@ impl Reader {
             indices: Vec::new(),
             normals: given_n.as_ref().map(|_| Vec::new()),
             uvs: Some(Vec::new()),
+            lights: Some(patches.len() / 4),
         };
         let mut curved = false;
         for q in patches.chunks(4) {
@@ -417,6 +419,7 @@ impl Reader {
                     .collect(),
             ),
             uvs: None,
+            lights: None,
         }))
     }
 
@@ -443,6 +446,7 @@ impl Reader {
             indices,
             normals,
             uvs,
+            lights: None,
         };
         mesh.orient_to_normals();
         Ok(Some(mesh))
@@ -632,6 +636,10 @@ struct InlineMesh {
     indices: Vec<u32>,
     normals: Option<Vec<f64>>,
     uvs: Option<Vec<f64>>,
+    /// How many lights pbrt-v4 makes of the shape under an area light (each normalises
+    /// `power` by its own area): one per patch of a bilinear mesh, one for a cylinder;
+    /// None: one per triangle.
+    lights: Option<usize>,
 }
 
 impl InlineMesh {
@@ -654,12 +662,13 @@ impl InlineMesh {
         }
     }
 
-    /// The area pbrt-v4 normalises an area light's `power` by on a triangle mesh: each
-    /// triangle is a light of its own, of its own area (so the mesh emits `power` per
-    /// triangle). foton gives the mesh one radiance: that of the mean triangle, which keeps
-    /// the total power and is exact where the triangles are of one area (a quad's two).
-    fn triangle_area(&self, m: DMat4) -> f64 {
-        let n = (self.indices.len() / 3).max(1);
+    /// The area pbrt-v4 normalises an area light's `power` by: each triangle of a mesh
+    /// (each patch of a bilinear mesh) is a light of its own, of its own area, so the mesh
+    /// emits `power` per triangle. foton gives the mesh one radiance: that of the mean
+    /// light, which keeps the total power and is exact where they are of one area (a quad's
+    /// two triangles).
+    fn light_area(&self, m: DMat4) -> f64 {
+        let n = self.lights.unwrap_or(self.indices.len() / 3).max(1);
         self.area(m) / n as f64
     }
 
