@@ -4,7 +4,7 @@
 //! normalize(e1 x e2) for triangles. [`SurfacePoint`] adds what shading needs: the shading
 //! normal, texture coordinates and the tangent dp/du, with Mitsuba 3's parameterisations.
 
-use glam::{Vec2, Vec3};
+use glam::{Mat3, Vec2, Vec3};
 use obvhs::aabb::Aabb;
 
 #[derive(Clone, Copy, Debug)]
@@ -39,10 +39,13 @@ pub fn offset_origin(p: Vec3, n: Vec3, dir: Vec3) -> Vec3 {
 #[derive(Clone, Copy, Debug)]
 pub enum Shape {
     /// The normal points outward, or inward if `inward` (Mitsuba's `flip_normals`).
+    /// `to_local` turns world directions into the sphere's own axes, about whose z its
+    /// texture coordinates run (the identity: the world's axes).
     Sphere {
         center: Vec3,
         radius: f32,
         inward: bool,
+        to_local: Mat3,
     },
     /// origin + s u + t v, s, t in [0, 1]. `w` = n / (n . n) with n = u x v (for the
     /// barycentric-style coordinates of a hit), `normal` = normalize(n).
@@ -167,6 +170,18 @@ impl Shape {
             center,
             radius,
             inward: false,
+            to_local: Mat3::IDENTITY,
+        }
+    }
+
+    /// A sphere whose texture coordinates run about its own axes: `to_local`'s rows are
+    /// the directions in the world of its x, y and z (orthonormal).
+    pub fn sphere_with_axes(center: Vec3, radius: f32, to_local: Mat3) -> Shape {
+        Shape::Sphere {
+            center,
+            radius,
+            inward: false,
+            to_local,
         }
     }
 
@@ -345,8 +360,13 @@ impl Shape {
             };
         }
         let (uv, dpdu, ns) = match *self {
-            Shape::Sphere { center, radius, .. } => {
-                let d = (p - center) / radius;
+            Shape::Sphere {
+                center,
+                radius,
+                to_local,
+                ..
+            } => {
+                let d = to_local * ((p - center) / radius);
                 let mut phi = d.y.atan2(d.x);
                 if phi < 0.0 {
                     phi += 2.0 * std::f32::consts::PI;
@@ -356,7 +376,8 @@ impl Shape {
                     phi * (0.5 * std::f32::consts::FRAC_1_PI),
                     theta * std::f32::consts::FRAC_1_PI,
                 );
-                let dpdu = Vec3::new(-d.y, d.x, 0.0) * (2.0 * std::f32::consts::PI * radius);
+                let dpdu = to_local.transpose()
+                    * (Vec3::new(-d.y, d.x, 0.0) * (2.0 * std::f32::consts::PI * radius));
                 (uv, dpdu, ng)
             }
             Shape::Quad {
@@ -430,6 +451,7 @@ impl Shape {
                 center,
                 radius,
                 inward,
+                ..
             } => {
                 let d = crate::sampling::uniform_sphere(u);
                 (center + radius * d, if inward { -d } else { d })
@@ -468,6 +490,13 @@ fn bounds(pts: &[Vec3]) -> (Vec3, Vec3) {
 
 #[cfg(test)]
 mod tests {
+
+    /// A sphere's axes fit in the room a quad takes: the shape (and the BVH's primitives)
+    /// stay the size they were.
+    #[test]
+    fn a_sphere_is_no_larger_than_a_quad() {
+        assert_eq!(std::mem::size_of::<Shape>(), 64);
+    }
     use super::*;
 
     #[test]

@@ -133,6 +133,7 @@ impl LightSource for AreaLight {
             center,
             radius,
             inward,
+            ..
         } = *shape
             && self.shapes.len() == 1
             && let Some(cone) = SphereCone::from(center, radius, x)

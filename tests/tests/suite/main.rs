@@ -67,6 +67,7 @@ mod scenes;
 mod shapes;
 mod spectra;
 mod sphere_light;
+mod sphere_uv;
 mod spot;
 mod sppm;
 mod techniques;

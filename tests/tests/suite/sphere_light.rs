@@ -38,11 +38,7 @@ fn sphere_cone_pdf_and_irradiance_are_exact_down_to_tiny_angles() {
         (1.0, 1e4),
     ] {
         let center = x + axis * d;
-        let sphere = Shape::Sphere {
-            center,
-            radius: r,
-            inward: false,
-        };
+        let sphere = Shape::sphere(center, r);
         let light = area_light(vec![sphere], Rgb::splat(radiance), 0);
         let want_pdf = 1.0 / (2.0 * PI * one_minus_cos_max(r as f64, d as f64));
         let n = 4096;

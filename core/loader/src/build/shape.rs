@@ -17,7 +17,7 @@ use foton_core::registry::Resources;
 use foton_core::scene::{Named, Object};
 use foton_core::texture::{Texture, luminance};
 use foton_core::value::Value;
-use glam::{Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec3};
 
 const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
 
@@ -46,7 +46,28 @@ pub(super) fn read_shapes(
                 if radius <= 0.0 {
                     return Err(s.error("radius", format!("must be positive, found {radius}")));
                 }
-                vec![Shape::sphere(center, radius)]
+                match s.floats_opt("axes", 9)? {
+                    None => vec![Shape::sphere(center, radius)],
+                    Some(a) => {
+                        let rows = [
+                            Vec3::new(a[0], a[1], a[2]),
+                            Vec3::new(a[3], a[4], a[5]),
+                            Vec3::new(a[6], a[7], a[8]),
+                        ];
+                        let orthonormal = rows.iter().all(|r| (r.length() - 1.0).abs() < 1e-3)
+                            && rows[0].dot(rows[1]).abs() < 1e-3
+                            && rows[1].dot(rows[2]).abs() < 1e-3
+                            && rows[2].dot(rows[0]).abs() < 1e-3;
+                        if !orthonormal {
+                            return Err(s.error(
+                                "axes",
+                                "expected three orthonormal rows: the directions of the sphere's x, y and z axes",
+                            ));
+                        }
+                        let to_local = Mat3::from_cols(rows[0], rows[1], rows[2]).transpose();
+                        vec![Shape::sphere_with_axes(center, radius, to_local)]
+                    }
+                }
             }
             "quad" => {
                 let origin = s.vec3_required("origin")?;

@@ -308,6 +308,14 @@ impl Reader {
                 if flip_normals != (full.determinant() < 0.0) {
                     t.insert("flip_normals", at(Value::Bool(true), line));
                 }
+                // Its texture coordinates run about its own axes (to_world's).
+                if is_similarity(full) {
+                    let axes = [DVec3::X, DVec3::Y, DVec3::Z]
+                        .map(|a| full.transform_vector3(a).normalize());
+                    if axes != [DVec3::X, DVec3::Y, DVec3::Z] {
+                        t.insert("axes", axes_node(axes, line));
+                    }
+                }
                 shapes.push(t);
             }
             "cylinder" => {
@@ -599,6 +607,19 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
                 t.insert("radius", at(Value::Float(r), line));
             }
             point(t, "center");
+            if uniform {
+                let own = match t.get("axes").map(|n| &n.value) {
+                    Some(Value::Array(xs)) if xs.len() == 9 => {
+                        let x: Vec<f64> = xs.iter().filter_map(|x| x.value.as_f64()).collect();
+                        [0, 3, 6].map(|i| DVec3::new(x[i], x[i + 1], x[i + 2]))
+                    }
+                    _ => [DVec3::X, DVec3::Y, DVec3::Z],
+                };
+                let axes = own.map(|a| m.transform_vector3(a).normalize());
+                if axes != [DVec3::X, DVec3::Y, DVec3::Z] {
+                    t.insert("axes", axes_node(axes, line));
+                }
+            }
             uniform
         }
         "quad" => {
@@ -617,4 +638,14 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
         }
         _ => true,
     }
+}
+
+/// A sphere's `axes`: the directions of its x, y and z axes, row after row.
+fn axes_node(axes: [DVec3; 3], line: u32) -> Node {
+    let items = axes
+        .iter()
+        .flat_map(|a| a.to_array())
+        .map(|x| at(Value::Float(x), line))
+        .collect();
+    at(Value::Array(items), line)
 }

@@ -55,6 +55,19 @@ impl Reader {
                 entries.push(("type", self.string("sphere", &loc)));
                 entries.push(("center", self.vec3(m.transform_point3(DVec3::ZERO), &loc)));
                 entries.push(("radius", self.num(r * s, &loc)));
+                // pbrt-v4's texture coordinates: u = phi / 2 pi about the sphere's own z, v =
+                // 1 - theta / pi (from its -z pole): foton's about the axes x, y, -z.
+                let (x, y, z) = (
+                    m.transform_vector3(DVec3::X) / s,
+                    m.transform_vector3(DVec3::Y) / s,
+                    m.transform_vector3(DVec3::Z) / s,
+                );
+                let axes: Vec<Node> = [x, y, -z]
+                    .iter()
+                    .flat_map(|r| r.to_array())
+                    .map(|v| self.num(v, &loc))
+                    .collect();
+                entries.push(("axes", self.node(Value::Array(axes), &loc)));
             }
             "disk" => {
                 let h = p.float("height", 0.0)?;
