@@ -66,6 +66,17 @@ pub fn srgb_to_linear(x: f32) -> f32 {
     }
 }
 
+/// A colour read as a number, as Mitsuba's `eval_1` reads a texture: a grey's value exactly,
+/// another colour's luminance (alpha, roughness).
+#[inline]
+pub fn scalar(c: Rgb) -> f32 {
+    if c.x == c.y && c.y == c.z {
+        c.x
+    } else {
+        luminance(c)
+    }
+}
+
 /// Luminance of linear sRGB (Rec. 709 primaries), Mitsuba's `luminance`.
 #[inline]
 pub fn luminance(c: Rgb) -> f32 {

@@ -203,7 +203,8 @@ impl LightSource for AreaLight {
 
     #[inline]
     fn emitted(&self, n: Vec3, w: Vec3) -> Rgb {
-        if n.dot(w) > 0.0 || (self.twosided && n.dot(w) < 0.0) {
+        let cos = n.dot(w);
+        if cos > 0.0 || (self.twosided && cos < 0.0) {
             self.radiance
         } else {
             Rgb::ZERO

@@ -33,7 +33,7 @@ pub struct CoatedConductorMaterial {
     pub reflectance: Option<Texture>,
     pub albedo: Texture,
     /// The coat's and the metal's roughness where they vary over the surface.
-    pub roughness: [Option<layered::GgxTextures>; 2],
+    pub roughness: [Option<super::RoughnessTextures>; 2],
 }
 
 /// pbrt's index of a metal of normal reflectance `r`: eta 1 and k = 2 sqrt(r) / sqrt(1 - r)
@@ -55,10 +55,10 @@ impl SurfaceMaterial for CoatedConductorMaterial {
             (lobe.base.eta, lobe.base.k) = index_of_reflectance(r.at(uv), lobe.top.eta);
         }
         if let Some(r) = &self.roughness[0] {
-            lobe.top.ggx = r.at(uv);
+            lobe.top.ggx = r.ggx_at(uv);
         }
         if let Some(r) = &self.roughness[1] {
-            lobe.base.ggx = r.at(uv);
+            lobe.base.ggx = r.ggx_at(uv);
         }
         lobe
     }

@@ -31,7 +31,7 @@ pub struct CoatedDiffuseMaterial {
     pub reflectance: Texture,
     pub albedo: Texture,
     /// The coat's roughness where it varies over the surface.
-    pub roughness: Option<layered::GgxTextures>,
+    pub roughness: Option<super::RoughnessTextures>,
 }
 
 impl SurfaceMaterial for CoatedDiffuseMaterial {
@@ -42,7 +42,7 @@ impl SurfaceMaterial for CoatedDiffuseMaterial {
         let clamp = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
         let mut top = self.lobe.top;
         if let Some(r) = &self.roughness {
-            top.ggx = r.at(uv);
+            top.ggx = r.ggx_at(uv);
         }
         Layered {
             top,

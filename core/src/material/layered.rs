@@ -995,28 +995,12 @@ pub fn read_ggx(m: &Properties<'_>, prefix: &str) -> Result<Ggx> {
     Ok(Ggx::new(u, v, m.bool("remaproughness", true)?))
 }
 
-/// A coat's or a base's roughness that varies over the surface: `roughness` (or
-/// `uroughness`, `vroughness`) given as textures (a grey's value, a colour's luminance).
-#[derive(Clone, Debug)]
-pub struct GgxTextures {
-    pub u: Texture,
-    pub v: Texture,
-    pub remap: bool,
-}
-
-impl GgxTextures {
-    /// The distribution at surface coordinates `uv`.
+impl super::RoughnessTextures {
+    /// A coat's or a base's distribution at surface coordinates `uv`.
     #[inline]
-    pub fn at(&self, uv: Vec2) -> Ggx {
-        let value = |t: &Texture| {
-            let c = t.at(uv);
-            if c.x == c.y && c.y == c.z {
-                c.x
-            } else {
-                crate::texture::luminance(c)
-            }
-        };
-        Ggx::new(value(&self.u), value(&self.v), self.remap)
+    pub fn ggx_at(&self, uv: Vec2) -> Ggx {
+        let (u, v) = self.values(uv);
+        Ggx::new(u, v, self.remap)
     }
 }
 
@@ -1026,41 +1010,26 @@ pub fn read_ggx_textured(
     m: &Properties<'_>,
     prefix: &str,
     resources: &mut dyn Resources,
-) -> Result<(Ggx, Option<GgxTextures>)> {
-    let key = |name: &str| format!("{prefix}{name}");
-    let is_table = |k: &str| {
-        m.node(k)
-            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
-    };
-    if !["roughness", "uroughness", "vroughness"]
-        .iter()
-        .any(|n| is_table(&key(n)))
-    {
+) -> Result<(Ggx, Option<super::RoughnessTextures>)> {
+    let [r, u, v] = ["roughness", "uroughness", "vroughness"].map(|n| format!("{prefix}{n}"));
+    if !super::any_texture_table(m, &[&r, &u, &v]) {
         return Ok((read_ggx(m, prefix)?, None));
     }
-    let read = |name: &str, default: Texture, resources: &mut dyn Resources| -> Result<Texture> {
-        let k = key(name);
-        if is_table(&k) {
-            return resources.texture(m, &k, Rgb::ZERO);
+    let r = super::read_roughness_texture(m, &r, Some(0.0), resources)?;
+    let mut read = |key: &str| -> Result<Texture> {
+        if m.has(key) {
+            super::read_roughness_texture(m, key, None, resources)
+        } else {
+            Ok(r.clone())
         }
-        if !m.has(&k) {
-            return Ok(default);
-        }
-        let x = m.f32(&k, 0.0)?;
-        if !(x >= 0.0 && x.is_finite()) {
-            return Err(m.error(&k, format!("must be >= 0, found {x}")));
-        }
-        Ok(Texture::Constant(Rgb::splat(x)))
     };
-    let r = read("roughness", Texture::Constant(Rgb::ZERO), resources)?;
-    let textures = GgxTextures {
-        u: read("uroughness", r.clone(), resources)?,
-        v: read("vroughness", r, resources)?,
+    let textures = super::RoughnessTextures {
+        u: read(&u)?,
+        v: read(&v)?,
         remap: m.bool("remaproughness", true)?,
     };
-    let mean = |t: &Texture| crate::texture::luminance(t.mean());
-    let ggx = Ggx::new(mean(&textures.u), mean(&textures.v), textures.remap);
-    Ok((ggx, Some(textures)))
+    let (mu, mv) = textures.means();
+    Ok((Ggx::new(mu, mv, textures.remap), Some(textures)))
 }
 
 /// A relative index of refraction `key` (default 1.5), positive; pbrt takes 0 as 1.

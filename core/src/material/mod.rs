@@ -23,7 +23,7 @@ use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::registry::{Factory, Resources};
 use crate::scattering::Bxdf;
-use crate::texture::Texture;
+use crate::texture::{Texture, scalar};
 use glam::{Vec2, Vec3};
 
 pub use crate::scattering::{
@@ -290,37 +290,68 @@ pub fn read_ior(m: &Properties<'_>, default: f32) -> Result<f32> {
 
 /// A microfacet distribution: `distribution` (`beckmann`, Mitsuba's default, or `ggx`) and
 /// `alpha` (default 0.1), or `alpha_u` and `alpha_v` where `anisotropic` lobes are allowed.
-/// A microfacet roughness that varies over the surface: alpha_u and alpha_v from textures
-/// (a grey's value, a colour's luminance: Mitsuba's `eval_1`), optionally as the square
-/// root of the value (pbrt-v4's `remaproughness`).
+/// A microfacet roughness that varies over the surface: its values along u and v from
+/// textures (read as numbers: [`crate::texture::scalar`]), alpha either the value or, with
+/// `remap`, its square root (pbrt-v4's `remaproughness`).
 #[derive(Clone, Debug)]
 pub struct RoughnessTextures {
-    pub alpha_u: Texture,
-    pub alpha_v: Texture,
+    pub u: Texture,
+    pub v: Texture,
     pub remap: bool,
 }
 
 impl RoughnessTextures {
+    /// The values along u and v at surface coordinates `uv`, before any remapping.
+    #[inline]
+    pub fn values(&self, uv: Vec2) -> (f32, f32) {
+        (scalar(self.u.at(uv)), scalar(self.v.at(uv)))
+    }
+
+    /// The textures' mean values, for what asks of the material as a whole.
+    pub fn means(&self) -> (f32, f32) {
+        (scalar(self.u.mean()), scalar(self.v.mean()))
+    }
+
     /// The distribution at surface coordinates `uv`, of the kind of `d`.
     #[inline]
     pub fn at(&self, d: Microfacet, uv: Vec2) -> Microfacet {
-        Microfacet::new(
-            d.kind,
-            self.alpha(self.alpha_u.at(uv)),
-            self.alpha(self.alpha_v.at(uv)),
-        )
+        let (u, v) = self.values(uv);
+        Microfacet::new(d.kind, self.alpha(u), self.alpha(v))
     }
 
-    /// The roughness a texture's value gives.
     #[inline]
-    fn alpha(&self, c: Rgb) -> f32 {
-        let x = if c.x == c.y && c.y == c.z {
-            c.x
-        } else {
-            crate::texture::luminance(c)
-        };
+    fn alpha(&self, x: f32) -> f32 {
         if self.remap { x.max(0.0).sqrt() } else { x }
     }
+}
+
+/// Whether any of `keys` is given as a texture table.
+pub(crate) fn any_texture_table(m: &Properties<'_>, keys: &[&str]) -> bool {
+    keys.iter().any(|k| {
+        m.node(k)
+            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
+    })
+}
+
+/// A roughness parameter `key` that may vary: a texture table, or a number (>= 0) as a
+/// constant texture; absent, `default` (None: required).
+pub(crate) fn read_roughness_texture(
+    m: &Properties<'_>,
+    key: &str,
+    default: Option<f32>,
+    resources: &mut dyn Resources,
+) -> Result<Texture> {
+    if any_texture_table(m, &[key]) {
+        return resources.texture(m, key, Rgb::ZERO);
+    }
+    let x = match default {
+        Some(d) => m.f32(key, d)?,
+        None => m.f32_required(key)?,
+    };
+    if !(x >= 0.0 && x.is_finite()) {
+        return Err(m.error(key, format!("must not be negative, found {x}")));
+    }
+    Ok(Texture::Constant(Rgb::splat(x)))
 }
 
 /// The roughness of a microfacet material: [`read_microfacet`]'s distribution, and, where
@@ -332,12 +363,8 @@ pub fn read_roughness(
     anisotropic: bool,
     resources: &mut dyn Resources,
 ) -> Result<(Microfacet, Option<RoughnessTextures>)> {
-    let is_table = |k: &str| {
-        m.node(k)
-            .is_some_and(|n| matches!(n.value, crate::value::Value::Table(_)))
-    };
     let remap = m.bool("remaproughness", false)?;
-    if !is_table("alpha") && !is_table("alpha_u") && !is_table("alpha_v") {
+    if !any_texture_table(m, &["alpha", "alpha_u", "alpha_v"]) {
         let mut d = read_microfacet(m, anisotropic)?;
         if remap {
             d = Microfacet::new(d.kind, d.alpha_u.sqrt(), d.alpha_v.sqrt());
@@ -345,16 +372,6 @@ pub fn read_roughness(
         return Ok((d, None));
     }
     let kind = read_microfacet_kind(m)?;
-    let read = |key: &str, resources: &mut dyn Resources| -> Result<Texture> {
-        if is_table(key) {
-            return resources.texture(m, key, Rgb::splat(0.1));
-        }
-        let x = m.f32_required(key)?;
-        if !(x >= 0.0 && x.is_finite()) {
-            return Err(m.error(key, format!("must not be negative, found {x}")));
-        }
-        Ok(Texture::Constant(Rgb::splat(x)))
-    };
     let (u, v) = if m.has("alpha_u") || m.has("alpha_v") {
         if !anisotropic {
             return Err(m.error(
@@ -362,23 +379,17 @@ pub fn read_roughness(
                 "this material's roughness is isotropic: give `alpha`",
             ));
         }
-        (read("alpha_u", resources)?, read("alpha_v", resources)?)
+        (
+            read_roughness_texture(m, "alpha_u", None, resources)?,
+            read_roughness_texture(m, "alpha_v", None, resources)?,
+        )
     } else {
-        let t = read("alpha", resources)?;
+        let t = read_roughness_texture(m, "alpha", None, resources)?;
         (t.clone(), t)
     };
-    let textures = RoughnessTextures {
-        alpha_u: u,
-        alpha_v: v,
-        remap,
-    };
-    // The distribution's own roughness: the textures' means', for what asks of the
-    // material as a whole.
-    let d = Microfacet::new(
-        kind,
-        textures.alpha(textures.alpha_u.mean()),
-        textures.alpha(textures.alpha_v.mean()),
-    );
+    let textures = RoughnessTextures { u, v, remap };
+    let (mu, mv) = textures.means();
+    let d = Microfacet::new(kind, textures.alpha(mu), textures.alpha(mv));
     Ok((d, Some(textures)))
 }
 

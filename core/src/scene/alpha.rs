@@ -7,10 +7,9 @@
 //! a ray spawned past a cut-out has another origin, so each layer decides independently.
 
 use super::Scene;
-use crate::Rgb;
 use crate::geometry::{Hit, Ray, offset_origin};
 use crate::sampling::splitmix64;
-use crate::texture::{Texture, luminance};
+use crate::texture::{Texture, scalar};
 use glam::Vec3;
 
 /// Cut-out hits one ray passes before the next is taken as opaque: a bound on the work of a
@@ -51,8 +50,8 @@ impl Scene {
             return false;
         };
         let a = match alpha {
-            Texture::Constant(c) => alpha_of(*c),
-            t => alpha_of(t.eval(self.surface(hit).uv)),
+            Texture::Constant(c) => scalar(*c),
+            t => scalar(t.eval(self.surface(hit).uv)),
         };
         if a >= 1.0 {
             false
@@ -85,23 +84,6 @@ impl Scene {
         }
         // Past the crossing limit the shadow ray is ended like any other ray (crate::walk).
         true
-    }
-
-    /// Whether any shape has a cut-out.
-    #[inline]
-    pub(super) fn has_alpha(&self) -> bool {
-        self.has_alpha
-    }
-}
-
-/// A texture's value as an alpha: a grey's value exactly, a colour's luminance (Mitsuba's
-/// `eval_1`).
-#[inline]
-fn alpha_of(c: Rgb) -> f32 {
-    if c.x == c.y && c.y == c.z {
-        c.x
-    } else {
-        luminance(c)
     }
 }
 

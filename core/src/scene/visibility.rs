@@ -35,7 +35,7 @@ impl Scene {
         if dist <= 0.0 || seg.dot(d) <= 0.0 {
             return self.transmittance_between(medium, p0, p1);
         }
-        if self.has_alpha() {
+        if self.has_alpha {
             return self.transmittance_walk(p0, p1, from, to, medium);
         }
         // One traversal of the segment: it stops at the first blocker, and collects the null
@@ -156,7 +156,7 @@ impl Scene {
         if dist <= 0.0 {
             return false;
         }
-        if self.has_alpha() {
+        if self.has_alpha {
             return self.occluded_past_cut_outs(from, to);
         }
         let ray = Ray::new(from, seg / dist);
