@@ -387,11 +387,11 @@ impl Scene {
     /// probability a, decided by a hash of the ray: the same ray decides the same).
     #[inline]
     pub fn intersect(&self, ray: &Ray, tmax: f32) -> Option<Hit> {
-        let hit = self.accel.intersect(ray, tmax)?;
+        let hit = self.accel.intersect(ray, tmax);
         if self.has_alpha {
-            return self.intersect_past_cut_outs(ray, tmax, hit);
+            return self.intersect_past_cut_outs(ray, tmax, hit?);
         }
-        Some(hit)
+        hit
     }
 
     #[inline]
