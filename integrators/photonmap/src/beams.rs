@@ -33,19 +33,22 @@
 //!
 //! **The map.** Beams are cut into pieces of 16 widths (a long diagonal beam's box would be
 //! mostly empty), and the pieces' boxes, grown by what a disc of radius r across the beam
-//! reaches on each axis, go into core's scene BVH (`Accel`: obvhs'
-//! compressed wide BVH8, each box as a flat triangle spanning it), so that a camera segment is
-//! traversed with core's eight-wide AVX2 node test where the processor has it, as a shadow
-//! ray that nothing blocks: it is offered every piece whose box it crosses. A piece is first
+//! reaches on each axis, go into a BVH of boxes ([`TwoLevelBvh`]: a top tree of median splits
+//! over core's `Accel`s, obvhs' compressed wide BVH8 with each box as a flat triangle spanning
+//! it, built in parallel), so that a camera segment is traversed with core's eight-wide AVX2
+//! node test where the processor has it, as a shadow ray that nothing blocks: it is offered
+//! every piece whose box it crosses. A piece is first
 //! rejected by the distance between the two lines (no division, no square root: most pieces
 //! a ray passes are farther than r), and counts the crossing only if the closest point on the
 //! beam lies within the piece, so a beam is counted once.
 
 use crate::map::Photon;
+use crate::twolevel::TwoLevelBvh;
 use foton_core::api::{
-    Accel, Medium, NO_ATTRS, NormalizedKernel, Phase, Primitive, Properties, Ray, Result, Rgb,
-    Scene, Shape, Vec3, transmittance_homogeneous,
+    Medium, NO_ATTRS, NormalizedKernel, Phase, Primitive, Properties, Ray, Result, Rgb, Scene,
+    Shape, Vec3, transmittance_homogeneous,
 };
+use rayon::prelude::*;
 
 /// Which flight segments a photon records (module comment).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -279,7 +282,7 @@ pub struct BeamMap {
     beams: Vec<Beam>,
     /// Indexed by the BVH primitives' `object`.
     pub(crate) pieces: Vec<Piece>,
-    pub(crate) bvh: Accel,
+    pub(crate) bvh: TwoLevelBvh,
     radius: f32,
     /// The box around every beam's segment (empty when there is none).
     bounds: (Vec3, Vec3),
@@ -290,38 +293,43 @@ impl BeamMap {
     /// pieces of at most [`PIECE_WIDTHS`] x `radius`.
     pub fn build(beams: Vec<Beam>, radius: f32) -> BeamMap {
         let piece = PIECE_WIDTHS * radius;
-        let mut pieces = Vec::with_capacity(beams.len());
-        let mut bounds = (Vec3::INFINITY, Vec3::NEG_INFINITY);
-        for (i, b) in beams.iter().enumerate() {
-            if !(b.length > 0.0 && b.length.is_finite()) {
-                continue;
-            }
-            let end = b.origin + b.dir * b.length;
-            bounds = (
-                bounds.0.min(b.origin).min(end),
-                bounds.1.max(b.origin).max(end),
-            );
-            let n = (b.length / piece).ceil().clamp(1.0, 1e6) as u32;
-            let step = b.length / n as f32;
-            for k in 0..n {
-                let t0 = k as f32 * step;
-                let t1 = if k + 1 == n { b.length } else { t0 + step };
-                pieces.push(Piece {
-                    origin: b.origin,
-                    dir: b.dir,
-                    t0,
-                    t1,
-                    beam: i as u32,
-                    medium: b.medium,
-                });
-            }
-        }
+        let usable = |b: &Beam| b.length > 0.0 && b.length.is_finite();
+        let pieces: Vec<Piece> = beams
+            .par_iter()
+            .enumerate()
+            .filter(|(_, b)| usable(b))
+            .flat_map_iter(|(i, b)| {
+                let n = (b.length / piece).ceil().clamp(1.0, 1e6) as u32;
+                let step = b.length / n as f32;
+                (0..n).map(move |k| {
+                    let t0 = k as f32 * step;
+                    let t1 = if k + 1 == n { b.length } else { t0 + step };
+                    Piece {
+                        origin: b.origin,
+                        dir: b.dir,
+                        t0,
+                        t1,
+                        beam: i as u32,
+                        medium: b.medium,
+                    }
+                })
+            })
+            .collect();
+        let empty = || (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        let bounds = beams
+            .par_iter()
+            .filter(|b| usable(b))
+            .map(|b| {
+                let end = b.origin + b.dir * b.length;
+                (b.origin.min(end), b.origin.max(end))
+            })
+            .reduce(empty, |a, b| (a.0.min(b.0), a.1.max(b.1)));
         let boxes = pieces
-            .iter()
+            .par_iter()
             .enumerate()
             .map(|(id, p)| p.primitive(radius, id as u32))
             .collect();
-        let bvh = Accel::build_boxes(boxes);
+        let bvh = TwoLevelBvh::build(boxes);
         BeamMap {
             beams,
             pieces,
@@ -402,18 +410,16 @@ impl BeamMap {
     /// pieces' boxes) that [`BeamMap::cross`] accepts.
     pub(crate) fn traverse(
         &self,
-        bvh: &Accel,
+        bvh: &TwoLevelBvh,
         ray: &Ray,
         t_end: f32,
         medium: u32,
         visit: &mut impl FnMut(u32, &Crossing),
     ) {
-        let visit = std::cell::RefCell::new(visit);
-        bvh.occluded(ray, t_end, |prim| {
+        bvh.visit(ray, t_end, |prim| {
             if let Some(c) = self.cross(prim.object, ray, t_end, medium) {
-                (visit.borrow_mut())(prim.object, &c);
+                visit(prim.object, &c);
             }
-            false
         });
     }
 

@@ -15,6 +15,8 @@
 //!   [`map::DISC_THICKNESS`] (1/4) of the radius are not counted.
 //! - [`beams`]: photon beams (each photon flight through a medium, short or long), their BVH
 //!   and the beam x beam estimate with a 1-D kernel (Jarosz et al. 2011), for `vpm` and `ppb`;
+//! - [`twolevel`]: the beams' BVH of boxes, a top tree of median splits over obvhs BVHs built
+//!   in parallel (the same tree for any number of threads);
 //! - [`screen`]: a pass's beams binned in screen space, the candidates of the camera's primary
 //!   rays (`ppb`), in place of the BVH's;
 //! - [`progressive`]: what `sppm` and `ppb` share: the pass loop (`run_passes`: iterations or
@@ -37,6 +39,7 @@ pub mod progressive;
 pub mod screen;
 pub mod surface;
 pub mod trace;
+pub mod twolevel;
 
 pub use map::{Estimate, Neighbour, Photon, PhotonMap};
 

@@ -360,7 +360,7 @@ fn build_range(photons: &mut [Photon], axis: &mut [u8], split: &mut [f32]) {
     let (left, right) = photons.split_at_mut(mid);
     let (left_axis, right_axis) = axis.split_at_mut(mid);
     let (left_split, right_split) = split.split_at_mut(mid);
-    if n > 50_000 {
+    if n > 8192 {
         rayon::join(
             || build_range(left, left_axis, left_split),
             || build_range(right, right_axis, right_split),

@@ -36,7 +36,9 @@
 //! out (no point of a camera ray is near them).
 
 use crate::beams::{BeamMap, Crossing, Gather, Kernel1d};
-use foton_core::api::{Accel, Camera, Ray, Rgb, Scene, Vec2, Vec3};
+use crate::twolevel::TwoLevelBvh;
+use foton_core::api::{Camera, Primitive, Ray, Rgb, Scene, Vec2, Vec3};
+use rayon::prelude::*;
 
 /// Bins are this many rows' bands wide (a band is one row up to 511 rows, [`ROWS`] more
 /// rows a band above). Narrower bins mean fewer pieces scanned and more entries built: 4, 8
@@ -49,6 +51,10 @@ pub const CHUNK: u32 = 8;
 /// the image's size (a piece is in every band its footprint crosses: at 1024 rows, one row a
 /// band held 130 MB of entries a pass), and a bin as many pieces.
 pub const ROWS: u32 = 256;
+
+/// Pieces binned together on one thread before the bins take them (a fixed number, so the
+/// bins' order does not depend on the threads).
+const PIECES_A_RUN: usize = 4096;
 
 /// Film-space margin (pixels) added to each range against the rounding of the projection
 /// and of the camera's rays (whose film positions round-trip to about 1e-4 pixel).
@@ -75,7 +81,7 @@ pub struct ScreenBeams {
     /// Band-major: band k, chunk c at k * chunks + c.
     bins: Vec<Vec<Span>>,
     /// Pieces too near the pinhole's plane to project, in a BVH of their own.
-    near: Option<Accel>,
+    near: Option<TwoLevelBvh>,
     /// The farthest a segment's line may pass from the pinhole and still use the bins.
     reach: f32,
     /// Whether the camera is a pinhole: the bins hold rays from a point only (a lens's or an
@@ -113,32 +119,71 @@ impl ScreenBeams {
             pinhole: camera.lens().0 == 0.0 && !camera.is_orthographic(),
         };
         let pinhole = Pinhole::of(camera);
-        let mut near = Vec::new();
-        for (id, piece) in map.pieces.iter().enumerate() {
-            let (p0, p1) = (piece.start(), piece.end());
-            let scale = p0.abs().max(p1.abs()).max_element() + camera.position.abs().max_element();
-            // The cubes' half-size: the width, what the segments' lines may be offset, and
-            // margins against rounding (as the BVH's boxes have).
-            let rho = r * 1.001 + reach + 16.0 * f32::EPSILON * scale;
-            let (c0, c1) = (pinhole.to_camera(p0), pinhole.to_camera(p1));
-            if c0.z.max(c1.z) + rho < 0.0 {
-                continue; // behind the camera: no camera ray comes near it
-            }
-            if c0.z.min(c1.z) - rho <= 1e-3 * r.max(1e-6 * scale) {
-                near.push(piece.primitive(r, id as u32));
-                continue;
-            }
-            screen.insert(id as u32, pinhole.cube(c0, rho), pinhole.cube(c1, rho));
-        }
+        // Pieces in fixed runs (the same for any number of threads), each binned on its own;
+        // the bins then take each run's entries in run order: piece order, as one loop.
+        // Per run: its (bin, span) entries sorted by bin, and its pieces near the pinhole.
+        type Run = (Vec<(u32, Span)>, Vec<Primitive>);
+        let runs: Vec<Run> = map
+            .pieces
+            .par_chunks(PIECES_A_RUN)
+            .enumerate()
+            .map(|(run, pieces)| {
+                let (mut entries, mut near) = (Vec::new(), Vec::new());
+                for (i, piece) in pieces.iter().enumerate() {
+                    let id = (run * PIECES_A_RUN + i) as u32;
+                    let (p0, p1) = (piece.start(), piece.end());
+                    let scale =
+                        p0.abs().max(p1.abs()).max_element() + camera.position.abs().max_element();
+                    // The cubes' half-size: the width, what the segments' lines may be
+                    // offset, and margins against rounding (as the BVH's boxes have).
+                    let rho = r * 1.001 + reach + 16.0 * f32::EPSILON * scale;
+                    let (c0, c1) = (pinhole.to_camera(p0), pinhole.to_camera(p1));
+                    if c0.z.max(c1.z) + rho < 0.0 {
+                        continue; // behind the camera: no camera ray comes near it
+                    }
+                    if c0.z.min(c1.z) - rho <= 1e-3 * r.max(1e-6 * scale) {
+                        near.push(piece.primitive(r, id));
+                        continue;
+                    }
+                    screen.spans(
+                        id,
+                        pinhole.cube(c0, rho),
+                        pinhole.cube(c1, rho),
+                        |bin, span| entries.push((bin as u32, span)),
+                    );
+                }
+                // Stable: within a bin, piece order.
+                entries.sort_by_key(|&(bin, _)| bin);
+                (entries, near)
+            })
+            .collect();
+        let starts: Vec<Vec<usize>> = runs
+            .par_iter()
+            .map(|(entries, _)| {
+                (0..=screen.bins.len())
+                    .map(|bin| entries.partition_point(|&(b, _)| (b as usize) < bin))
+                    .collect()
+            })
+            .collect();
+        screen
+            .bins
+            .par_iter_mut()
+            .enumerate()
+            .for_each(|(bin, spans)| {
+                for ((entries, _), start) in runs.iter().zip(&starts) {
+                    spans.extend(entries[start[bin]..start[bin + 1]].iter().map(|&(_, s)| s));
+                }
+            });
+        let near: Vec<Primitive> = runs.into_iter().flat_map(|(_, near)| near).collect();
         if !near.is_empty() {
-            screen.near = Some(Accel::build_boxes(near));
+            screen.near = Some(TwoLevelBvh::build(near));
         }
         screen
     }
 
-    /// Puts piece `id` into the bins its rows' x-ranges touch: `a` and `b` are the
-    /// rectangles (x_lo, y_lo, x_hi, y_hi) around its two ends' cubes.
-    fn insert(&mut self, id: u32, a: [f32; 4], b: [f32; 4]) {
+    /// Calls `add(bin, span)` for each bin piece `id`'s rows' x-ranges touch: `a` and `b`
+    /// are the rectangles (x_lo, y_lo, x_hi, y_hi) around its two ends' cubes.
+    fn spans(&self, id: u32, a: [f32; 4], b: [f32; 4], mut add: impl FnMut(usize, Span)) {
         let (w, h, m) = (self.width as f32, self.height as f32, self.margin);
         let (y_lo, y_hi) = (a[1].min(b[1]) - FILM_EPS, a[3].max(b[3]) + FILM_EPS);
         if y_hi < -m || y_lo > h + m || a[2].max(b[2]) < -m || a[0].min(b[0]) > w + m {
@@ -176,7 +221,7 @@ impl ScreenBeams {
             let (c0, c1) = (self.chunk_of(x0), self.chunk_of(x1));
             let bins = k * self.chunks as usize;
             for chunk in c0..=c1 {
-                self.bins[bins + chunk].push(Span { piece: id, x0, x1 });
+                add(bins + chunk, Span { piece: id, x0, x1 });
             }
         }
     }
@@ -485,8 +530,8 @@ mod tests {
     }
 
     /// The map's own BVH (private to the map: rebuilt here from its pieces).
-    fn map_bvh(map: &BeamMap) -> Accel {
-        Accel::build_boxes(
+    fn map_bvh(map: &BeamMap) -> TwoLevelBvh {
+        TwoLevelBvh::build(
             map.pieces
                 .iter()
                 .enumerate()

@@ -212,10 +212,17 @@ impl Ppb {
         let _build = ctx.phase("beam and photon map build");
         let margin = scene.film().filter.margin();
         with_pool(ctx.threads, || {
-            let beams = BeamMap::build(beams, r);
+            let ((beams, screen), surface) = rayon::join(
+                || {
+                    let beams = BeamMap::build(beams, r);
+                    let screen = ScreenBeams::build(&beams, scene.camera(), margin);
+                    (beams, screen)
+                },
+                || PhotonMap::build(photons),
+            );
             Pass {
-                surface: PhotonMap::build(photons),
-                screen: ScreenBeams::build(&beams, scene.camera(), margin),
+                surface,
+                screen,
                 beams,
                 surface_shrink: scale.sqrt(),
                 pixel_angle: pixel_angle(scene),
