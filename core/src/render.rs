@@ -11,7 +11,10 @@
 //! **Splats.** An integrator that also traces paths from the lights ([`render_pixels_splatting`])
 //! adds what they bring to the camera to any pixel ([`Splats::add`]). Each tile keeps its splats
 //! as exact fixed-point sums ([`RadianceSum`]) in a short list and adds them to one image-sized
-//! splat buffer under a lock when the list fills and when the tile ends. Integer addition is
+//! splat buffer when the list fills and when the tile ends, sorted by pixel, band of rows by
+//! band of rows: each band has its own lock, and a band another thread holds is left for
+//! later rather than waited for (with one lock for the image, the tiles of a light-tracing
+//! render queued on it). Integer addition is
 //! associative and commutative, so the buffer holds the same bits whatever order the tiles and
 //! threads add in: the image stays bit-identical for any thread count (a per-thread buffer
 //! would too, at one image of memory per thread; floating-point atomics would not). A tile's
@@ -101,12 +104,73 @@ pub struct PixelSample {
 pub struct Splats<'a> {
     width: u32,
     pending: Vec<(u32, RadianceSum)>,
-    buffer: Option<&'a Mutex<Vec<RadianceSum>>>,
+    buffer: Option<&'a SplatBuffer>,
     bad: u64,
 }
 
 /// Splats a tile keeps before it adds them to the shared buffer.
 const SPLAT_BATCH: usize = 4096;
+
+/// Bands of rows the splat buffer is locked by, at most.
+const SPLAT_BANDS: u32 = 64;
+
+/// The film's splat sums, in bands of rows with a lock each (module comment).
+struct SplatBuffer {
+    /// Pixels a band.
+    band: usize,
+    bands: Vec<Mutex<Vec<RadianceSum>>>,
+}
+
+impl SplatBuffer {
+    fn new(width: u32, height: u32) -> SplatBuffer {
+        let rows = height.div_ceil(SPLAT_BANDS).max(1);
+        let band = (rows * width).max(1) as usize;
+        let pixels = width as usize * height as usize;
+        SplatBuffer {
+            band,
+            bands: (0..pixels.div_ceil(band))
+                .map(|b| Mutex::new(vec![RadianceSum::ZERO; band.min(pixels - b * band)]))
+                .collect(),
+        }
+    }
+
+    /// Adds `splats` (sorted by pixel) to the sums: each band's run under its lock, the
+    /// bands another thread holds after the others.
+    fn add(&self, splats: &[(u32, RadianceSum)]) {
+        let mut busy = Vec::new();
+        let mut rest = splats;
+        while let Some(&(first, _)) = rest.first() {
+            let b = first as usize / self.band;
+            let end = rest.partition_point(|&(i, _)| i as usize / self.band == b);
+            let (run, next) = rest.split_at(end);
+            match self.bands[b].try_lock() {
+                Ok(mut sums) => self.merge(b, &mut sums, run),
+                Err(std::sync::TryLockError::WouldBlock) => busy.push((b, run)),
+                Err(std::sync::TryLockError::Poisoned(e)) => {
+                    self.merge(b, &mut e.into_inner(), run)
+                }
+            }
+            rest = next;
+        }
+        for (b, run) in busy {
+            let mut sums = self.bands[b].lock().unwrap_or_else(|e| e.into_inner());
+            self.merge(b, &mut sums, run);
+        }
+    }
+
+    fn merge(&self, b: usize, sums: &mut [RadianceSum], run: &[(u32, RadianceSum)]) {
+        for (i, sum) in run {
+            sums[*i as usize - b * self.band].merge(sum);
+        }
+    }
+
+    /// The sums, pixel by pixel.
+    fn into_sums(self) -> impl Iterator<Item = RadianceSum> {
+        self.bands
+            .into_iter()
+            .flat_map(|m| m.into_inner().unwrap_or_else(|e| e.into_inner()))
+    }
+}
 
 impl Splats<'_> {
     /// Adds `value` to pixel (x, y)'s splat sum. The film multiplies the sum by one over the
@@ -141,10 +205,8 @@ impl Splats<'_> {
 
     fn flush(&mut self) {
         if let Some(buffer) = self.buffer {
-            let mut buffer = buffer.lock().unwrap_or_else(|e| e.into_inner());
-            for (i, sum) in self.pending.drain(..) {
-                buffer[i as usize].merge(&sum);
-            }
+            self.pending.sort_unstable_by_key(|&(i, _)| i);
+            buffer.add(&self.pending);
         }
         self.pending.clear();
     }
@@ -281,11 +343,7 @@ where
     let bad_samples = AtomicU64::new(0);
     let bad_splats = AtomicU64::new(0);
     let rays = AtomicU64::new(0);
-    let splat_buffer = Mutex::new(if splatting {
-        vec![RadianceSum::ZERO; width as usize * height as usize]
-    } else {
-        Vec::new()
-    });
+    let splat_buffer = SplatBuffer::new(width, if splatting { height } else { 0 });
     ctx.progress.begin(
         "pixels",
         width as u64 * height as u64 * (spp - first) as u64,
@@ -410,9 +468,8 @@ where
     }
     ctx.progress.finish();
     if splatting {
-        let buffer = splat_buffer.into_inner().unwrap_or_else(|e| e.into_inner());
-        for (i, sum) in buffer.iter().enumerate() {
-            film.add_splat(i, sum);
+        for (i, sum) in splat_buffer.into_sums().enumerate() {
+            film.add_splat(i, &sum);
         }
         let buffer = layer_splats.into_inner().unwrap_or_else(|e| e.into_inner());
         for (j, sum) in buffer.iter().enumerate() {
