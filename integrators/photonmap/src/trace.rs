@@ -59,8 +59,13 @@ pub const STREAM_GLOBAL: u64 = 0x676c_6f62;
 pub const STREAM_CAUSTIC: u64 = 0x6361_7573;
 pub const STREAM_VOLUME: u64 = 0x766f_6c75;
 
-/// Photons per parallel work unit (also the granularity of progress reports).
-const CHUNK: u64 = 4096;
+/// Photons per parallel work unit (also the granularity of progress reports): a 256th of the
+/// pass, from 64 to 4096 (a progressive pass of a few thousand photons was one unit, traced on
+/// one thread). The results do not depend on it: photon i's random numbers depend on i alone,
+/// and the units' photons are joined in order.
+fn chunk(photons: u64) -> u64 {
+    photons.div_ceil(256).clamp(64, 4096)
+}
 
 /// Where a photon is stored.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -291,7 +296,8 @@ pub fn trace_photons_and_beams(
 ) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
     let media = scene.emission_media()?;
     ctx.progress.begin("photons", opts.photons);
-    let chunks = opts.photons.div_ceil(CHUNK);
+    let chunk = chunk(opts.photons);
+    let chunks = opts.photons.div_ceil(chunk);
     let _tracing = ctx.phase("photon tracing");
     let parts: Vec<(Vec<Vec<Photon>>, Vec<Beam>)> = with_pool(ctx.threads, || {
         (0..chunks)
@@ -302,8 +308,8 @@ pub fn trace_photons_and_beams(
                 if ctx.cancelled() {
                     return (out, out_beams);
                 }
-                let end = ((c + 1) * CHUNK).min(opts.photons);
-                for i in c * CHUNK..end {
+                let end = ((c + 1) * chunk).min(opts.photons);
+                for i in c * chunk..end {
                     trace_one_with_beams(
                         scene,
                         opts,
@@ -322,7 +328,7 @@ pub fn trace_photons_and_beams(
                         },
                     );
                 }
-                ctx.progress.advance(end - c * CHUNK);
+                ctx.progress.advance(end - c * chunk);
                 (out, out_beams)
             })
             .collect()
