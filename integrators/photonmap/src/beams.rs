@@ -45,8 +45,8 @@
 use crate::map::Photon;
 use crate::twolevel::TwoLevelBvh;
 use foton_core::api::{
-    Medium, NO_ATTRS, NormalizedKernel, Phase, Primitive, Properties, Ray, Result, Rgb, Scene,
-    Shape, Vec3, transmittance_homogeneous,
+    Medium, NormalizedKernel, Phase, Properties, Ray, Result, Rgb, Scene, Shape, Vec3,
+    transmittance_homogeneous,
 };
 use rayon::prelude::*;
 
@@ -257,23 +257,21 @@ impl Piece {
         self.origin + self.dir * self.t1
     }
 
-    /// The piece's box in the BVH (`piece_grow`), as core's BVH holds it: a flat triangle
-    /// from one corner to the opposite one has the box as its bounds, and is never
-    /// intersected (the traversal's callback tests the beam itself). `object` names the piece.
-    pub(crate) fn primitive(&self, r: f32, id: u32) -> Primitive {
+    /// The piece's box in the BVH (`piece_grow`), with the padding core's BVH gives flat
+    /// boxes (`Shape::aabb` of the flat triangle from one corner to the opposite one), and
+    /// its number `id`. The traversal's callback tests the beam itself.
+    pub(crate) fn bounds(&self, r: f32, id: u32) -> (Vec3, Vec3, u32) {
         let (p0, p1) = (self.start(), self.end());
         let scale = p0.abs().max(p1.abs()).max_element();
         let grow = piece_grow(self.dir, r, scale);
         let (lo, hi) = (p0.min(p1) - grow, p0.max(p1) + grow);
-        Primitive {
-            shape: Shape::Triangle {
-                p0: lo,
-                e1: hi - lo,
-                e2: Vec3::ZERO,
-            },
-            object: id,
-            attrs: NO_ATTRS,
+        let b = Shape::Triangle {
+            p0: lo,
+            e1: hi - lo,
+            e2: Vec3::ZERO,
         }
+        .aabb();
+        (b.min.into(), b.max.into(), id)
     }
 }
 
@@ -327,7 +325,7 @@ impl BeamMap {
         let boxes = pieces
             .par_iter()
             .enumerate()
-            .map(|(id, p)| p.primitive(radius, id as u32))
+            .map(|(id, p)| p.bounds(radius, id as u32))
             .collect();
         let bvh = TwoLevelBvh::build(boxes);
         BeamMap {
@@ -416,9 +414,9 @@ impl BeamMap {
         medium: u32,
         visit: &mut impl FnMut(u32, &Crossing),
     ) {
-        bvh.visit(ray, t_end, |prim| {
-            if let Some(c) = self.cross(prim.object, ray, t_end, medium) {
-                visit(prim.object, &c);
+        bvh.visit(ray, t_end, |id| {
+            if let Some(c) = self.cross(id, ray, t_end, medium) {
+                visit(id, &c);
             }
         });
     }
@@ -706,9 +704,8 @@ mod tests {
             map.pieces.len()
         );
         assert!(per_beam >= record, "{per_beam}");
-        // Not yet within twice the records (docs/PERFORMANCE.md); no worse than today's.
         assert!(
-            per_beam <= 4.5 * record,
+            per_beam <= 2.0 * record,
             "{per_beam} bytes per {record}-byte beam"
         );
     }

@@ -37,7 +37,7 @@
 
 use crate::beams::{BeamMap, Crossing, Gather, Kernel1d};
 use crate::twolevel::TwoLevelBvh;
-use foton_core::api::{Camera, Primitive, Ray, Rgb, Scene, Vec2, Vec3};
+use foton_core::api::{Camera, Ray, Rgb, Scene, Vec2, Vec3};
 use rayon::prelude::*;
 
 /// Bins are this many rows' bands wide (a band is one row up to 511 rows, [`ROWS`] more
@@ -122,7 +122,7 @@ impl ScreenBeams {
         // Pieces in fixed runs (the same for any number of threads), each binned on its own;
         // the bins then take each run's entries in run order: piece order, as one loop.
         // Per run: its (bin, span) entries sorted by bin, and its pieces near the pinhole.
-        type Run = (Vec<(u32, Span)>, Vec<Primitive>);
+        type Run = (Vec<(u32, Span)>, Vec<(Vec3, Vec3, u32)>);
         let runs: Vec<Run> = map
             .pieces
             .par_chunks(PIECES_A_RUN)
@@ -142,7 +142,7 @@ impl ScreenBeams {
                         continue; // behind the camera: no camera ray comes near it
                     }
                     if c0.z.min(c1.z) - rho <= 1e-3 * r.max(1e-6 * scale) {
-                        near.push(piece.primitive(r, id));
+                        near.push(piece.bounds(r, id));
                         continue;
                     }
                     screen.spans(
@@ -174,7 +174,7 @@ impl ScreenBeams {
                     spans.extend(entries[start[bin]..start[bin + 1]].iter().map(|&(_, s)| s));
                 }
             });
-        let near: Vec<Primitive> = runs.into_iter().flat_map(|(_, near)| near).collect();
+        let near: Vec<(Vec3, Vec3, u32)> = runs.into_iter().flat_map(|(_, near)| near).collect();
         if !near.is_empty() {
             screen.near = Some(TwoLevelBvh::build(near));
         }
@@ -535,7 +535,7 @@ mod tests {
             map.pieces
                 .iter()
                 .enumerate()
-                .map(|(id, p)| p.primitive(map.radius(), id as u32))
+                .map(|(id, p)| p.bounds(map.radius(), id as u32))
                 .collect(),
         )
     }

@@ -14,9 +14,8 @@
 //! unevenly spread; with at least [`LEAF`] boxes a leaf, a few tens of top boxes are tested
 //! against obvhs' thousands of node boxes per query.
 
-use foton_core::api::{Accel, Primitive, Ray, Vec3};
+use foton_core::api::{BoxBvh, Ray, Vec3};
 use rayon::prelude::*;
-use std::cell::RefCell;
 
 /// The fewest boxes a leaf BVH is split down to (a leaf holds between this and twice this).
 pub const LEAF: usize = 2048;
@@ -30,16 +29,16 @@ pub fn levels(n: usize) -> u32 {
     levels
 }
 
-/// Boxes (primitives that stand for their bounds, as [`Accel::build_boxes`] takes them) in a
-/// top tree of median splits over obvhs BVHs.
+/// Boxes, each known by a number, in a top tree of median splits over obvhs BVHs (core's
+/// [`BoxBvh`]).
 pub struct TwoLevelBvh {
     /// The top tree's boxes in heap order (node k's children are 2k + 1 and 2k + 2); the last
     /// `leaves.len()` are the leaves'. Empty boxes (lo > hi) where a leaf has no box.
     boxes: Vec<(Vec3, Vec3)>,
-    leaves: Vec<Accel>,
+    leaves: Vec<BoxBvh>,
 }
 
-/// A box's centre and the primitive's index: what the median splits move.
+/// A box's centre and its index in the input: what the median splits move.
 #[derive(Clone, Copy)]
 struct Centre {
     c: [f32; 3],
@@ -99,64 +98,66 @@ fn union(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
 const EMPTY: (Vec3, Vec3) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
 
 impl TwoLevelBvh {
-    /// The tree over `prims`, built on the current rayon pool's threads.
-    pub fn build(prims: Vec<Primitive>) -> TwoLevelBvh {
-        let levels = levels(prims.len());
-        let mut items: Vec<Centre> = prims
+    /// The tree over `boxes` (lower corner, upper corner, the box's number), built on the
+    /// current rayon pool's threads.
+    pub fn build(boxes: Vec<(Vec3, Vec3, u32)>) -> TwoLevelBvh {
+        let levels = levels(boxes.len());
+        let mut items: Vec<Centre> = boxes
             .par_iter()
             .enumerate()
-            .map(|(index, p)| {
-                let b = p.shape.aabb();
-                let c = (Vec3::from(b.min) + Vec3::from(b.max)) * 0.5;
-                Centre {
-                    c: c.to_array(),
-                    index: index as u32,
-                }
+            .map(|(index, &(lo, hi, _))| Centre {
+                c: ((lo + hi) * 0.5).to_array(),
+                index: index as u32,
             })
             .collect();
         split(&mut items, levels);
         let mut ranges = Vec::with_capacity(1 << levels);
         leaf_ranges(0, items.len(), levels, &mut ranges);
-        let built: Vec<((Vec3, Vec3), Accel)> = ranges
+        let built: Vec<((Vec3, Vec3), BoxBvh)> = ranges
             .par_iter()
             .map(|&(lo, hi)| {
-                let leaf: Vec<Primitive> = items[lo..hi]
+                let leaf = &items[lo..hi];
+                let corners: Vec<(Vec3, Vec3)> = leaf
                     .iter()
-                    .map(|it| prims[it.index as usize])
+                    .map(|it| {
+                        let (lo, hi, _) = boxes[it.index as usize];
+                        (lo, hi)
+                    })
                     .collect();
-                let bounds = leaf.iter().fold(EMPTY, |acc, p| {
-                    let b = p.shape.aabb();
-                    union(acc, (b.min.into(), b.max.into()))
-                });
-                (bounds, Accel::build_boxes(leaf))
+                let ids: Vec<u32> = leaf.iter().map(|it| boxes[it.index as usize].2).collect();
+                let bounds = corners.iter().fold(EMPTY, |acc, &b| union(acc, b));
+                (bounds, BoxBvh::build(&corners, &ids))
             })
             .collect();
         let inner = (1 << levels) - 1;
-        let mut boxes = vec![EMPTY; inner];
+        let mut tops = vec![EMPTY; inner];
         let mut leaves = Vec::with_capacity(built.len());
-        for (bounds, accel) in built {
-            boxes.push(bounds);
-            leaves.push(accel);
+        for (bounds, bvh) in built {
+            tops.push(bounds);
+            leaves.push(bvh);
         }
         for k in (0..inner).rev() {
-            boxes[k] = union(boxes[2 * k + 1], boxes[2 * k + 2]);
+            tops[k] = union(tops[2 * k + 1], tops[2 * k + 2]);
         }
-        TwoLevelBvh { boxes, leaves }
+        TwoLevelBvh {
+            boxes: tops,
+            leaves,
+        }
     }
 
     /// The bytes the tree holds on the heap: its top boxes and its leaves' BVHs.
     pub fn heap_bytes(&self) -> usize {
         self.boxes.capacity() * std::mem::size_of::<(Vec3, Vec3)>()
-            + self.leaves.iter().map(Accel::heap_bytes).sum::<usize>()
+            + self.leaves.capacity() * std::mem::size_of::<BoxBvh>()
+            + self.leaves.iter().map(BoxBvh::heap_bytes).sum::<usize>()
     }
 
-    /// Calls `visit` for the primitives whose boxes the segment from `ray.origin` to
-    /// `ray.at(t_end)` may cross (obvhs' culling in the leaves: a superset of those it
-    /// crosses), leaf by leaf from left to right.
-    pub fn visit(&self, ray: &Ray, t_end: f32, visit: impl FnMut(&Primitive)) {
+    /// Calls `visit(id)` for the boxes the segment from `ray.origin` to `ray.at(t_end)` may
+    /// cross (obvhs' culling in the leaves: a superset of those it crosses), leaf by leaf from
+    /// left to right.
+    pub fn visit(&self, ray: &Ray, t_end: f32, mut visit: impl FnMut(u32)) {
         let inner = self.boxes.len() - self.leaves.len();
         let inv = Vec3::ONE / ray.dir;
-        let visit = RefCell::new(visit);
         let mut stack = [0usize; 16];
         let mut top = 1;
         while top > 0 {
@@ -170,10 +171,7 @@ impl TwoLevelBvh {
                 stack[top + 1] = 2 * k + 1;
                 top += 2;
             } else {
-                self.leaves[k - inner].occluded(ray, t_end, |p| {
-                    (visit.borrow_mut())(p);
-                    false
-                });
+                self.leaves[k - inner].visit(ray, t_end, &mut visit);
             }
         }
     }
@@ -211,30 +209,20 @@ fn slab((lo, hi): (Vec3, Vec3), ray: &Ray, inv: Vec3, t_end: f32) -> bool {
 mod tests {
     use super::*;
     use foton_core::api::Rng;
-    use foton_core::api::{NO_ATTRS, Shape};
 
-    fn boxes(rng: &mut Rng, n: usize) -> Vec<Primitive> {
+    fn boxes(rng: &mut Rng, n: usize) -> Vec<(Vec3, Vec3, u32)> {
         (0..n)
             .map(|i| {
                 let p = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32() * 0.1) * 10.0;
                 let e = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()) * 0.3;
-                Primitive {
-                    shape: Shape::Triangle {
-                        p0: p,
-                        e1: e,
-                        e2: Vec3::ZERO,
-                    },
-                    object: i as u32,
-                    attrs: NO_ATTRS,
-                }
+                (p, p + e, 3 * i as u32)
             })
             .collect()
     }
 
     /// Whether the segment passes well inside the box (clear of what rounding decides).
-    fn crosses(p: &Primitive, ray: &Ray, t_end: f32) -> bool {
-        let b = p.shape.aabb();
-        let (lo, hi) = (Vec3::from(b.min) + 0.01, Vec3::from(b.max) - 0.01);
+    fn crosses((lo, hi, _): (Vec3, Vec3, u32), ray: &Ray, t_end: f32) -> bool {
+        let (lo, hi) = (lo + 0.01, hi - 0.01);
         let (mut near, mut far) = (0.01f32, t_end - 0.01);
         for i in 0..3 {
             if ray.dir[i] == 0.0 {
@@ -267,13 +255,13 @@ mod tests {
     #[test]
     fn offers_every_crossed_box_once_in_the_same_order_on_any_pool() {
         let mut rng = Rng::new(&[7]);
-        let prims = boxes(&mut rng, 9000);
+        let all = boxes(&mut rng, 9000);
         let build = |threads| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| TwoLevelBvh::build(prims.clone()))
+                .install(|| TwoLevelBvh::build(all.clone()))
         };
         let (one, three) = (build(1), build(3));
         assert_eq!(one.leaves.len(), 4);
@@ -291,21 +279,17 @@ mod tests {
             let ray = Ray::new(o, d.normalize());
             let t_end = rng.next_f32() * 15.0;
             let mut a = Vec::new();
-            one.visit(&ray, t_end, |p| a.push(p.object));
+            one.visit(&ray, t_end, |id| a.push(id));
             let mut b = Vec::new();
-            three.visit(&ray, t_end, |p| b.push(p.object));
+            three.visit(&ray, t_end, |id| b.push(id));
             assert_eq!(a, b);
             let mut sorted = a.clone();
             sorted.sort();
             sorted.dedup();
             assert_eq!(sorted.len(), a.len(), "a box offered twice");
-            for p in &prims {
-                if crosses(p, &ray, t_end) {
-                    assert!(
-                        sorted.binary_search(&p.object).is_ok(),
-                        "missed {}",
-                        p.object
-                    );
+            for &bx in &all {
+                if crosses(bx, &ray, t_end) {
+                    assert!(sorted.binary_search(&bx.2).is_ok(), "missed {}", bx.2);
                 }
             }
             offered_total += a.len();
