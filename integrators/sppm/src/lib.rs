@@ -168,6 +168,7 @@ impl PixelStats {
 const STREAM_CAMERA: u64 = 0x7370_706d;
 
 /// What an iteration's camera pass found at one pixel.
+#[derive(Clone, Copy)]
 struct CameraSample {
     /// Emission and shadow-ray direct light, weighted by the path throughput.
     ld: Rgb,
@@ -189,63 +190,67 @@ impl CameraSample {
 }
 
 impl Sppm {
-    fn camera_pass(&self, scene: &Scene, iteration: u64, rays: &mut u64) -> Vec<CameraSample> {
+    /// The camera pass of iteration `iteration` into `samples` (one a pixel, row by row; a
+    /// buffer kept across iterations, so that a pass neither allocates nor copies the
+    /// samples on one thread); returns the rays it traced.
+    fn camera_pass(&self, scene: &Scene, iteration: u64, samples: &mut Vec<CameraSample>) -> u64 {
         let (width, height) = (scene.film().width, scene.film().height);
         let seed = scene.render().seed;
-        let rows: Vec<(Vec<CameraSample>, u64)> = (0..height)
-            .into_par_iter()
-            .map(|y| {
-                let mut row_rays = 0u64;
-                let row = (0..width)
-                    .map(|x| {
-                        let pixel = y as u64 * width as u64 + x as u64;
-                        let mut sampler = Sampler::with_keys(
-                            scene.render().sampler,
-                            &[seed, STREAM_CAMERA, pixel, iteration],
-                            seed,
-                            pixel,
-                            iteration as u32,
-                            self.passes.iterations.unwrap_or(1) as u32,
-                        );
-                        let at = scene.film().filter.sample(x, y, sampler.next_2d());
-                        let ray = scene
-                            .camera()
-                            .generate_ray_lens(at.film, || sampler.next_2d());
-                        let path =
-                            trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
-                        let mut ld = path.emitted;
-                        if let (Some(vp), Direct::ShadowRays) = (&path.visible, self.direct) {
-                            let at = Scatter::Surface {
-                                hit: &vp.hit,
-                                bsdf: &vp.bsdf,
-                            };
-                            ld += vp.beta
-                                * estimate_direct(
-                                    scene,
-                                    at,
-                                    vp.wo,
-                                    vp.medium,
-                                    Mis::LightOnly,
-                                    &mut sampler,
-                                    &mut row_rays,
-                                );
-                        }
-                        CameraSample {
-                            ld,
-                            visible: path.visible,
-                            weight: at.weight,
-                        }
-                    })
-                    .collect();
-                (row, row_rays)
-            })
-            .collect();
-        let mut samples = Vec::with_capacity(width as usize * height as usize);
-        for (row, row_rays) in rows {
-            *rays += row_rays;
-            samples.extend(row);
-        }
+        let none = CameraSample {
+            ld: Rgb::ZERO,
+            visible: None,
+            weight: 0.0,
+        };
+        samples.resize(width as usize * height as usize, none);
         samples
+            .par_chunks_mut(width as usize)
+            .enumerate()
+            .map(|(y, row)| {
+                let y = y as u32;
+                let mut row_rays = 0u64;
+                for (x, sample) in row.iter_mut().enumerate() {
+                    let x = x as u32;
+                    let pixel = y as u64 * width as u64 + x as u64;
+                    let mut sampler = Sampler::with_keys(
+                        scene.render().sampler,
+                        &[seed, STREAM_CAMERA, pixel, iteration],
+                        seed,
+                        pixel,
+                        iteration as u32,
+                        self.passes.iterations.unwrap_or(1) as u32,
+                    );
+                    let at = scene.film().filter.sample(x, y, sampler.next_2d());
+                    let ray = scene
+                        .camera()
+                        .generate_ray_lens(at.film, || sampler.next_2d());
+                    let path =
+                        trace_to_diffuse(scene, ray, self.camera, &mut sampler, &mut row_rays);
+                    let mut ld = path.emitted;
+                    if let (Some(vp), Direct::ShadowRays) = (&path.visible, self.direct) {
+                        let at = Scatter::Surface {
+                            hit: &vp.hit,
+                            bsdf: &vp.bsdf,
+                        };
+                        ld += vp.beta
+                            * estimate_direct(
+                                scene,
+                                at,
+                                vp.wo,
+                                vp.medium,
+                                Mis::LightOnly,
+                                &mut sampler,
+                                &mut row_rays,
+                            );
+                    }
+                    *sample = CameraSample {
+                        ld,
+                        visible: path.visible,
+                        weight: at.weight,
+                    };
+                }
+                row_rays
+            })
+            .sum()
     }
 
     /// The photons iteration `iteration` (0-based) stores: every one but the L D ones with
@@ -291,6 +296,8 @@ struct SppmPasses<'a> {
     tally: &'a Tally,
     /// Whether a pass has run (a part that starts later first needs the radii r_1).
     started: bool,
+    /// The camera pass's samples, a pixel each (kept across iterations).
+    camera: Vec<CameraSample>,
 }
 
 impl Passes for SppmPasses<'_> {
@@ -301,17 +308,18 @@ impl Passes for SppmPasses<'_> {
         if global && iteration > 0 && !self.started {
             // r_1 comes from the first iteration's camera sample: a part that starts later
             // traces that camera pass for its radii alone.
-            let camera = with_pool(quiet.threads, || sppm.camera_pass(scene, 0, &mut rays))?;
-            for (st, cs) in self.stats.iter_mut().zip(&camera) {
+            let camera = &mut self.camera;
+            rays += with_pool(quiet.threads, || sppm.camera_pass(scene, 0, camera))?;
+            for (st, cs) in self.stats.iter_mut().zip(&self.camera) {
                 st.radius = sppm.first_radius(scene, angle, cs.distance());
             }
         }
         self.started = true;
-        let camera = quiet.timed("camera pass", || {
-            with_pool(quiet.threads, || {
-                sppm.camera_pass(scene, iteration, &mut rays)
-            })
+        let camera = &mut self.camera;
+        rays += quiet.timed("camera pass", || {
+            with_pool(quiet.threads, || sppm.camera_pass(scene, iteration, camera))
         })?;
+        let camera = &self.camera;
         Tally::add(&tally.rays, rays);
         let photons = sppm.iteration_photons(scene, iteration, quiet)?;
         if quiet.cancelled() {
@@ -433,6 +441,7 @@ impl Integrator for Sppm {
             angle: pixel_angle(scene),
             tally: &tally,
             started: false,
+            camera: Vec::new(),
         };
         let splittable = match self.schedule {
             RadiusSchedule::Global => Ok(()),
