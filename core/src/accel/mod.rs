@@ -26,9 +26,11 @@
 
 mod boxes;
 mod float_nodes;
+mod parallel;
 mod simd;
 
 pub use boxes::BoxBvh;
+pub use parallel::{median_parts, median_split};
 
 use crate::geometry::{Hit, Primitive, Ray};
 use float_nodes::Node;
@@ -62,15 +64,27 @@ fn bvh_ray(ray: &Ray, tmax: f32) -> BvhRay {
     BvhRay::new(ray.origin.into(), (ray.dir + Vec3::ZERO).into(), 0.0, tmax)
 }
 
-fn cwbvh(prims: &[Primitive]) -> (CwBvh, Vec<Primitive>) {
-    let aabbs: Vec<Aabb> = prims.iter().map(|p| p.shape.aabb()).collect();
+/// obvhs' BVH over `aabbs`, built on one thread.
+fn cwbvh_serial(aabbs: &[Aabb]) -> CwBvh {
     let mut bvh = build_cwbvh(
-        &aabbs,
+        aabbs,
         BvhBuildParams::medium_build(),
         &mut std::time::Duration::default(),
     );
     // obvhs reserves a node a primitive (80 bytes each); about a tenth of that is used.
     bvh.nodes.shrink_to_fit();
+    bvh
+}
+
+/// The BVH over `prims` (in eight parts built at once from [`parallel::PARALLEL`]
+/// primitives) and the primitives in its leaf order.
+fn cwbvh(prims: &[Primitive]) -> (CwBvh, Vec<Primitive>) {
+    let aabbs: Vec<Aabb> = prims.iter().map(|p| p.shape.aabb()).collect();
+    let bvh = if prims.len() >= parallel::PARALLEL {
+        parallel::build(&aabbs, cwbvh_serial)
+    } else {
+        cwbvh_serial(&aabbs)
+    };
     let ordered = bvh
         .primitive_indices
         .iter()
@@ -429,6 +443,64 @@ mod tests {
                 "{n}: {hits} hits, {blocked} blocked"
             );
         }
+    }
+
+    /// A BVH built in parts ([`parallel`]) answers every query as testing every primitive
+    /// does (closest hits bit for bit, shadow rays, every crossing, what `visit` is offered),
+    /// and is the same tree on one thread and on three.
+    #[test]
+    fn a_bvh_built_in_parts_answers_as_every_primitive_does() {
+        let mut rng = Rng::new(&[8]);
+        let mut prims = scene(&mut rng, parallel::PARALLEL + 4321);
+        for (i, p) in prims.iter_mut().enumerate() {
+            p.object = i as u32;
+        }
+        let build = |threads| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| Accel::build(prims.clone()))
+        };
+        let (accel, other) = (build(1), build(3));
+        let bvh = accel.bvh.as_ref().unwrap();
+        assert_eq!(bvh.nodes, other.bvh.as_ref().unwrap().nodes);
+        let objects = |a: &Accel| a.prims.iter().map(|p| p.object).collect::<Vec<_>>();
+        assert_eq!(objects(&accel), objects(&other));
+        assert_eq!(bvh.nodes[0].imask, 0xff, "not built in eight parts");
+        let (mut hits, mut crossings) = (0, 0);
+        for (ray, tmax) in rays_through(&mut rng, &prims, 400) {
+            let want = brute_force(&prims, &ray, tmax);
+            let got = accel.intersect(&ray, tmax);
+            assert_eq!(got.map(|h| h.t.to_bits()), want.map(f32::to_bits));
+            hits += got.is_some() as u32;
+            assert_eq!(accel.occluded(&ray, tmax, |_| true), want.is_some());
+            let mut every: Vec<(u32, u32)> = prims
+                .iter()
+                .filter_map(|p| Some((p.object, p.shape.intersect(&ray, tmax)?.to_bits())))
+                .collect();
+            every.sort();
+            let mut found = Vec::new();
+            accel.for_each_hit(&ray, tmax, |i, t| {
+                found.push((accel.prims[i as usize].object, t.to_bits()))
+            });
+            found.sort();
+            assert_eq!(found, every, "for_each_hit");
+            let mut offered = Vec::new();
+            accel.visit(&ray, tmax, |_, p| {
+                if let Some(t) = p.shape.intersect(&ray, tmax) {
+                    offered.push((p.object, t.to_bits()));
+                }
+                false
+            });
+            offered.sort();
+            assert_eq!(offered, every, "visit");
+            crossings += every.len();
+        }
+        assert!(
+            hits > 50 && crossings > 100,
+            "{hits} hits, {crossings} crossings"
+        );
     }
 
     /// The ball query finds what testing every primitive's box finds: some accepted box

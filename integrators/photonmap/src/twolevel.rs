@@ -5,7 +5,8 @@
 //! depends on the threads' timing, so images would too), and a progressive pass builds a BVH
 //! over tens of thousands of beam pieces: on one thread that was a third of `ppb`'s time at two
 //! threads. Here the boxes are first split at the median of their centres along the widest
-//! axis, [`levels`] times (a complete binary tree whose shape depends only on the boxes),
+//! axis, [`levels`] times (core's `median_split`: a complete binary tree whose shape depends
+//! only on the boxes),
 //! and obvhs builds each of the leaves' BVHs, all at once on the pool's threads. A query
 //! tests the top tree's boxes, then walks the leaves' BVHs it reaches, left to right, so
 //! the order in which it offers primitives is fixed too.
@@ -14,7 +15,7 @@
 //! unevenly spread; with at least [`LEAF`] boxes a leaf, a few tens of top boxes are tested
 //! against obvhs' thousands of node boxes per query.
 
-use foton_core::api::{BoxBvh, Ray, Vec3};
+use foton_core::api::{BoxBvh, Ray, Vec3, median_parts, median_split};
 use rayon::prelude::*;
 
 /// The fewest boxes a leaf BVH is split down to (a leaf holds between this and twice this).
@@ -38,59 +39,6 @@ pub struct TwoLevelBvh {
     leaves: Vec<BoxBvh>,
 }
 
-/// A box's centre and its index in the input: what the median splits move.
-#[derive(Clone, Copy)]
-struct Centre {
-    c: [f32; 3],
-    index: u32,
-}
-
-fn split(items: &mut [Centre], levels: u32) {
-    if levels == 0 || items.len() < 2 {
-        return;
-    }
-    let (lo, hi) = items.iter().fold(
-        ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-        |(lo, hi), it| {
-            (
-                std::array::from_fn(|i| lo[i].min(it.c[i])),
-                std::array::from_fn(|i| hi[i].max(it.c[i])),
-            )
-        },
-    );
-    let e = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
-    let a = if e[0] >= e[1] && e[0] >= e[2] {
-        0
-    } else if e[1] >= e[2] {
-        1
-    } else {
-        2
-    };
-    let mid = items.len() / 2;
-    // Ties broken by index: the partition is a function of the boxes alone.
-    items.select_nth_unstable_by(mid, |p, q| {
-        p.c[a].total_cmp(&q.c[a]).then(p.index.cmp(&q.index))
-    });
-    let (left, right) = items.split_at_mut(mid);
-    if left.len() > 4 * LEAF {
-        rayon::join(|| split(left, levels - 1), || split(right, levels - 1));
-    } else {
-        split(left, levels - 1);
-        split(right, levels - 1);
-    }
-}
-
-/// The ranges of the 2^levels leaves of `n` items split as [`split`] splits them.
-fn leaf_ranges(lo: usize, hi: usize, levels: u32, out: &mut Vec<(usize, usize)>) {
-    if levels == 0 {
-        out.push((lo, hi));
-        return;
-    }
-    let mid = lo + (hi - lo) / 2;
-    leaf_ranges(lo, mid, levels - 1, out);
-    leaf_ranges(mid, hi, levels - 1, out);
-}
-
 fn union(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
     (a.0.min(b.0), a.1.max(b.1))
 }
@@ -102,29 +50,25 @@ impl TwoLevelBvh {
     /// current rayon pool's threads.
     pub fn build(boxes: Vec<(Vec3, Vec3, u32)>) -> TwoLevelBvh {
         let levels = levels(boxes.len());
-        let mut items: Vec<Centre> = boxes
+        let mut items: Vec<([f32; 3], u32)> = boxes
             .par_iter()
             .enumerate()
-            .map(|(index, &(lo, hi, _))| Centre {
-                c: ((lo + hi) * 0.5).to_array(),
-                index: index as u32,
-            })
+            .map(|(index, &(lo, hi, _))| (((lo + hi) * 0.5).to_array(), index as u32))
             .collect();
-        split(&mut items, levels);
-        let mut ranges = Vec::with_capacity(1 << levels);
-        leaf_ranges(0, items.len(), levels, &mut ranges);
+        median_split(&mut items, levels);
+        let ranges = median_parts(items.len(), levels);
         let built: Vec<((Vec3, Vec3), BoxBvh)> = ranges
             .par_iter()
             .map(|&(lo, hi)| {
                 let leaf = &items[lo..hi];
                 let corners: Vec<(Vec3, Vec3)> = leaf
                     .iter()
-                    .map(|it| {
-                        let (lo, hi, _) = boxes[it.index as usize];
+                    .map(|&(_, i)| {
+                        let (lo, hi, _) = boxes[i as usize];
                         (lo, hi)
                     })
                     .collect();
-                let ids: Vec<u32> = leaf.iter().map(|it| boxes[it.index as usize].2).collect();
+                let ids: Vec<u32> = leaf.iter().map(|&(_, i)| boxes[i as usize].2).collect();
                 let bounds = corners.iter().fold(EMPTY, |acc, &b| union(acc, b));
                 (bounds, BoxBvh::build(&corners, &ids))
             })
