@@ -445,32 +445,55 @@ mod tests {
         }
     }
 
-    /// A BVH built in parts ([`parallel`]) answers every query as testing every primitive
-    /// does (closest hits bit for bit, shadow rays, every crossing, what `visit` is offered),
-    /// and is the same tree on one thread and on three.
+    /// A BVH built in parts ([`parallel`]: eight median parts; with quads as large as the
+    /// scene, four and one of those) answers every query as testing every primitive does (closest hits bit for bit, shadow
+    /// rays, every crossing, what `visit` is offered), and is the same tree on one thread and
+    /// on three.
     #[test]
     fn a_bvh_built_in_parts_answers_as_every_primitive_does() {
-        let mut rng = Rng::new(&[8]);
-        let mut prims = scene(&mut rng, parallel::PARALLEL + 4321);
-        for (i, p) in prims.iter_mut().enumerate() {
-            p.object = i as u32;
+        for large in [false, true] {
+            let mut rng = Rng::new(&[8, large as u64]);
+            let mut prims = scene(&mut rng, parallel::PARALLEL + 4321);
+            if large {
+                // Three quads as large as the scene (a floor and walls): a part of their own.
+                for k in 0..3 {
+                    let o = Vec3::splat(k as f32 * 0.1);
+                    prims.push(Primitive {
+                        shape: Shape::quad(o, Vec3::X * 10.0, Vec3::Y * 10.0 + Vec3::Z * k as f32),
+                        object: 0,
+                        attrs: crate::geometry::NO_ATTRS,
+                    });
+                }
+            }
+            for (i, p) in prims.iter_mut().enumerate() {
+                p.object = i as u32;
+            }
+            let parts = if large { 0b1_1111 } else { 0xff };
+            built_in_parts_answers_as_every_primitive_does(&mut rng, &prims, parts);
         }
+    }
+
+    fn built_in_parts_answers_as_every_primitive_does(
+        rng: &mut Rng,
+        prims: &[Primitive],
+        parts: u8,
+    ) {
         let build = |threads| {
             rayon::ThreadPoolBuilder::new()
                 .num_threads(threads)
                 .build()
                 .unwrap()
-                .install(|| Accel::build(prims.clone()))
+                .install(|| Accel::build(prims.to_vec()))
         };
         let (accel, other) = (build(1), build(3));
         let bvh = accel.bvh.as_ref().unwrap();
         assert_eq!(bvh.nodes, other.bvh.as_ref().unwrap().nodes);
         let objects = |a: &Accel| a.prims.iter().map(|p| p.object).collect::<Vec<_>>();
         assert_eq!(objects(&accel), objects(&other));
-        assert_eq!(bvh.nodes[0].imask, 0xff, "not built in eight parts");
+        assert_eq!(bvh.nodes[0].imask, parts, "the root's children: one a part");
         let (mut hits, mut crossings) = (0, 0);
-        for (ray, tmax) in rays_through(&mut rng, &prims, 400) {
-            let want = brute_force(&prims, &ray, tmax);
+        for (ray, tmax) in rays_through(rng, prims, 400) {
+            let want = brute_force(prims, &ray, tmax);
             let got = accel.intersect(&ray, tmax);
             assert_eq!(got.map(|h| h.t.to_bits()), want.map(f32::to_bits));
             hits += got.is_some() as u32;

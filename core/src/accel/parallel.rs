@@ -3,9 +3,9 @@
 //! obvhs builds a BVH on one thread (its `parallel` feature builds trees that depend on the
 //! threads' timing, so images would too): a million triangles took 0.9 s, most of a large
 //! mesh's load. Here the primitives are split at the median of their boxes' centres along the
-//! widest axis, three times (a function of the boxes alone, ties broken by index), obvhs builds
-//! the eight parts' BVHs at once, and one root node whose eight children are the parts' roots
-//! joins them into one compressed BVH8. Everything after (the float nodes, every traversal) is
+//! widest axis, three times (a function of the boxes alone, ties broken by index; large boxes
+//! apart, see [`build`]), obvhs builds the parts' BVHs at once, and one root node whose
+//! children are the parts' roots joins them into one compressed BVH8. Everything after (the float nodes, every traversal) is
 //! as for a BVH built in one piece.
 
 use glam::{Vec3, Vec3A};
@@ -71,21 +71,42 @@ pub fn median_parts(n: usize, levels: u32) -> Vec<(usize, usize)> {
     out
 }
 
-/// The BVH over `aabbs` built in eight parts at once (module comment); `build` builds one
-/// part's BVH over the boxes it is given.
+/// The BVH over `aabbs` built in parts at once (module comment); `build` builds one part's BVH
+/// over the boxes it is given. Boxes larger than a quarter of the scene's box on some axis (a
+/// floor under a detailed mesh) are a part of their own: in a median part its box would
+/// cover the others', and every ray would enter it. The rest is split into eight parts, or
+/// four beside the large boxes' part (a root holds eight children).
 pub(super) fn build(aabbs: &[Aabb], build: impl Fn(&[Aabb]) -> CwBvh + Sync) -> CwBvh {
-    let mut items: Vec<([f32; 3], u32)> = aabbs
-        .par_iter()
-        .enumerate()
-        .map(|(i, b)| (((b.min + b.max) * 0.5).to_array(), i as u32))
+    let scene = aabbs.iter().fold(Aabb::empty(), |b, a| b.union(a));
+    let quarter = (scene.max - scene.min) * 0.25;
+    let large = |b: &Aabb| (b.max - b.min).cmpgt(quarter).any();
+    let (mut items, big): (Vec<([f32; 3], u32)>, Vec<u32>) = {
+        let mut items = Vec::with_capacity(aabbs.len());
+        let mut big = Vec::new();
+        for (i, b) in aabbs.iter().enumerate() {
+            if large(b) {
+                big.push(i as u32);
+            } else {
+                items.push((((b.min + b.max) * 0.5).to_array(), i as u32));
+            }
+        }
+        (items, big)
+    };
+    let levels = if big.is_empty() { 3 } else { 2 };
+    median_split(&mut items, levels);
+    let mut members: Vec<Vec<u32>> = median_parts(items.len(), levels)
+        .into_iter()
+        .map(|(lo, hi)| items[lo..hi].iter().map(|&(_, i)| i).collect())
         .collect();
-    median_split(&mut items, 3);
-    let parts: Vec<(CwBvh, Vec<u32>)> = median_parts(items.len(), 3)
+    if !big.is_empty() {
+        members.push(big);
+    }
+    let parts: Vec<(CwBvh, Vec<u32>)> = members
         .into_par_iter()
-        .map(|(lo, hi)| {
-            let members: Vec<u32> = items[lo..hi].iter().map(|&(_, i)| i).collect();
-            let boxes: Vec<Aabb> = members.iter().map(|&i| aabbs[i as usize]).collect();
-            (build(&boxes), members)
+        .filter(|m| !m.is_empty())
+        .map(|m| {
+            let boxes: Vec<Aabb> = m.iter().map(|&i| aabbs[i as usize]).collect();
+            (build(&boxes), m)
         })
         .collect();
     join(parts)
