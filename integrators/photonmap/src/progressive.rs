@@ -8,7 +8,7 @@
 use crate::map::{DISC_THICKNESS, DiscClip, PhotonMap};
 use foton_core::api::{
     Budget, Error, Film, NormalizedKernel, Parameter, Progress, Properties, RenderContext, Result,
-    Rgb, Scene, VisiblePoint, Work, usable, warn_unusable,
+    Rgb, Sampler, Scene, VisiblePoint, Work, usable, warn_unusable,
 };
 use glam::{DVec3, Vec2, Vec3};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -24,6 +24,29 @@ pub struct PassBudget {
     pub time: Option<f64>,
     /// Photons (for `vcm`: light subpaths) each pass traces: the summary's count.
     pub photons_per_iteration: u64,
+}
+
+impl PassBudget {
+    /// The sampler of the camera sample of pixel `pixel` (row-major index) in pass
+    /// `iteration`, on the integrator's own random stream `stream`: its numbers depend on
+    /// the pixel and the pass alone (the scene's sampler, stratified over the passes).
+    pub fn camera_sampler(
+        &self,
+        scene: &Scene,
+        stream: u64,
+        pixel: u64,
+        iteration: u64,
+    ) -> Sampler {
+        let seed = scene.render().seed;
+        Sampler::with_keys(
+            scene.render().sampler,
+            &[seed, stream, pixel, iteration],
+            seed,
+            pixel,
+            iteration as u32,
+            self.iterations.unwrap_or(1) as u32,
+        )
+    }
 }
 
 /// Reads a progressive integrator's `time` (seconds, > 0) and `iterations` (>= 1; `default`

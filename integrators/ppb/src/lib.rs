@@ -247,16 +247,10 @@ impl Ppb {
         bad_photons: &mut u64,
         mut share: impl FnMut(usize, Rgb),
     ) -> (Rgb, f32) {
-        let seed = scene.render().seed;
         let pixel = y as u64 * scene.film().width as u64 + x as u64;
-        let mut sampler = Sampler::with_keys(
-            scene.render().sampler,
-            &[seed, STREAM_CAMERA, pixel, iteration],
-            seed,
-            pixel,
-            iteration as u32,
-            self.passes.iterations.unwrap_or(1) as u32,
-        );
+        let mut sampler = self
+            .passes
+            .camera_sampler(scene, STREAM_CAMERA, pixel, iteration);
         let placed = scene.film().filter.sample(x, y, sampler.next_2d());
         let film = placed.film;
 

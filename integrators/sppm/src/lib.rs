@@ -80,7 +80,7 @@
 
 use foton_core::api::{
     Budget, CameraWalk, Direct, Error, Film, Integrator, Mis, NormalizedKernel, Parameter,
-    PhotonMapView, Properties, RadianceSum, RenderContext, Result, Rgb, Sampler, Scatter, Scene,
+    PhotonMapView, Properties, RadianceSum, RenderContext, Result, Rgb, Scatter, Scene,
     VisiblePoint, estimate_direct, splitmix64, trace_to_diffuse, usable, with_pool,
 };
 use foton_photonmap::map::PhotonMap;
@@ -195,7 +195,6 @@ impl Sppm {
     /// samples on one thread); returns the rays it traced.
     fn camera_pass(&self, scene: &Scene, iteration: u64, samples: &mut Vec<CameraSample>) -> u64 {
         let (width, height) = (scene.film().width, scene.film().height);
-        let seed = scene.render().seed;
         let none = CameraSample {
             ld: Rgb::ZERO,
             visible: None,
@@ -211,14 +210,9 @@ impl Sppm {
                 for (x, sample) in row.iter_mut().enumerate() {
                     let x = x as u32;
                     let pixel = y as u64 * width as u64 + x as u64;
-                    let mut sampler = Sampler::with_keys(
-                        scene.render().sampler,
-                        &[seed, STREAM_CAMERA, pixel, iteration],
-                        seed,
-                        pixel,
-                        iteration as u32,
-                        self.passes.iterations.unwrap_or(1) as u32,
-                    );
+                    let mut sampler =
+                        self.passes
+                            .camera_sampler(scene, STREAM_CAMERA, pixel, iteration);
                     let at = scene.film().filter.sample(x, y, sampler.next_2d());
                     let ray = scene
                         .camera()
