@@ -80,14 +80,7 @@ impl Reader {
                     return Ok(None);
                 };
                 let opacity = self.as_eval_1(&o, "opacity", opacity);
-                let inner = o
-                    .props
-                    .iter()
-                    .position(|(_, p, _)| matches!(p, Prop::Object(_) | Prop::Ref(_)));
-                let Some(i) = inner else {
-                    return Err(o.error("a mask BSDF without the BSDF it wraps"));
-                };
-                let (_, inner, l) = o.props.remove(i);
+                let (inner, l) = take_wrapped(&mut o, "mask")?;
                 self.leftovers(&o)?;
                 let name = match inner {
                     Prop::Object(mut inner) if inner.tag == "bsdf" => {
@@ -131,14 +124,7 @@ impl Reader {
                         "the map's normals are used as given, as pbrt-v4 uses them: not Mitsuba 3's shadowing term (Estevez et al. 2019; `use_shadowing_function`, which darkens light arriving at grazing angles to a strongly tilted normal) nor its flip of normals facing away from the viewer (`flip_invalid_normals`)",
                     );
                 }
-                let inner = o
-                    .props
-                    .iter()
-                    .position(|(_, p, _)| matches!(p, Prop::Object(_) | Prop::Ref(_)));
-                let Some(i) = inner else {
-                    return Err(o.error("a normalmap BSDF without the BSDF it wraps"));
-                };
-                let (_, inner, l) = o.props.remove(i);
+                let (inner, l) = take_wrapped(&mut o, "normalmap")?;
                 self.leftovers(&o)?;
                 let name = match inner {
                     Prop::Object(inner) if inner.tag == "bsdf" => self.bsdf(inner)?,
@@ -568,6 +554,20 @@ impl Reader {
 
 /// Makes a material table two-sided (Mitsuba's `twosided` around it): its own switch, or
 /// those of a blend's components.
+/// Takes from a wrapping BSDF (`mask`, `normalmap`) the BSDF it wraps, nested or referenced,
+/// with its line; an error if it has none.
+fn take_wrapped(o: &mut Obj, what: &str) -> Result<(Prop, u32)> {
+    let Some(i) = o
+        .props
+        .iter()
+        .position(|(_, p, _)| matches!(p, Prop::Object(_) | Prop::Ref(_)))
+    else {
+        return Err(o.error(format!("a {what} BSDF without the BSDF it wraps")));
+    };
+    let (_, inner, line) = o.props.remove(i);
+    Ok((inner, line))
+}
+
 fn make_twosided(t: &mut Table, line: u32) {
     if t.get("twosided").is_some() {
         t.insert("twosided", at(Value::Bool(true), line));
