@@ -11,8 +11,8 @@
 //! **Splats.** An integrator that also traces paths from the lights ([`render_pixels_splatting`])
 //! adds what they bring to the camera to any pixel ([`Splats::add`]). Each tile keeps its splats
 //! as exact fixed-point sums ([`RadianceSum`]) in a short list and adds them to one image-sized
-//! splat buffer when the list fills and when the tile ends, sorted by pixel, band of rows by
-//! band of rows: each band has its own lock, and a band another thread holds is left for
+//! splat buffer when the list fills and when the tile ends, grouped by band of rows: each band
+//! has its own lock, and a band another thread holds is left for
 //! later rather than waited for (with one lock for the image, the tiles of a light-tracing
 //! render queued on it). Integer addition is
 //! associative and commutative, so the buffer holds the same bits whatever order the tiles and
@@ -104,6 +104,8 @@ pub struct PixelSample {
 pub struct Splats<'a> {
     width: u32,
     pending: Vec<(u32, RadianceSum)>,
+    /// Scratch for grouping `pending` by band.
+    order: Vec<u32>,
     buffer: Option<&'a SplatBuffer>,
     bad: u64,
 }
@@ -134,32 +136,56 @@ impl SplatBuffer {
         }
     }
 
-    /// Adds `splats` (sorted by pixel) to the sums: each band's run under its lock, the
-    /// bands another thread holds after the others.
-    fn add(&self, splats: &[(u32, RadianceSum)]) {
-        let mut busy = Vec::new();
-        let mut rest = splats;
-        while let Some(&(first, _)) = rest.first() {
-            let b = first as usize / self.band;
-            let end = rest.partition_point(|&(i, _)| i as usize / self.band == b);
-            let (run, next) = rest.split_at(end);
-            match self.bands[b].try_lock() {
-                Ok(mut sums) => self.merge(b, &mut sums, run),
-                Err(std::sync::TryLockError::WouldBlock) => busy.push((b, run)),
+    /// Adds `splats` to the sums: grouped by band (a counting pass, not a sort: `order` is
+    /// scratch), each band's group under its lock, the bands another thread holds after the
+    /// others.
+    fn add(&self, splats: &[(u32, RadianceSum)], order: &mut Vec<u32>) {
+        const N: usize = SPLAT_BANDS as usize + 1;
+        let mut start = [0u32; N];
+        for &(i, _) in splats {
+            start[i as usize / self.band + 1] += 1;
+        }
+        for b in 1..N {
+            start[b] += start[b - 1];
+        }
+        let mut next = start;
+        order.resize(splats.len(), 0);
+        for (k, &(i, _)) in splats.iter().enumerate() {
+            let b = i as usize / self.band;
+            order[next[b] as usize] = k as u32;
+            next[b] += 1;
+        }
+        let group = |b: usize| &order[start[b] as usize..start[b + 1] as usize];
+        let mut busy = [false; N];
+        for (b, band) in self.bands.iter().enumerate() {
+            if group(b).is_empty() {
+                continue;
+            }
+            match band.try_lock() {
+                Ok(mut sums) => self.merge(b, &mut sums, splats, group(b)),
+                Err(std::sync::TryLockError::WouldBlock) => busy[b] = true,
                 Err(std::sync::TryLockError::Poisoned(e)) => {
-                    self.merge(b, &mut e.into_inner(), run)
+                    self.merge(b, &mut e.into_inner(), splats, group(b))
                 }
             }
-            rest = next;
         }
-        for (b, run) in busy {
-            let mut sums = self.bands[b].lock().unwrap_or_else(|e| e.into_inner());
-            self.merge(b, &mut sums, run);
+        for (b, band) in self.bands.iter().enumerate() {
+            if busy[b] {
+                let mut sums = band.lock().unwrap_or_else(|e| e.into_inner());
+                self.merge(b, &mut sums, splats, group(b));
+            }
         }
     }
 
-    fn merge(&self, b: usize, sums: &mut [RadianceSum], run: &[(u32, RadianceSum)]) {
-        for (i, sum) in run {
+    fn merge(
+        &self,
+        b: usize,
+        sums: &mut [RadianceSum],
+        splats: &[(u32, RadianceSum)],
+        group: &[u32],
+    ) {
+        for &k in group {
+            let (i, sum) = &splats[k as usize];
             sums[*i as usize - b * self.band].merge(sum);
         }
     }
@@ -205,8 +231,7 @@ impl Splats<'_> {
 
     fn flush(&mut self) {
         if let Some(buffer) = self.buffer {
-            self.pending.sort_unstable_by_key(|&(i, _)| i);
-            buffer.add(&self.pending);
+            buffer.add(&self.pending, &mut self.order);
         }
         self.pending.clear();
     }
@@ -371,6 +396,7 @@ where
                         let mut splats = Splats {
                             width,
                             pending: Vec::new(),
+                            order: Vec::new(),
                             buffer: splatting.then_some(&splat_buffer),
                             bad: 0,
                         };
