@@ -446,30 +446,28 @@ mod tests {
     }
 
     /// A BVH built in parts ([`parallel`]: eight median parts; with quads as large as the
-    /// scene, four and one of those) answers every query as testing every primitive does (closest hits bit for bit, shadow
+    /// scene, four and those apart) answers every query as testing every primitive does (closest hits bit for bit, shadow
     /// rays, every crossing, what `visit` is offered), and is the same tree on one thread and
     /// on three.
     #[test]
     fn a_bvh_built_in_parts_answers_as_every_primitive_does() {
-        for large in [false, true] {
-            let mut rng = Rng::new(&[8, large as u64]);
+        // Quads as large as the scene (a floor and walls): none (eight median parts), three
+        // (four parts and a leaf of the root), five (four parts and a part of theirs).
+        for (large, imask) in [(0, 0xff), (3, 0b1111), (5, 0b1_1111)] {
+            let mut rng = Rng::new(&[8, large]);
             let mut prims = scene(&mut rng, parallel::PARALLEL + 4321);
-            if large {
-                // Three quads as large as the scene (a floor and walls): a part of their own.
-                for k in 0..3 {
-                    let o = Vec3::splat(k as f32 * 0.1);
-                    prims.push(Primitive {
-                        shape: Shape::quad(o, Vec3::X * 10.0, Vec3::Y * 10.0 + Vec3::Z * k as f32),
-                        object: 0,
-                        attrs: crate::geometry::NO_ATTRS,
-                    });
-                }
+            for k in 0..large {
+                let o = Vec3::splat(k as f32 * 0.1);
+                prims.push(Primitive {
+                    shape: Shape::quad(o, Vec3::X * 10.0, Vec3::Y * 10.0 + Vec3::Z * k as f32),
+                    object: 0,
+                    attrs: crate::geometry::NO_ATTRS,
+                });
             }
             for (i, p) in prims.iter_mut().enumerate() {
                 p.object = i as u32;
             }
-            let parts = if large { 0b1_1111 } else { 0xff };
-            built_in_parts_answers_as_every_primitive_does(&mut rng, &prims, parts);
+            built_in_parts_answers_as_every_primitive_does(&mut rng, &prims, imask);
         }
     }
 

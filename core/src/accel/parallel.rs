@@ -73,9 +73,10 @@ pub fn median_parts(n: usize, levels: u32) -> Vec<(usize, usize)> {
 
 /// The BVH over `aabbs` built in parts at once (module comment); `build` builds one part's BVH
 /// over the boxes it is given. Boxes larger than a quarter of the scene's box on some axis (a
-/// floor under a detailed mesh) are a part of their own: in a median part its box would
-/// cover the others', and every ray would enter it. The rest is split into eight parts, or
-/// four beside the large boxes' part (a root holds eight children).
+/// floor under a detailed mesh) are kept apart: in a median part its box would cover the
+/// others', and every ray would enter it. Up to three are a leaf of the root, more a part of
+/// their own. The rest is split into eight parts, or four beside the large boxes (a root
+/// holds eight children).
 pub(super) fn build(aabbs: &[Aabb], build: impl Fn(&[Aabb]) -> CwBvh + Sync) -> CwBvh {
     let scene = aabbs.iter().fold(Aabb::empty(), |b, a| b.union(a));
     let quarter = (scene.max - scene.min) * 0.25;
@@ -98,9 +99,14 @@ pub(super) fn build(aabbs: &[Aabb], build: impl Fn(&[Aabb]) -> CwBvh + Sync) -> 
         .into_iter()
         .map(|(lo, hi)| items[lo..hi].iter().map(|&(_, i)| i).collect())
         .collect();
-    if !big.is_empty() {
+    // Up to three large boxes are a leaf of the root itself (a ray that meets them goes down no
+    // part's tree); more, a part of their own.
+    let leaf = if big.len() <= 3 {
+        big
+    } else {
         members.push(big);
-    }
+        Vec::new()
+    };
     let parts: Vec<(CwBvh, Vec<u32>)> = members
         .into_par_iter()
         .filter(|m| !m.is_empty())
@@ -109,19 +115,27 @@ pub(super) fn build(aabbs: &[Aabb], build: impl Fn(&[Aabb]) -> CwBvh + Sync) -> 
             (build(&boxes), m)
         })
         .collect();
-    join(parts)
+    let leaf: Vec<(u32, Aabb)> = leaf.into_iter().map(|i| (i, aabbs[i as usize])).collect();
+    join(parts, &leaf)
 }
 
-/// One BVH of the parts' BVHs (each with the input indices of its boxes): a root whose
-/// children are copies of the parts' roots, then each part's nodes, moved.
-fn join(parts: Vec<(CwBvh, Vec<u32>)>) -> CwBvh {
+/// One BVH of the parts' BVHs (each with the input indices of its boxes) and of up to three
+/// boxes `leaf` (input index, box): a root whose children are copies of the parts' roots and
+/// one leaf of those boxes, then each part's nodes, moved.
+fn join(parts: Vec<(CwBvh, Vec<u32>)>, leaf: &[(u32, Aabb)]) -> CwBvh {
     let k = parts.len();
-    assert!((1..=8).contains(&k), "a root holds up to eight parts");
+    assert!(leaf.len() <= 3, "a leaf holds up to three boxes");
+    assert!(
+        (1..=8).contains(&(k + !leaf.is_empty() as usize)),
+        "a root holds up to eight children"
+    );
+    let leaf_box = leaf.iter().fold(Aabb::empty(), |b, (_, a)| b.union(a));
     let total = parts
         .iter()
-        .fold(Aabb::empty(), |b, (p, _)| b.union(&p.total_aabb));
+        .fold(leaf_box, |b, (p, _)| b.union(&p.total_aabb));
     let mut nodes = vec![CwBvhNode::default(); 1 + k];
-    let mut primitive_indices = Vec::new();
+    // The root's leaf first: its boxes at primitive 0.
+    let mut primitive_indices: Vec<u32> = leaf.iter().map(|&(i, _)| i).collect();
     for (g, (part, members)) in parts.iter().enumerate() {
         let (node_base, prim_base) = (nodes.len() as u32, primitive_indices.len() as u32);
         for node in &part.nodes {
@@ -149,8 +163,7 @@ fn join(parts: Vec<(CwBvh, Vec<u32>)>) -> CwBvh {
         primitive_base_idx: 0,
         ..CwBvhNode::default()
     };
-    for (i, (part, _)) in parts.iter().enumerate() {
-        let b = part.total_aabb;
+    let mut child = |i: usize, b: &Aabb| {
         let lo = ((b.min - p) * rcp)
             .floor()
             .clamp(Vec3A::ZERO, Vec3A::splat(255.0));
@@ -163,8 +176,20 @@ fn join(parts: Vec<(CwBvh, Vec<u32>)>) -> CwBvh {
         root.child_max_x[i] = hi.x as u8;
         root.child_max_y[i] = hi.y as u8;
         root.child_max_z[i] = hi.z as u8;
+    };
+    for (i, (part, _)) in parts.iter().enumerate() {
+        child(i, &part.total_aabb);
+    }
+    if !leaf.is_empty() {
+        child(k, &leaf_box);
+    }
+    for i in 0..k {
         root.imask |= 1 << i;
         root.child_meta[i] = (24 + i as u8) | 0b0010_0000;
+    }
+    if !leaf.is_empty() {
+        // Primitives 0.. of the root's: the count in unary in the high three bits.
+        root.child_meta[k] = [0, 0b0010_0000, 0b0110_0000, 0b1110_0000][leaf.len()];
     }
     nodes[0] = root;
     CwBvh {
