@@ -97,6 +97,8 @@ pub struct SurfacePoint {
     pub uv: Vec2,
     /// Tangent dp/du (zero where the parameterisation gives none): orients anisotropic BSDFs.
     pub dpdu: Vec3,
+    /// Tangent dp/dv (zero where dp/du is): with dp/du, the frame a bump map tilts.
+    pub dpdv: Vec3,
 }
 
 /// A shape instance in the scene: geometry plus the index of the scene object it belongs to
@@ -357,9 +359,10 @@ impl Shape {
                 ns: ng,
                 uv: Vec2::ZERO,
                 dpdu: Vec3::ZERO,
+                dpdv: Vec3::ZERO,
             };
         }
-        let (uv, dpdu, ns) = match *self {
+        let (uv, dpdu, dpdv, ns) = match *self {
             Shape::Sphere {
                 center,
                 radius,
@@ -376,15 +379,26 @@ impl Shape {
                     phi * (0.5 * std::f32::consts::FRAC_1_PI),
                     theta * std::f32::consts::FRAC_1_PI,
                 );
-                let dpdu = to_local.transpose()
-                    * (Vec3::new(-d.y, d.x, 0.0) * (2.0 * std::f32::consts::PI * radius));
-                (uv, dpdu, ng)
+                let to_world = to_local.transpose();
+                let dpdu =
+                    to_world * (Vec3::new(-d.y, d.x, 0.0) * (2.0 * std::f32::consts::PI * radius));
+                // d p / d theta times d theta / d v = pi: (cos theta cos phi, cos theta sin
+                // phi, -sin theta) pi r.
+                let sin_theta = (d.x * d.x + d.y * d.y).sqrt();
+                let dpdv = if sin_theta > 0.0 {
+                    to_world
+                        * (Vec3::new(d.z * d.x / sin_theta, d.z * d.y / sin_theta, -sin_theta)
+                            * (std::f32::consts::PI * radius))
+                } else {
+                    Vec3::ZERO
+                };
+                (uv, dpdu, dpdv, ng)
             }
             Shape::Quad {
                 origin, u, v, w, ..
             } => {
                 let q = p - origin;
-                (Vec2::new(w.dot(q.cross(v)), w.dot(u.cross(q))), u, ng)
+                (Vec2::new(w.dot(q.cross(v)), w.dot(u.cross(q))), u, v, ng)
             }
             Shape::Disk {
                 center, u, v, w, ..
@@ -398,9 +412,12 @@ impl Shape {
                 let r = (a * a + b * b).sqrt();
                 // d p / d r along the radius, as Mitsuba's disk (u = r).
                 let dpdu = if r > 0.0 { (a * u + b * v) / r } else { u };
+                // d p / d phi times d phi / d v = 2 pi.
+                let dpdv = (a * v - b * u) * (2.0 * std::f32::consts::PI);
                 (
                     Vec2::new(r, phi * (0.5 * std::f32::consts::FRAC_1_PI)),
                     dpdu,
+                    dpdv,
                     ng,
                 )
             }
@@ -412,7 +429,7 @@ impl Shape {
                 let b2 = e1.cross(q).dot(n) * inv;
                 let b0 = 1.0 - b1 - b2;
                 let mut uv = Vec2::new(b1, b2);
-                let mut dpdu = Vec3::ZERO;
+                let (mut dpdu, mut dpdv) = (Vec3::ZERO, Vec3::ZERO);
                 let mut ns = ng;
                 if let Some(a) = attrs {
                     if let Some(t) = a.uvs {
@@ -422,6 +439,7 @@ impl Shape {
                         let det = d1.x * d2.y - d1.y * d2.x;
                         if det.abs() > 1e-20 {
                             dpdu = (d2.y * e1 - d1.y * e2) / det;
+                            dpdv = (d1.x * e2 - d2.x * e1) / det;
                         }
                     }
                     if let Some(nv) = a.normals {
@@ -431,7 +449,7 @@ impl Shape {
                         }
                     }
                 }
-                (uv, dpdu, ns)
+                (uv, dpdu, dpdv, ns)
             }
         };
         SurfacePoint {
@@ -440,6 +458,7 @@ impl Shape {
             ns,
             uv,
             dpdu,
+            dpdv,
         }
     }
 
@@ -522,6 +541,70 @@ mod tests {
         assert!((s.intersect(&r, f32::INFINITY).unwrap() - 4.0).abs() < 1e-5);
         let inside = Ray::new(Vec3::ZERO, Vec3::X);
         assert!((s.intersect(&inside, f32::INFINITY).unwrap() - 1.0).abs() < 1e-5);
+    }
+
+    /// dp/du and dp/dv are the derivatives of the parameterisation: a small step along
+    /// either, put back on the surface, moves the texture coordinates by that step in u or v
+    /// alone (sphere under a rotation, quad, ellipse-shaped disk, triangle with uvs).
+    #[test]
+    fn tangents_are_the_derivatives_of_the_texture_coordinates() {
+        let sphere = Shape::Sphere {
+            center: Vec3::new(0.5, 0.0, 1.0),
+            radius: 2.0,
+            inward: false,
+            to_local: Mat3::from_rotation_x(0.7) * Mat3::from_rotation_z(0.3),
+        };
+        let quad = Shape::quad(
+            Vec3::ZERO,
+            Vec3::new(2.0, 0.5, 0.0),
+            Vec3::new(0.0, 1.0, 3.0),
+        );
+        let disk = Shape::disk(
+            Vec3::ONE,
+            Vec3::new(2.0, 0.0, 0.0),
+            Vec3::new(0.0, 1.0, 0.5),
+        );
+        let triangle = Shape::Triangle {
+            p0: Vec3::ZERO,
+            e1: Vec3::new(2.0, 0.0, 0.0),
+            e2: Vec3::new(0.5, 1.0, 1.0),
+        };
+        let attrs = TriangleAttrs {
+            normals: None,
+            uvs: Some([
+                Vec2::new(0.1, 0.2),
+                Vec2::new(0.9, 0.4),
+                Vec2::new(0.3, 1.5),
+            ]),
+        };
+        let onto = |shape: &Shape, p: Vec3| match *shape {
+            Shape::Sphere { center, radius, .. } => center + (p - center).normalize() * radius,
+            _ => p,
+        };
+        for (shape, attrs) in [
+            (sphere, None),
+            (quad, None),
+            (disk, None),
+            (triangle, Some(&attrs)),
+        ] {
+            for u in [
+                Vec2::new(0.3, 0.4),
+                Vec2::new(0.6, 0.2),
+                Vec2::new(0.45, 0.7),
+            ] {
+                let (p, _) = shape.sample_area(u);
+                let sp = shape.surface(p, attrs);
+                let h = 1e-3;
+                for (tangent, step) in [(sp.dpdu, Vec2::X), (sp.dpdv, Vec2::Y)] {
+                    let moved = shape.surface(onto(&shape, p + h * tangent), attrs).uv;
+                    let duv = (moved - sp.uv) / h;
+                    assert!(
+                        (duv - step).length() < 2e-2,
+                        "{shape:?} at {p}: a step along the tangent of {step} moved uv by {duv}"
+                    );
+                }
+            }
+        }
     }
 
     #[test]

@@ -96,6 +96,19 @@ pub struct Object {
     /// `normalmap`): a texture whose colour c gives the normal 2c - 1 in the surface's
     /// shading frame (x along dp/du, z the normal). None: the surface's own normals.
     pub normal_map: Option<Texture>,
+    /// Its material's bump map (Mitsuba's `bumpmap`, pbrt-v4's `displacement`). At most one
+    /// of `normal_map` and `bump_map` is given.
+    pub bump_map: Option<BumpMap>,
+}
+
+/// A height field over a surface's texture coordinates that tilts its shading normal: the
+/// surface p + h(u, v) n, whose normal, the usually negligible derivative of n left out (as
+/// Mitsuba's `bumpmap` leaves it out), is (dp/du + h_u n) x (dp/dv + h_v n) with h the
+/// texture's value (a colour's luminance) times `scale`.
+#[derive(Clone, Debug)]
+pub struct BumpMap {
+    pub height: Texture,
+    pub scale: f32,
 }
 
 /// A medium of any kind.
@@ -137,7 +150,8 @@ pub struct Scene {
     has_media: bool,
     /// Whether any object has a cut-out (its `alpha`): only then do ray queries test them.
     has_alpha: bool,
-    /// Whether any object has a normal map: only then does [`Scene::bsdf`] look for one.
+    /// Whether any object has a normal or a bump map: only then does [`Scene::bsdf`] look
+    /// for one.
     has_normal_maps: bool,
     /// Per light: the medium the file puts it in (a point or spot light's `medium`, an area
     /// light whose shape names its exterior); None: found from where it lies.
@@ -281,7 +295,9 @@ impl Scene {
             )?;
         }
         let has_alpha = objects.iter().any(|o| o.alpha.is_some());
-        let has_normal_maps = objects.iter().any(|o| o.normal_map.is_some());
+        let has_normal_maps = objects
+            .iter()
+            .any(|o| o.normal_map.is_some() || o.bump_map.is_some());
         Ok(Scene {
             file,
             render,
@@ -437,12 +453,18 @@ impl Scene {
         if material.is_null() {
             return None;
         }
-        if self.has_normal_maps
-            && let Some(map) = &self.object(hit).normal_map
-        {
-            let mut sp = self.surface(hit);
-            sp.ns = normal_mapped(&sp, map);
-            return material.bsdf(&sp);
+        if self.has_normal_maps {
+            let object = self.object(hit);
+            if let Some(map) = &object.normal_map {
+                let mut sp = self.surface(hit);
+                sp.ns = normal_mapped(&sp, map);
+                return material.bsdf(&sp);
+            }
+            if let Some(bump) = &object.bump_map {
+                let mut sp = self.surface(hit);
+                sp.ns = bumped(&sp, bump);
+                return material.bsdf(&sp);
+            }
         }
         let prim = self.primitive(hit);
         let attrs = self.triangle_attrs.get(prim.attrs as usize);
@@ -542,6 +564,21 @@ fn normal_mapped(sp: &SurfacePoint, map: &Texture) -> Vec3 {
         return sp.ns;
     }
     if n.dot(sp.ng) < 0.0 { -n } else { n }
+}
+
+/// The shading normal a bump map gives at a surface point (see [`BumpMap`]; Mitsuba 3's
+/// `bumpmap`), turned to the geometric normal's side; the surface's own where the surface has
+/// no tangents.
+fn bumped(sp: &SurfacePoint, bump: &BumpMap) -> Vec3 {
+    let h = bump.scale * bump.height.gradient(sp.uv);
+    let n = sp.ns;
+    let dpdu = sp.dpdu + n * (h.x - n.dot(sp.dpdu));
+    let dpdv = sp.dpdv + n * (h.y - n.dot(sp.dpdv));
+    let b = dpdu.cross(dpdv).normalize_or_zero();
+    if b == Vec3::ZERO {
+        return sp.ns;
+    }
+    if b.dot(sp.ng) < 0.0 { -b } else { b }
 }
 
 /// What the host (the loader, the tools, the tests) reads and changes of a scene besides what

@@ -66,6 +66,7 @@ fn albedo_at(m: &Material, p: Vec3, uv: Vec2) -> f32 {
         ns: Vec3::Z,
         uv,
         dpdu: Vec3::ZERO,
+        dpdv: Vec3::ZERO,
     };
     match m.bsdf(&sp).expect("a blend scatters").lobe {
         Lobe::Diffuse(d) => d.reflectance.x,

@@ -525,6 +525,7 @@ fn the_classic_lobes_are_one_sided_unless_twosided() {
         ns: Vec3::Z,
         uv: Vec2::ZERO,
         dpdu: Vec3::X,
+        dpdv: Vec3::Y,
     };
     let (wo, wi) = (dir(30.0, 0.0), dir(35.0, 170.0));
     let flip = |w: Vec3| Vec3::new(w.x, w.y, -w.z);

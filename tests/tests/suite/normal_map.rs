@@ -2,7 +2,8 @@
 //! texture's colour c gives the shading normal 2c - 1 in the surface's shading frame. A
 //! Lambertian surface then reflects rho / pi E cos(shading normal, light): every integrator
 //! (the path tracer's next-event estimate, light tracing's adjoint BSDF with its shading
-//! normal correction, photons) must give that.
+//! normal correction, photons) must give that. Bump maps (`bump_map`, Mitsuba's `bumpmap`)
+//! tilt the normal by the height's slope: the same test with a height ramp.
 
 use foton_tests::{header, render_toml};
 
@@ -174,4 +175,230 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
         "Mitsuba: tilted / flat {ratio}, expected {want}"
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A bump map whose height falls along u at a constant rate tilts a quad's normal by a
+/// constant angle: (dp/du + h_u n) x (dp/dv) with dp/du = 4 x, dp/dv = 4 y tilts it towards
+/// +x by atan(-h_u / 4). The height is an 8-bit ramp, texel i of 256 at 255 - i, read
+/// bilinear: h_u = -256 / 255 per unit of u times `bump_scale`, except in the outer half
+/// texels, which the camera does not see. Every integrator must shade it by the tilted
+/// cosine, in the TOML form, through pbrt-v4's `displacement` and through Mitsuba's
+/// `bumpmap` (a `scale` texture around the height, as Mitsuba 0.6 files write it).
+#[test]
+fn a_height_ramp_tilts_a_lambertian_surface_by_its_slope() {
+    let dir = foton_tests::temp_dir("bump-map");
+    let ramp: Vec<u8> = (0..256).map(|i| 255 - i as u8).collect();
+    image::GrayImage::from_raw(256, 1, ramp)
+        .unwrap()
+        .save(dir.join("ramp.png"))
+        .unwrap();
+    let ramp = dir.join("ramp.png");
+    let rho_over_pi = 0.5 / std::f32::consts::PI;
+    let a = 60f32.to_radians();
+    // A tilt of t degrees towards +x: h_u = -4 tan t.
+    let scale_for = |t: f32| 4.0 * t.to_radians().tan() * 255.0 / 256.0;
+    let scale = scale_for(30.0);
+    for (integrator, spp) in [
+        ("path", 16),
+        ("bdpt", 16),
+        ("vcm", 16),
+        ("photon", 16),
+        ("sppm", 16),
+    ] {
+        for (bump_scale, cosine) in [
+            (0.0, a.cos()),
+            (scale, (a - 30f32.to_radians()).cos()),
+            (scale_for(-20.0), (a + 20f32.to_radians()).cos()),
+        ] {
+            let toml = scene(integrator, spp, None).replace(
+                "reflectance = [0.5, 0.5, 0.5]\n",
+                &format!(
+                    "reflectance = [0.5, 0.5, 0.5]\nbump_map = {{ type = \"bitmap\", filename = {ramp:?}, raw = true }}\nbump_scale = {bump_scale}\n"
+                ),
+            );
+            let film = render_toml("bump-map", &toml, &[], 2);
+            let want = rho_over_pi * cosine;
+            let mean = film.mean().x;
+            assert!(
+                (mean / want - 1.0).abs() < 0.03,
+                "{integrator}, bump scale {bump_scale}: mean {mean}, rho / pi E cos = {want}"
+            );
+        }
+    }
+
+    // pbrt-v4's `displacement`: the ramp as a float image texture (read at (u, 1 - v); its
+    // one row is the same at every v) scaled by its `scale`, on a quad of uv (0, 0) to (1, 1)
+    // 4 wide; against the same scene without it (pbrt's distant light is normalised to the
+    // scene).
+    let pbrt = |displacement: &str| {
+        format!(
+            r#"LookAt 0 0 3  0 0 0  0 1 0
+Camera "orthographic" "float screenwindow" [-0.5 0.5 -0.5 0.5]
+Film "rgb" "integer xresolution" 8 "integer yresolution" 8 "string filename" "o.exr"
+Sampler "independent" "integer pixelsamples" 16
+Integrator "path" "integer maxdepth" 1
+WorldBegin
+LightSource "distant" "point3 from" [{lx} 0 {lz}] "point3 to" [0 0 0] "rgb L" [1 1 1]
+Texture "h" "float" "imagemap" "string filename" "ramp.png" "string encoding" "linear" "float scale" {scale}
+Material "diffuse" "rgb reflectance" [0.5 0.5 0.5] {displacement}
+Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
+  "point2 uv" [0 0  1 0  1 1  0 1] "integer indices" [0 1 2  0 2 3]
+"#,
+            lx = a.sin(),
+            lz = a.cos()
+        )
+    };
+    let mean = |text: String, name: &str| {
+        let file = foton_tests::write(&dir, name, &text);
+        foton_tests::render_file(&file, &[], 2).mean().x
+    };
+    let ratio =
+        mean(pbrt("\"texture displacement\" \"h\""), "b.pbrt") / mean(pbrt(""), "flat.pbrt");
+    let want = (a - 30f32.to_radians()).cos() / a.cos();
+    assert!(
+        (ratio / want - 1.0).abs() < 0.03,
+        "pbrt displacement: bumped / flat {ratio}, expected {want}"
+    );
+
+    // Mitsuba: a rectangle scaled to 4 x 4 (dp/du = 4 x as above), the height in a 0.6-style
+    // `scale` texture, the BSDF referenced.
+    let xml = format!(
+        r#"<scene version="3.0.0">
+<integrator type="path"><integer name="max_depth" value="2"/></integrator>
+<sensor type="orthographic">
+  <transform name="to_world"><scale x="1" y="1"/><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+  <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+  <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+</sensor>
+<emitter type="directional"><vector name="direction" x="{dx}" y="0" z="{dz}"/></emitter>
+<bsdf type="diffuse" id="grey"/>
+<shape type="rectangle">
+  <transform name="to_world"><scale value="2"/></transform>
+  <bsdf type="bumpmap">
+    <texture type="scale"><float name="scale" value="{half}"/>
+      <texture type="bitmap"><boolean name="raw" value="true"/><string name="filename" value="ramp.png"/></texture>
+    </texture>
+    <float name="scale" value="2"/>
+    <ref id="grey"/>
+  </bsdf>
+</shape>
+<shape type="sphere"><point name="center" x="0" y="0" z="-10"/><ref id="grey"/></shape>
+</scene>"#,
+        dx = -a.sin(),
+        dz = -a.cos(),
+        half = scale / 2.0,
+    );
+    let file = foton_tests::write(&dir, "b.xml", &xml);
+    let scene = foton_loader::load(&file, &[]).unwrap();
+    let bumps: Vec<Option<f32>> = scene
+        .objects()
+        .iter()
+        .map(|o| o.bump_map.as_ref().map(|b| b.scale))
+        .collect();
+    assert_eq!(bumps.len(), 2);
+    assert!((bumps[0].unwrap() / scale - 1.0).abs() < 1e-6, "{bumps:?}");
+    assert_eq!(
+        bumps[1], None,
+        "the referenced BSDF's other user is not bumped"
+    );
+    let film = foton_tests::render_file(&file, &[], 2);
+    // Mitsuba's directional light has irradiance 1, its diffuse reflectance 0.5.
+    let want = rho_over_pi * (a - 30f32.to_radians()).cos();
+    let mean = film.mean().x;
+    assert!(
+        (mean / want - 1.0).abs() < 0.03,
+        "Mitsuba bumpmap: mean {mean}, rho / pi E cos = {want}"
+    );
+}
+
+/// The BSDF a bump map gives (its shading normal tilted 30 degrees off the geometric one) is
+/// sampled by its own pdf: chi-square over the sphere of directions, for a diffuse and a
+/// rough conductor, with the camera direction in the plane of the tilt and across it; each
+/// sample's weight is f cos / pdf.
+#[test]
+fn a_bump_mapped_bsdf_samples_its_pdf() {
+    use crate::sampling::{P_HORIZON, SphereGrid, check_directions, d};
+    use foton_core::api::{Ray, TransportMode, Vec3};
+    use foton_core::sampling::Rng;
+    let dir = foton_tests::temp_dir("bump-map-sampling");
+    let ramp: Vec<u8> = (0..256).map(|i| 255 - i as u8).collect();
+    image::GrayImage::from_raw(256, 1, ramp)
+        .unwrap()
+        .save(dir.join("ramp.png"))
+        .unwrap();
+    let scale = 4.0 * 30f32.to_radians().tan() * 255.0 / 256.0;
+    for (k, material) in [
+        "type = \"diffuse\"\nreflectance = [0.8, 0.5, 0.2]",
+        "type = \"roughconductor\"\ndistribution = \"ggx\"\nmaterial = \"Au\"\nalpha = 0.3",
+    ]
+    .into_iter()
+    .enumerate()
+    {
+        let toml = header("path", 1, 1, 4, 4)
+            + &format!(
+                r#"
+[camera]
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 30.0
+
+[materials.m]
+{material}
+bump_map = {{ type = "bitmap", filename = "ramp.png", raw = true }}
+bump_scale = {scale}
+
+[[lights]]
+type = "point"
+position = [0.0, 0.0, 3.0]
+intensity = [1.0, 1.0, 1.0]
+
+[[shapes]]
+type = "quad"
+origin = [-2.0, -2.0, 0.0]
+u = [4.0, 0.0, 0.0]
+v = [0.0, 4.0, 0.0]
+material = "m"
+"#
+            );
+        let file = foton_tests::write(&dir, "b.toml", &toml);
+        let scene = foton_loader::load(&file, &[]).unwrap();
+        let hit = scene
+            .intersect(&Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z), f32::INFINITY)
+            .unwrap();
+        let bsdf = scene.bsdf(&hit).unwrap();
+        let tilt = bsdf.frame.n.dot(Vec3::Z).acos().to_degrees();
+        assert!(
+            (tilt - 30.0).abs() < 0.5 && bsdf.frame.n.x > 0.0,
+            "tilt {tilt}"
+        );
+        for (j, wo) in [
+            Vec3::new(-0.4, 0.0, 0.9).normalize(),
+            Vec3::new(0.2, 0.6, 0.7).normalize(),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let name = format!("{material}, wo = {wo}");
+            let grid = SphereGrid::full_sphere(d(bsdf.frame.n), 20, 20);
+            let mut rng = Rng::new(&[21, k as u64, j as u64]);
+            let pdf = |w: glam::DVec3| bsdf.pdf(wo, w.as_vec3()) as f64;
+            // A microfacet reflection below the shading normal's horizon is no sample.
+            let p_none = (1.0 - grid.probabilities(&pdf).iter().sum::<f64>()).max(P_HORIZON);
+            let integral = check_directions(&name, &grid, 400_000, p_none, &pdf, &mut || {
+                let s = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)?;
+                let want = bsdf.eval(wo, s.wi) / s.pdf;
+                assert!(
+                    (s.weight - want).abs().max_element() <= 1e-3 * want.max_element().max(1e-3),
+                    "{name}: weight {} against f cos / pdf {want}",
+                    s.weight
+                );
+                Some(d(s.wi))
+            });
+            assert!(
+                integral <= 1.0 + 1e-3,
+                "{name}: pdf integrates to {integral}"
+            );
+        }
+    }
 }

@@ -51,6 +51,7 @@ fn lobe(material: &Material) -> Lobe {
         ns: Vec3::Z,
         uv: Vec2::new(0.3, 0.6),
         dpdu: Vec3::X,
+        dpdv: Vec3::Y,
     };
     material.bsdf(&sp).expect("a material that scatters").lobe
 }

@@ -8,15 +8,22 @@ use foton_core::material::{MATERIALS, Material};
 use foton_core::props::Properties;
 use foton_core::registry;
 use foton_core::registry::Resources;
-use foton_core::scene::Named;
+use foton_core::scene::{BumpMap, Named};
 use foton_core::texture::Texture;
 use std::collections::HashMap;
 
-/// Per material, its `normal_map` (read here, for every type: the shapes that use the
-/// material carry it).
-pub(super) type NormalMaps = Vec<Option<Texture>>;
+/// A material's `normal_map` or `bump_map` (read here, for every type: the shapes that use
+/// the material carry it).
+#[derive(Clone, Default)]
+pub(super) struct ShadingMaps {
+    pub normal_map: Option<Texture>,
+    pub bump_map: Option<BumpMap>,
+}
 
-/// The materials, their names' index, and their normal maps.
+/// Per material, its shading maps.
+pub(super) type NormalMaps = Vec<ShadingMaps>;
+
+/// The materials, their names' index, and their normal and bump maps.
 pub(super) fn read_materials(
     root: &Properties<'_>,
     ld: &mut Loader,
@@ -34,18 +41,37 @@ pub(super) fn read_materials(
         let ty = type_of(&m, &types)?;
         let factory = registry::find(MATERIALS, ty)
             .ok_or_else(|| m.error("type", registry::unknown("material type", ty, MATERIALS)))?;
-        let normal_map = if m.has("normal_map") {
-            if ty == "null" {
+        let mut maps = ShadingMaps::default();
+        for key in ["normal_map", "bump_map"] {
+            if m.has(key) && ty == "null" {
                 return Err(m.error(
-                    "normal_map",
-                    "the null material does not scatter: a normal map has nothing to shade",
+                    key,
+                    "the null material does not scatter: a normal or bump map has nothing to shade",
                 ));
             }
-            Some(ld.texture(&m, "normal_map", Rgb::new(0.5, 0.5, 1.0))?)
-        } else {
-            None
-        };
-        normal_maps.push(normal_map);
+        }
+        if m.has("normal_map") {
+            if m.has("bump_map") {
+                return Err(m.error(
+                    "bump_map",
+                    "a material has a normal_map or a bump_map, not both",
+                ));
+            }
+            maps.normal_map = Some(ld.texture(&m, "normal_map", Rgb::new(0.5, 0.5, 1.0))?);
+        }
+        if m.has("bump_map") {
+            let scale = m.f32("bump_scale", 1.0)?;
+            if !scale.is_finite() {
+                return Err(m.error("bump_scale", "expected a finite number"));
+            }
+            maps.bump_map = Some(BumpMap {
+                height: ld.texture(&m, "bump_map", Rgb::ZERO)?,
+                scale,
+            });
+        } else if m.has("bump_scale") {
+            return Err(m.error("bump_scale", "a bump_scale without a bump_map"));
+        }
+        normal_maps.push(maps);
         let mut nested = Vec::new();
         let material = *(factory.create)(&m, &mut nested, ld)?;
         for bag in &nested {

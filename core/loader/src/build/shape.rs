@@ -4,6 +4,7 @@
 use super::common::{
     Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined,
 };
+use super::material::ShadingMaps;
 use super::medium::medium_ref;
 use crate::mesh::{MeshOptions, inline_mesh, load_mesh};
 use foton_core::Rgb;
@@ -30,7 +31,7 @@ pub(super) fn read_shapes(
     ld: &mut Loader,
     material_defs: &[Named<Material>],
     materials: &Index,
-    normal_maps: &[Option<Texture>],
+    normal_maps: &[ShadingMaps],
     media: &Index,
     g: &mut Geometry,
 ) -> Result<()> {
@@ -245,7 +246,8 @@ pub(super) fn read_shapes(
             explicit_media,
             closed,
             alpha,
-            normal_map: normal_maps[material as usize].clone(),
+            normal_map: normal_maps[material as usize].normal_map.clone(),
+            bump_map: normal_maps[material as usize].bump_map.clone(),
         });
         let first_attrs = g.triangle_attrs.len() as u32;
         let with_attrs = !attrs.is_empty();

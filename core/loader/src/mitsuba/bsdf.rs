@@ -126,40 +126,65 @@ impl Reader {
                 }
                 let (inner, l) = take_wrapped(&mut o, "normalmap")?;
                 self.leftovers(&o)?;
-                let name = match inner {
-                    Prop::Object(inner) if inner.tag == "bsdf" => self.bsdf(inner)?,
+                return self.wrapped_with(&o, inner, l, "normal map", vec![("normal_map", map)]);
+            }
+            "bumpmap" => {
+                // Mitsuba takes the first texture among the children, whatever its name.
+                let Some(i) = o.props.iter().position(|(_, p, _)| match p {
+                    Prop::Object(t) => t.tag == "texture",
                     Prop::Ref(id) => {
-                        let Some(original) = self.bsdfs.get(&id).cloned() else {
-                            return Err(o.error(format!(
-                                "line {l}: no BSDF with id `{id}` for the normal map to wrap"
-                            )));
-                        };
-                        let materials = table_mut(&mut self.root, "materials");
-                        let copy = materials.get(&original).cloned();
-                        let name = self.new_name("bsdf", &None);
-                        if let Some(copy) = copy {
-                            table_mut(&mut self.root, "materials").insert(&name, copy);
-                        }
-                        if let Some(mask) = self.masks.get(&original).cloned() {
-                            self.masks.insert(name.clone(), mask);
-                        }
-                        Some(name)
+                        self.textures.contains_key(id) || self.left_out_ids.contains(id)
                     }
-                    _ => return Err(o.error("a normalmap BSDF wraps a BSDF")),
+                    _ => false,
+                }) else {
+                    return Err(o.error("a bumpmap BSDF without its height texture"));
                 };
-                let Some(name) = name else {
-                    return Ok(None);
+                let (_, height, hl) = o.props.remove(i);
+                let mut scale = o.float("scale", 1.0)?;
+                let height = match height {
+                    Prop::Object(mut t) => {
+                        // Mitsuba 0.6's bump maps are written as a `scale` texture around
+                        // the height: its factor is the bump map's scale.
+                        while t.ty == "scale" {
+                            scale *= t.float("scale", 1.0)?;
+                            let Some(j) = t.props.iter().position(
+                                |(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "texture"),
+                            ) else {
+                                return Err(
+                                    t.error("a scale texture without the texture it scales")
+                                );
+                            };
+                            let (_, inner, _) = t.props.remove(j);
+                            self.leftovers(&t)?;
+                            let Prop::Object(inner) = inner else {
+                                unreachable!()
+                            };
+                            t = inner;
+                        }
+                        self.texture_table(t)?
+                    }
+                    Prop::Ref(id) => self.textures.get(&id).cloned(),
+                    _ => unreachable!(),
                 };
-                if let Some(Value::Table(t)) = table_mut(&mut self.root, "materials")
-                    .get_mut(&name)
-                    .map(|n| &mut n.value)
-                {
-                    t.insert("normal_map", map);
+                let shadowing = o.boolean("use_shadowing_function", true)?;
+                let flip = o.boolean("flip_invalid_normals", true)?;
+                if !o.v1 && (shadowing || flip) {
+                    self.note(
+                        &o,
+                        "the bump map's normals are used as given, as pbrt-v4 uses them: not Mitsuba 3's shadowing term (Estevez et al. 2019; `use_shadowing_function`, which darkens light arriving at grazing angles to a strongly tilted normal) nor its flip of normals facing away from the viewer (`flip_invalid_normals`)",
+                    );
                 }
-                if let Some(id) = &o.id {
-                    self.bsdfs.insert(id.clone(), name.clone());
-                }
-                return Ok(Some(name));
+                let (inner, l) = take_wrapped(&mut o, "bumpmap")?;
+                self.leftovers(&o)?;
+                // A height texture left out (--lenient, reported): the BSDF without bumps.
+                let entries = match height {
+                    Some(h) => vec![
+                        ("bump_map", at(Value::Table(h), hl)),
+                        ("bump_scale", at(Value::Float(scale), hl)),
+                    ],
+                    None => Vec::new(),
+                };
+                return self.wrapped_with(&o, inner, l, "bump map", entries);
             }
             "diffuse" => {
                 put("type", Value::Str("diffuse".into()));
@@ -549,6 +574,64 @@ impl Reader {
             );
         }
         node
+    }
+}
+
+impl Reader {
+    /// The material of a BSDF that a wrapper (`normalmap`, `bumpmap`) wraps, with the
+    /// wrapper's `entries` added: nested, it is read with them; referenced, a copy of it gets
+    /// them (the original may be used without them elsewhere). Registers the wrapper's id.
+    fn wrapped_with(
+        &mut self,
+        o: &Obj,
+        inner: Prop,
+        l: u32,
+        what: &str,
+        entries: Vec<(&str, Node)>,
+    ) -> Result<Option<String>> {
+        let name = match inner {
+            Prop::Object(inner) if inner.tag == "bsdf" => self.bsdf(inner)?,
+            Prop::Ref(id) => {
+                let Some(original) = self.bsdfs.get(&id).cloned() else {
+                    return Err(o.error(format!(
+                        "line {l}: no BSDF with id `{id}` for the {what} to wrap"
+                    )));
+                };
+                let materials = table_mut(&mut self.root, "materials");
+                let copy = materials.get(&original).cloned();
+                let name = self.new_name("bsdf", &None);
+                if let Some(copy) = copy {
+                    table_mut(&mut self.root, "materials").insert(&name, copy);
+                }
+                if let Some(mask) = self.masks.get(&original).cloned() {
+                    self.masks.insert(name.clone(), mask);
+                }
+                Some(name)
+            }
+            _ => return Err(o.error(format!("a {what} BSDF wraps a BSDF"))),
+        };
+        let Some(name) = name else {
+            return Ok(None);
+        };
+        if let Some(Value::Table(t)) = table_mut(&mut self.root, "materials")
+            .get_mut(&name)
+            .map(|n| &mut n.value)
+        {
+            if t.get("normal_map").is_none() && t.get("bump_map").is_none() {
+                for (key, value) in entries {
+                    t.insert(key, value);
+                }
+            } else {
+                self.unsupported(
+                    o,
+                    &format!("a {what} around a BSDF that already has a normal or bump map: foton applies one map per material, the inner one"),
+                )?;
+            }
+        }
+        if let Some(id) = &o.id {
+            self.bsdfs.insert(id.clone(), name.clone());
+        }
+        Ok(Some(name))
     }
 }
 

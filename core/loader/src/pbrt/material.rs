@@ -97,13 +97,21 @@ impl Reader {
         } else {
             (d.string(0).to_string(), d.what())
         };
-        if let Some(q) = p.take("displacement") {
-            self.unsupported(
-                &q.loc,
-                &what,
-                &format!("{} (bump mapping) is not read yet", q.decl()),
-            )?;
-        }
+        // pbrt-v4's bump map: a float texture of heights (a constant one tilts nothing).
+        let displacement = match p.take("displacement") {
+            Some(q) if q.ty == Type::Texture => match self.named_texture(&q, true, &what)? {
+                Some(Tex::Table(t)) => Some((t, q.loc.clone())),
+                _ => None,
+            },
+            Some(q) if q.ty == Type::Float => None,
+            Some(q) => {
+                return Err(q.loc.error(
+                    &what,
+                    format!("{}: expected a float or a float texture", q.decl()),
+                ));
+            }
+            None => None,
+        };
         // pbrt-v4 reads the map as linear values at (u, 1 - v), repeated, bilinearly.
         let normal_map = p.string_opt("normalmap")?.map(|(file, l)| {
             self.table(
@@ -442,10 +450,21 @@ impl Reader {
             }
         }
         self.finish(&mut p)?;
-        if let Some(map) = normal_map
-            && ty != "interface"
-        {
-            entries.push(("normal_map", map));
+        if ty != "interface" {
+            // pbrt-v4 applies the normal map where a material has both.
+            match (normal_map, displacement) {
+                (Some(map), displacement) => {
+                    if let Some((_, l)) = displacement {
+                        self.note(&l, &what, "\"displacement\" beside a \"normalmap\": the normal map is used, as pbrt-v4 uses it");
+                    }
+                    entries.push(("normal_map", map));
+                }
+                (None, Some((height, l))) => {
+                    entries.push(("bump_map", height));
+                    entries.push(("bump_scale", self.num(1.0, &l)));
+                }
+                (None, None) => {}
+            }
         }
         let t = self.table(entries, &loc);
         table_mut(&mut self.root, "materials").insert(name, t);
