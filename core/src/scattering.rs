@@ -130,7 +130,8 @@ pub trait Bxdf {
     }
 
     /// The probability that `sample` picks a delta part for `wo`, for a lobe that mixes a
-    /// delta part with a non-delta one (a smooth plastic's coat); 0 for the others.
+    /// delta part with a non-delta one (a smooth plastic's coat); 0 for the others. `sample`
+    /// picks it exactly when its `uc` is below this probability.
     fn delta_probability(&self, _wo: Vec3) -> f32 {
         0.0
     }

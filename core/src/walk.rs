@@ -382,10 +382,12 @@ pub fn walk_to_diffuse(
         };
         if glossy || p_delta > 0.0 {
             let (u, uc) = (sampler.next_2d(), sampler.next_f32());
-            let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
-                break;
-            };
-            if glossy || bs.delta {
+            // `sample` picks the delta part exactly when uc < p_delta; the non-delta part
+            // is estimated here whether or not its sampled direction would carry anything.
+            if glossy || uc < p_delta {
+                let Some(bs) = bsdf.sample(wo, u, uc, TransportMode::Radiance) else {
+                    break;
+                };
                 beta *= bs.weight;
                 bounces += 1;
                 glossy_from = (!bs.delta).then_some((bs.pdf, hit.p));

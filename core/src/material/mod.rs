@@ -56,6 +56,7 @@ materials! {
         DiffTrans(difftrans::DiffTransMaterial, difftrans::DiffTransBxdf),
         CoatedDiffuse(coateddiffuse::CoatedDiffuseMaterial, coateddiffuse::CoatedDiffuseBxdf),
         CoatedConductor(coatedconductor::CoatedConductorMaterial, coatedconductor::CoatedConductorBxdf),
+        Coating(coating::CoatingMaterial, coating::CoatingBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

@@ -20,6 +20,7 @@ mod blend;
 mod build_id;
 mod capabilities;
 mod coated;
+mod coating;
 mod conductor;
 mod consistency;
 mod crossing_limit;

@@ -306,6 +306,63 @@ impl Reader {
                 t.insert("nonlinear", at(Value::Bool(nonlinear), line));
                 t.insert("twosided", at(Value::Bool(false), line));
             }
+            "coating" => {
+                put("type", Value::Str("coating".into()));
+                let int = self.ior(&mut o, "int_ior", 1.5046)?;
+                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
+                t.insert("ior", at(Value::Float(int / ext), line));
+                let sigma_a = o.color("sigma_a", DVec3::ZERO)?;
+                t.insert("sigma_a", vec3(sigma_a, line));
+                let thickness = o.float("thickness", 1.0)?;
+                t.insert("thickness", at(Value::Float(thickness), line));
+                let Some(c) = self.texture(&mut o, "specular_reflectance", DVec3::ONE)? else {
+                    return Ok(None);
+                };
+                t.insert("specular_reflectance", c);
+                let (inner, l) = take_wrapped(&mut o, "coating")?;
+                let base = match inner {
+                    Prop::Object(inner) if inner.tag == "bsdf" => self.bsdf(inner)?,
+                    Prop::Ref(id) => match self.bsdfs.get(&id) {
+                        Some(name) => Some(name.clone()),
+                        None => {
+                            return Err(o.error(format!(
+                                "line {l}: no BSDF with id `{id}` for the coating to cover"
+                            )));
+                        }
+                    },
+                    _ => return Err(o.error("a coating BSDF covers a BSDF")),
+                };
+                let Some(base) = base else {
+                    return Ok(None);
+                };
+                let table = table_mut(&mut self.root, "materials").get(&base).cloned();
+                let kind = match table.as_ref().map(|n| &n.value) {
+                    Some(Value::Table(b)) => match b.get("type").map(|n| &n.value) {
+                        Some(Value::Str(ty)) => ty.clone(),
+                        _ => String::new(),
+                    },
+                    _ => String::new(),
+                };
+                let covered = ["diffuse", "roughconductor", "roughplastic", "roughdiffuse"];
+                if !covered.contains(&kind.as_str())
+                    || self.masks.contains_key(&base)
+                    || table.as_ref().is_some_and(|n| {
+                        matches!(&n.value, Value::Table(b) if b.get("normal_map").is_some() || b.get("bump_map").is_some())
+                    })
+                {
+                    self.unsupported(
+                        &o,
+                        &format!("a coating over this BSDF (`{kind}`, or one with a mask or a normal or bump map): foton coats diffuse, roughconductor, roughplastic and roughdiffuse BSDFs (--lenient: the BSDF without the coating)"),
+                    )?;
+                    if let Some(id) = &o.id {
+                        self.bsdfs.insert(id.clone(), base.clone());
+                    }
+                    return Ok(Some(base));
+                }
+                if let Some(table) = table {
+                    t.insert("base", table);
+                }
+            }
             "phong" | "ward" => {
                 put("type", Value::Str(o.ty.clone()));
                 if o.ty == "phong" {

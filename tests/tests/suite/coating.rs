@@ -1,0 +1,284 @@
+//! `coating` (Mitsuba 0.6's smooth dielectric layer over another material): its sampling
+//! against its pdf, its albedo against the model's formula integrated here, every integrator
+//! agreeing with `path` on it, and the Mitsuba reader's mapping.
+
+use crate::sampling::{SphereGrid, check_directions, d};
+use foton_core::api::{Ray, Rgb, TransportMode, Vec3};
+use foton_core::bsdf::Bsdf;
+use foton_core::sampling::Rng;
+use foton_tests::stats::{Tolerance, assert_blocks_agree};
+use foton_tests::{header, render_toml};
+
+/// A scene whose one quad has material `m` (a TOML table body), and that quad's BSDF at its
+/// centre, the quad's normal +z.
+fn quad_bsdf(name: &str, m: &str) -> Bsdf {
+    let dir = foton_tests::temp_dir(name);
+    let toml = header("path", 1, 1, 4, 4)
+        + &format!(
+            r#"
+[camera]
+position = [0.0, 0.0, 3.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+fov = 30.0
+
+[materials.m]
+{m}
+
+[[lights]]
+type = "point"
+position = [0.0, 0.0, 3.0]
+intensity = [1.0, 1.0, 1.0]
+
+[[shapes]]
+type = "quad"
+origin = [-1.0, -1.0, 0.0]
+u = [2.0, 0.0, 0.0]
+v = [0.0, 2.0, 0.0]
+material = "m"
+"#
+        );
+    let file = foton_tests::write(&dir, "c.toml", &toml);
+    let scene = foton_loader::load(&file, &[]).unwrap();
+    let hit = scene
+        .intersect(&Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z), f32::INFINITY)
+        .unwrap();
+    scene.bsdf(&hit).unwrap()
+}
+
+const DIFFUSE: &str = r#"type = "coating"
+ior = 1.7
+sigma_a = [0.1, 0.2, 0.5]
+thickness = 2.0
+base = { type = "diffuse", reflectance = [0.8, 0.6, 0.4] }"#;
+
+const COPPER: &str = r#"type = "coating"
+ior = 1.5
+base = { type = "roughconductor", material = "Cu", distribution = "ggx", alpha = 0.2 }"#;
+
+/// Samples follow the pdf (the mirror reflection and the samples that cannot leave the layer
+/// are the "no direction" class, expected with 1 - the pdf's integral); each weight is
+/// f cos / pdf, or F / p for the mirror.
+#[test]
+fn coating_samples_its_pdf() {
+    for (k, (name, m)) in [("diffuse", DIFFUSE), ("copper", COPPER)]
+        .into_iter()
+        .enumerate()
+    {
+        let bsdf = quad_bsdf(&format!("coating-sampling-{name}"), m);
+        for (j, wo) in [
+            Vec3::new(0.3, 0.1, 0.95).normalize(),
+            Vec3::new(-0.8, 0.3, 0.25).normalize(),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            let label = format!("coating over {name}, wo = {wo}");
+            let grid = SphereGrid::full_sphere(d(Vec3::Z), 20, 20);
+            let pdf = |w: glam::DVec3| bsdf.pdf(wo, w.as_vec3()) as f64;
+            let p_none = 1.0 - grid.probabilities(&pdf).iter().sum::<f64>();
+            let mut rng = Rng::new(&[31, k as u64, j as u64]);
+            let mut deltas = 0u32;
+            check_directions(&label, &grid, 400_000, p_none, &pdf, &mut || {
+                let s = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)?;
+                if s.delta {
+                    deltas += 1;
+                    assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5);
+                    return None;
+                }
+                let want = bsdf.eval(wo, s.wi) / s.pdf;
+                assert!(
+                    (s.weight - want).abs().max_element() <= 1e-3 * want.max_element().max(1e-3),
+                    "{label}: weight {} against f cos / pdf {want}",
+                    s.weight
+                );
+                Some(d(s.wi))
+            });
+            let p_delta = bsdf.delta_probability(wo) as f64;
+            let got = deltas as f64 / 400_000.0;
+            assert!(
+                (got - p_delta).abs() < 5.0 * (p_delta * (1.0 - p_delta) / 400_000.0).sqrt() + 1e-4,
+                "{label}: mirror picked {got}, delta_probability {p_delta}"
+            );
+        }
+    }
+}
+
+/// Fresnel reflectance of a smooth dielectric interface, eta inside over outside, from
+/// outside at cos_i (written out here, independent of the renderer's).
+fn fresnel(cos_i: f64, eta: f64) -> f64 {
+    let sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
+    if sin_t2 >= 1.0 {
+        return 1.0;
+    }
+    let cos_t = (1.0 - sin_t2).sqrt();
+    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
+    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
+    0.5 * (rs * rs + rp * rp)
+}
+
+/// The albedo of a coated diffuse surface seen from `cos_o`, by quadrature of Mitsuba 0.6's
+/// model: F(cos_o) + int (rho / pi) (1 - F(cos_o)) (1 - F(cos_i)) A / eta^2 cos_i d omega_i,
+/// A = exp(-depth (1 / cos_o' + 1 / cos_i')), the primed cosines refracted into the layer.
+fn coated_diffuse_albedo(cos_o: f64, rho: f64, eta: f64, depth: f64) -> f64 {
+    let refracted = |c: f64| (1.0 - (1.0 - c * c) / (eta * eta)).sqrt();
+    let n = 20_000;
+    let mut sum = 0.0;
+    for i in 0..n {
+        let c = (i as f64 + 0.5) / n as f64;
+        let a = (-depth * (1.0 / refracted(cos_o) + 1.0 / refracted(c))).exp();
+        // d omega = 2 pi sin d theta = 2 pi d cos.
+        sum +=
+            rho / std::f64::consts::PI * (1.0 - fresnel(cos_o, eta)) * (1.0 - fresnel(c, eta)) * a
+                / (eta * eta)
+                * c
+                * 2.0
+                * std::f64::consts::PI
+                / n as f64;
+    }
+    fresnel(cos_o, eta) + sum
+}
+
+/// The mean sample weight is the albedo the formula gives (each channel its own absorption).
+#[test]
+fn coated_diffuse_albedo_matches_the_model() {
+    let bsdf = quad_bsdf("coating-albedo", DIFFUSE);
+    let rho = [0.8, 0.6, 0.4];
+    let sigma = [0.1, 0.2, 0.5];
+    for cos_o in [0.95f32, 0.5, 0.15] {
+        let wo = Vec3::new((1.0 - cos_o * cos_o).sqrt(), 0.0, cos_o);
+        let mut rng = Rng::new(&[5, (cos_o * 100.0) as u64]);
+        let n = 400_000;
+        let mut sum = glam::DVec3::ZERO;
+        for _ in 0..n {
+            if let Some(s) = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)
+            {
+                sum += s.weight.as_dvec3();
+            }
+        }
+        let got = sum / n as f64;
+        for c in 0..3 {
+            let want = coated_diffuse_albedo(cos_o as f64, rho[c], 1.7, sigma[c] * 2.0);
+            assert!(
+                (got[c] / want - 1.0).abs() < 0.01,
+                "cos_o {cos_o}, channel {c}: mean weight {}, the model's albedo {want}",
+                got[c]
+            );
+        }
+    }
+}
+
+/// Every integrator that renders surfaces agrees with `path` on coated spheres and walls:
+/// the photon mappers estimate the base's part at the visible point and follow the mirror
+/// reflection with its probability.
+#[test]
+fn integrators_agree_on_coatings() {
+    let materials =
+        format!("[materials.coat_diffuse]\n{DIFFUSE}\n\n[materials.coat_copper]\n{COPPER}\n");
+    let scene = crate::bdpt::cornell(
+        "coat_diffuse",
+        "coat_copper",
+        &materials,
+        crate::bdpt::CEILING_LIGHT,
+    );
+    let render = |integrator: &str, spp: u32| {
+        render_toml(
+            &format!("coating-{integrator}"),
+            &scene,
+            &[
+                &format!("render.integrator=\"{integrator}\""),
+                &format!("render.spp={spp}"),
+            ],
+            2,
+        )
+    };
+    let reference = render("path", 512);
+    let tolerance = Tolerance {
+        rel: 0.04,
+        z: 4.5,
+        floor: 1e-3,
+    };
+    for (integrator, spp) in [("bdpt", 64), ("vcm", 64), ("photon", 64), ("sppm", 64)] {
+        let film = render(integrator, spp);
+        let (a, b) = (film.mean(), reference.mean());
+        assert!(
+            (a / b - Rgb::ONE).abs().max_element() < 0.03,
+            "{integrator}: image mean {a} against path's {b}"
+        );
+        assert_blocks_agree(
+            &format!("{integrator} against path on coatings"),
+            &film,
+            &reference,
+            4,
+            tolerance,
+        );
+    }
+}
+
+/// Mitsuba 0.6's `coating`: its layer's parameters and the BSDF it covers (nested or
+/// referenced) become a `coating` table; a BSDF foton cannot coat is refused, and left
+/// uncoated with `--lenient`.
+#[test]
+fn the_mitsuba_reader_maps_coating() {
+    let dir = foton_tests::temp_dir("coating-mitsuba");
+    let scene = |bsdf: &str| {
+        format!(
+            r#"<scene version="0.6.0">
+<sensor type="perspective"><transform name="toWorld"><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+  <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film></sensor>
+<emitter type="point"><point name="position" x="0" y="0" z="2"/></emitter>
+<bsdf type="roughconductor" id="cu"><string name="material" value="Cu"/></bsdf>
+<shape type="rectangle">{bsdf}</shape>
+</scene>"#
+        )
+    };
+    let load = |name: &str, bsdf: &str, lenient: bool| {
+        let file = foton_tests::write(&dir, name, &scene(bsdf));
+        foton_loader::load_with(&file, &[], &[], lenient)
+    };
+    let s = load(
+        "a.xml",
+        r#"<bsdf type="coating"><float name="intIOR" value="1.7"/><float name="thickness" value="2"/><rgb name="sigmaA" value="0.1, 0.2, 0.3"/><ref id="cu"/></bsdf>"#,
+        false,
+    )
+    .unwrap();
+    let coating = s
+        .materials()
+        .iter()
+        .find_map(|m| match &m.value {
+            foton_core::material::Material::Coating(c) => Some(c.clone()),
+            _ => None,
+        })
+        .expect("a coating material");
+    assert!(
+        (coating.eta - 1.7 / 1.000277).abs() < 1e-5,
+        "{}",
+        coating.eta
+    );
+    assert!(
+        (coating.depth - Rgb::new(0.2, 0.4, 0.6))
+            .abs()
+            .max_element()
+            < 1e-6
+    );
+    assert!(matches!(
+        *coating.base,
+        foton_core::material::Material::RoughConductor(_)
+    ));
+    let over_glass = r#"<bsdf type="coating"><bsdf type="dielectric"/></bsdf>"#;
+    let Err(err) = load("b.xml", over_glass, false) else {
+        panic!("a coating over glass was read")
+    };
+    let err = err.to_string();
+    assert!(
+        err.contains("coating") && err.contains("--lenient"),
+        "{err}"
+    );
+    let s = load("c.xml", over_glass, true).unwrap();
+    assert!(
+        s.materials()
+            .iter()
+            .all(|m| !matches!(m.value, foton_core::material::Material::Coating(_))),
+        "left uncoated"
+    );
+}
