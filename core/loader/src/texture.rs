@@ -19,17 +19,34 @@ pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard"];
 /// images are taken as linear. The error names the file; a texel that is not finite is
 /// an error.
 pub fn load_bitmap(path: &Path, raw: bool) -> Result<Bitmap> {
+    load_bitmap_decoded(path, if raw { Decode::Linear } else { Decode::Srgb })
+}
+
+/// How an image's stored values become linear ones (floating-point images are linear
+/// whatever this says).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Decode {
+    /// The sRGB curve (8- and 16-bit images' usual encoding).
+    Srgb,
+    /// As stored (`raw`).
+    Linear,
+    /// A power law: stored value v is linear v^gamma (Mitsuba 0.6's bitmap `gamma`).
+    Gamma(f32),
+}
+
+/// [`load_bitmap`] with the decoding of its values given.
+pub fn load_bitmap_decoded(path: &Path, decode: Decode) -> Result<Bitmap> {
     let decoded = image::ImageReader::open(path)
         .map_err(|e| Error::io(path, e))?
         .with_guessed_format()
         .map_err(|e| Error::io(path, e))?
         .decode()
         .map_err(|e| Error::io(path, format!("cannot decode the image: {e}")))?;
-    let linear = raw
-        || matches!(
-            decoded,
-            image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
-        );
+    let float = matches!(
+        decoded,
+        image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
+    );
+    let decode = if float { Decode::Linear } else { decode };
     let rgb = decoded.to_rgb32f();
     let (width, height) = (rgb.width() as usize, rgb.height() as usize);
     let mut texels = Vec::with_capacity(width * height);
@@ -45,14 +62,18 @@ pub fn load_bitmap(path: &Path, raw: bool) -> Result<Bitmap> {
                 ),
             ));
         }
-        texels.push(if linear { c } else { c.map(srgb_to_linear) });
+        texels.push(match decode {
+            Decode::Linear => c,
+            Decode::Srgb => c.map(srgb_to_linear),
+            Decode::Gamma(g) => c.map(|v| v.max(0.0).powf(g)),
+        });
     }
     Bitmap::new(width, height, texels).ok_or_else(|| Error::io(path, "the image is empty"))
 }
 
-/// The images a load has decoded, by file and `raw`: a file that many materials' textures
+/// The images a load has decoded, by file and decoding: a file that many materials' textures
 /// name is read once.
-pub type Bitmaps = std::collections::HashMap<(std::path::PathBuf, bool), Arc<Bitmap>>;
+pub type Bitmaps = std::collections::HashMap<(std::path::PathBuf, u64), Arc<Bitmap>>;
 
 /// A texture table (`type = "bitmap"` or `"checkerboard"` and its parameters, see
 /// docs/scene-format.md); `filename` is relative to `base_dir`. Every error names the
@@ -68,6 +89,20 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) 
         "bitmap" => {
             let filename = t.string_required("filename")?;
             let raw = t.bool("raw", false)?;
+            let decode = match t.f32_opt("gamma")? {
+                None if raw => Decode::Linear,
+                None => Decode::Srgb,
+                Some(_) if raw => {
+                    return Err(t.error("gamma", "give `raw` or `gamma`, not both"));
+                }
+                Some(g) if g > 0.0 && g.is_finite() => Decode::Gamma(g),
+                Some(g) => return Err(t.error("gamma", format!("must be positive, found {g}"))),
+            };
+            let key = match decode {
+                Decode::Srgb => 0,
+                Decode::Linear => 1,
+                Decode::Gamma(g) => 2 + g.to_bits() as u64,
+            };
             let filter = match t.choice("filter_type", &["bilinear", "nearest"], "bilinear")? {
                 "nearest" => FilterType::Nearest,
                 _ => FilterType::Bilinear,
@@ -87,13 +122,14 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) 
                 return Err(t.error("scale", "must not be negative"));
             }
             let path = base_dir.join(filename);
-            let mut bitmap = match bitmaps.get(&(path.clone(), raw)) {
+            let mut bitmap = match bitmaps.get(&(path.clone(), key)) {
                 Some(b) => b.clone(),
                 None => {
                     let b = Arc::new(
-                        load_bitmap(&path, raw).map_err(|e| t.error("filename", e.to_string()))?,
+                        load_bitmap_decoded(&path, decode)
+                            .map_err(|e| t.error("filename", e.to_string()))?,
                     );
-                    bitmaps.insert((path, raw), b.clone());
+                    bitmaps.insert((path, key), b.clone());
                     b
                 }
             };

@@ -83,10 +83,21 @@ impl Reader {
                 let Some(Value::Str(file)) = t.get("filename").map(|n| &n.value) else {
                     return Ok(default);
                 };
+                use crate::texture::Decode;
                 let raw = matches!(t.get("raw").map(|n| &n.value), Some(Value::Bool(true)));
-                let bitmap = crate::texture::load_bitmap(&self.dir.join(file), raw)?;
+                let decode = match t.get("gamma").and_then(|n| n.value.as_f64()) {
+                    Some(g) => Decode::Gamma(g as f32),
+                    None if raw => Decode::Linear,
+                    None => Decode::Srgb,
+                };
+                let bitmap = crate::texture::load_bitmap_decoded(&self.dir.join(file), decode)?;
                 let m = bitmap.mean();
-                Ok(DVec3::new(m.x as f64, m.y as f64, m.z as f64))
+                let scale = if t.get("scale").is_some() {
+                    colour("scale")
+                } else {
+                    DVec3::ONE
+                };
+                Ok(DVec3::new(m.x as f64, m.y as f64, m.z as f64) * scale)
             }
             _ => Ok(default),
         }
@@ -106,13 +117,68 @@ impl Reader {
         match o.ty.as_str() {
             "bitmap" => {
                 t.insert("filename", self.filename(&mut o)?);
-                if o.boolean("raw", false)? {
+                let mut raw = o.boolean("raw", false)?;
+                // Mitsuba 0.6's `gamma`: 1 linear, -1 sRGB, another a power law.
+                match o.take("gamma") {
+                    None => {}
+                    Some((Prop::Float(1.0), _)) => raw = true,
+                    Some((Prop::Float(-1.0), _)) => raw = false,
+                    Some((Prop::Float(g), l)) if g > 0.0 => {
+                        t.insert("gamma", at(Value::Float(g), l));
+                    }
+                    Some((p, _)) => {
+                        return Err(o.error(format!(
+                            "`gamma`: expected 1 (linear), -1 (sRGB) or another positive exponent, found {}",
+                            show(&p)
+                        )));
+                    }
+                }
+                if raw {
                     t.insert("raw", at(Value::Bool(true), line));
                 }
                 self.bitmap_lookup(&mut o, &mut t)?;
                 // Storage format and value clamping change nothing foton renders.
                 o.take("format");
                 o.take("accel");
+            }
+            "scale" => {
+                // Mitsuba 0.6's `scale`: the texture it holds times a number or colour,
+                // folded into that texture's values.
+                let factor = o.color("scale", DVec3::ONE)?;
+                let Some(j) = o
+                    .props
+                    .iter()
+                    .position(|(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "texture"))
+                else {
+                    return Err(o.error("a scale texture without the texture it scales"));
+                };
+                let (_, Prop::Object(inner), _) = o.props.remove(j) else {
+                    unreachable!()
+                };
+                self.leftovers(&o)?;
+                let Some(mut inner) = self.texture_table(inner)? else {
+                    return Ok(None);
+                };
+                let colour = |n: Option<&Node>| -> DVec3 {
+                    match n.map(|n| &n.value) {
+                        Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
+                            a[0].value.as_f64().unwrap_or(1.0),
+                            a[1].value.as_f64().unwrap_or(1.0),
+                            a[2].value.as_f64().unwrap_or(1.0),
+                        ),
+                        Some(v) => DVec3::splat(v.as_f64().unwrap_or(1.0)),
+                        None => DVec3::ONE,
+                    }
+                };
+                let keys: &[&str] = match inner.get("type").map(|n| &n.value) {
+                    Some(Value::Str(ty)) if ty == "checkerboard" => &["color0", "color1"],
+                    _ => &["scale"],
+                };
+                for key in keys {
+                    let scaled = colour(inner.get(key)) * factor;
+                    inner.insert(key, vec3(scaled, line));
+                }
+                return Ok(Some(inner));
             }
             "checkerboard" => {
                 for (key, default) in [("color0", 0.4), ("color1", 0.2)] {
