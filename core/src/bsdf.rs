@@ -83,6 +83,60 @@ pub struct BsdfSample {
     pub delta: bool,
 }
 
+/// What Mitsuba puts on the light's side of a normal- or bump-mapped BSDF, the map having
+/// tilted the shading normal away from the surface's own `base_n`: light arriving from the
+/// other side of `base_n` than of the tilted normal is cut off (Mitsuba 0.6 and 3), and the
+/// rest multiplied by Estevez et al.'s shadowing term (Ray Tracing Gems, 2019; Mitsuba 3's
+/// `use_shadowing_function`) 2 / (1 + sqrt(1 + alpha^2 tan^2 theta)), theta the light's
+/// angle to `base_n`, alpha^2 = min(tan^2 of the tilt / 8, 1). Not reciprocal: the light's
+/// side is `wi` of [`Bsdf::eval`] and of radiance sampling, `wo` of importance sampling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightTerms {
+    /// The surface's shading normal before the map; zero: no terms.
+    pub base_n: Vec3,
+    /// alpha^2 of the shadowing term; negative: no shadowing term (the cut-off alone).
+    pub alpha2: f32,
+}
+
+impl LightTerms {
+    /// No terms (every BSDF but a mapped one of a Mitsuba file).
+    pub const NONE: LightTerms = LightTerms {
+        base_n: Vec3::ZERO,
+        alpha2: -1.0,
+    };
+
+    /// The terms for a map that tilted `base_n` to `n`, with the shadowing term if `shadowing`.
+    pub fn new(base_n: Vec3, n: Vec3, shadowing: bool) -> LightTerms {
+        let alpha2 = if shadowing {
+            let c = n.dot(base_n).clamp(-1.0, 1.0);
+            let tan2 = if c * c > 0.0 {
+                (1.0 - c * c) / (c * c)
+            } else {
+                f32::INFINITY
+            };
+            (0.125 * tan2).min(1.0)
+        } else {
+            -1.0
+        };
+        LightTerms { base_n, alpha2 }
+    }
+
+    /// The factor on light arriving along `w` at a BSDF of shading normal `n`.
+    #[inline]
+    fn factor(&self, n: Vec3, w: Vec3) -> f32 {
+        let c0 = w.dot(self.base_n);
+        if c0 * w.dot(n) <= 0.0 {
+            return 0.0;
+        }
+        if self.alpha2 < 0.0 {
+            return 1.0;
+        }
+        let c2 = c0 * c0;
+        let tan2 = ((1.0 - c2) / c2).max(0.0);
+        2.0 / (1.0 + (1.0 + self.alpha2 * tan2).sqrt())
+    }
+}
+
 /// The BSDF at a surface point.
 #[derive(Clone, Copy, Debug)]
 pub struct Bsdf {
@@ -94,6 +148,8 @@ pub struct Bsdf {
     /// A one-sided lobe seen from below acts as seen from above (Mitsuba's `twosided`): both
     /// directions are mirrored to the upper side.
     pub twosided: bool,
+    /// [`LightTerms::NONE`] but on the normal- and bump-mapped surfaces of Mitsuba files.
+    pub light_terms: LightTerms,
 }
 
 impl Bsdf {
@@ -128,12 +184,24 @@ impl Bsdf {
     /// f(wo, wi) |cos theta_i| (radiance: the cosine from the shading normal).
     #[inline]
     pub fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
-        if let Lobe::Diffuse(d) = &self.lobe {
+        let f = if let Lobe::Diffuse(d) = &self.lobe {
             let (cos_o, cos_i) = self.cosines(wo, wi);
-            return d.eval_cos(d.twosided || self.twosided, cos_o, cos_i);
+            d.eval_cos(d.twosided || self.twosided, cos_o, cos_i)
+        } else {
+            let (wo, wi) = self.local(wo, wi);
+            self.lobe.eval(wo, wi)
+        };
+        f * self.light_factor(wi)
+    }
+
+    /// The [`LightTerms`] factor on light arriving along `w`.
+    #[inline]
+    fn light_factor(&self, w: Vec3) -> f32 {
+        if self.light_terms.base_n == Vec3::ZERO {
+            1.0
+        } else {
+            self.light_terms.factor(self.frame.n, w)
         }
-        let (wo, wi) = self.local(wo, wi);
-        self.lobe.eval(wo, wi)
     }
 
     /// What a photon arriving along `wi` with unit flux gives the radiance towards `wo`, per
@@ -151,16 +219,17 @@ impl Bsdf {
     /// directions taken to the local frame once.
     #[inline]
     pub fn eval_pdf(&self, wo: Vec3, wi: Vec3) -> (Rgb, f32) {
+        let light = self.light_factor(wi);
         if let Lobe::Diffuse(d) = &self.lobe {
             let (cos_o, cos_i) = self.cosines(wo, wi);
             let twosided = d.twosided || self.twosided;
             return (
-                d.eval_cos(twosided, cos_o, cos_i),
+                d.eval_cos(twosided, cos_o, cos_i) * light,
                 DiffuseBxdf::pdf_cos(twosided, cos_o, cos_i),
             );
         }
         let (wo, wi) = self.local(wo, wi);
-        (self.lobe.eval(wo, wi), self.lobe.pdf(wo, wi))
+        (self.lobe.eval(wo, wi) * light, self.lobe.pdf(wo, wi))
     }
 
     /// Solid-angle pdf with which `sample` produces `wi` (its non-delta part).
@@ -207,6 +276,14 @@ impl Bsdf {
                 return None;
             }
             weight *= (wo.dot(self.frame.n).abs() * wi.dot(self.ng).abs()) / (cos_o_g * cos_i_s);
+        }
+        if self.light_terms.base_n != Vec3::ZERO {
+            // The light arrives along the sampled direction in radiance transport, along wo in
+            // importance transport.
+            weight *= self.light_factor(match mode {
+                TransportMode::Radiance => wi,
+                TransportMode::Importance => wo,
+            });
         }
         Some(BsdfSample {
             wi,
@@ -266,6 +343,7 @@ impl Material {
             frame: frame(),
             ng,
             twosided,
+            light_terms: LightTerms::NONE,
         })
     }
 }
@@ -311,6 +389,7 @@ mod tests {
                     frame: Frame::from_normal_tangent(n, dir()),
                     ng: n,
                     twosided,
+                    light_terms: LightTerms::NONE,
                 };
                 for _ in 0..200 {
                     let (wo, wi) = (dir(), dir());
@@ -346,6 +425,7 @@ mod tests {
             frame: Frame::from_normal(ng),
             ng,
             twosided: false,
+            light_terms: LightTerms::NONE,
         };
         let wo = Vec3::new(0.6, 0.0, 0.8);
         let (u, uc) = (Vec2::new(0.3, 0.7), 0.5);
@@ -360,6 +440,7 @@ mod tests {
             frame: Frame::from_normal(ns),
             ng,
             twosided: false,
+            light_terms: LightTerms::NONE,
         };
         let r = tilted.sample(wo, u, uc, TransportMode::Radiance).unwrap();
         let i = tilted.sample(wo, u, uc, TransportMode::Importance).unwrap();

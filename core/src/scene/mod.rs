@@ -13,7 +13,7 @@ use volumes::Volume;
 
 use crate::Rgb;
 use crate::accel::Accel;
-use crate::bsdf::{Bsdf, Frame};
+use crate::bsdf::{Bsdf, Frame, LightTerms};
 use crate::camera::Camera;
 use crate::error::{Location, Result};
 use crate::film::{DisplayTransform, ToneMap};
@@ -99,6 +99,17 @@ pub struct Object {
     /// Its material's bump map (Mitsuba's `bumpmap`, pbrt-v4's `displacement`). At most one
     /// of `normal_map` and `bump_map` is given.
     pub bump_map: Option<BumpMap>,
+    /// What the map does to the light's side of the BSDF (see [`LightTerms`]).
+    pub map_light: MapLight,
+}
+
+/// Which of Mitsuba's [`LightTerms`] a normal or bump map brings: none (pbrt-v4, and
+/// foton's default), the cut-off of light from below the surface's own normal (Mitsuba 0.6),
+/// or that and the shadowing term (Mitsuba 3's default).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct MapLight {
+    pub cut_off: bool,
+    pub shadowing: bool,
 }
 
 /// A height field over a surface's texture coordinates that tilts its shading normal: the
@@ -455,15 +466,19 @@ impl Scene {
         }
         if self.has_normal_maps {
             let object = self.object(hit);
-            if let Some(map) = &object.normal_map {
+            if object.normal_map.is_some() || object.bump_map.is_some() {
                 let mut sp = self.surface(hit);
-                sp.ns = normal_mapped(&sp, map);
-                return material.bsdf(&sp);
-            }
-            if let Some(bump) = &object.bump_map {
-                let mut sp = self.surface(hit);
-                sp.ns = bumped(&sp, bump);
-                return material.bsdf(&sp);
+                let base_n = sp.ns;
+                sp.ns = match (&object.normal_map, &object.bump_map) {
+                    (Some(map), _) => normal_mapped(&sp, map),
+                    (None, Some(bump)) => bumped(&sp, bump),
+                    (None, None) => unreachable!(),
+                };
+                let mut bsdf = material.bsdf(&sp)?;
+                if object.map_light.cut_off || object.map_light.shadowing {
+                    bsdf.light_terms = LightTerms::new(base_n, sp.ns, object.map_light.shadowing);
+                }
+                return Some(bsdf);
             }
         }
         let prim = self.primitive(hit);
@@ -486,6 +501,7 @@ impl Scene {
                 frame: Frame::from_normal(hit.ng),
                 ng: hit.ng,
                 twosided: false,
+                light_terms: LightTerms::NONE,
             });
         }
         let coordinates = material.needs_coordinates();

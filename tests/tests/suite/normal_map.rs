@@ -170,9 +170,13 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
     let (top, _) = foton_tests::region_mean(&film, 0, 2, 16, 7);
     let (bottom, _) = foton_tests::region_mean(&film, 0, 10, 16, 15);
     let ratio = bottom.x / top.x;
+    // Mitsuba 3's shadowing term on the tilted half (none on the flat one, alpha = 0).
+    let tan2 = |x: f32| x.tan().powi(2);
+    let g = 2.0 / (1.0 + (1.0 + tan2(b) / 8.0 * tan2(a)).sqrt());
     assert!(
-        (ratio / want - 1.0).abs() < 0.03,
-        "Mitsuba: tilted / flat {ratio}, expected {want}"
+        (ratio / (want * g) - 1.0).abs() < 0.03,
+        "Mitsuba: tilted / flat {ratio}, expected {}",
+        want * g
     );
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -302,8 +306,11 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
         "the referenced BSDF's other user is not bumped"
     );
     let film = foton_tests::render_file(&file, &[], 2);
-    // Mitsuba's directional light has irradiance 1, its diffuse reflectance 0.5.
-    let want = rho_over_pi * (a - 30f32.to_radians()).cos();
+    // Mitsuba's directional light has irradiance 1, its diffuse reflectance 0.5; Mitsuba 3
+    // multiplies by its shadowing term (alpha^2 = tan^2 30 / 8, the light 60 degrees off).
+    let tan2 = |deg: f32| deg.to_radians().tan().powi(2);
+    let g = 2.0 / (1.0 + (1.0 + tan2(30.0) / 8.0 * tan2(60.0)).sqrt());
+    let want = rho_over_pi * (a - 30f32.to_radians()).cos() * g;
     let mean = film.mean().x;
     assert!(
         (mean / want - 1.0).abs() < 0.03,
@@ -398,6 +405,60 @@ material = "m"
             assert!(
                 integral <= 1.0 + 1e-3,
                 "{name}: pdf integrates to {integral}"
+            );
+        }
+    }
+}
+
+/// Mitsuba's light-side terms on a mapped surface (`map_cut_off`, `map_shadowing`): under a
+/// directional light 60 degrees off the quad's normal and a 30 degree tilt towards it, the
+/// Lambertian quad reflects rho / pi E cos 30 times Estevez et al.'s term
+/// 2 / (1 + sqrt(1 + alpha^2 tan^2 60)), alpha^2 = tan^2 30 / 8; with the light 100 degrees
+/// off the normal (below the quad, above the tilted normal) nothing with the cut-off and
+/// rho / pi E cos 70 without. Every integrator: the term is on the light's side of the BSDF
+/// whichever way the integrator traces.
+#[test]
+fn mitsuba_light_terms_on_a_tilted_normal_map() {
+    let rho_over_pi = 0.5 / std::f32::consts::PI;
+    let tan2 = |deg: f32| deg.to_radians().tan().powi(2);
+    let g = 2.0 / (1.0 + (1.0 + tan2(30.0) / 8.0 * tan2(60.0)).sqrt());
+    for (integrator, spp) in [
+        ("path", 16),
+        ("bdpt", 16),
+        ("vcm", 16),
+        ("photon", 16),
+        ("sppm", 16),
+    ] {
+        for (light, terms, want) in [
+            (
+                60f32,
+                "map_shadowing = true\n",
+                rho_over_pi * 30f32.to_radians().cos() * g,
+            ),
+            (
+                60.0,
+                "map_cut_off = true\n",
+                rho_over_pi * 30f32.to_radians().cos(),
+            ),
+            (100.0, "map_cut_off = true\n", 0.0),
+            (100.0, "", rho_over_pi * 70f32.to_radians().cos()),
+        ] {
+            let a = light.to_radians();
+            let toml = scene(integrator, spp, Some(30.0))
+                .replace("normal_map = {", &format!("{terms}normal_map = {{"))
+                .replace(
+                    &format!(
+                        "direction = [{}, 0.0, {}]",
+                        -60f64.to_radians().sin(),
+                        -60f64.to_radians().cos()
+                    ),
+                    &format!("direction = [{}, 0.0, {}]", -a.sin(), -a.cos()),
+                );
+            assert!(toml.contains(terms) && toml.contains(&format!("{}", -a.cos())));
+            let mean = render_toml("normal-map-terms", &toml, &[], 2).mean().x;
+            assert!(
+                (mean - want).abs() <= 0.03 * want.max(rho_over_pi * 0.1),
+                "{integrator}, light {light} degrees, {terms:?}: mean {mean}, expected {want}"
             );
         }
     }

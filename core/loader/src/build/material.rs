@@ -8,7 +8,7 @@ use foton_core::material::{MATERIALS, Material};
 use foton_core::props::Properties;
 use foton_core::registry;
 use foton_core::registry::Resources;
-use foton_core::scene::{BumpMap, Named};
+use foton_core::scene::{BumpMap, MapLight, Named};
 use foton_core::texture::Texture;
 use std::collections::HashMap;
 
@@ -18,6 +18,7 @@ use std::collections::HashMap;
 pub(super) struct ShadingMaps {
     pub normal_map: Option<Texture>,
     pub bump_map: Option<BumpMap>,
+    pub map_light: MapLight,
 }
 
 /// Per material, its shading maps.
@@ -71,6 +72,18 @@ pub(super) fn read_materials(
         } else if m.has("bump_scale") {
             return Err(m.error("bump_scale", "a bump_scale without a bump_map"));
         }
+        for key in ["map_cut_off", "map_shadowing"] {
+            if m.has(key) && maps.normal_map.is_none() && maps.bump_map.is_none() {
+                return Err(m.error(
+                    key,
+                    "applies to a normal_map or a bump_map, and there is none",
+                ));
+            }
+        }
+        maps.map_light = MapLight {
+            cut_off: m.bool("map_cut_off", false)?,
+            shadowing: m.bool("map_shadowing", false)?,
+        };
         normal_maps.push(maps);
         let mut nested = Vec::new();
         let material = *(factory.create)(&m, &mut nested, ld)?;

@@ -248,6 +248,7 @@ pub(super) fn read_shapes(
             alpha,
             normal_map: normal_maps[material as usize].normal_map.clone(),
             bump_map: normal_maps[material as usize].bump_map.clone(),
+            map_light: normal_maps[material as usize].map_light,
         });
         let first_attrs = g.triangle_attrs.len() as u32;
         let with_attrs = !attrs.is_empty();

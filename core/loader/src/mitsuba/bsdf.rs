@@ -115,18 +115,11 @@ impl Reader {
                 else {
                     return Ok(None);
                 };
-                // Mitsuba 3.7 and later.
-                let shadowing = o.boolean("use_shadowing_function", true)?;
-                let flip = o.boolean("flip_invalid_normals", true)?;
-                if !o.v1 && (shadowing || flip) {
-                    self.note(
-                        &o,
-                        "the map's normals are used as given, as pbrt-v4 uses them: not Mitsuba 3's shadowing term (Estevez et al. 2019; `use_shadowing_function`, which darkens light arriving at grazing angles to a strongly tilted normal) nor its flip of normals facing away from the viewer (`flip_invalid_normals`)",
-                    );
-                }
+                let mut entries = self.map_light(&mut o, "normal map")?;
+                entries.push(("normal_map", map));
                 let (inner, l) = take_wrapped(&mut o, "normalmap")?;
                 self.leftovers(&o)?;
-                return self.wrapped_with(&o, inner, l, "normal map", vec![("normal_map", map)]);
+                return self.wrapped_with(&o, inner, l, "normal map", entries);
             }
             "bumpmap" => {
                 // Mitsuba takes the first texture among the children, whatever its name.
@@ -166,24 +159,17 @@ impl Reader {
                     Prop::Ref(id) => self.textures.get(&id).cloned(),
                     _ => unreachable!(),
                 };
-                let shadowing = o.boolean("use_shadowing_function", true)?;
-                let flip = o.boolean("flip_invalid_normals", true)?;
-                if !o.v1 && (shadowing || flip) {
-                    self.note(
-                        &o,
-                        "the bump map's normals are used as given, as pbrt-v4 uses them: not Mitsuba 3's shadowing term (Estevez et al. 2019; `use_shadowing_function`, which darkens light arriving at grazing angles to a strongly tilted normal) nor its flip of normals facing away from the viewer (`flip_invalid_normals`)",
-                    );
-                }
+                let mut entries = self.map_light(&mut o, "bump map")?;
                 let (inner, l) = take_wrapped(&mut o, "bumpmap")?;
                 self.leftovers(&o)?;
                 // A height texture left out (--lenient, reported): the BSDF without bumps.
-                let entries = match height {
-                    Some(h) => vec![
-                        ("bump_map", at(Value::Table(h), hl)),
-                        ("bump_scale", at(Value::Float(scale), hl)),
-                    ],
-                    None => Vec::new(),
-                };
+                match height {
+                    Some(h) => {
+                        entries.push(("bump_map", at(Value::Table(h), hl)));
+                        entries.push(("bump_scale", at(Value::Float(scale), hl)));
+                    }
+                    None => entries.clear(),
+                }
                 return self.wrapped_with(&o, inner, l, "bump map", entries);
             }
             "diffuse" => {
@@ -631,6 +617,28 @@ impl Reader {
             );
         }
         node
+    }
+}
+
+impl Reader {
+    /// What a `normalmap` or `bumpmap` does to the light's side of the BSDF it wraps: Mitsuba
+    /// 0.6 and 3 cut off light from below the surface's own normal, Mitsuba 3 (3.7 and
+    /// later) also applies its shadowing term unless `use_shadowing_function` is false. Its
+    /// `flip_invalid_normals` is noted: foton does not flip normals.
+    fn map_light(&mut self, o: &mut Obj, what: &str) -> Result<Vec<(&'static str, Node)>> {
+        let line = o.line;
+        let shadowing = o.boolean("use_shadowing_function", true)? && !o.v1;
+        let flip = o.boolean("flip_invalid_normals", true)?;
+        if !o.v1 && flip {
+            self.note(
+                o,
+                &format!("the {what}'s normals are not flipped where they face away from the viewer (Mitsuba 3's `flip_invalid_normals`): the same wherever the viewer sees the surface from above its tilted normal"),
+            );
+        }
+        Ok(vec![
+            ("map_cut_off", at(Value::Bool(true), line)),
+            ("map_shadowing", at(Value::Bool(shadowing), line)),
+        ])
     }
 }
 
