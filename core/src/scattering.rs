@@ -106,6 +106,13 @@ pub trait Bxdf {
     /// on it.
     const DELTA: bool = false;
 
+    /// Whether this lobe is all Dirac deltas: [`Bxdf::DELTA`] but for a lobe whose kind is
+    /// delta only with some parameters (a coating over a smooth metal).
+    #[inline]
+    fn is_delta(&self) -> bool {
+        Self::DELTA
+    }
+
     /// f(wo, wi) |cos theta_i| (zero for a delta lobe).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb;
 

@@ -3,7 +3,7 @@
 //!
 //! | Parameter              | Type           | Meaning                                            | Default |
 //! |------------------------|----------------|----------------------------------------------------|---------|
-//! | `base`                 | material table | the material under the layer: `diffuse`, `roughconductor`, `roughplastic` or `roughdiffuse` | (required) |
+//! | `base`                 | material table | the material under the layer: `diffuse`, `conductor`, `roughconductor`, `roughplastic` or `roughdiffuse` | (required) |
 //! | `ior`                  | number         | the layer's index relative to the outside          | `1.5046` (BK7 in air) |
 //! | `sigma_a`              | RGB            | absorption inside the layer, per unit of `thickness` | `0`   |
 //! | `thickness`            | number         | the layer's thickness, in the inverse units of `sigma_a` | `1` |
@@ -14,11 +14,13 @@
 //! reflects F(cos_o) in the mirror direction; the rest enters, refracted to wo' and wi', is
 //! scattered once by the base, attenuated by exp(-sigma_a thickness (1 / cos_o' + 1 / cos_i'))
 //! and leaves: f = f_base(wo', wi') (1 - F(cos_o)) (1 - F(cos_i)) A / eta^2. Light that the
-//! layer's underside reflects back onto the base is lost, as in Mitsuba 0.6.
+//! layer's underside reflects back onto the base is lost, as in Mitsuba 0.6. Over a smooth
+//! metal every part is a mirror reflection: F(cos) + (1 - F(cos))^2 F_metal(cos') A.
 
 use super::{Material, SurfaceMaterial, read_ior};
 use crate::Rgb;
 use crate::glossy::{RoughConductor, RoughPlastic};
+use crate::material::conductor::ConductorBxdf;
 use crate::material::diffuse::DiffuseBxdf;
 use crate::material::roughdiffuse::RoughDiffuseBxdf;
 use crate::material::{Lobe, MATERIALS};
@@ -32,6 +34,8 @@ use glam::{Vec2, Vec3};
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum CoatBase {
     Diffuse(DiffuseBxdf),
+    /// A smooth metal: the coating is then a mirror reflection.
+    Conductor(ConductorBxdf),
     RoughConductor(RoughConductor),
     RoughPlastic(RoughPlastic),
     RoughDiffuse(RoughDiffuseBxdf),
@@ -41,6 +45,7 @@ impl CoatBase {
     fn of(lobe: Lobe) -> Option<CoatBase> {
         match lobe {
             Lobe::Diffuse(l) => Some(CoatBase::Diffuse(l)),
+            Lobe::Conductor(l) => Some(CoatBase::Conductor(l)),
             Lobe::RoughConductor(l) => Some(CoatBase::RoughConductor(l)),
             Lobe::RoughPlastic(l) => Some(CoatBase::RoughPlastic(l)),
             Lobe::RoughDiffuse(l) => Some(CoatBase::RoughDiffuse(l)),
@@ -52,6 +57,7 @@ impl CoatBase {
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         match self {
             CoatBase::Diffuse(l) => Bxdf::eval(l, wo, wi),
+            CoatBase::Conductor(l) => Bxdf::eval(l, wo, wi),
             CoatBase::RoughConductor(l) => Bxdf::eval(l, wo, wi),
             CoatBase::RoughPlastic(l) => Bxdf::eval(l, wo, wi),
             CoatBase::RoughDiffuse(l) => Bxdf::eval(l, wo, wi),
@@ -62,6 +68,7 @@ impl CoatBase {
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         match self {
             CoatBase::Diffuse(l) => Bxdf::pdf(l, wo, wi),
+            CoatBase::Conductor(l) => Bxdf::pdf(l, wo, wi),
             CoatBase::RoughConductor(l) => Bxdf::pdf(l, wo, wi),
             CoatBase::RoughPlastic(l) => Bxdf::pdf(l, wo, wi),
             CoatBase::RoughDiffuse(l) => Bxdf::pdf(l, wo, wi),
@@ -72,6 +79,7 @@ impl CoatBase {
     fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
         match self {
             CoatBase::Diffuse(l) => Bxdf::sample(l, wo, u, uc, mode),
+            CoatBase::Conductor(l) => Bxdf::sample(l, wo, u, uc, mode),
             CoatBase::RoughConductor(l) => Bxdf::sample(l, wo, u, uc, mode),
             CoatBase::RoughPlastic(l) => Bxdf::sample(l, wo, u, uc, mode),
             CoatBase::RoughDiffuse(l) => Bxdf::sample(l, wo, u, uc, mode),
@@ -81,6 +89,7 @@ impl CoatBase {
     fn roughness(&self) -> f32 {
         match self {
             CoatBase::Diffuse(l) => Bxdf::roughness(l),
+            CoatBase::Conductor(l) => Bxdf::roughness(l),
             CoatBase::RoughConductor(l) => Bxdf::roughness(l),
             CoatBase::RoughPlastic(l) => Bxdf::roughness(l),
             CoatBase::RoughDiffuse(l) => Bxdf::roughness(l),
@@ -149,6 +158,10 @@ impl CoatingBxdf {
 }
 
 impl Bxdf for CoatingBxdf {
+    fn is_delta(&self) -> bool {
+        matches!(self.base, CoatBase::Conductor(_))
+    }
+
     /// The light through the layer (the mirror reflection is a delta).
     fn eval(&self, wo: Vec3, wi: Vec3) -> Rgb {
         if wo.z <= 0.0 || wi.z <= 0.0 {
@@ -180,6 +193,19 @@ impl Bxdf for CoatingBxdf {
             return None;
         }
         let (wo_in, f_o) = self.inside(wo);
+        if let CoatBase::Conductor(metal) = &self.base {
+            // Both parts leave in the mirror direction: one delta of their sum.
+            let inner = metal.sample(wo_in, u, uc, mode)?;
+            let through = inner.weight
+                * self.attenuation(wo_in.z, wo_in.z)
+                * ((1.0 - f_o) * (1.0 - f_o));
+            return Some(LocalSample {
+                wi: Vec3::new(-wo.x, -wo.y, wo.z),
+                weight: self.specular_reflectance * f_o + through,
+                pdf: 1.0,
+                delta: true,
+            });
+        }
         let p_spec = self.prob_specular(f_o);
         if uc < p_spec {
             return Some(LocalSample {
@@ -214,6 +240,9 @@ impl Bxdf for CoatingBxdf {
     fn delta_probability(&self, wo: Vec3) -> f32 {
         if wo.z <= 0.0 {
             return 0.0;
+        }
+        if self.is_delta() {
+            return 1.0;
         }
         self.prob_specular(fresnel_dielectric(wo.z, self.eta))
     }
@@ -256,6 +285,10 @@ impl SurfaceMaterial for CoatingMaterial {
     fn twosided(&self) -> bool {
         self.twosided
     }
+
+    fn is_delta(&self) -> bool {
+        matches!(*self.base, Material::Conductor(_))
+    }
 }
 
 pub const FACTORY: Factory<CoatingMaterial> = Factory {
@@ -283,7 +316,7 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
         if !supported || matches!(base, Material::Blend(_)) {
             return Err(bag.error(
                 "type",
-                format!("a coating lies on a diffuse, roughconductor, roughplastic or roughdiffuse material, not on `{ty}`"),
+                format!("a coating lies on a diffuse, conductor, roughconductor, roughplastic or roughdiffuse material, not on `{ty}`"),
             ));
         }
         let base_twosided = base.lobe_at(Vec3::ZERO, Vec2::ZERO).is_some_and(|(l, t)| {

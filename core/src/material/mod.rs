@@ -79,6 +79,11 @@ pub trait SurfaceMaterial {
     /// around the geometric normal, without the surface's parametrisation.
     fn needs_coordinates(&self) -> bool;
 
+    /// Whether its lobes are all Dirac deltas (see [`Bxdf::is_delta`]).
+    fn is_delta(&self) -> bool {
+        <Self::Bxdf as Bxdf>::DELTA
+    }
+
     /// Whether the BSDF mirrors both directions to the upper side when seen from below
     /// (Mitsuba's `twosided` around a one-sided lobe). A lobe that handles both sides itself
     /// (the diffuse one, a dielectric) says false.
@@ -143,7 +148,7 @@ macro_rules! materials {
             #[inline]
             pub fn is_delta(&self) -> bool {
                 match self {
-                    $(Material::$variant(_) => <$bxdf as Bxdf>::DELTA,)*
+                    $(Material::$variant(m) => m.is_delta(),)*
                     Material::Null => false,
                     Material::Blend(b) => b.is_delta(),
                 }
@@ -187,7 +192,7 @@ macro_rules! materials {
             #[inline]
             pub fn is_delta(&self) -> bool {
                 match self {
-                    $(Lobe::$variant(_) => <$bxdf as Bxdf>::DELTA,)*
+                    $(Lobe::$variant(l) => Bxdf::is_delta(l),)*
                 }
             }
 

@@ -168,50 +168,86 @@ fn coated_diffuse_albedo_matches_the_model() {
     }
 }
 
+/// Over a smooth metal the coating is one mirror reflection: its weight is the layer's
+/// F(cos) plus (1 - F(cos))^2 A times the metal's reflectance (a perfect mirror here), A the
+/// layer's absorption along the refracted cosine both ways.
+#[test]
+fn coating_over_a_smooth_metal_is_one_mirror_reflection() {
+    let bsdf = quad_bsdf(
+        "coating-metal",
+        r#"type = "coating"
+ior = 1.5
+sigma_a = [0.1, 0.3, 0.6]
+base = { type = "conductor" }"#,
+    );
+    assert!(bsdf.is_delta());
+    let mut rng = Rng::new(&[8]);
+    for cos in [0.9f32, 0.5, 0.1] {
+        let wo = Vec3::new((1.0 - cos * cos).sqrt(), 0.0, cos);
+        assert_eq!(bsdf.delta_probability(wo), 1.0);
+        assert_eq!(bsdf.eval(wo, Vec3::new(-wo.x, 0.0, wo.z)), Rgb::ZERO);
+        let s = bsdf
+            .sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)
+            .unwrap();
+        assert!(s.delta && (s.wi - Vec3::new(-wo.x, 0.0, wo.z)).length() < 1e-5);
+        let f = fresnel(cos as f64, 1.5);
+        let cos_in = (1.0 - (1.0 - (cos * cos) as f64) / 2.25).sqrt();
+        for (c, sigma) in [0.1, 0.3, 0.6].into_iter().enumerate() {
+            let want = f + (1.0 - f).powi(2) * (-2.0 * sigma / cos_in).exp();
+            assert!(
+                (s.weight[c] as f64 - want).abs() < 1e-4,
+                "cos {cos}, channel {c}: weight {}, expected {want}",
+                s.weight[c]
+            );
+        }
+    }
+}
+
 /// Every integrator that renders surfaces agrees with `path` on coated spheres and walls:
 /// the photon mappers estimate the base's part at the visible point and follow the mirror
 /// reflection with its probability.
 #[test]
 fn integrators_agree_on_coatings() {
-    let materials =
-        format!("[materials.coat_diffuse]\n{DIFFUSE}\n\n[materials.coat_copper]\n{COPPER}\n");
-    let scene = crate::bdpt::cornell(
-        "coat_diffuse",
-        "coat_copper",
-        &materials,
-        crate::bdpt::CEILING_LIGHT,
+    let materials = format!(
+        "[materials.coat_diffuse]\n{DIFFUSE}\n\n[materials.coat_copper]\n{COPPER}\n\n[materials.coat_gold]\ntype = \"coating\"\nsigma_a = [0.05, 0.1, 0.3]\nbase = {{ type = \"conductor\", material = \"Au\" }}\n"
     );
-    let render = |integrator: &str, spp: u32| {
-        render_toml(
-            &format!("coating-{integrator}"),
-            &scene,
-            &[
-                &format!("render.integrator=\"{integrator}\""),
-                &format!("render.spp={spp}"),
-            ],
-            2,
-        )
-    };
-    let reference = render("path", 512);
-    let tolerance = Tolerance {
-        rel: 0.04,
-        z: 4.5,
-        floor: 1e-3,
-    };
-    for (integrator, spp) in [("bdpt", 64), ("vcm", 64), ("photon", 64), ("sppm", 64)] {
-        let film = render(integrator, spp);
-        let (a, b) = (film.mean(), reference.mean());
-        assert!(
-            (a / b - Rgb::ONE).abs().max_element() < 0.03,
-            "{integrator}: image mean {a} against path's {b}"
-        );
-        assert_blocks_agree(
-            &format!("{integrator} against path on coatings"),
-            &film,
-            &reference,
-            4,
-            tolerance,
-        );
+    for (a, b) in [
+        ("coat_diffuse", "coat_copper"),
+        ("coat_gold", "coat_diffuse"),
+    ] {
+        let scene = crate::bdpt::cornell(a, b, &materials, crate::bdpt::CEILING_LIGHT);
+        let render = |integrator: &str, spp: u32| {
+            render_toml(
+                &format!("coating-{integrator}"),
+                &scene,
+                &[
+                    &format!("render.integrator=\"{integrator}\""),
+                    &format!("render.spp={spp}"),
+                ],
+                2,
+            )
+        };
+        let reference = render("path", 512);
+        let tolerance = Tolerance {
+            rel: 0.04,
+            z: 4.5,
+            floor: 1e-3,
+        };
+        for (integrator, spp) in [("bdpt", 64), ("vcm", 64), ("photon", 64), ("sppm", 64)] {
+            let film = render(integrator, spp);
+            let (a, b) = (film.mean(), reference.mean());
+            assert!(
+                (a / b - Rgb::ONE).abs().max_element() < 0.03,
+                "{integrator}: image mean {a} against path's {b}"
+            );
+            assert_blocks_agree(
+                &format!("{integrator} against path on coatings {a} and {b}"),
+                &film,
+                &reference,
+                4,
+                tolerance,
+            );
+        }
     }
 }
 

@@ -329,7 +329,13 @@ impl Reader {
                     },
                     _ => String::new(),
                 };
-                let covered = ["diffuse", "roughconductor", "roughplastic", "roughdiffuse"];
+                let covered = [
+                    "diffuse",
+                    "conductor",
+                    "roughconductor",
+                    "roughplastic",
+                    "roughdiffuse",
+                ];
                 if !covered.contains(&kind.as_str())
                     || self.masks.contains_key(&base)
                     || table.as_ref().is_some_and(|n| {
@@ -338,7 +344,7 @@ impl Reader {
                 {
                     self.unsupported(
                         &o,
-                        &format!("a coating over this BSDF (`{kind}`, or one with a mask or a normal or bump map): foton coats diffuse, roughconductor, roughplastic and roughdiffuse BSDFs (--lenient: the BSDF without the coating)"),
+                        &format!("a coating over this BSDF (`{kind}`, or one with a mask or a normal or bump map): foton coats diffuse, conductor, roughconductor, roughplastic and roughdiffuse BSDFs (--lenient: the BSDF without the coating)"),
                     )?;
                     if let Some(id) = &o.id {
                         self.bsdfs.insert(id.clone(), base.clone());
