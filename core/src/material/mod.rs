@@ -57,6 +57,7 @@ materials! {
         CoatedDiffuse(coateddiffuse::CoatedDiffuseMaterial, coateddiffuse::CoatedDiffuseBxdf),
         CoatedConductor(coatedconductor::CoatedConductorMaterial, coatedconductor::CoatedConductorBxdf),
         Coating(coating::CoatingMaterial, coating::CoatingBxdf),
+        PPlastic(pplastic::PPlasticMaterial, pplastic::PPlasticBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

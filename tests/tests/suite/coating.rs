@@ -11,7 +11,7 @@ use foton_tests::{header, render_toml};
 
 /// A scene whose one quad has material `m` (a TOML table body), and that quad's BSDF at its
 /// centre, the quad's normal +z.
-fn quad_bsdf(name: &str, m: &str) -> Bsdf {
+pub(crate) fn quad_bsdf(name: &str, m: &str) -> Bsdf {
     let dir = foton_tests::temp_dir(name);
     let toml = header("path", 1, 1, 4, 4)
         + &format!(
@@ -106,7 +106,7 @@ fn coating_samples_its_pdf() {
 
 /// Fresnel reflectance of a smooth dielectric interface, eta inside over outside, from
 /// outside at cos_i (written out here, independent of the renderer's).
-fn fresnel(cos_i: f64, eta: f64) -> f64 {
+pub(crate) fn fresnel(cos_i: f64, eta: f64) -> f64 {
     let sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
     if sin_t2 >= 1.0 {
         return 1.0;

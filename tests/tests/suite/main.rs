@@ -57,6 +57,7 @@ mod plugin_api;
 mod plugins;
 mod ply;
 mod ppb;
+mod pplastic;
 mod principled;
 mod rough_texture;
 mod samplers;

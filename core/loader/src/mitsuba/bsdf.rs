@@ -292,6 +292,25 @@ impl Reader {
                 t.insert("nonlinear", at(Value::Bool(nonlinear), line));
                 t.insert("twosided", at(Value::Bool(false), line));
             }
+            "pplastic" => {
+                put("type", Value::Str("pplastic".into()));
+                self.microfacet(&mut o, &mut t, true)?;
+                let int = self.ior(&mut o, "int_ior", 1.49)?;
+                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
+                t.insert("ior", at(Value::Float(int / ext), line));
+                for (k, default) in [("diffuse_reflectance", 0.5), ("specular_reflectance", 1.0)] {
+                    let Some(c) = self.texture(&mut o, k, DVec3::splat(default))? else {
+                        return Ok(None);
+                    };
+                    t.insert(k, c);
+                }
+                // Mitsuba 3 samples visible normals or not; the image is the same.
+                o.take("sample_visible");
+                self.note(
+                    &o,
+                    "pplastic's polarisation is not tracked: rendered as Mitsuba 3's RGB variants render it",
+                );
+            }
             "coating" => {
                 put("type", Value::Str("coating".into()));
                 let int = self.ior(&mut o, "int_ior", 1.5046)?;
