@@ -94,6 +94,22 @@ pub struct LocalSample {
     pub delta: bool,
 }
 
+/// The sample of a lobe that drew `wi` for `wo` from the density its `pdf` gives: weighted
+/// f cos / pdf (None where that density is zero).
+#[inline]
+pub fn sampled_direction<B: Bxdf + ?Sized>(lobe: &B, wo: Vec3, wi: Vec3) -> Option<LocalSample> {
+    let pdf = lobe.pdf(wo, wi);
+    if pdf <= 0.0 {
+        return None;
+    }
+    Some(LocalSample {
+        wi,
+        weight: lobe.eval(wo, wi) / pdf,
+        pdf,
+        delta: false,
+    })
+}
+
 /// A material's scattering at one point in the local shading frame, its textures looked up
 /// (pbrt-v4's `BxDF`): z is the shading normal, both directions point away from the surface,
 /// `wo` towards the viewer (or where a photon came from), `wi` the other one. `eval` is

@@ -83,6 +83,17 @@ pub fn luminance(c: Rgb) -> f32 {
     0.212671 * c.x + 0.715160 * c.y + 0.072169 * c.z
 }
 
+/// The texels a bilinear lookup blends: columns `xa`, `xb`, rows `ya`, `yb`, weights of the
+/// second ones `fx`, `fy`.
+struct Cell {
+    xa: usize,
+    xb: usize,
+    ya: usize,
+    yb: usize,
+    fx: f32,
+    fy: f32,
+}
+
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Bitmap {
@@ -134,23 +145,37 @@ impl Bitmap {
         }
     }
 
+    /// The four texels around continuous texel coordinates (x, y) (texel (i, j)'s centre at
+    /// (i, j)), wrapped per axis, and the position between them.
+    #[inline]
+    fn cell(&self, x: f32, y: f32, wrap: [WrapMode; 2]) -> Cell {
+        let (x, y) = (finite_or_zero(x), finite_or_zero(y));
+        let (x0, y0) = (x.floor(), y.floor());
+        let (fx, fy) = (x - x0, y - y0);
+        let (x0, y0) = (x0 as i64, y0 as i64);
+        Cell {
+            xa: wrap[0].wrap(x0, self.width),
+            xb: wrap[0].wrap(x0 + 1, self.width),
+            ya: wrap[1].wrap(y0, self.height),
+            yb: wrap[1].wrap(y0 + 1, self.height),
+            fx,
+            fy,
+        }
+    }
+
     /// Bilinear interpolation at continuous texel coordinates (x, y), texel (i, j)'s centre
     /// at (i, j), indices outside the image wrapped per axis: the one lookup of the textures
     /// and the environment map.
     #[inline]
     pub fn bilinear(&self, x: f32, y: f32, wrap: [WrapMode; 2]) -> Rgb {
-        let (x, y) = (finite_or_zero(x), finite_or_zero(y));
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let (xa, xb) = (
-            wrap[0].wrap(x0, self.width),
-            wrap[0].wrap(x0 + 1, self.width),
-        );
-        let (ya, yb) = (
-            wrap[1].wrap(y0, self.height),
-            wrap[1].wrap(y0 + 1, self.height),
-        );
+        let Cell {
+            xa,
+            xb,
+            ya,
+            yb,
+            fx,
+            fy,
+        } = self.cell(x, y, wrap);
         let top = self.texel(xa, ya) * (1.0 - fx) + self.texel(xb, ya) * fx;
         let bottom = self.texel(xa, yb) * (1.0 - fx) + self.texel(xb, yb) * fx;
         top * (1.0 - fy) + bottom * fy
@@ -161,18 +186,14 @@ impl Bitmap {
     /// four texels that (x, y) falls in (Mitsuba 3's `eval_1_grad`).
     #[inline]
     pub fn bilinear_gradient(&self, x: f32, y: f32, wrap: [WrapMode; 2]) -> Vec2 {
-        let (x, y) = (finite_or_zero(x), finite_or_zero(y));
-        let (x0, y0) = (x.floor(), y.floor());
-        let (fx, fy) = (x - x0, y - y0);
-        let (x0, y0) = (x0 as i64, y0 as i64);
-        let (xa, xb) = (
-            wrap[0].wrap(x0, self.width),
-            wrap[0].wrap(x0 + 1, self.width),
-        );
-        let (ya, yb) = (
-            wrap[1].wrap(y0, self.height),
-            wrap[1].wrap(y0 + 1, self.height),
-        );
+        let Cell {
+            xa,
+            xb,
+            ya,
+            yb,
+            fx,
+            fy,
+        } = self.cell(x, y, wrap);
         let f = |x, y| scalar(self.texel(x, y));
         let (f00, f10, f01, f11) = (f(xa, ya), f(xb, ya), f(xa, yb), f(xb, yb));
         Vec2::new(

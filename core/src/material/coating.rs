@@ -26,7 +26,7 @@ use crate::material::roughdiffuse::RoughDiffuseBxdf;
 use crate::material::{Lobe, MATERIALS};
 use crate::props::Properties;
 use crate::registry::{self, Factory};
-use crate::scattering::{Bxdf, LocalSample, TransportMode, fresnel_dielectric};
+use crate::scattering::{Bxdf, LocalSample, TransportMode, fresnel_dielectric, sampled_direction};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 
@@ -221,16 +221,7 @@ impl Bxdf for CoatingBxdf {
             return None;
         }
         let wi = self.outside(s.wi)?;
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: self.eval(wo, wi) / pdf,
-            pdf,
-            delta: false,
-        })
+        sampled_direction(self, wo, wi)
     }
 
     fn roughness(&self) -> f32 {

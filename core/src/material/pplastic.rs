@@ -21,7 +21,9 @@ use crate::Rgb;
 use crate::microfacet::Microfacet;
 use crate::registry::Factory;
 use crate::sampling::cosine_hemisphere;
-use crate::scattering::{Bxdf, LocalSample, TransportMode, fresnel_dielectric, reflect};
+use crate::scattering::{
+    Bxdf, LocalSample, TransportMode, fresnel_dielectric, reflect, sampled_direction,
+};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::FRAC_1_PI;
@@ -91,16 +93,7 @@ impl Bxdf for PPlasticBxdf {
         if wi.z <= 0.0 {
             return None;
         }
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: self.eval(wo, wi) / pdf,
-            pdf,
-            delta: false,
-        })
+        sampled_direction(self, wo, wi)
     }
 
     fn roughness(&self) -> f32 {

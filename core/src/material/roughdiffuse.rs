@@ -21,7 +21,7 @@ use super::phong::{channel_mean, energy_conserving_scale, scalar_texture};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::sampling::cosine_hemisphere;
-use crate::scattering::{Bxdf, LocalSample, TransportMode};
+use crate::scattering::{Bxdf, LocalSample, TransportMode, sampled_direction};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, FRAC_1_SQRT_2};
@@ -151,16 +151,7 @@ impl Bxdf for RoughDiffuseBxdf {
             return None;
         }
         let wi = cosine_hemisphere(u);
-        let pdf = self.pdf(wo, wi);
-        if pdf <= 0.0 {
-            return None;
-        }
-        Some(LocalSample {
-            wi,
-            weight: self.eval(wo, wi) / pdf,
-            pdf,
-            delta: false,
-        })
+        sampled_direction(self, wo, wi)
     }
 
     /// Diffuse, whatever alpha (Mitsuba's).

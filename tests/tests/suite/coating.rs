@@ -2,49 +2,11 @@
 //! against its pdf, its albedo against the model's formula integrated here, every integrator
 //! agreeing with `path` on it, and the Mitsuba reader's mapping.
 
-use crate::sampling::{SphereGrid, check_directions, d};
-use foton_core::api::{Ray, Rgb, TransportMode, Vec3};
-use foton_core::bsdf::Bsdf;
+use crate::lobes::{check_lobe_sampling, quad_bsdf};
+use foton_core::api::{Rgb, TransportMode, Vec3};
 use foton_core::sampling::Rng;
+use foton_tests::render_toml;
 use foton_tests::stats::{Tolerance, assert_blocks_agree};
-use foton_tests::{header, render_toml};
-
-/// A scene whose one quad has material `m` (a TOML table body), and that quad's BSDF at its
-/// centre, the quad's normal +z.
-pub(crate) fn quad_bsdf(name: &str, m: &str) -> Bsdf {
-    let dir = foton_tests::temp_dir(name);
-    let toml = header("path", 1, 1, 4, 4)
-        + &format!(
-            r#"
-[camera]
-position = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 30.0
-
-[materials.m]
-{m}
-
-[[lights]]
-type = "point"
-position = [0.0, 0.0, 3.0]
-intensity = [1.0, 1.0, 1.0]
-
-[[shapes]]
-type = "quad"
-origin = [-1.0, -1.0, 0.0]
-u = [2.0, 0.0, 0.0]
-v = [0.0, 2.0, 0.0]
-material = "m"
-"#
-        );
-    let file = foton_tests::write(&dir, "c.toml", &toml);
-    let scene = foton_loader::load(&file, &[]).unwrap();
-    let hit = scene
-        .intersect(&Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z), f32::INFINITY)
-        .unwrap();
-    scene.bsdf(&hit).unwrap()
-}
 
 const DIFFUSE: &str = r#"type = "coating"
 ior = 1.7
@@ -74,28 +36,8 @@ fn coating_samples_its_pdf() {
         .enumerate()
         {
             let label = format!("coating over {name}, wo = {wo}");
-            let grid = SphereGrid::full_sphere(d(Vec3::Z), 20, 20);
-            let pdf = |w: glam::DVec3| bsdf.pdf(wo, w.as_vec3()) as f64;
-            let p_none = 1.0 - grid.probabilities(&pdf).iter().sum::<f64>();
-            let mut rng = Rng::new(&[31, k as u64, j as u64]);
-            let mut deltas = 0u32;
-            check_directions(&label, &grid, 400_000, p_none, &pdf, &mut || {
-                let s = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)?;
-                if s.delta {
-                    deltas += 1;
-                    assert!((s.wi - Vec3::new(-wo.x, -wo.y, wo.z)).length() < 1e-5);
-                    return None;
-                }
-                let want = bsdf.eval(wo, s.wi) / s.pdf;
-                assert!(
-                    (s.weight - want).abs().max_element() <= 1e-3 * want.max_element().max(1e-3),
-                    "{label}: weight {} against f cos / pdf {want}",
-                    s.weight
-                );
-                Some(d(s.wi))
-            });
+            let got = check_lobe_sampling(&label, &bsdf, wo, Vec3::Z, &[31, k as u64, j as u64]);
             let p_delta = bsdf.delta_probability(wo) as f64;
-            let got = deltas as f64 / 400_000.0;
             assert!(
                 (got - p_delta).abs() < 5.0 * (p_delta * (1.0 - p_delta) / 400_000.0).sqrt() + 1e-4,
                 "{label}: mirror picked {got}, delta_probability {p_delta}"

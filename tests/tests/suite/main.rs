@@ -35,6 +35,7 @@ mod filter;
 mod glossy;
 mod heterogeneous;
 mod kernels;
+mod lobes;
 mod materials_classic;
 mod media;
 mod media_sides;

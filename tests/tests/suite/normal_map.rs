@@ -324,9 +324,8 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
 /// sample's weight is f cos / pdf.
 #[test]
 fn a_bump_mapped_bsdf_samples_its_pdf() {
-    use crate::sampling::{P_HORIZON, SphereGrid, check_directions, d};
-    use foton_core::api::{Ray, TransportMode, Vec3};
-    use foton_core::sampling::Rng;
+    use crate::lobes::{check_lobe_sampling, quad_bsdf_in};
+    use foton_core::api::Vec3;
     let dir = foton_tests::temp_dir("bump-map-sampling");
     let ramp: Vec<u8> = (0..256).map(|i| 255 - i as u8).collect();
     image::GrayImage::from_raw(256, 1, ramp)
@@ -341,39 +340,12 @@ fn a_bump_mapped_bsdf_samples_its_pdf() {
     .into_iter()
     .enumerate()
     {
-        let toml = header("path", 1, 1, 4, 4)
-            + &format!(
-                r#"
-[camera]
-position = [0.0, 0.0, 3.0]
-look_at = [0.0, 0.0, 0.0]
-up = [0.0, 1.0, 0.0]
-fov = 30.0
-
-[materials.m]
-{material}
-bump_map = {{ type = "bitmap", filename = "ramp.png", raw = true }}
-bump_scale = {scale}
-
-[[lights]]
-type = "point"
-position = [0.0, 0.0, 3.0]
-intensity = [1.0, 1.0, 1.0]
-
-[[shapes]]
-type = "quad"
-origin = [-2.0, -2.0, 0.0]
-u = [4.0, 0.0, 0.0]
-v = [0.0, 4.0, 0.0]
-material = "m"
-"#
-            );
-        let file = foton_tests::write(&dir, "b.toml", &toml);
-        let scene = foton_loader::load(&file, &[]).unwrap();
-        let hit = scene
-            .intersect(&Ray::new(Vec3::new(0.1, 0.2, 1.0), -Vec3::Z), f32::INFINITY)
-            .unwrap();
-        let bsdf = scene.bsdf(&hit).unwrap();
+        let bsdf = quad_bsdf_in(
+            &dir,
+            &format!(
+                "{material}\nbump_map = {{ type = \"bitmap\", filename = \"ramp.png\", raw = true }}\nbump_scale = {scale}"
+            ),
+        );
         let tilt = bsdf.frame.n.dot(Vec3::Z).acos().to_degrees();
         assert!(
             (tilt - 30.0).abs() < 0.5 && bsdf.frame.n.x > 0.0,
@@ -386,26 +358,10 @@ material = "m"
         .into_iter()
         .enumerate()
         {
-            let name = format!("{material}, wo = {wo}");
-            let grid = SphereGrid::full_sphere(d(bsdf.frame.n), 20, 20);
-            let mut rng = Rng::new(&[21, k as u64, j as u64]);
-            let pdf = |w: glam::DVec3| bsdf.pdf(wo, w.as_vec3()) as f64;
-            // A microfacet reflection below the shading normal's horizon is no sample.
-            let p_none = (1.0 - grid.probabilities(&pdf).iter().sum::<f64>()).max(P_HORIZON);
-            let integral = check_directions(&name, &grid, 400_000, p_none, &pdf, &mut || {
-                let s = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)?;
-                let want = bsdf.eval(wo, s.wi) / s.pdf;
-                assert!(
-                    (s.weight - want).abs().max_element() <= 1e-3 * want.max_element().max(1e-3),
-                    "{name}: weight {} against f cos / pdf {want}",
-                    s.weight
-                );
-                Some(d(s.wi))
-            });
-            assert!(
-                integral <= 1.0 + 1e-3,
-                "{name}: pdf integrates to {integral}"
-            );
+            let label = format!("{material}, wo = {wo}");
+            let deltas =
+                check_lobe_sampling(&label, &bsdf, wo, bsdf.frame.n, &[21, k as u64, j as u64]);
+            assert_eq!(deltas, 0.0, "{label}: a delta sample");
         }
     }
 }

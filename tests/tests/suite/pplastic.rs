@@ -2,10 +2,9 @@
 //! diffuse part against the formula, and the Mitsuba reader's mapping. Its image against
 //! Mitsuba 3's: docs/scene-format.md.
 
-use crate::coating::{fresnel, quad_bsdf};
-use crate::sampling::{SphereGrid, check_directions, d};
-use foton_core::api::{Rgb, TransportMode, Vec3};
-use foton_core::sampling::Rng;
+use crate::coating::fresnel;
+use crate::lobes::{check_lobe_sampling, quad_bsdf};
+use foton_core::api::{Rgb, Vec3};
 
 #[test]
 fn pplastic_samples_its_pdf() {
@@ -27,21 +26,8 @@ fn pplastic_samples_its_pdf() {
         .enumerate()
         {
             let label = format!("{m:?}, wo = {wo}");
-            let grid = SphereGrid::full_sphere(d(Vec3::Z), 20, 20);
-            let pdf = |w: glam::DVec3| bsdf.pdf(wo, w.as_vec3()) as f64;
-            let p_none = 1.0 - grid.probabilities(&pdf).iter().sum::<f64>();
-            let mut rng = Rng::new(&[41, k as u64, j as u64]);
-            check_directions(&label, &grid, 400_000, p_none.max(0.0), &pdf, &mut || {
-                let s = bsdf.sample(wo, rng.next_2d(), rng.next_f32(), TransportMode::Radiance)?;
-                assert!(!s.delta);
-                let want = bsdf.eval(wo, s.wi) / s.pdf;
-                assert!(
-                    (s.weight - want).abs().max_element() <= 1e-3 * want.max_element().max(1e-3),
-                    "{label}: weight {} against f cos / pdf {want}",
-                    s.weight
-                );
-                Some(d(s.wi))
-            });
+            let deltas = check_lobe_sampling(&label, &bsdf, wo, Vec3::Z, &[41, k as u64, j as u64]);
+            assert_eq!(deltas, 0.0, "{label}: a delta sample");
         }
     }
 }

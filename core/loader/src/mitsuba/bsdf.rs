@@ -279,14 +279,8 @@ impl Reader {
                 if o.ty == "roughplastic" {
                     self.microfacet(&mut o, &mut t, false)?;
                 }
-                let int = self.ior(&mut o, "int_ior", 1.49)?;
-                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
-                t.insert("ior", at(Value::Float(int / ext), line));
-                for (k, default) in [("diffuse_reflectance", 0.5), ("specular_reflectance", 1.0)] {
-                    let Some(c) = self.texture(&mut o, k, DVec3::splat(default))? else {
-                        return Ok(None);
-                    };
-                    t.insert(k, c);
+                if !self.plastic_params(&mut o, &mut t)? {
+                    return Ok(None);
                 }
                 let nonlinear = o.boolean("nonlinear", false)?;
                 t.insert("nonlinear", at(Value::Bool(nonlinear), line));
@@ -295,14 +289,8 @@ impl Reader {
             "pplastic" => {
                 put("type", Value::Str("pplastic".into()));
                 self.microfacet(&mut o, &mut t, true)?;
-                let int = self.ior(&mut o, "int_ior", 1.49)?;
-                let ext = self.ior(&mut o, "ext_ior", 1.000277)?;
-                t.insert("ior", at(Value::Float(int / ext), line));
-                for (k, default) in [("diffuse_reflectance", 0.5), ("specular_reflectance", 1.0)] {
-                    let Some(c) = self.texture(&mut o, k, DVec3::splat(default))? else {
-                        return Ok(None);
-                    };
-                    t.insert(k, c);
+                if !self.plastic_params(&mut o, &mut t)? {
+                    return Ok(None);
                 }
                 // Mitsuba 3 samples visible normals or not; the image is the same.
                 o.take("sample_visible");
@@ -646,6 +634,22 @@ impl Reader {
 }
 
 impl Reader {
+    /// What the plastics share: `int_ior` and `ext_ior` (polypropylene in air) as `ior`, and
+    /// the two reflectances. false: a texture was left out (lenient).
+    fn plastic_params(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
+        let line = o.line;
+        let int = self.ior(o, "int_ior", 1.49)?;
+        let ext = self.ior(o, "ext_ior", 1.000277)?;
+        t.insert("ior", at(Value::Float(int / ext), line));
+        for (k, default) in [("diffuse_reflectance", 0.5), ("specular_reflectance", 1.0)] {
+            let Some(c) = self.texture(o, k, DVec3::splat(default))? else {
+                return Ok(false);
+            };
+            t.insert(k, c);
+        }
+        Ok(true)
+    }
+
     /// What a `normalmap` or `bumpmap` does to the light's side of the BSDF it wraps: Mitsuba
     /// 0.6 and 3 cut off light from below the surface's own normal, Mitsuba 3 (3.7 and
     /// later) also applies its shadowing term unless `use_shadowing_function` is false. Its
