@@ -6,7 +6,7 @@
 # equal spp and at foton's time against a foton `path` reference of 4096 spp.
 #
 #   python -m venv /tmp/mi && /tmp/mi/bin/pip install mitsuba==3.9.1 numpy
-#   export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so   # where libLLVM is
+#   export DRJIT_LIBLLVM_PATH=/usr/lib/x86_64-linux-gnu/libLLVM-19.so   # libLLVM 19 (apt: libllvm19); Dr.Jit refuses 14, and 15 fails
 #   cargo build --release && MI_PYTHON=/tmp/mi/bin/python tests/benches/mitsuba3-cornell.sh
 #
 # ROUNDS (default 7); OUT (default /tmp/foton-mitsuba3) keeps the images and the reference.

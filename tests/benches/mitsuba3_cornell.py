@@ -16,7 +16,7 @@ import sys
 import time
 from pathlib import Path
 
-XML = Path(__file__).resolve().parent.parent / "docs" / "cornell_point-mitsuba3.xml"
+XML = Path(__file__).resolve().parents[2] / "docs" / "cornell_point-mitsuba3.xml"
 
 
 def load(mi, sampler, spp):
