@@ -7,8 +7,8 @@ use foton_core::Rgb;
 use foton_core::error::{Error, Result};
 use foton_core::props::Properties;
 use foton_core::texture::{Bitmap, FilterType, Texture, WrapMode, srgb_to_linear};
-use foton_core::value::Value;
-use glam::{Affine2, Mat2, Vec2};
+use foton_core::value::{Node, Table, Value};
+use glam::{Affine2, DVec3, Mat2, Vec2};
 use std::path::Path;
 use std::sync::Arc;
 
@@ -69,6 +69,36 @@ pub fn load_bitmap_decoded(path: &Path, decode: Decode) -> Result<Bitmap> {
         });
     }
     Bitmap::new(width, height, texels).ok_or_else(|| Error::io(path, "the image is empty"))
+}
+
+/// A colour of a texture table: `key` as `[r, g, b]` or one number, `missing` per channel
+/// where it is absent or not a number.
+pub(crate) fn table_colour(table: &Table, key: &str, missing: f64) -> DVec3 {
+    match table.get(key).map(|n| &n.value) {
+        Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
+            a[0].value.as_f64().unwrap_or(missing),
+            a[1].value.as_f64().unwrap_or(missing),
+            a[2].value.as_f64().unwrap_or(missing),
+        ),
+        Some(v) => DVec3::splat(v.as_f64().unwrap_or(missing)),
+        None => DVec3::splat(missing),
+    }
+}
+
+/// Multiplies a texture table's values by `s` (a bitmap's `scale`, a checkerboard's two
+/// colours), each new colour written by `node`: the readers' scale textures.
+pub(crate) fn scale_texture_table(table: &mut Table, s: DVec3, node: impl Fn(DVec3) -> Node) {
+    let is_checkerboard =
+        matches!(table.get("type"), Some(Node { value: Value::Str(k), .. }) if k == "checkerboard");
+    let keys: &[&str] = if is_checkerboard {
+        &["color0", "color1"]
+    } else {
+        &["scale"]
+    };
+    for key in keys {
+        let scaled = table_colour(table, key, 1.0) * s;
+        table.insert(key, node(scaled));
+    }
 }
 
 /// The images a load has decoded, by file and decoding: a file that many materials' textures

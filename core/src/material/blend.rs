@@ -17,10 +17,10 @@
 //! for holes everywhere, not at some points.
 
 use super::phong::{channel_mean, scalar_texture};
-use super::{Lobe, MATERIALS, Material};
+use super::{Lobe, Material, nested_material};
 use crate::Rgb;
 use crate::props::Properties;
-use crate::registry::{self, Factory};
+use crate::registry::Factory;
 use crate::sampling::splitmix64;
 use crate::texture::Texture;
 use crate::value::Value;
@@ -145,17 +145,7 @@ pub const FACTORY: Factory<Material> = Factory {
         for (i, item) in items.iter().enumerate() {
             let path = format!("{}[{i}]", m.key_path("materials"));
             let bag = Properties::new(m.file(), &path, item)?;
-            let types: Vec<&str> = registry::names(MATERIALS).collect();
-            let ty = bag.string_opt("type")?.ok_or_else(|| {
-                bag.error(
-                    "type",
-                    format!("missing; expected one of: {}", types.join(", ")),
-                )
-            })?;
-            let factory = registry::find(MATERIALS, ty).ok_or_else(|| {
-                bag.error("type", registry::unknown("material type", ty, MATERIALS))
-            })?;
-            let material = *(factory.create)(&bag, nested, resources)?;
+            let material = nested_material(&bag, nested, resources)?;
             if material.is_null() {
                 return Err(bag.error(
                     "type",

@@ -17,15 +17,16 @@
 //! layer's underside reflects back onto the base is lost, as in Mitsuba 0.6. Over a smooth
 //! metal every part is a mirror reflection: F(cos) + (1 - F(cos))^2 F_metal(cos') A.
 
-use super::{Material, SurfaceMaterial, read_ior};
+use super::mirror::delta_sample;
+use super::{Material, SurfaceMaterial, nested_material, read_ior};
 use crate::Rgb;
 use crate::glossy::{RoughConductor, RoughPlastic};
 use crate::material::conductor::ConductorBxdf;
 use crate::material::diffuse::DiffuseBxdf;
 use crate::material::roughdiffuse::RoughDiffuseBxdf;
-use crate::material::{Lobe, MATERIALS};
+use crate::material::Lobe;
 use crate::props::Properties;
-use crate::registry::{self, Factory};
+use crate::registry::Factory;
 use crate::scattering::{Bxdf, LocalSample, TransportMode, fresnel_dielectric, sampled_direction};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
@@ -199,21 +200,19 @@ impl Bxdf for CoatingBxdf {
             let through = inner.weight
                 * self.attenuation(wo_in.z, wo_in.z)
                 * ((1.0 - f_o) * (1.0 - f_o));
-            return Some(LocalSample {
-                wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                weight: self.specular_reflectance * f_o + through,
-                pdf: 1.0,
-                delta: true,
-            });
+            return delta_sample(
+                Vec3::new(-wo.x, -wo.y, wo.z),
+                self.specular_reflectance * f_o + through,
+                1.0,
+            );
         }
         let p_spec = self.prob_specular(f_o);
         if uc < p_spec {
-            return Some(LocalSample {
-                wi: Vec3::new(-wo.x, -wo.y, wo.z),
-                weight: self.specular_reflectance * (f_o / p_spec),
-                pdf: p_spec,
-                delta: true,
-            });
+            return delta_sample(
+                Vec3::new(-wo.x, -wo.y, wo.z),
+                self.specular_reflectance * (f_o / p_spec),
+                p_spec,
+            );
         }
         let uc = ((uc - p_spec) / (1.0 - p_spec)).min(1.0 - f32::EPSILON);
         let s = self.base.sample(wo_in, u, uc, mode)?;
@@ -290,16 +289,8 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
             return Err(m.error("base", "missing: the material under the layer, a table"));
         };
         let bag = Properties::new(m.file(), &m.key_path("base"), node)?;
-        let types: Vec<&str> = registry::names(MATERIALS).collect();
-        let ty = bag.string_opt("type")?.ok_or_else(|| {
-            bag.error(
-                "type",
-                format!("missing; expected one of: {}", types.join(", ")),
-            )
-        })?;
-        let factory = registry::find(MATERIALS, ty)
-            .ok_or_else(|| bag.error("type", registry::unknown("material type", ty, MATERIALS)))?;
-        let base = *(factory.create)(&bag, nested, resources)?;
+        let base = nested_material(&bag, nested, resources)?;
+        let ty = bag.string_opt("type")?.unwrap_or_default();
         let supported = base
             .lobe_at(Vec3::ZERO, Vec2::ZERO)
             .and_then(|(lobe, _)| CoatBase::of(lobe))

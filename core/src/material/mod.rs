@@ -21,7 +21,7 @@ use crate::error::Result;
 use crate::glossy;
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
-use crate::registry::{Factory, Resources};
+use crate::registry::{self, Factory, Resources};
 use crate::scattering::Bxdf;
 use crate::texture::{Texture, scalar};
 use glam::{Vec2, Vec3};
@@ -270,6 +270,25 @@ const NULL: Factory<Material> = Factory {
     description: "an invisible boundary of a medium: rays cross it without scattering",
     create: |_, _, _| Ok(Box::new(Material::Null)),
 };
+
+/// A material given as a table inside another's bag (a blend's component, a coating's
+/// base), read by the factory its `type` names; `bag` is then owed to `nested`.
+pub(crate) fn nested_material<'a>(
+    bag: &Properties<'a>,
+    nested: &mut Vec<Properties<'a>>,
+    resources: &mut dyn Resources,
+) -> Result<Material> {
+    let ty = bag.string_opt("type")?.ok_or_else(|| {
+        let types: Vec<&str> = registry::names(MATERIALS).collect();
+        bag.error(
+            "type",
+            format!("missing; expected one of: {}", types.join(", ")),
+        )
+    })?;
+    let factory = registry::find(MATERIALS, ty)
+        .ok_or_else(|| bag.error("type", registry::unknown("material type", ty, MATERIALS)))?;
+    Ok(*(factory.create)(bag, nested, resources)?)
+}
 
 /// A reflectance that may vary over the surface (`key`, `default` when absent); one above 1
 /// is warned about, since the material then creates energy.

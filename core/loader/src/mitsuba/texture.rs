@@ -5,6 +5,7 @@ use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::upgrade::camel_to_snake;
 use super::{Reader, at, matrix_table, vec3};
+use crate::texture::{scale_texture_table, table_colour};
 use foton_core::error::Result;
 use foton_core::value::{Node, Table, Value};
 use glam::{DMat4, DVec3};
@@ -64,17 +65,7 @@ impl Reader {
         let Some(t) = table else {
             return Ok(default);
         };
-        let colour = |key: &str| -> DVec3 {
-            match t.get(key).map(|n| &n.value) {
-                Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
-                    a[0].value.as_f64().unwrap_or(0.0),
-                    a[1].value.as_f64().unwrap_or(0.0),
-                    a[2].value.as_f64().unwrap_or(0.0),
-                ),
-                Some(v) => DVec3::splat(v.as_f64().unwrap_or(0.0)),
-                None => DVec3::ZERO,
-            }
-        };
+        let colour = |key: &str| table_colour(&t, key, 0.0);
         match t.get("type").map(|n| &n.value) {
             Some(Value::Str(ty)) if ty == "checkerboard" => {
                 Ok((colour("color0") + colour("color1")) * 0.5)
@@ -92,11 +83,7 @@ impl Reader {
                 };
                 let bitmap = crate::texture::load_bitmap_decoded(&self.dir.join(file), decode)?;
                 let m = bitmap.mean();
-                let scale = if t.get("scale").is_some() {
-                    colour("scale")
-                } else {
-                    DVec3::ONE
-                };
+                let scale = table_colour(&t, "scale", 1.0);
                 Ok(DVec3::new(m.x as f64, m.y as f64, m.z as f64) * scale)
             }
             _ => Ok(default),
@@ -159,25 +146,7 @@ impl Reader {
                 let Some(mut inner) = self.texture_table(inner)? else {
                     return Ok(None);
                 };
-                let colour = |n: Option<&Node>| -> DVec3 {
-                    match n.map(|n| &n.value) {
-                        Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
-                            a[0].value.as_f64().unwrap_or(1.0),
-                            a[1].value.as_f64().unwrap_or(1.0),
-                            a[2].value.as_f64().unwrap_or(1.0),
-                        ),
-                        Some(v) => DVec3::splat(v.as_f64().unwrap_or(1.0)),
-                        None => DVec3::ONE,
-                    }
-                };
-                let keys: &[&str] = match inner.get("type").map(|n| &n.value) {
-                    Some(Value::Str(ty)) if ty == "checkerboard" => &["color0", "color1"],
-                    _ => &["scale"],
-                };
-                for key in keys {
-                    let scaled = colour(inner.get(key)) * factor;
-                    inner.insert(key, vec3(scaled, line));
-                }
+                scale_texture_table(&mut inner, factor, |v| vec3(v, line));
                 return Ok(Some(inner));
             }
             "checkerboard" => {

@@ -16,6 +16,7 @@ use super::params::Bag;
 use super::parse::{Directive, Param, Type, Values};
 use super::spectra::{Kind, rgb};
 use super::{Loc, Reader};
+use crate::texture::scale_texture_table;
 use foton_core::error::Result;
 use foton_core::value::{Node, Value};
 use glam::DVec3;
@@ -393,29 +394,7 @@ impl Reader {
 
 /// Multiplies a texture table's colours by `s`: a bitmap's `scale`, a checkerboard's colours.
 fn scale_table(r: &Reader, t: &mut Node, s: DVec3, loc: &Loc) {
-    let Value::Table(table) = &mut t.value else {
-        return;
-    };
-    let is_bitmap =
-        matches!(table.get("type"), Some(Node { value: Value::Str(k), .. }) if k == "bitmap");
-    let get = |table: &foton_core::value::Table, key: &str| -> DVec3 {
-        match table.get(key).map(|n| &n.value) {
-            Some(Value::Array(a)) if a.len() == 3 => DVec3::new(
-                a[0].value.as_f64().unwrap_or(1.0),
-                a[1].value.as_f64().unwrap_or(1.0),
-                a[2].value.as_f64().unwrap_or(1.0),
-            ),
-            Some(v) => DVec3::splat(v.as_f64().unwrap_or(1.0)),
-            None => DVec3::ONE,
-        }
-    };
-    if is_bitmap {
-        let old = get(table, "scale");
-        table.insert("scale", r.vec3(old * s, loc));
-    } else {
-        for key in ["color0", "color1"] {
-            let old = get(table, key);
-            table.insert(key, r.vec3(old * s, loc));
-        }
+    if let Value::Table(table) = &mut t.value {
+        scale_texture_table(table, s, |v| r.vec3(v, loc));
     }
 }
