@@ -36,6 +36,7 @@ pub mod render;
 pub mod sampling;
 pub mod scattering;
 pub mod scene;
+pub mod sky;
 pub mod spectrum;
 pub mod texture;
 pub mod value;

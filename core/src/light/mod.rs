@@ -22,6 +22,7 @@ lights! {
         Constant(constant::ConstantLight),
         Envmap(envmap::EnvmapLight),
         Area(area::AreaLight),
+        SunSky(sunsky::SunSkyLight),
     }
 }
 

@@ -73,6 +73,7 @@ mod sphere_light;
 mod sphere_uv;
 mod spot;
 mod sppm;
+mod sunsky;
 mod techniques;
 mod textures;
 mod thin_dielectric;
