@@ -97,7 +97,12 @@ impl Segment {
     pub fn emitted<'a>(&self, scene: &'a Scene) -> Option<(u32, &'a Light, Rgb)> {
         let hit = self.hit.as_ref()?;
         let (id, light) = scene.area_light(hit)?;
-        let le = light.emitted(hit.ng, -self.ray.dir);
+        let uv = if light.needs_uv() {
+            scene.surface(hit).uv
+        } else {
+            glam::Vec2::ZERO
+        };
+        let le = light.emitted(hit.ng, uv, -self.ray.dir);
         (le != Rgb::ZERO).then_some((id, light, le))
     }
 

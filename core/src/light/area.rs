@@ -6,11 +6,13 @@
 
 use super::{EmittedRay, Light, LightSample, LightSource, LightType};
 use crate::Rgb;
-use crate::geometry::Shape;
+use crate::geometry::{Shape, TriangleAttrs};
 use crate::registry::Factory;
 use crate::sampling::{Distribution1D, cosine_hemisphere, to_world};
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct AreaLight {
@@ -19,12 +21,26 @@ pub struct AreaLight {
     /// Chooses a shape proportionally to its area.
     pub by_area: Distribution1D,
     pub area: f32,
-    /// W/(sr m^2).
+    /// W/(sr m^2): the radiance, or its scale where a texture gives it.
     pub radiance: Rgb,
+    /// Radiance varying over the surface (Mitsuba's textured `radiance`), looked up at the
+    /// surface's texture coordinates; None: `radiance` everywhere.
+    pub texture: Option<Arc<EmissionTexture>>,
     /// The scene object that emits.
     pub object: u32,
     /// Whether it emits on both sides.
     pub twosided: bool,
+}
+
+/// An area light's radiance texture, with what finds the texture coordinates at a point the
+/// light samples: each shape's mesh attributes (as the scene holds them for its hits).
+#[derive(Clone, Debug)]
+pub struct EmissionTexture {
+    pub texture: Texture,
+    /// Per shape, in the order of [`AreaLight::shapes`] (empty: no shape has attributes).
+    pub attrs: Vec<TriangleAttrs>,
+    /// The texture's mean over the light's area (its power's factor).
+    mean: Rgb,
 }
 
 impl AreaLight {
@@ -37,6 +53,7 @@ impl AreaLight {
             shapes,
             area,
             radiance,
+            texture: None,
             object,
             twosided: false,
         }
@@ -47,10 +64,59 @@ impl AreaLight {
         AreaLight { twosided, ..self }
     }
 
+    /// The light whose radiance is `radiance` times `texture` at the surface's texture
+    /// coordinates, `attrs` giving each shape's mesh attributes (empty if none has any).
+    pub fn with_texture(self, texture: Texture, attrs: Vec<TriangleAttrs>) -> AreaLight {
+        let mut t = EmissionTexture {
+            texture,
+            attrs,
+            mean: Rgb::ONE,
+        };
+        // The mean by area: a grid of points on each shape, finer where there are few.
+        let per_side = ((4096 / self.shapes.len().max(1)) as f32).sqrt().max(4.0) as usize;
+        let mut sum = glam::DVec3::ZERO;
+        for (i, shape) in self.shapes.iter().enumerate() {
+            let mut shape_sum = glam::DVec3::ZERO;
+            for a in 0..per_side {
+                for b in 0..per_side {
+                    let u = Vec2::new(
+                        (a as f32 + 0.5) / per_side as f32,
+                        (b as f32 + 0.5) / per_side as f32,
+                    );
+                    let (p, n) = shape.sample_area(u);
+                    shape_sum += t.at(shape, i, p, n).as_dvec3();
+                }
+            }
+            sum += shape_sum * (shape.area() as f64 / (per_side * per_side) as f64);
+        }
+        t.mean = (sum / self.area.max(f32::MIN_POSITIVE) as f64).as_vec3();
+        AreaLight {
+            texture: Some(Arc::new(t)),
+            ..self
+        }
+    }
+
     /// How many sides emit.
     #[inline]
     fn sides(&self) -> f32 {
         if self.twosided { 2.0 } else { 1.0 }
+    }
+
+    /// The radiance at point `p` (normal `n`) of shape `i`.
+    #[inline]
+    fn radiance_at(&self, i: usize, p: Vec3, n: Vec3) -> Rgb {
+        match &self.texture {
+            None => self.radiance,
+            Some(t) => self.radiance * t.at(&self.shapes[i], i, p, n),
+        }
+    }
+}
+
+impl EmissionTexture {
+    /// The texture at point `p` (normal `n`) of shape `shape`, the light's `i`-th.
+    fn at(&self, shape: &Shape, i: usize, p: Vec3, n: Vec3) -> Rgb {
+        let uv = shape.surface_at(p, n, self.attrs.get(i), true).uv;
+        self.texture.eval(uv)
     }
 }
 
@@ -120,9 +186,10 @@ impl LightSource for AreaLight {
         LightType::Area
     }
 
-    /// pi A L per emitting side.
+    /// pi A L per emitting side (L the mean over the area of a textured radiance).
     fn power(&self) -> Rgb {
-        self.sides() * PI * self.area * self.radiance
+        let mean = self.texture.as_ref().map_or(Rgb::ONE, |t| t.mean);
+        self.sides() * PI * self.area * self.radiance * mean
     }
 
     #[inline(never)]
@@ -152,7 +219,7 @@ impl LightSource for AreaLight {
                 li: if inward && !self.twosided {
                     Rgb::ZERO
                 } else {
-                    self.radiance
+                    self.radiance_at(0, p, n)
                 },
                 pdf: cone.pdf(),
                 delta: false,
@@ -178,7 +245,7 @@ impl LightSource for AreaLight {
         Some(LightSample {
             wi,
             dist,
-            li: self.radiance,
+            li: self.radiance_at(i, p, n),
             pdf: dist2 / (cos_l * self.area),
             delta: false,
             p,
@@ -202,10 +269,13 @@ impl LightSource for AreaLight {
     }
 
     #[inline]
-    fn emitted(&self, n: Vec3, w: Vec3) -> Rgb {
+    fn emitted(&self, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
         let cos = n.dot(w);
         if cos > 0.0 || (self.twosided && cos < 0.0) {
-            self.radiance
+            match &self.texture {
+                None => self.radiance,
+                Some(t) => self.radiance * t.texture.eval(uv),
+            }
         } else {
             Rgb::ZERO
         }
@@ -216,6 +286,13 @@ impl LightSource for AreaLight {
     fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2, uc: f32) -> EmittedRay {
         let (i, _) = self.by_area.sample(uc);
         let (p, mut n) = self.shapes[i].sample_area(u_pos);
+        let (le, uv) = match &self.texture {
+            None => (self.radiance, Vec2::ZERO),
+            Some(t) => {
+                let uv = self.shapes[i].surface_at(p, n, t.attrs.get(i), true).uv;
+                (self.radiance * t.texture.eval(uv), uv)
+            }
+        };
         let mut u_dir = u_dir;
         if self.twosided {
             if u_dir.x < 0.5 {
@@ -231,8 +308,9 @@ impl LightSource for AreaLight {
             dir: to_world(local, n),
             n,
             // L cos / (1/A * cos/(sides pi)) = sides pi A L
-            flux: self.sides() * PI * self.area * self.radiance,
-            le: self.radiance,
+            flux: self.sides() * PI * self.area * le,
+            le,
+            uv,
             pdf_pos: 1.0 / self.area,
             pdf_dir: local.z * std::f32::consts::FRAC_1_PI / self.sides(),
         }

@@ -65,6 +65,7 @@ impl LightSource for ConstantLight {
             n: Vec3::ZERO,
             flux: self.radiance * (4.0 * PI * PI * radius * radius),
             le: self.radiance,
+            uv: Vec2::ZERO,
             pdf_pos: 1.0 / self.sphere.disc_area(),
             pdf_dir: UNIFORM_SPHERE_PDF,
         }

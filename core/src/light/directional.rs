@@ -52,6 +52,7 @@ impl LightSource for DirectionalLight {
             n: Vec3::ZERO,
             flux: self.irradiance * self.sphere.disc_area(),
             le: self.irradiance,
+            uv: Vec2::ZERO,
             pdf_pos: 1.0 / self.sphere.disc_area(),
             pdf_dir: 1.0,
         }

@@ -71,6 +71,7 @@ impl LightSource for EnvmapLight {
             n: Vec3::ZERO,
             flux,
             le,
+            uv: Vec2::ZERO,
             pdf_pos: 1.0 / self.sphere.disc_area(),
             pdf_dir,
         }

@@ -70,9 +70,9 @@ pub trait LightSource {
     /// cone).
     fn pdf_le(&self, n: Vec3, dir: Vec3) -> (f32, f32);
 
-    /// Radiance leaving the light at a point with normal `n` in direction `w` (an area
-    /// light's; zero for the others).
-    fn emitted(&self, _n: Vec3, _w: Vec3) -> Rgb {
+    /// Radiance leaving the light at a point with normal `n` and texture coordinates `uv`
+    /// in direction `w` (an area light's; zero for the others).
+    fn emitted(&self, _n: Vec3, _uv: Vec2, _w: Vec3) -> Rgb {
         Rgb::ZERO
     }
 
@@ -173,9 +173,9 @@ macro_rules! lights {
 
             /// See [`LightSource::emitted`].
             #[inline]
-            pub fn emitted(&self, n: Vec3, w: Vec3) -> Rgb {
+            pub fn emitted(&self, n: Vec3, uv: Vec2, w: Vec3) -> Rgb {
                 match self {
-                    $(Light::$variant(l) => l.emitted(n, w),)*
+                    $(Light::$variant(l) => l.emitted(n, uv, w),)*
                 }
             }
 
@@ -239,6 +239,13 @@ impl Light {
             LightType::DeltaDirection | LightType::Infinite
         )
     }
+
+    /// Whether [`Light::emitted`] reads its texture coordinates (a textured area light):
+    /// the others need not be computed.
+    #[inline]
+    pub fn needs_uv(&self) -> bool {
+        matches!(self, Light::Area(a) if a.texture.is_some())
+    }
 }
 
 /// A light sample seen from a receiving point.
@@ -267,6 +274,8 @@ pub struct EmittedRay {
     /// Le cos / (pdf_pos pdf_dir): the flux carried by one emitted sample (before dividing by
     /// the number of samples and the light-selection probability).
     pub flux: Rgb,
+    /// Texture coordinates at the origin (a textured area light's; zero for the others).
+    pub uv: Vec2,
     /// What leaves along `dir`: radiance (area lights, lights at infinity: per unit area of
     /// the disc they are emitted from; for a directional light, its irradiance) or intensity
     /// (point and spot lights).

@@ -64,6 +64,7 @@ impl LightSource for PointLight {
             n: Vec3::ZERO,
             flux: 4.0 * PI * self.intensity,
             le: self.intensity,
+            uv: Vec2::ZERO,
             pdf_pos: 1.0,
             pdf_dir: UNIFORM_SPHERE_PDF,
         }

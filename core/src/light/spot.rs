@@ -150,6 +150,7 @@ impl LightSource for SpotLight {
             n: Vec3::ZERO,
             flux: self.intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
             le: self.intensity * falloff,
+            uv: Vec2::ZERO,
             pdf_pos: 1.0,
             pdf_dir: 1.0 / (2.0 * PI * (1.0 - cos_max)),
         }

@@ -80,7 +80,7 @@ impl Bidir {
         let Some(cs) = camera.sample_wi(o.p, margin, || sampler.next_2d()) else {
             return;
         };
-        let le = scene.lights()[o.light].emitted(o.n, cs.wi);
+        let le = scene.lights()[o.light].emitted(o.n, o.uv, cs.wi);
         if le == Rgb::ZERO {
             return;
         }

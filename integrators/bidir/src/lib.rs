@@ -31,7 +31,7 @@ pub use vertex::{At, Vertex};
 
 use foton_core::api::{
     Light, LightType, PixelSample, Ray, RayWalk, Reached, Rgb, Sampler, Scene, Splats,
-    TransportMode, Vec3, channel, offset_origin, russian_roulette,
+    TransportMode, Vec2, Vec3, channel, offset_origin, russian_roulette,
 };
 use mis::{Factors, Running, weight_emitter_hit};
 
@@ -135,6 +135,7 @@ pub struct Origin {
     light: usize,
     p: Vec3,
     n: Vec3,
+    uv: Vec2,
     /// pick x pdf_pos: its density per unit area.
     pdf: f32,
     medium: Option<u32>,
@@ -331,6 +332,7 @@ impl Bidir {
             light: id,
             p: e.origin,
             n: e.n,
+            uv: e.uv,
             pdf: pick * e.pdf_pos,
             medium,
         });

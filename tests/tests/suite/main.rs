@@ -75,6 +75,7 @@ mod spot;
 mod sppm;
 mod sunsky;
 mod techniques;
+mod textured_light;
 mod textures;
 mod thin_dielectric;
 mod thin_lens;

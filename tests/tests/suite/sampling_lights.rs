@@ -352,7 +352,7 @@ fn sphere_light_seen_from_inside_is_dark_and_its_pdf_li_normalised() {
     for _ in 0..100_000 {
         if let Some(ls) = light.sample_li(x, rng.next_2d(), rng.next_f32()) {
             assert_eq!(ls.li, Rgb::ZERO, "light from inside a one-sided sphere");
-            assert_eq!(light.emitted(ls.n, -ls.wi), Rgb::ZERO);
+            assert_eq!(light.emitted(ls.n, glam::Vec2::ZERO, -ls.wi), Rgb::ZERO);
         }
     }
     // pdf_li (the area density converted to solid angle) still integrates to one over the

@@ -214,8 +214,14 @@ pub(super) fn read_shapes(
         }
         let object = g.objects.len() as u32;
         let mut light = None;
-        if let Some(emission) = s.rgb_opt("emission")?
-            && emission.max_element() > 0.0
+        // A colour, or a texture (radiance varying over the surface, at its uv).
+        let emission = if s.has("emission") {
+            Some(ld.texture(&s, "emission", Rgb::ZERO)?)
+        } else {
+            None
+        };
+        if let Some(emission) = emission
+            && emission.max().max_element() > 0.0
         {
             if material_defs[material as usize].value.is_null() {
                 return Err(s.error(
@@ -231,9 +237,12 @@ pub(super) fn read_shapes(
             }
             light = Some(g.lights.len() as u32);
             let twosided = s.bool("emission_twosided", false)?;
-            g.lights.push(Light::Area(
-                AreaLight::new(shapes.clone(), emission, object).with_twosided(twosided),
-            ));
+            let area = match emission {
+                Texture::Constant(c) => AreaLight::new(shapes.clone(), c, object),
+                texture => AreaLight::new(shapes.clone(), Rgb::ONE, object)
+                    .with_texture(texture, attrs.clone()),
+            };
+            g.lights.push(Light::Area(area.with_twosided(twosided)));
             // Mitsuba's area emitter emits into its shape's exterior.
             g.light_media.push(explicit_media.then_some(exterior));
         }

@@ -86,7 +86,9 @@ impl Reader {
                 }
                 Prop::Object(mut e) if e.tag == "emitter" => {
                     once(emission.is_some(), "emitter")?;
-                    emission = Some(self.constant(&mut e, "radiance", DVec3::ONE)?);
+                    // A texture left out (lenient, reported): the default radiance.
+                    let radiance = self.texture(&mut e, "radiance", DVec3::ONE)?;
+                    emission = Some(radiance.unwrap_or_else(|| vec3(DVec3::ONE, e.line)));
                     // Noise, not the image: see `Reader::emitter`.
                     e.take("sampling_weight");
                     self.leftovers(&e)?;
@@ -404,8 +406,8 @@ impl Reader {
             if let Some(a) = &alpha {
                 t.insert("alpha", a.clone());
             }
-            if let Some(e) = emission {
-                t.insert("emission", vec3(e, line));
+            if let Some(e) = &emission {
+                t.insert("emission", e.clone());
             }
             // Both sides, as Mitsuba crosses them: a side without a medium is vacuum.
             if interior.is_some() || exterior.is_some() {

@@ -655,7 +655,22 @@ impl Reader {
             if let Value::Table(t) = &mut s.value
                 && let Some(n) = t.get_mut("emission")
             {
-                scale(n);
+                match &mut n.value {
+                    Value::Table(texture) => {
+                        let (line, column) = (n.line, n.column);
+                        let num = |x: f64| Node {
+                            value: Value::Float(x),
+                            line,
+                            column,
+                        };
+                        crate::texture::scale_texture_table(texture, DVec3::splat(k), |c| Node {
+                            value: Value::Array(c.to_array().map(num).to_vec()),
+                            line,
+                            column,
+                        })
+                    }
+                    _ => scale(n),
+                }
             }
         }
     }

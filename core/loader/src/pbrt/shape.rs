@@ -185,7 +185,7 @@ impl Reader {
         if let Some(light) = state.area_light.clone()
             && let Some((emission, twosided)) = self.area_light(&light, area)?
         {
-            entries.push(("emission", self.vec3(emission, &light.loc)));
+            entries.push(("emission", emission));
             if twosided {
                 entries.push((
                     "emission_twosided",
@@ -741,10 +741,12 @@ fn uniform_scale(m: DMat4) -> Option<f64> {
 
 impl Reader {
     /// The emission of a shape under the `AreaLightSource` `d` (pbrt-v4's `DiffuseAreaLight`):
-    /// `L` (default: the colour space's illuminant, white) times `scale`; `power` sets the
-    /// emitted power (with the shape's `area`, over both sides when `twosided`); and whether
-    /// it is two-sided. None: nothing emitted (left out, `lenient`).
-    fn area_light(&mut self, d: &Directive, area: Option<f64>) -> Result<Option<(DVec3, bool)>> {
+    /// `L` (default: the colour space's illuminant, white), or an image `filename` looked
+    /// up at the shape's (u, 1 - v) (bilinear, clamped at its edges; PNG sRGB-decoded, other
+    /// files linear), times `scale`; `power` sets the emitted power (with the shape's
+    /// `area`, over both sides when `twosided`; an image's power by its mean luminance);
+    /// and whether it is two-sided. None: nothing emitted (left out, `lenient`).
+    fn area_light(&mut self, d: &Directive, area: Option<f64>) -> Result<Option<(Node, bool)>> {
         let mut p = Bag::new(d);
         let what = d.what();
         if d.string(0) != "diffuse" {
@@ -753,26 +755,45 @@ impl Reader {
                 .error(&what, "unknown area light; pbrt-v4 has diffuse"));
         }
         let l = match p.take("L") {
-            Some(q) => rgb(&q, Kind::Illuminant, &what, &self.dir)?,
-            None => DVec3::ONE,
+            Some(q) => Some(rgb(&q, Kind::Illuminant, &what, &self.dir)?),
+            None => None,
         };
         let mut scale = p.float("scale", 1.0)?;
-        if let Some((f, fl)) = p.string_opt("filename")? {
-            self.unsupported(
-                &fl,
-                &what,
-                &format!("\"filename\" {f:?}: image area lights are not read yet"),
-            )?;
-            return Ok(None);
-        }
+        // The image and the mean luminance of its pixels (pbrt-v4's k_e for `power`).
+        let image = match p.string_opt("filename")? {
+            Some((f, fl)) => {
+                if l.is_some() {
+                    return Err(fl.error(
+                        &what,
+                        "both \"L\" and \"filename\" are given; pbrt-v4 takes one of them",
+                    ));
+                }
+                let path = super::parse::resolve(&self.dir, &fl.file, &f);
+                let png = f.to_ascii_lowercase().ends_with(".png");
+                let decode = if png {
+                    crate::texture::Decode::Srgb
+                } else {
+                    crate::texture::Decode::Linear
+                };
+                let bitmap = crate::texture::load_bitmap_decoded(&path, decode)
+                    .map_err(|e| fl.error(&what, format!("\"filename\" {f:?}: {e}")))?;
+                let mean = bitmap.mean().as_dvec3();
+                Some((f, fl, png, super::spectra::luminance(mean)))
+            }
+            None => None,
+        };
         let twosided = p.bool("twosided", false)?;
         let sides = if twosided { 2.0 } else { 1.0 };
         if let Some((phi, pl)) = p.float_opt("power")?
             && phi > 0.0
         {
+            // k_e: the power of unit radiance (pbrt-v4 does not count an rgb's colour; an
+            // image's mean luminance it does).
+            let k = image.as_ref().map_or(1.0, |i| i.3);
             match area {
-                // k_e: the power of unit radiance (pbrt-v4 does not count the rgb's colour).
-                Some(a) if a > 0.0 => scale *= phi / (sides * std::f64::consts::PI * a),
+                Some(a) if a > 0.0 && k > 0.0 => {
+                    scale *= phi / (k * sides * std::f64::consts::PI * a)
+                }
                 _ => {
                     self.unsupported(
                         &pl,
@@ -783,6 +804,25 @@ impl Reader {
             }
         }
         self.finish(&mut p)?;
-        Ok(Some((l * scale, twosided)))
+        let loc = &d.loc;
+        let emission = match image {
+            None => self.vec3(l.unwrap_or(DVec3::ONE) * scale, loc),
+            Some((f, fl, png, _)) => {
+                let mut entries = vec![
+                    ("type", self.string("bitmap", loc)),
+                    ("filename", self.string(&f, &fl)),
+                    ("wrap_mode", self.string("clamp", loc)),
+                    ("to_uv", self.to_uv([1.0, -1.0], [0.0, 1.0], loc)),
+                ];
+                if !png {
+                    entries.push(("raw", self.node(Value::Bool(true), loc)));
+                }
+                if scale != 1.0 {
+                    entries.push(("scale", self.num(scale, loc)));
+                }
+                self.table(entries, loc)
+            }
+        };
+        Ok(Some((emission, twosided)))
     }
 }
