@@ -910,3 +910,18 @@ fn lenient_textures_where_foton_takes_constants_are_their_means() {
     };
     assert!(matches!(&alpha.get("type").unwrap().value, Value::Str(t) if t == "checkerboard"));
 }
+
+/// A `<default>` inside an object (Mitsuba 0.6 and 3 read it there too) defines its name as
+/// one at the top does; `-D` still wins.
+#[test]
+fn a_default_inside_an_object_defines_its_name() {
+    let dir = temp_dir("mitsuba-nested-default");
+    let body = format!(
+        "<bsdf type=\"roughplastic\" id=\"plate\">\n<default name=\"a\" value=\"0.25\"/>\n<float name=\"alpha\" value=\"$a\"/>\n</bsdf>\n<shape type=\"sphere\"><ref id=\"plate\"/></shape>\n{SENSOR}"
+    );
+    let xml = write(&dir, "nested.xml", &scene("0.6.0", &body));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(number(&doc.root, "materials.plate.alpha"), 0.25);
+    let (doc, _) = read_xml(&xml, &["a=0.5".to_string()], false).unwrap();
+    assert_eq!(number(&doc.root, "materials.plate.alpha"), 0.5);
+}

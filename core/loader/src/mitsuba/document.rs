@@ -112,23 +112,36 @@ impl Reader {
         read
     }
 
+    /// A `<default name value>`: the name's value unless `-D` or an earlier default gave one.
+    fn declare_default(&mut self, n: roxmltree::Node<'_, '_>, path: &Path, pos: Pos) -> Result<()> {
+        let name = attr(n, "name", path, pos)?;
+        let value = attr(n, "value", path, pos)?;
+        self.declared.insert(name.clone());
+        if !self.defined.contains(&name) {
+            self.defaults.entry(name).or_insert(value);
+        }
+        Ok(())
+    }
+
     fn read_scene_children(
         &mut self,
         path: &Path,
         scene: roxmltree::Node<'_, '_>,
         line_of: &dyn Fn(roxmltree::Node<'_, '_>) -> Pos,
     ) -> Result<()> {
+        // Mitsuba (0.6 and 3) takes a <default> inside an object too, defining the name from
+        // there on: every default of the file is declared first, in document order (a use
+        // before its declaration, which Mitsuba refuses, is read).
+        for d in scene
+            .descendants()
+            .filter(|n| n.is_element() && n.tag_name().name() == "default")
+        {
+            self.declare_default(d, path, line_of(d))?;
+        }
         for child in scene.children().filter(|n| n.is_element()) {
             let pos = line_of(child);
             match child.tag_name().name() {
-                "default" => {
-                    let name = attr(child, "name", path, pos)?;
-                    let value = attr(child, "value", path, pos)?;
-                    self.declared.insert(name.clone());
-                    if !self.defined.contains(&name) {
-                        self.defaults.entry(name).or_insert(value);
-                    }
-                }
+                "default" => self.declare_default(child, path, pos)?,
                 "include" => {
                     let file = self.subst(&attr(child, "filename", path, pos)?, path, pos)?;
                     let inc = self.resolve(path, &file).map_err(|looked| {
@@ -394,6 +407,10 @@ impl Reader {
         for c in n.children().filter(|c| c.is_element()) {
             let cpos = line_of(c);
             let cl = cpos.line;
+            // Declared before the file's objects were read (`read_scene_children`).
+            if c.tag_name().name() == "default" {
+                continue;
+            }
             if !OBJECT_TAGS.contains(&c.tag_name().name())
                 && self.leave_out_unresolved(c, file, cpos)
             {
