@@ -23,7 +23,7 @@ pub struct AreaLight {
     pub area: f32,
     /// W/(sr m^2): the radiance, or its scale where a texture gives it.
     pub radiance: Rgb,
-    /// Radiance varying over the surface (Mitsuba's textured `radiance`), looked up at the
+    /// What varies over the surface (a radiance texture, a cut-out), looked up at the
     /// surface's texture coordinates; None: `radiance` everywhere.
     pub texture: Option<Arc<EmissionTexture>>,
     /// The scene object that emits.
@@ -32,14 +32,21 @@ pub struct AreaLight {
     pub twosided: bool,
 }
 
-/// An area light's radiance texture, with what finds the texture coordinates at a point the
-/// light samples: each shape's mesh attributes (as the scene holds them for its hits).
+/// What varies over an area light's surface, with what finds the texture coordinates at a
+/// point the light samples: each shape's mesh attributes (as the scene holds them for its
+/// hits).
 #[derive(Clone, Debug)]
 pub struct EmissionTexture {
-    pub texture: Texture,
+    /// The radiance's factor (Mitsuba's textured `radiance`, pbrt-v4's image); None: 1.
+    pub texture: Option<Texture>,
+    /// The shape's cut-out (its `alpha`, a grey texture): a ray meets the surface with
+    /// probability alpha ([`crate::scene::Scene`]'s cut-out test), so a point the light
+    /// samples emits alpha times the radiance, a point a ray finds the radiance (pbrt-v4's
+    /// `DiffuseAreaLight` with `alpha`, in expectation). None: opaque.
+    pub alpha: Option<Texture>,
     /// Per shape, in the order of [`AreaLight::shapes`] (empty: no shape has attributes).
     pub attrs: Vec<TriangleAttrs>,
-    /// The texture's mean over the light's area (its power's factor).
+    /// The mean over the light's area of alpha times the texture (its power's factor).
     mean: Rgb,
 }
 
@@ -64,11 +71,21 @@ impl AreaLight {
         AreaLight { twosided, ..self }
     }
 
-    /// The light whose radiance is `radiance` times `texture` at the surface's texture
-    /// coordinates, `attrs` giving each shape's mesh attributes (empty if none has any).
-    pub fn with_texture(self, texture: Texture, attrs: Vec<TriangleAttrs>) -> AreaLight {
+    /// The light whose radiance is `radiance` times `texture` (if any) at the surface's
+    /// texture coordinates, cut out by `alpha` (if any); `attrs` gives each shape's mesh
+    /// attributes (empty if none has any).
+    pub fn with_texture(
+        self,
+        texture: Option<Texture>,
+        alpha: Option<Texture>,
+        attrs: Vec<TriangleAttrs>,
+    ) -> AreaLight {
+        if texture.is_none() && alpha.is_none() {
+            return self;
+        }
         let mut t = EmissionTexture {
             texture,
+            alpha,
             attrs,
             mean: Rgb::ONE,
         };
@@ -84,7 +101,7 @@ impl AreaLight {
                         (b as f32 + 0.5) / per_side as f32,
                     );
                     let (p, n) = shape.sample_area(u);
-                    shape_sum += t.at(shape, i, p, n).as_dvec3();
+                    shape_sum += t.sampled(t.uv(shape, i, p, n)).as_dvec3();
                 }
             }
             sum += shape_sum * (shape.area() as f64 / (per_side * per_side) as f64);
@@ -102,21 +119,48 @@ impl AreaLight {
         if self.twosided { 2.0 } else { 1.0 }
     }
 
-    /// The radiance at point `p` (normal `n`) of shape `i`.
+    /// The radiance at point `p` (normal `n`) of shape `i`, a point the light sampled, and
+    /// its texture coordinates (zero if nothing varies).
     #[inline]
-    fn radiance_at(&self, i: usize, p: Vec3, n: Vec3) -> Rgb {
+    fn sampled_at(&self, i: usize, p: Vec3, n: Vec3) -> (Rgb, Vec2) {
         match &self.texture {
-            None => self.radiance,
-            Some(t) => self.radiance * t.at(&self.shapes[i], i, p, n),
+            None => (self.radiance, Vec2::ZERO),
+            Some(t) => {
+                let uv = t.uv(&self.shapes[i], i, p, n);
+                (self.radiance * t.sampled(uv), uv)
+            }
+        }
+    }
+
+    /// The cut-out's opacity at `uv` (1 without one): what a point the light samples, not a
+    /// ray, finds of its emission.
+    #[inline]
+    pub fn opacity(&self, uv: Vec2) -> f32 {
+        match self.texture.as_ref().and_then(|t| t.alpha.as_ref()) {
+            None => 1.0,
+            Some(a) => crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0),
         }
     }
 }
 
 impl EmissionTexture {
-    /// The texture at point `p` (normal `n`) of shape `shape`, the light's `i`-th.
-    fn at(&self, shape: &Shape, i: usize, p: Vec3, n: Vec3) -> Rgb {
-        let uv = shape.surface_at(p, n, self.attrs.get(i), true).uv;
-        self.texture.eval(uv)
+    /// The texture coordinates at point `p` (normal `n`) of `shape`, the light's `i`-th.
+    fn uv(&self, shape: &Shape, i: usize, p: Vec3, n: Vec3) -> Vec2 {
+        shape.surface_at(p, n, self.attrs.get(i), true).uv
+    }
+
+    /// The radiance's factor where a ray meets the surface at `uv`.
+    #[inline]
+    fn seen(&self, uv: Vec2) -> Rgb {
+        self.texture.as_ref().map_or(Rgb::ONE, |t| t.eval(uv))
+    }
+
+    /// The radiance's factor at a sampled point: times the opacity there.
+    fn sampled(&self, uv: Vec2) -> Rgb {
+        let alpha = self.alpha.as_ref().map_or(1.0, |a| {
+            crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0)
+        });
+        self.seen(uv) * alpha
     }
 }
 
@@ -219,7 +263,7 @@ impl LightSource for AreaLight {
                 li: if inward && !self.twosided {
                     Rgb::ZERO
                 } else {
-                    self.radiance_at(0, p, n)
+                    self.sampled_at(0, p, n).0
                 },
                 pdf: cone.pdf(),
                 delta: false,
@@ -245,7 +289,7 @@ impl LightSource for AreaLight {
         Some(LightSample {
             wi,
             dist,
-            li: self.radiance_at(i, p, n),
+            li: self.sampled_at(i, p, n).0,
             pdf: dist2 / (cos_l * self.area),
             delta: false,
             p,
@@ -274,7 +318,7 @@ impl LightSource for AreaLight {
         if cos > 0.0 || (self.twosided && cos < 0.0) {
             match &self.texture {
                 None => self.radiance,
-                Some(t) => self.radiance * t.texture.eval(uv),
+                Some(t) => self.radiance * t.seen(uv),
             }
         } else {
             Rgb::ZERO
@@ -286,13 +330,7 @@ impl LightSource for AreaLight {
     fn sample_emission(&self, u_pos: Vec2, u_dir: Vec2, uc: f32) -> EmittedRay {
         let (i, _) = self.by_area.sample(uc);
         let (p, mut n) = self.shapes[i].sample_area(u_pos);
-        let (le, uv) = match &self.texture {
-            None => (self.radiance, Vec2::ZERO),
-            Some(t) => {
-                let uv = self.shapes[i].surface_at(p, n, t.attrs.get(i), true).uv;
-                (self.radiance * t.texture.eval(uv), uv)
-            }
-        };
+        let (le, uv) = self.sampled_at(i, p, n);
         let mut u_dir = u_dir;
         if self.twosided {
             if u_dir.x < 0.5 {

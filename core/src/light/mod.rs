@@ -240,11 +240,22 @@ impl Light {
         )
     }
 
-    /// Whether [`Light::emitted`] reads its texture coordinates (a textured area light):
-    /// the others need not be computed.
+    /// Whether [`Light::emitted`] reads its texture coordinates (an area light whose
+    /// radiance is a texture): the others need not be computed.
     #[inline]
     pub fn needs_uv(&self) -> bool {
-        matches!(self, Light::Area(a) if a.texture.is_some())
+        matches!(self, Light::Area(a) if a.texture.as_ref().is_some_and(|t| t.texture.is_some()))
+    }
+
+    /// The opacity at `uv` of a cut-out area light (1 for every other light): a point the
+    /// light sampled emits [`Light::emitted`] times it (a ray that meets the surface has
+    /// passed the cut-out's test already).
+    #[inline]
+    pub fn opacity(&self, uv: Vec2) -> f32 {
+        match self {
+            Light::Area(a) => a.opacity(uv),
+            _ => 1.0,
+        }
     }
 }
 

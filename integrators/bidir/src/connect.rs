@@ -80,7 +80,8 @@ impl Bidir {
         let Some(cs) = camera.sample_wi(o.p, margin, || sampler.next_2d()) else {
             return;
         };
-        let le = scene.lights()[o.light].emitted(o.n, o.uv, cs.wi);
+        let light = &scene.lights()[o.light];
+        let le = light.emitted(o.n, o.uv, cs.wi) * light.opacity(o.uv);
         if le == Rgb::ZERO {
             return;
         }

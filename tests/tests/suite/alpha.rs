@@ -173,10 +173,6 @@ fn bad_alphas_are_clear_errors() {
     let base = screened_floor("path", 1, None);
     for (extra, words) in [
         ("alpha = 1.5\n", "expected a number in [0, 1]"),
-        (
-            "alpha = 0.5\nemission = [1.0, 1.0, 1.0]\n",
-            "emitting shape with a cut-out",
-        ),
         ("alpha = \"half\"\n", "alpha"),
     ] {
         let dir = temp_dir("alpha-bad");

@@ -28,6 +28,11 @@ fn radiance(s: f64, t: f64) -> DVec3 {
 
 /// E at the target: the midpoint rule over the quad.
 fn irradiance() -> DVec3 {
+    irradiance_of(radiance)
+}
+
+/// E at the target from a quad of radiance `l(s, t)`.
+fn irradiance_of(l: impl Fn(f64, f64) -> DVec3) -> DVec3 {
     let x = DVec3::from(TARGET);
     let n = 800;
     let h = 1.0 / n as f64;
@@ -40,13 +45,22 @@ fn irradiance() -> DVec3 {
             let r2 = d.length_squared();
             let cos_x = d.y / r2.sqrt();
             // The light's normal is -y: its cosine towards x is the same as x's towards it.
-            e += radiance(s, t) * (cos_x * cos_x / r2) * (4.0 * h * h);
+            e += l(s, t) * (cos_x * cos_x / r2) * (4.0 * h * h);
         }
     }
     e
 }
 
 fn scene(dir: &std::path::Path, integrator: &str, spp: u32) -> String {
+    let file = dir.join("light.exr").display().to_string();
+    let emission = format!(
+        "emission = {{ type = \"bitmap\", filename = \"{file}\", raw = true, filter_type = \"nearest\" }}"
+    );
+    scene_with(dir, integrator, spp, &emission)
+}
+
+/// The scene with the light's `emission` (and `alpha`) lines.
+fn scene_with(dir: &std::path::Path, integrator: &str, spp: u32, light: &str) -> String {
     let texels: Vec<f32> = TEXELS.iter().flatten().copied().collect();
     image::Rgb32FImage::from_raw(2, 2, texels)
         .unwrap()
@@ -91,10 +105,9 @@ origin = [-1.0, 1.0, -1.0]
 u = [2.0, 0.0, 0.0]
 v = [0.0, 0.0, 2.0]
 material = "black"
-emission = {{ type = "bitmap", filename = "{file}", raw = true, filter_type = "nearest" }}
+{light}
 "#,
             cz = tz + 1.5,
-            file = dir.join("light.exr").display(),
         )
 }
 
@@ -202,5 +215,54 @@ AttributeEnd
         .unwrap_err()
         .to_string();
     assert!(e.contains("both \"L\" and \"filename\""), "{e}");
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+/// A cut-out light (pbrt-v4's `alpha` on an area light): a constant radiance through a
+/// 2 x 2 opacity image lights the floor as alpha x L would, E integrated here: the points
+/// next-event estimation and the photons sample emit alpha L, rays that meet the surface
+/// pass its cut-out test first.
+#[test]
+fn a_cut_out_light_emits_alpha_times_its_radiance() {
+    let dir = temp_dir("cut-out-light");
+    const ALPHA: [f32; 4] = [1.0, 0.0, 0.5, 0.25];
+    let texels: Vec<f32> = ALPHA.iter().flat_map(|&a| [a, a, a]).collect();
+    image::Rgb32FImage::from_raw(2, 2, texels)
+        .unwrap()
+        .save(dir.join("alpha.exr"))
+        .unwrap();
+    let l = DVec3::new(2.0, 1.5, 1.0);
+    let want = (irradiance_of(|s, t| {
+        let (i, j) = (((2.0 * s) as usize).min(1), ((2.0 * t) as usize).min(1));
+        l * ALPHA[2 * j + i] as f64
+    }) * (0.5 / PI))
+        .as_vec3();
+    let light = format!(
+        "emission = [{}, {}, {}]\nalpha = {{ type = \"bitmap\", filename = \"{}\", raw = true, filter_type = \"nearest\" }}",
+        l.x,
+        l.y,
+        l.z,
+        dir.join("alpha.exr").display()
+    );
+    for (integrator, spp) in [
+        ("path", 64),
+        ("bdpt", 32),
+        ("vcm", 16),
+        ("photon", 16),
+        ("sppm", 4),
+    ] {
+        let film = render_toml(
+            "cut-out-light",
+            &scene_with(&dir, integrator, spp, &light),
+            &[],
+            2,
+        );
+        let (mean, se) = region_mean(&film, 4, 4, 12, 12);
+        let rel = ((mean - want) / want).abs().max_element();
+        assert!(
+            rel < 0.02,
+            "{integrator}: floor {mean} (standard error {se}) against rho E / pi {want} ({rel})"
+        );
+    }
     let _ = std::fs::remove_dir_all(dir);
 }

@@ -229,19 +229,16 @@ pub(super) fn read_shapes(
                     "a shape with the null material is invisible and cannot emit; give it a real material (e.g. a black diffuse one)",
                 ));
             }
-            if alpha.is_some() {
-                return Err(s.error(
-                    "alpha",
-                    "an emitting shape with a cut-out is not supported yet: give the emission to a shape without `alpha`",
-                ));
-            }
             light = Some(g.lights.len() as u32);
             let twosided = s.bool("emission_twosided", false)?;
-            let area = match emission {
-                Texture::Constant(c) => AreaLight::new(shapes.clone(), c, object),
-                texture => AreaLight::new(shapes.clone(), Rgb::ONE, object)
-                    .with_texture(texture, attrs.clone()),
+            let (radiance, texture) = match emission {
+                Texture::Constant(c) => (c, None),
+                texture => (Rgb::ONE, Some(texture)),
             };
+            let mut area = AreaLight::new(shapes.clone(), radiance, object);
+            if texture.is_some() || alpha.is_some() {
+                area = area.with_texture(texture, alpha.clone(), attrs.clone());
+            }
             g.lights.push(Light::Area(area.with_twosided(twosided)));
             // Mitsuba's area emitter emits into its shape's exterior.
             g.light_media.push(explicit_media.then_some(exterior));

@@ -197,13 +197,7 @@ impl Reader {
         entries.push(("material", self.string(&material, &loc)));
         let sides = self.medium_sides(state, &loc);
         if let Some((alpha, aloc)) = alpha {
-            if entries.iter().any(|(k, _)| *k == "emission") {
-                self.unsupported(
-                    &aloc,
-                    &what,
-                    "\"alpha\" on an area light: an emitter with a cut-out is not rendered yet",
-                )?;
-            } else if !sides.is_empty() {
+            if !sides.is_empty() {
                 self.unsupported(&aloc, &what, "\"alpha\" on a shape between two media: a cut-out medium boundary is not rendered yet")?;
             } else {
                 entries.push(("alpha", alpha));
