@@ -925,3 +925,26 @@ fn a_default_inside_an_object_defines_its_name() {
     let (doc, _) = read_xml(&xml, &["a=0.5".to_string()], false).unwrap();
     assert_eq!(number(&doc.root, "materials.plate.alpha"), 0.5);
 }
+
+/// The specular manifold sampling fork's hints (on shapes and emitters) choose what its
+/// caustic integrators connect: read, with a note, in a file that opens as written.
+#[test]
+fn manifold_sampling_hints_are_noted() {
+    let dir = temp_dir("mitsuba-sms-hints");
+    let body = format!(
+        "<shape type=\"sphere\"><boolean name=\"caustic_caster_single\" value=\"true\"/>\n<emitter type=\"area\"><rgb name=\"radiance\" value=\"1\"/><boolean name=\"caustic_emitter_single\" value=\"true\"/></emitter></shape>\n{SENSOR}"
+    );
+    let xml = write(&dir, "hints.xml", &scene("2.0.0", &body));
+    let (_, report) = read(&xml, false).unwrap();
+    let noted = |h: &str| {
+        report
+            .notes
+            .iter()
+            .any(|n| n.contains(h) && n.contains("manifold"))
+    };
+    assert!(
+        noted("caustic_caster_single") && noted("caustic_emitter_single"),
+        "{:?}",
+        report.notes
+    );
+}

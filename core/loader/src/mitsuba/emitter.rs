@@ -99,6 +99,7 @@ impl Reader {
         // How often next-event estimation picks this emitter: noise, not the image (foton
         // picks by power).
         o.take("sampling_weight");
+        self.manifold_hints(&mut o);
         self.leftovers(&o)?;
         self.lights.push(at(Value::Table(t), line));
         Ok(())

@@ -347,6 +347,34 @@ impl Reader {
         }
     }
 
+    /// Takes the hints of the specular manifold sampling fork of Mitsuba 2 (Zeltner et al.
+    /// 2020: which emitters, casters and receivers its caustic integrators connect), which
+    /// its other integrators ignore: noted, as they change no image foton renders.
+    fn manifold_hints(&mut self, o: &mut Obj) {
+        const HINTS: [&str; 7] = [
+            "caustic_emitter_single",
+            "caustic_emitter_multi",
+            "caustic_caster_single",
+            "caustic_caster_multi",
+            "caustic_receiver",
+            "caustic_bouncer",
+            "glinty",
+        ];
+        let mut taken = Vec::new();
+        for h in HINTS {
+            if o.take(h).is_some() {
+                taken.push(format!("`{h}`"));
+            }
+        }
+        if !taken.is_empty() {
+            let what = format!(
+                "{} read as the hints of Mitsuba 2's specular manifold sampling fork: they choose what its caustic integrators connect and change nothing else",
+                taken.join(", ")
+            );
+            self.note(o, &what);
+        }
+    }
+
     fn note(&mut self, obj: &Obj, what: &str) {
         self.report
             .notes

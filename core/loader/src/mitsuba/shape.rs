@@ -91,6 +91,7 @@ impl Reader {
                     emission = Some(radiance.unwrap_or_else(|| vec3(DVec3::ONE, e.line)));
                     // Noise, not the image: see `Reader::emitter`.
                     e.take("sampling_weight");
+                    self.manifold_hints(&mut e);
                     self.leftovers(&e)?;
                 }
                 Prop::Object(med) if med.tag == "medium" => match name.as_str() {
@@ -391,6 +392,7 @@ impl Reader {
         }
         // Only for differentiable rendering.
         self.ignored(&mut o, "silhouette_sampling_weight", &|_| true, "");
+        self.manifold_hints(&mut o);
         self.leftovers(&o)?;
         let mut alpha = self.masks.get(&material).cloned();
         if alpha.is_some() && (emission.is_some() || interior.is_some() || exterior.is_some()) {
