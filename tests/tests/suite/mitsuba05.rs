@@ -715,3 +715,20 @@ fn old_media_colours_and_parameters() {
     let run = foton(&["convert", s(&xml)]);
     assert!(failed(&run).contains("not both"), "{}", run.stderr);
 }
+
+/// Mitsuba 0.6's `conductor` of `material` "none" (a perfect mirror) with an `extEta`
+/// (a name or a number): read, and still a perfect mirror (its eta is 0, so eta / ext is).
+#[test]
+fn a_mirror_conductor_takes_an_exterior_index() {
+    let dir = temp_dir("none-ext-eta");
+    let extra = r#"<shape type="sphere"><bsdf type="conductor"><string name="material" value="none"/>
+        <string name="extEta" value="air"/></bsdf></shape>"#;
+    let (toml, run) = convert(&dir, "mirror.xml", &scene_with("", "", FILM, extra), &[]);
+    ok(&run);
+    assert!(toml.contains("material = \"none\""), "{toml}");
+    let bad = r#"<shape type="sphere"><bsdf type="conductor"><string name="material" value="none"/>
+        <string name="extEta" value="unobtainium"/></bsdf></shape>"#;
+    let xml = write(&dir, "bad.xml", &scene_with("", "", FILM, bad));
+    let run = foton(&["convert", s(&xml)]);
+    assert!(failed(&run).contains("unobtainium"), "{}", run.stderr);
+}

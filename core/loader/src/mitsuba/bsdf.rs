@@ -224,6 +224,13 @@ impl Reader {
                         let default = if o.v1 { "Cu" } else { "none" };
                         let name = material.unwrap_or_else(|| default.into());
                         let spectra = foton_core::spectrum::conductor(&name);
+                        // Mitsuba 0.6's index of the outside: the Fresnel terms take eta / ext
+                        // and k / ext (all of them 1 for `none`, whose eta is 0).
+                        let ext = if o.v1 {
+                            self.ior(&mut o, "ext_eta", 1.0)?
+                        } else {
+                            1.0
+                        };
                         if name.eq_ignore_ascii_case("none") {
                             t.insert("material", at(Value::Str("none".into()), line));
                         } else if spectra.is_none() {
@@ -231,7 +238,6 @@ impl Reader {
                         } else if let (Some((eta, k)), true) = (spectra, o.v1) {
                             // Mitsuba 0.6 reduces the measured spectra its own way (a
                             // negative component, out of gamut, clamped as Mitsuba 3 does).
-                            let ext = self.ior(&mut o, "ext_eta", 1.0)?;
                             let rgb = |s: foton_core::spectrum::Spectrum| {
                                 s.to_srgb_v06().max(DVec3::ZERO) / ext
                             };
