@@ -375,6 +375,7 @@ mod tests {
                     beam_width: 0.3,
                     cutoff: 0.6,
                     falloff: Falloff::Linear,
+                    texture: None,
                 }),
             ),
             (

@@ -12,13 +12,21 @@
 //! | `cutoff_angle` | degrees    | no light past it, in (0, 90]                 | `20`                 |
 //! | `beam_width`   | degrees    | full intensity within it, in [0, cutoff]     | 3/4 of the cutoff    |
 //! | `falloff`      | string     | `"linear"` (in the angle) or `"smoothstep"` (in the cosine) | `"linear"` |
+//! | `texture`      | texture    | multiplies the intensity by an image across the cone (Mitsuba 3's spot `texture`) | none |
+//! | `up`           | vector     | with `texture`: the image's up (v grows towards it), as a look-at's `up` | `[0, 1, 0]` |
+//!
+//! A texture is looked up at uv = 1/2 + (x, y) / (2 z tan(cutoff)) for a direction (x, y, z)
+//! in the light's frame (+z the axis, +x = up x axis, +y = axis x x, Mitsuba's look-at
+//! frame): the image spans the square of half-width tan(cutoff) at unit distance.
 
 use super::{EmittedRay, LightSample, LightSource, LightType, towards};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::sampling::{to_world, uniform_cone};
+use crate::texture::Texture;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
+use std::sync::Arc;
 
 #[derive(Clone, Debug)]
 pub struct SpotLight {
@@ -32,6 +40,21 @@ pub struct SpotLight {
     pub beam_width: f32,
     pub cutoff: f32,
     pub falloff: Falloff,
+    /// An image across the cone; None: the same intensity at every angle about the axis.
+    pub texture: Option<Arc<SpotTexture>>,
+}
+
+/// A spot light's image and the frame that places it.
+#[derive(Clone, Debug)]
+pub struct SpotTexture {
+    pub texture: Texture,
+    /// The light's +x and +y (+z is its axis).
+    pub x: Vec3,
+    pub y: Vec3,
+    /// 1 / tan(cutoff).
+    inv_tan_cutoff: f32,
+    /// The falloff-weighted mean of the image over the cone (the power's factor).
+    mean: Rgb,
 }
 
 /// How the intensity falls from the beam width to the cutoff.
@@ -44,6 +67,57 @@ pub enum Falloff {
 }
 
 impl SpotLight {
+    /// The light with the image `texture` across its cone, `up` giving its orientation.
+    pub fn with_texture(self, texture: Texture, up: Vec3) -> Result<SpotLight, String> {
+        let x = up.cross(self.axis);
+        if x.length_squared() < 1e-12 {
+            return Err("`up` is parallel to the axis".into());
+        }
+        let x = x.normalize();
+        let y = self.axis.cross(x);
+        let mut t = SpotTexture {
+            texture,
+            x,
+            y,
+            inv_tan_cutoff: 1.0 / self.cutoff.tan().max(1e-6),
+            mean: Rgb::ONE,
+        };
+        // The mean weighted by the falloff: a grid uniform in the cone's solid angle.
+        let cos_max = self.cutoff.cos();
+        let n = 64;
+        let (mut sum, mut weight) = (glam::DVec3::ZERO, 0.0f64);
+        for a in 0..n {
+            for b in 0..n {
+                let u = Vec2::new((a as f32 + 0.5) / n as f32, (b as f32 + 0.5) / n as f32);
+                let local = uniform_cone(u, cos_max);
+                let f = self.falloff(local.z) as f64;
+                let d = t.x * local.x + t.y * local.y + self.axis * local.z;
+                sum += t.at(self.axis, d).as_dvec3() * f;
+                weight += f;
+            }
+        }
+        t.mean = if weight > 0.0 {
+            (sum / weight).as_vec3()
+        } else {
+            Rgb::ZERO
+        };
+        Ok(SpotLight {
+            texture: Some(Arc::new(t)),
+            ..self
+        })
+    }
+
+    /// The image's factor towards the unit direction `d` (1 without an image, 0 outside
+    /// the cone).
+    #[inline]
+    fn image(&self, d: Vec3) -> Rgb {
+        match &self.texture {
+            None => Rgb::ONE,
+            Some(t) if self.axis.dot(d) > 0.0 => t.at(self.axis, d),
+            Some(_) => Rgb::ZERO,
+        }
+    }
+
     /// The falloff at angle theta from the axis.
     #[inline]
     fn falloff(&self, cos_theta: f32) -> f32 {
@@ -111,9 +185,10 @@ impl LightSource for SpotLight {
         LightType::DeltaPosition
     }
 
-    /// I times the falloff's solid angle.
+    /// I times the falloff's solid angle (and the image's mean over it).
     fn power(&self) -> Rgb {
-        self.intensity * self.solid_angle()
+        let mean = self.texture.as_ref().map_or(Rgb::ONE, |t| t.mean);
+        self.intensity * self.solid_angle() * mean
     }
 
     fn position(&self) -> Option<Vec3> {
@@ -123,11 +198,10 @@ impl LightSource for SpotLight {
     #[inline(never)]
     fn sample_li(&self, x: Vec3, _: Vec2, _: f32) -> Option<LightSample> {
         let (wi, dist, dist2) = towards(x, self.position)?;
-        let falloff = self.falloff(self.axis.dot(-wi));
         Some(LightSample {
             wi,
             dist,
-            li: self.intensity * (falloff / dist2),
+            li: self.intensity * self.image(-wi) * (self.falloff(self.axis.dot(-wi)) / dist2),
             pdf: 1.0,
             delta: true,
             p: self.position,
@@ -144,12 +218,13 @@ impl LightSource for SpotLight {
         let cos_max = self.cutoff.cos();
         let dir = to_world(uniform_cone(u_dir, cos_max), self.axis);
         let falloff = self.falloff(self.axis.dot(dir));
+        let intensity = self.intensity * self.image(dir);
         EmittedRay {
             origin: self.position,
             dir,
             n: Vec3::ZERO,
-            flux: self.intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
-            le: self.intensity * falloff,
+            flux: intensity * (falloff * 2.0 * PI * (1.0 - cos_max)),
+            le: intensity * falloff,
             uv: Vec2::ZERO,
             pdf_pos: 1.0,
             pdf_dir: 1.0 / (2.0 * PI * (1.0 - cos_max)),
@@ -167,10 +242,21 @@ impl LightSource for SpotLight {
     }
 }
 
+impl SpotTexture {
+    /// The image towards the unit direction `d` (in the cone: d . axis > 0).
+    #[inline]
+    fn at(&self, axis: Vec3, d: Vec3) -> Rgb {
+        let z = d.dot(axis);
+        let k = 0.5 * self.inv_tan_cutoff / z;
+        self.texture
+            .eval(Vec2::new(0.5 + d.dot(self.x) * k, 0.5 + d.dot(self.y) * k))
+    }
+}
+
 pub const FACTORY: Factory<SpotLight> = Factory {
     name: "spot",
     description: "a point light emitting in a cone (Mitsuba's spot)",
-    create: |l, _, _| {
+    create: |l, _, resources| {
         let position = l.vec3_required("position")?;
         let intensity = l.rgb("intensity", Rgb::ONE)?;
         let axis = match (l.vec3_opt("look_at")?, l.vec3_opt("direction")?) {
@@ -212,13 +298,23 @@ pub const FACTORY: Factory<SpotLight> = Factory {
             "smoothstep" => Falloff::Smoothstep,
             _ => Falloff::Linear,
         };
-        Ok(Box::new(SpotLight {
+        let spot = SpotLight {
             position,
             axis: axis.normalize(),
             intensity,
             beam_width: beam_width.to_radians(),
             cutoff: cutoff.to_radians(),
             falloff,
-        }))
+            texture: None,
+        };
+        if !l.has("texture") {
+            return Ok(Box::new(spot));
+        }
+        let texture = resources.texture(l, "texture", Rgb::ONE)?;
+        let up = l.vec3("up", Vec3::Y)?;
+        let spot = spot
+            .with_texture(texture, up)
+            .map_err(|e| l.error("up", e))?;
+        Ok(Box::new(spot))
     },
 };

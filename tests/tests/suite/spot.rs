@@ -22,6 +22,7 @@ fn spot_with(falloff: Falloff) -> Light {
         beam_width: 15f32.to_radians(),
         cutoff: 30f32.to_radians(),
         falloff,
+        texture: None,
     })
 }
 
@@ -257,4 +258,114 @@ fn bad_spot_parameters_are_clear_errors() {
         assert!(!run.stderr.contains("panicked"));
         let _ = std::fs::remove_dir_all(dir);
     }
+}
+
+/// Mitsuba 3's spot `texture`: an image across the cone, at uv = 1/2 + (x, y) / (2 z tan
+/// cutoff) in the light's frame. A spot 2 above a grey floor, pointing down, with a 2 x 2
+/// image of four colours (nearest): the floor under each quadrant shows rho I tex cos / (pi
+/// r^2) in path (next-event estimation), bdpt and photon (its photons carry the image);
+/// its power is I times the falloff's solid angle times the image's mean.
+#[test]
+fn a_textured_spot_projects_its_image() {
+    let dir = foton_tests::temp_dir("spot-texture");
+    let texels: [[f32; 3]; 4] = [
+        [4.0, 1.0, 0.5],
+        [0.5, 3.0, 1.0],
+        [1.0, 0.5, 5.0],
+        [2.0, 2.0, 2.0],
+    ];
+    let data: Vec<f32> = texels.iter().flatten().copied().collect();
+    image::Rgb32FImage::from_raw(2, 2, data)
+        .unwrap()
+        .save(dir.join("slide.exr"))
+        .unwrap();
+    let scene = |integrator: &str, spp: u32| {
+        header(integrator, spp, 1, 24, 24)
+            + &format!(
+                r#"
+[camera]
+position = [0.0, 1.0, 0.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 0.0, -1.0]
+fov = 70.0
+
+[integrators.photon]
+global_photons = 2000000
+caustic_photons = 0
+k = 100
+
+[materials.grey]
+type = "diffuse"
+reflectance = [0.5, 0.5, 0.5]
+
+[[shapes]]
+type = "quad"
+origin = [-3.0, 0.0, 3.0]
+u = [6.0, 0.0, 0.0]
+v = [0.0, 0.0, -6.0]
+material = "grey"
+
+[[lights]]
+type = "spot"
+position = [0.0, 2.0, 0.0]
+direction = [0.0, -1.0, 0.0]
+up = [0.0, 0.0, -1.0]
+intensity = [3.0, 3.0, 3.0]
+cutoff_angle = 30.0
+beam_width = 30.0
+texture = {{ type = "bitmap", filename = "{}", raw = true, filter_type = "nearest" }}
+"#,
+                dir.join("slide.exr").display()
+            )
+    };
+    // The light's frame: +x = up x axis = -X, +y = axis x x = -Z. A floor point (px, 0, pz)
+    // is seen at local (-px, -pz, 2): u = 1/2 - px / (4 tan 30), v = 1/2 - pz / (4 tan 30).
+    let t = 30f64.to_radians().tan();
+    let want_at = |px: f64, pz: f64| {
+        let (u, v) = (0.5 - px / (4.0 * t), 0.5 - pz / (4.0 * t));
+        let texel = Vec3::from(texels[2 * ((2.0 * v) as usize) + (2.0 * u) as usize]).as_dvec3();
+        let r2 = px * px + pz * pz + 4.0;
+        let cos = 2.0 / r2.sqrt();
+        (texel * (3.0 * cos / r2) * (0.5 / PI)).as_vec3()
+    };
+    // Pixel (x, y) of the 24 x 24 view from 1 above the origin, fov 70 (up = -z: image up is
+    // -z, image right is +x).
+    let half = 35f64.to_radians().tan();
+    let floor_at = |x: u32, y: u32| {
+        let sx = ((x as f64 + 0.5) / 12.0 - 1.0) * half;
+        let sy = (1.0 - (y as f64 + 0.5) / 12.0) * half;
+        (sx, -sy)
+    };
+    for (integrator, spp) in [("path", 64), ("bdpt", 32), ("photon", 16)] {
+        let film = render_toml("spot-texture", &scene(integrator, spp), &[], 2);
+        // A 4 x 4 block well inside each quadrant of the image.
+        for (x0, y0) in [(3, 3), (17, 3), (3, 17), (17, 17)] {
+            let (mut got, mut want) = (Vec3::ZERO, Vec3::ZERO);
+            for y in y0..y0 + 4 {
+                for x in x0..x0 + 4 {
+                    got += film.pixel(x, y);
+                    let (px, pz) = floor_at(x, y);
+                    want += want_at(px, pz);
+                }
+            }
+            let rel = ((got - want) / want).abs().max_element();
+            assert!(
+                rel < 0.03,
+                "{integrator}: block ({x0}, {y0}) {} against {} ({rel})",
+                got / 16.0,
+                want / 16.0
+            );
+        }
+    }
+    let path = foton_tests::write(&dir, "scene.toml", &scene("path", 1));
+    let loaded = foton_loader::load(&path, &[]).unwrap();
+    let mean: Vec3 = texels.iter().map(|&c| Vec3::from(c)).sum::<Vec3>() / 4.0;
+    let want = mean * 3.0 * (2.0 * std::f32::consts::PI * (1.0 - 30f32.to_radians().cos()));
+    let power = loaded.lights()[0].power();
+    // The grid over the cone weighs the four quadrants alike up to its resolution.
+    assert!(
+        ((power - want) / want).abs().max_element() < 0.02,
+        "{power} against {want}"
+    );
+    let _ = std::fs::remove_dir_all(dir);
 }

@@ -53,6 +53,14 @@ impl Reader {
                 let beam = o.float("beam_width", cutoff * 0.75)?;
                 t.insert("cutoff_angle", at(Value::Float(cutoff), line));
                 t.insert("beam_width", at(Value::Float(beam), line));
+                // Mitsuba 3's image across the cone, in the frame of the spot's to_world.
+                // (A texture left out, lenient, is reported: the spot without it.)
+                if o.props.iter().any(|(n, _, _)| n == "texture")
+                    && let Some(tex) = self.texture(&mut o, "texture", DVec3::ONE)?
+                {
+                    t.insert("texture", tex);
+                    t.insert("up", vec3(m.transform_vector3(DVec3::Y), line));
+                }
             }
             "directional" => {
                 let d = match o.take("direction") {
