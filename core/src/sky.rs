@@ -384,37 +384,43 @@ pub struct SunSky {
 }
 
 impl SunSky {
-    /// Checks the ranges Mitsuba 0.6 checks.
-    pub fn validate(&self) -> Result<(), String> {
+    /// Checks the ranges Mitsuba 0.6 checks: Err(parameter, message).
+    pub fn validate(&self) -> Result<(), (&'static str, String)> {
         if !(1.0..=10.0).contains(&self.turbidity) {
-            return Err(format!(
-                "the turbidity must be in [1, 10], found {}",
-                self.turbidity
+            return Err((
+                "turbidity",
+                format!("must be in [1, 10], found {}", self.turbidity),
             ));
         }
         if !(1.0..=2.0).contains(&self.stretch) {
-            return Err(format!(
-                "the stretch must be in [1, 2], found {}",
-                self.stretch
+            return Err((
+                "stretch",
+                format!("must be in [1, 2], found {}", self.stretch),
             ));
         }
         if self.albedo.min_element() < 0.0 || self.albedo.max_element() > 1.0 {
-            return Err(format!(
-                "the albedo must be in [0, 1], found {}",
-                self.albedo
+            return Err((
+                "albedo",
+                format!("must be in [0, 1], found {}", self.albedo),
             ));
         }
         if self.sky_scale > 0.0 && self.sun.theta > FRAC_PI_2 {
-            return Err(format!(
-                "the sun is {:.2}° below the horizon, which the sky model does not cover",
-                (self.sun.theta - FRAC_PI_2).to_degrees()
+            return Err((
+                "sun_direction",
+                format!(
+                    "the sun is {:.2}° below the horizon, which the sky model does not cover",
+                    (self.sun.theta - FRAC_PI_2).to_degrees()
+                ),
             ));
         }
         if self.sun_scale > 0.0 && (self.sun_radius_scale <= 0.0 || self.sun_radius_scale.is_nan())
         {
-            return Err(format!(
-                "the sun's radius scale must be > 0 for a sun in the map, found {}",
-                self.sun_radius_scale
+            return Err((
+                "sun_radius_scale",
+                format!(
+                    "must be > 0 for a sun in the map, found {}",
+                    self.sun_radius_scale
+                ),
             ));
         }
         Ok(())

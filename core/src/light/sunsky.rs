@@ -140,7 +140,17 @@ pub const FACTORY: Factory<SunSkyLight> = Factory {
                  `sun_scale = 0` here",
             ));
         }
-        sky.validate().map_err(|e| l.error("sunsky", e))?;
+        sky.validate().map_err(|(key, e)| {
+            // The sun's position may come from the date, time and place.
+            let key = if l.has(key) {
+                key
+            } else if key == "sun_direction" {
+                DATE_KEYS.iter().copied().find(|k| l.has(k)).unwrap_or("type")
+            } else {
+                "type"
+            };
+            l.error(key, e)
+        })?;
         let resolution = l.u32("resolution", 512)? as usize;
         if !(4..=1 << 14).contains(&resolution) {
             return Err(l.error(

@@ -232,15 +232,31 @@ fn sunsky_errors_name_the_parameter() {
             .unwrap_err()
             .to_string()
     };
-    for (extra, want) in [
-        ("turbidity = 12.0", "turbidity must be in [1, 10]"),
-        ("sun_direction = [0.0, -1.0, 0.2]", "below the horizon"),
-        ("sun_direction = [0.0, 1.0, 0.0]\nhour = 9.0", "not both"),
-        ("sun_radius_scale = 0.0", "`directional` light"),
-        ("stretch = 3.0", "stretch must be in [1, 2]"),
+    for (extra, key, want) in [
+        ("turbidity = 12.0", "turbidity", "must be in [1, 10]"),
+        (
+            "sun_direction = [0.0, -1.0, 0.2]",
+            "sun_direction",
+            "below the horizon",
+        ),
+        ("hour = 23.0", "hour", "below the horizon"),
+        (
+            "sun_direction = [0.0, 1.0, 0.0]\nhour = 9.0",
+            "hour",
+            "not both",
+        ),
+        (
+            "sun_radius_scale = 0.0",
+            "sun_radius_scale",
+            "`directional` light",
+        ),
+        ("stretch = 3.0", "stretch", "must be in [1, 2]"),
     ] {
         let e = load(extra);
-        assert!(e.contains(want) && e.contains("lights[0]"), "{extra}: {e}");
+        assert!(
+            e.contains(want) && e.contains(&format!("lights[0].{key}")),
+            "{extra}: {e}"
+        );
     }
     let _ = std::fs::remove_dir_all(dir);
 }
