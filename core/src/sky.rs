@@ -70,6 +70,20 @@ impl Spherical {
     }
 }
 
+/// The parameters that place the sun by date, time and place (instead of a direction), in
+/// Mitsuba 0.6's names and the TOML light's.
+pub const DATE_KEYS: [&str; 9] = [
+    "year",
+    "month",
+    "day",
+    "hour",
+    "minute",
+    "second",
+    "latitude",
+    "longitude",
+    "timezone",
+];
+
 /// A date and a time of day in the time zone of a [`Place`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct DateTime {

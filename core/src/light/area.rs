@@ -136,10 +136,7 @@ impl AreaLight {
     /// ray, finds of its emission.
     #[inline]
     pub fn opacity(&self, uv: Vec2) -> f32 {
-        match self.texture.as_ref().and_then(|t| t.alpha.as_ref()) {
-            None => 1.0,
-            Some(a) => crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0),
-        }
+        self.texture.as_ref().map_or(1.0, |t| t.opacity(uv))
     }
 }
 
@@ -155,12 +152,16 @@ impl EmissionTexture {
         self.texture.as_ref().map_or(Rgb::ONE, |t| t.eval(uv))
     }
 
+    /// The cut-out's opacity at `uv` (1 without one).
+    fn opacity(&self, uv: Vec2) -> f32 {
+        self.alpha
+            .as_ref()
+            .map_or(1.0, |a| crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0))
+    }
+
     /// The radiance's factor at a sampled point: times the opacity there.
     fn sampled(&self, uv: Vec2) -> Rgb {
-        let alpha = self.alpha.as_ref().map_or(1.0, |a| {
-            crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0)
-        });
-        self.seen(uv) * alpha
+        self.seen(uv) * self.opacity(uv)
     }
 }
 

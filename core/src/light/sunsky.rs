@@ -28,7 +28,7 @@ use super::{EmittedRay, LightSample, LightSource, LightType, SceneSphere};
 use crate::Rgb;
 use crate::envmap::EnvironmentMap;
 use crate::registry::Factory;
-use crate::sky::{DateTime, Place, SunSky, Spherical, sun_position};
+use crate::sky::{DATE_KEYS, DateTime, Place, Spherical, SunSky, sun_position};
 use glam::{Mat3, Vec2, Vec3};
 use std::sync::Arc;
 
@@ -66,10 +66,6 @@ impl LightSource for SunSkyLight {
         self.map.pdf_le(n, dir)
     }
 }
-
-const DATE_KEYS: [&str; 9] = [
-    "year", "month", "day", "hour", "minute", "second", "latitude", "longitude", "timezone",
-];
 
 pub const FACTORY: Factory<SunSkyLight> = Factory {
     name: "sunsky",

@@ -132,27 +132,14 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
 
     // Mitsuba reads the image at (u, v), v = 0 its top row: the tilted rows are at the
     // rectangle's v < 1/2, its lower half.
-    let xml = format!(
-        r#"<scene version="3.0.0">
-<integrator type="path"><integer name="max_depth" value="2"/></integrator>
-<sensor type="orthographic">
-  <transform name="to_world"><scale x="2" y="2"/><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
-  <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
-  <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
-</sensor>
-<emitter type="directional"><vector name="direction" x="{dx}" y="0" z="{dz}"/></emitter>
-<bsdf type="diffuse" id="grey"/>
-<shape type="rectangle">
-  <transform name="to_world"><scale value="2"/></transform>
-  <bsdf type="normalmap">
+    let xml = ortho_rectangle_xml(
+        2.0,
+        a,
+        r#"  <bsdf type="normalmap">
     <texture name="normalmap" type="bitmap"><boolean name="raw" value="true"/><string name="filename" value="n.png"/></texture>
     <ref id="grey"/>
   </bsdf>
-</shape>
-<shape type="sphere"><point name="center" x="0" y="0" z="-10"/><ref id="grey"/></shape>
-</scene>"#,
-        dx = -a.sin(),
-        dz = -a.cos()
+"#,
     );
     let file = foton_tests::write(&dir, "n.xml", &xml);
     let scene = foton_loader::load(&file, &[]).unwrap();
@@ -266,31 +253,20 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
 
     // Mitsuba: a rectangle scaled to 4 x 4 (dp/du = 4 x as above), the height in a 0.6-style
     // `scale` texture, the BSDF referenced.
-    let xml = format!(
-        r#"<scene version="3.0.0">
-<integrator type="path"><integer name="max_depth" value="2"/></integrator>
-<sensor type="orthographic">
-  <transform name="to_world"><scale x="1" y="1"/><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
-  <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
-  <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
-</sensor>
-<emitter type="directional"><vector name="direction" x="{dx}" y="0" z="{dz}"/></emitter>
-<bsdf type="diffuse" id="grey"/>
-<shape type="rectangle">
-  <transform name="to_world"><scale value="2"/></transform>
-  <bsdf type="bumpmap">
-    <texture type="scale"><float name="scale" value="{half}"/>
+    let xml = ortho_rectangle_xml(
+        1.0,
+        a,
+        &format!(
+            r#"  <bsdf type="bumpmap">
+    <texture type="scale"><float name="scale" value="{}"/>
       <texture type="bitmap"><boolean name="raw" value="true"/><string name="filename" value="ramp.png"/></texture>
     </texture>
     <float name="scale" value="2"/>
     <ref id="grey"/>
   </bsdf>
-</shape>
-<shape type="sphere"><point name="center" x="0" y="0" z="-10"/><ref id="grey"/></shape>
-</scene>"#,
-        dx = -a.sin(),
-        dz = -a.cos(),
-        half = scale / 2.0,
+"#,
+            scale / 2.0
+        ),
     );
     let file = foton_tests::write(&dir, "b.xml", &xml);
     let scene = foton_loader::load(&file, &[]).unwrap();
@@ -418,4 +394,28 @@ fn mitsuba_light_terms_on_a_tilted_normal_map() {
             );
         }
     }
+}
+
+/// A Mitsuba 3 scene: an orthographic view `view` wide (in half-widths) of a 4 x 4 rectangle
+/// with `bsdf` (which may refer to the diffuse `grey`), lit by a directional light at angle
+/// `a` from its normal in the xz plane, and a sphere behind it that uses `grey` too.
+fn ortho_rectangle_xml(view: f32, a: f32, bsdf: &str) -> String {
+    format!(
+        r#"<scene version="3.0.0">
+<integrator type="path"><integer name="max_depth" value="2"/></integrator>
+<sensor type="orthographic">
+  <transform name="to_world"><scale x="{view}" y="{view}"/><lookat origin="0, 0, 3" target="0, 0, 0" up="0, 1, 0"/></transform>
+  <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+  <film type="hdrfilm"><integer name="width" value="16"/><integer name="height" value="16"/></film>
+</sensor>
+<emitter type="directional"><vector name="direction" x="{dx}" y="0" z="{dz}"/></emitter>
+<bsdf type="diffuse" id="grey"/>
+<shape type="rectangle">
+  <transform name="to_world"><scale value="2"/></transform>
+{bsdf}</shape>
+<shape type="sphere"><point name="center" x="0" y="0" z="-10"/><ref id="grey"/></shape>
+</scene>"#,
+        dx = -a.sin(),
+        dz = -a.cos()
+    )
 }

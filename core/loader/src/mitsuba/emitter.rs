@@ -5,7 +5,7 @@ use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::{Reader, at, matrix_table, vec3};
 use foton_core::error::Result;
-use foton_core::sky::{DateTime, Place, Spherical, SunSky, sun_position};
+use foton_core::sky::{DATE_KEYS, DateTime, Place, Spherical, SunSky, sun_position};
 use foton_core::value::{Table, Value};
 use glam::{DMat4, DVec3};
 
@@ -114,19 +114,6 @@ impl Reader {
     }
 }
 
-/// Mitsuba 0.6's date, time and place parameters of `sunsky`, `sky` and `sun`.
-const SUN_DATE_KEYS: [&str; 9] = [
-    "year",
-    "month",
-    "day",
-    "hour",
-    "minute",
-    "second",
-    "latitude",
-    "longitude",
-    "timezone",
-];
-
 impl Reader {
     /// Mitsuba 0.6's `sunsky`, `sky` (no sun) or `sun` (no sky) as a `sunsky` light (`t`);
     /// a sun of radius 0 (`sun_radius_scale` 0) becomes the
@@ -187,7 +174,7 @@ impl Reader {
         // Where the sun is: a direction in world space, or a date, a time and a place.
         let sun = match o.take("sun_direction") {
             Some((Prop::Point(d), _)) => {
-                if let Some(k) = SUN_DATE_KEYS
+                if let Some(k) = DATE_KEYS
                     .iter()
                     .find(|k| o.props.iter().any(|(n, _, _)| n == *k))
                 {
