@@ -49,6 +49,10 @@ pub struct FreeFlight {
     /// Per channel c, the probability (density, 1/m, at a scattering event) of this outcome
     /// had channel c been sampled: sigma_t,c Tr_c(t), or Tr_c(tmax) when passing.
     pub pdf: Rgb,
+    /// The medium's emission integrand at a scattering event, Tr(t) sigma_a(t) Le(t) (zero
+    /// when passing, and in a medium that does not emit): the collision estimator of the
+    /// emission along the segment, int Tr sigma_a Le dt, is this over the pdf.
+    pub emitted: Rgb,
 }
 
 impl FreeFlight {
@@ -59,6 +63,17 @@ impl FreeFlight {
     pub fn weight(&self) -> Rgb {
         let pdf = crate::average(self.pdf);
         if pdf > 0.0 { self.f / pdf } else { Rgb::ZERO }
+    }
+
+    /// What the throughput before this event is multiplied by for the emission the medium
+    /// adds here (one-sample MIS over the channels of this event, as [`Self::weight`]).
+    pub fn emission_weight(&self) -> Rgb {
+        let pdf = crate::average(self.pdf);
+        if pdf > 0.0 {
+            self.emitted / pdf
+        } else {
+            Rgb::ZERO
+        }
     }
 }
 
@@ -84,6 +99,18 @@ impl HeroChannel {
         HeroChannel {
             channel: channel(u),
             r: Rgb::ONE,
+        }
+    }
+
+    /// For a free-flight sample of the path (drawn with `self.channel`) and before
+    /// [`Self::update`] accounts for it: the factor the throughput is multiplied by for the
+    /// emission the medium adds at the event.
+    pub fn emission(&self, flight: &FreeFlight) -> Rgb {
+        let mean = crate::average(self.r * flight.pdf);
+        if mean > 0.0 {
+            flight.emitted / mean
+        } else {
+            Rgb::ZERO
         }
     }
 
@@ -143,6 +170,15 @@ pub trait Medium: Send + Sync + std::fmt::Debug {
         self.sigma_a(p) + self.sigma_s(p)
     }
     fn phase(&self) -> Phase;
+    /// Emitted radiance Le at `p` (W m^-2 sr^-1, the same in every direction); the medium adds
+    /// sigma_a Le per unit length along a ray (pbrt-v4's media). Zero by default.
+    fn emission(&self, _p: Vec3) -> Rgb {
+        Rgb::ZERO
+    }
+    /// Whether [`Self::emission`] is anywhere other than zero (false by default).
+    fn is_emissive(&self) -> bool {
+        false
+    }
     /// Transmittance along `ray` from its origin over the distance `d` (which may be
     /// infinite; `ray.dir` is a unit vector).
     fn transmittance(&self, ray: &Ray, d: f32) -> Rgb;
@@ -170,6 +206,7 @@ mod tests {
             sigma_a: Rgb::new(0.0, 1.0, 0.0),
             sigma_s: Rgb::new(0.0, 0.0, 2.0),
             phase: Phase::Isotropic,
+            emission: Rgb::ZERO,
         };
         // Channel 0 (vacuum) chosen: the sample passes with weight Tr / P(pass) = 1 / (1/3).
         let ray = Ray::new(Vec3::ZERO, Vec3::X);

@@ -211,6 +211,7 @@ mod tests {
             sigma_a: crate::Rgb::new(0.1, 0.2, 0.3),
             sigma_s: crate::Rgb::new(0.5, 0.25, 0.0),
             phase: Phase::HenyeyGreenstein { g: 0.5 },
+            emission: crate::Rgb::ZERO,
         };
         assert_eq!(m.homogeneous(), Some(direct));
         // The nested phase table is handed back, its keys read.

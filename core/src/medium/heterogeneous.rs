@@ -12,6 +12,7 @@
 //! | `sigma_t` | RGB or number (1/m)      | extinction at density 1                    | `[1, 1, 1]`    |
 //! | `albedo`  | RGB or volume table      | single-scattering albedo                   | `[0.75, 0.75, 0.75]` |
 //! | `phase`   | string/table             | `"isotropic"` or `{ type = "hg", g = ... }`| `"isotropic"`  |
+//! | `emission`| RGB, number or volume table | emitted radiance Le (W m^-2 sr^-1): sigma_a Le per metre along a ray | none |
 //!
 //! A volume table is `{ file = "smoke.vol" }` (Mitsuba's binary grid) or
 //! `{ resolution = [nx, ny, nz], values = [...] }` (x fastest, then y, then z; three values per
@@ -32,35 +33,45 @@ use crate::registry::{Factory, Resources};
 use crate::value::Value;
 use glam::{Mat4, Vec3};
 
-/// The albedo: the same everywhere or on a grid.
+/// A colour the same everywhere or on a grid (the albedo, the emission).
 #[derive(Clone, Debug)]
-pub enum Albedo {
+pub enum Field {
     Constant(Rgb),
     Grid(Grid),
 }
 
-impl Albedo {
+/// The single-scattering albedo (clamped to [0, 1] where it is looked up).
+pub type Albedo = Field;
+
+impl Field {
     #[inline]
     fn at(&self, p: Vec3) -> Rgb {
         match self {
-            Albedo::Constant(a) => *a,
-            Albedo::Grid(g) => g.lookup(p).min(Rgb::ONE),
+            Field::Constant(a) => *a,
+            Field::Grid(g) => g.lookup(p),
         }
     }
 }
 
-/// A medium of spatially varying density and albedo.
+/// A medium of spatially varying density and albedo, which may emit.
 #[derive(Clone, Debug)]
 pub struct Heterogeneous {
     pub density: Grid,
     pub sigma_t: Rgb,
     pub albedo: Albedo,
     pub phase: Phase,
+    /// Emitted radiance Le; None where the medium does not emit.
+    pub emission: Option<Field>,
 }
 
 impl Heterogeneous {
     fn extinction(&self, p: Vec3) -> Rgb {
         self.sigma_t * self.density.lookup(p)
+    }
+
+    #[inline]
+    fn albedo(&self, p: Vec3) -> Rgb {
+        self.albedo.at(p).min(Rgb::ONE)
     }
 }
 
@@ -69,16 +80,22 @@ impl Medium for Heterogeneous {
         self.density.max() == 0.0 || self.sigma_t.max_element() == 0.0
     }
     fn sigma_a(&self, p: Vec3) -> Rgb {
-        self.extinction(p) * (Rgb::ONE - self.albedo.at(p))
+        self.extinction(p) * (Rgb::ONE - self.albedo(p))
     }
     fn sigma_s(&self, p: Vec3) -> Rgb {
-        self.extinction(p) * self.albedo.at(p)
+        self.extinction(p) * self.albedo(p)
     }
     fn sigma_t(&self, p: Vec3) -> Rgb {
         self.extinction(p)
     }
     fn phase(&self) -> Phase {
         self.phase
+    }
+    fn emission(&self, p: Vec3) -> Rgb {
+        self.emission.as_ref().map_or(Rgb::ZERO, |e| e.at(p))
+    }
+    fn is_emissive(&self) -> bool {
+        self.emission.is_some()
     }
     /// exp(-sigma_t D), D the integral of the density along the segment.
     fn transmittance(&self, ray: &Ray, d: f32) -> Rgb {
@@ -101,11 +118,17 @@ impl Medium for Heterogeneous {
                 let t = t as f32;
                 let p = ray.at(t);
                 let sigma_t = self.extinction(p);
+                let albedo = self.albedo(p);
+                let emitted = match &self.emission {
+                    Some(e) => sigma_t * (Rgb::ONE - albedo) * e.at(p) * tr,
+                    None => Rgb::ZERO,
+                };
                 FreeFlight {
                     t,
                     scattered: true,
-                    f: sigma_t * self.albedo.at(p) * tr,
+                    f: sigma_t * albedo * tr,
                     pdf: sigma_t * tr,
+                    emitted,
                 }
             }
             _ => FreeFlight {
@@ -113,6 +136,7 @@ impl Medium for Heterogeneous {
                 scattered: false,
                 f: tr,
                 pdf: tr,
+                emitted: Rgb::ZERO,
             },
         }
     }
@@ -242,11 +266,26 @@ pub const FACTORY: Factory<dyn Medium> = Factory {
             }
         };
         let phase = Phase::read(m, nested)?;
+        let emission = match volume(m, "emission", &[1, 3], nested, res)? {
+            Some(g) if g.max() > 0.0 => Some(Field::Grid(g)),
+            Some(_) => None,
+            None => {
+                let e = match m.node("emission").map(|n| &n.value) {
+                    Some(Value::Array(_)) | None => m.rgb("emission", Rgb::ZERO)?,
+                    _ => Rgb::splat(m.f32("emission", 0.0)?),
+                };
+                if e.min_element() < 0.0 {
+                    return Err(m.error("emission", "must not be negative"));
+                }
+                (e != Rgb::ZERO).then_some(Field::Constant(e))
+            }
+        };
         Ok(Box::new(Heterogeneous {
             density,
             sigma_t,
             albedo,
             phase,
+            emission,
         }))
     },
 };

@@ -5,6 +5,7 @@
 //! | `sigma_a` | RGB (1/m)   | absorption coefficient                              | `[0, 0, 0]`   |
 //! | `sigma_s` | RGB (1/m)   | scattering coefficient                              | `[0, 0, 0]`   |
 //! | `phase`   | string/table| `"isotropic"` or `{ type = "hg", g = ... }`         | `"isotropic"` |
+//! | `emission`| RGB (W m^-2 sr^-1) | emitted radiance Le: sigma_a Le per metre along a ray | `[0, 0, 0]` |
 
 use super::{FreeFlight, Medium, Phase, transmittance_homogeneous};
 use crate::Rgb;
@@ -18,6 +19,8 @@ pub struct Homogeneous {
     pub sigma_a: Rgb,
     pub sigma_s: Rgb,
     pub phase: Phase,
+    /// Emitted radiance Le.
+    pub emission: Rgb,
 }
 
 impl Homogeneous {
@@ -45,6 +48,12 @@ impl Medium for Homogeneous {
     fn phase(&self) -> Phase {
         self.phase
     }
+    fn emission(&self, _: Vec3) -> Rgb {
+        self.emission
+    }
+    fn is_emissive(&self) -> bool {
+        self.emission != Rgb::ZERO && self.sigma_a != Rgb::ZERO
+    }
     /// Beer-Lambert: exp(-sigma_t d) per channel.
     fn transmittance(&self, _ray: &Ray, d: f32) -> Rgb {
         self.transmittance_over(d)
@@ -66,6 +75,7 @@ impl Medium for Homogeneous {
                 scattered: true,
                 f: self.sigma_s * tr,
                 pdf: sigma_t * tr,
+                emitted: self.sigma_a * self.emission * tr,
             }
         } else {
             let tr = transmittance_homogeneous(sigma_t, tmax);
@@ -74,6 +84,7 @@ impl Medium for Homogeneous {
                 scattered: false,
                 f: tr,
                 pdf: tr,
+                emitted: Rgb::ZERO,
             }
         }
     }
@@ -89,10 +100,15 @@ pub const FACTORY: Factory<dyn Medium> = Factory {
         let sigma_a = m.rgb("sigma_a", Rgb::ZERO)?;
         let sigma_s = m.rgb("sigma_s", Rgb::ZERO)?;
         let phase = Phase::read(m, nested)?;
+        let emission = m.rgb("emission", Rgb::ZERO)?;
+        if emission.min_element() < 0.0 {
+            return Err(m.error("emission", "must not be negative"));
+        }
         Ok(Box::new(Homogeneous {
             sigma_a,
             sigma_s,
             phase,
+            emission,
         }))
     },
 };

@@ -566,6 +566,18 @@ impl Scene {
     pub fn has_media(&self) -> bool {
         self.has_media
     }
+
+    /// The name of the first medium that emits light, if the scene uses media: integrators
+    /// that do not render a medium's emission refuse such a scene with it.
+    pub fn emissive_medium(&self) -> Option<&str> {
+        if !self.has_media {
+            return None;
+        }
+        self.media
+            .iter()
+            .find(|m| m.value.is_emissive())
+            .map(|m| m.name.as_str())
+    }
 }
 
 /// The shading normal a normal map gives at a surface point: its colour c as 2c - 1 in the

@@ -49,7 +49,9 @@
 //! carries the transmittance of the media and null boundaries it crosses
 //! (`Scene::transmittance`). The densities of the MIS weights leave out the free-flight
 //! probabilities (as pbrt-v3's do): the weights of a path's strategies still sum to one.
-//! Light tracing alone (`strategy = "light"` or `"s,1"`) has infinite variance in a medium
+//! An emitting medium is found by the camera subpath alone (s = 0 at each scattering event
+//! in it, weight 1: no light subpath starts in a medium). Light tracing alone (`strategy =
+//! "light"` or `"s,1"`) has infinite variance in a medium
 //! around the pinhole (a vertex at distance d contributes as 1 / d^2); the full estimator
 //! weights it away there.
 //!

@@ -431,6 +431,17 @@ impl Bidir {
                 let channel = channel(sampler.next_f32());
                 let flight =
                     m.sample_free_flight(&seg.start(), seg.length(), channel, sampler.next_f32());
+                // ---- s = 0: the medium's emission at the event ----
+                // No light subpath starts in a medium and no connection ends at an emitting
+                // medium point: this strategy alone renders such paths, with weight 1.
+                if side == Side::Camera && flight.emitted != Rgb::ZERO {
+                    let t = length + 2;
+                    let value = beta * flight.emission_weight() * self.weight(0, t, || 1.0);
+                    if let Some(f) = on_emission.as_mut() {
+                        f(t, value);
+                    }
+                    radiance += value;
+                }
                 beta *= flight.weight();
                 if beta == Rgb::ZERO {
                     break;

@@ -24,7 +24,9 @@
 //! scattering event is a path vertex (it counts toward `max_depth`) with next-event
 //! estimation (shadow rays carry the transmittance of the media and null boundaries they
 //! cross; area lights are combined with phase-function sampling by MIS) and a
-//! phase-function-sampled continuation. A medium with sigma_t = 0 is skipped, so it renders
+//! phase-function-sampled continuation. An emitting medium adds its emission at each
+//! scattering event sampled in it (Tr sigma_a Le over the event's pdf: the collision
+//! estimator); no shadow ray aims at it. A medium with sigma_t = 0 is skipped, so it renders
 //! exactly as vacuum; a scene without media renders exactly as before media existed.
 //!
 //! It is unbiased and converges to the right image for any scene, but caustics seen through
@@ -91,6 +93,10 @@ impl PathTracer {
                     hero.channel,
                     sampler.next_f32(),
                 );
+                // ---- The medium's emission at the event (no other strategy samples it) ----
+                if flight.emitted != Rgb::ZERO {
+                    radiance += beta * hero.emission(&flight);
+                }
                 beta *= hero.update(&flight);
                 if beta == Rgb::ZERO {
                     break;

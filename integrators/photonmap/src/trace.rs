@@ -11,11 +11,24 @@
 use crate::beams::{Beam, BeamKind, exit_distance};
 use crate::map::Photon;
 use foton_core::api::{
-    HeroChannel, Ray, RayWalk, Reached, RenderContext, Result, Rgb, Rng, SOBOL_DIMENSIONS,
+    Error, HeroChannel, Ray, RayWalk, Reached, RenderContext, Result, Rgb, Rng, SOBOL_DIMENSIONS,
     SamplerKind, Scene, SobolPoint, TransportMode, offset_origin, splitmix64, with_pool,
 };
 use glam::Vec2;
 use rayon::prelude::*;
+
+/// An error for a scene with an emitting medium: photons leave the lights only, so the
+/// photon mappers would miss what such a medium lights (`path` and `bdpt` render it).
+pub fn refuse_emissive_media(scene: &Scene, integrator: &str) -> Result<()> {
+    match scene.emissive_medium() {
+        Some(name) => Err(Error::Usage(format!(
+            "{}: medium {name:?} emits light, which `{integrator}` does not render yet (its \
+             photons leave the lights only): use `path` or `bdpt`",
+            scene.file().display()
+        ))),
+        None => Ok(()),
+    }
+}
 
 /// The path a photon took to reach a diffuse surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -18,6 +18,7 @@ fn medium(res: [usize; 3], values: Vec<f32>, sigma_t: Rgb, samples: Samples) -> 
         sigma_t,
         albedo: Albedo::Constant(Rgb::splat(0.5)),
         phase: Phase::Isotropic,
+        emission: None,
     }
 }
 

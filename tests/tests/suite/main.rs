@@ -30,6 +30,7 @@ mod directional;
 mod disc_edges;
 mod disc_estimate;
 mod docs;
+mod emissive_media;
 mod environment;
 mod filter;
 mod glossy;

@@ -71,6 +71,7 @@ impl Medium for Ramp {
                 scattered: true,
                 f: Rgb::splat(self.albedo * sigma_t * tr),
                 pdf: Rgb::splat(sigma_t * tr),
+                emitted: Rgb::ZERO,
             }
         } else {
             let tr = self.transmittance(ray, tmax);
@@ -79,6 +80,7 @@ impl Medium for Ramp {
                 scattered: false,
                 f: tr,
                 pdf: tr,
+                emitted: Rgb::ZERO,
             }
         }
     }

@@ -88,6 +88,7 @@ fn free_flight_sampling_follows_the_spectral_mis_density_and_is_unbiased() {
             sigma_a: Vec3::from(sigma_a),
             sigma_s: Vec3::from(sigma_s),
             phase: Phase::Isotropic,
+            emission: Vec3::ZERO,
         };
         let sigma_t = medium.sigma_t().as_dvec3().to_array();
         let name = format!("free flight {sigma_t:?}, tmax {tmax}");

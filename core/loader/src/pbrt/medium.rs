@@ -92,11 +92,21 @@ impl Reader {
                     },
                     None => None,
                 };
-                self.emission(&mut p, &what, &["Le", "Lescale"])?;
+                // Le (an illuminant, luminance 1) times `Lescale`.
+                let le = match p.take("Le") {
+                    Some(q) => rgb(&q, Kind::Illuminant, &what, &self.dir)?,
+                    None => DVec3::ZERO,
+                } * p.float("Lescale", 1.0)?;
                 let (sa, ss, g) = coefficients(self, &mut p, preset)?;
                 entries.push(("type", self.string("homogeneous", &loc)));
                 entries.push(("sigma_a", self.vec3(sa, &loc)));
                 entries.push(("sigma_s", self.vec3(ss, &loc)));
+                if le.min_element() < 0.0 {
+                    return Err(loc.error(&what, "\"Lescale\": must not be negative"));
+                }
+                if le != DVec3::ZERO {
+                    entries.push(("emission", self.vec3(le, &loc)));
+                }
                 if g != 0.0 {
                     entries.push(("phase", self.phase(g, &loc)));
                 }
@@ -126,6 +136,7 @@ impl Reader {
                         v => Ok(v),
                     }
                 };
+                let has_sigma_a = p.has("sigma_a");
                 let (extinction, albedo_grid, dloc) = if rgb_grid {
                     let sa = grid(&mut p, "sigma_a", Type::Rgb, 3)?;
                     let ss = grid(&mut p, "sigma_s", Type::Rgb, 3)?;
@@ -150,18 +161,36 @@ impl Reader {
                     (d, None, l)
                 };
                 let channels = if rgb_grid { 3 } else { 1 };
-                self.emission(
-                    &mut p,
-                    &what,
-                    &[
-                        "Le",
-                        "Lescale",
-                        "temperature",
-                        "temperatureoffset",
-                        "temperaturecutoff",
-                        "temperaturescale",
-                    ],
-                )?;
+                // The emitted radiance per sample (RGB), on a grid of `n` or (a constant Le
+                // without `Lescale`) of one sample, which pbrt-v4 also reads as a grid.
+                let emission = if rgb_grid {
+                    let le = grid(&mut p, "Le", Type::Rgb, 3)?;
+                    let scale = p.float("Lescale", 1.0)?;
+                    match le {
+                        Some(_) if !has_sigma_a => {
+                            return Err(loc.error(&what, "an RGB grid with \"Le\" needs \"sigma_a\" (pbrt-v4 refuses it too)"));
+                        }
+                        Some((v, l)) => {
+                            Some((n, v.iter().map(|x| x * scale).collect::<Vec<f64>>(), l))
+                        }
+                        None => None,
+                    }
+                } else {
+                    self.temperature(&mut p, &what)?;
+                    let le = match p.take("Le") {
+                        Some(q) => Some((rgb(&q, Kind::Illuminant, &what, &self.dir)?, q.loc)),
+                        None => None,
+                    };
+                    let scales = grid(&mut p, "Lescale", Type::Float, 1)?;
+                    match (le, scales) {
+                        (Some((c, l)), Some((v, _))) => {
+                            Some((n, v.iter().flat_map(|x| (c * *x).to_array()).collect(), l))
+                        }
+                        (Some((c, l)), None) => Some(([1, 1, 1], c.to_array().to_vec(), l)),
+                        // pbrt-v4 reads a scale without Le as no emission.
+                        (None, _) => None,
+                    }
+                };
                 let corner = |p: &mut Bag, k: &str, default: DVec3| -> Result<DVec3> {
                     Ok(p.numbers(k, &[Type::Point3])?
                         .map_or(default, |(v, _)| vec(&v)))
@@ -194,25 +223,16 @@ impl Reader {
                 if g.abs() >= 1.0 {
                     return Err(loc.error(&what, format!("\"g\" {g}: must be within (-1, 1)")));
                 }
-                // The extinction with a border of zeros: (n + 2) samples per axis at the
-                // centres of cells of the same size, the first one a cell before p0.
-                let padded = n.map(|x| x + 2);
-                let mut values = vec![0.0; padded[0] * padded[1] * padded[2] * channels];
-                for z in 0..n[2] {
-                    for y in 0..n[1] {
-                        for x in 0..n[0] {
-                            let to = ((z + 1) * padded[1] + y + 1) * padded[0] + x + 1;
-                            let from = (z * n[1] + y) * n[0] + x;
-                            values[to * channels..(to + 1) * channels].copy_from_slice(
-                                &extinction[from * channels..(from + 1) * channels],
-                            );
-                        }
-                    }
-                }
-                let cell = size / DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
-                let padded_box = self.state.ctm
-                    * DMat4::from_translation(p0 - cell)
-                    * DMat4::from_scale(size + 2.0 * cell);
+                // A grid of n samples over [p0, p1] as pbrt-v4's `SampledGrid` reads it.
+                let sampled =
+                    |r: &Reader, n: [usize; 3], values: &[f64], channels: usize, l: &Loc| {
+                        let (padded, values) = bordered(n, values, channels);
+                        let cell = size / DVec3::new(n[0] as f64, n[1] as f64, n[2] as f64);
+                        let padded_box = r.state.ctm
+                            * DMat4::from_translation(p0 - cell)
+                            * DMat4::from_scale(size + 2.0 * cell);
+                        r.grid_table(padded, &values, padded_box, "zero", l)
+                    };
                 entries.push(("type", self.string("heterogeneous", &loc)));
                 entries.push(("sigma_t", self.vec3(sigma_t, &loc)));
                 match albedo_grid {
@@ -227,8 +247,13 @@ impl Reader {
                     }
                     None => entries.push(("albedo", self.vec3(albedo, &loc))),
                 }
-                let density = self.grid_table(padded, &values, padded_box, "zero", &dloc);
+                let density = sampled(self, n, &extinction, channels, &dloc);
                 entries.push(("density", density));
+                if let Some((res, values, l)) = emission
+                    && values.iter().any(|x| *x > 0.0)
+                {
+                    entries.push(("emission", sampled(self, res, &values, 3, &l)));
+                }
                 if g != 0.0 {
                     entries.push(("phase", self.phase(g, &loc)));
                 }
@@ -256,20 +281,28 @@ impl Reader {
         Ok(())
     }
 
-    /// Emission parameters of a medium: refused (foton's media do not emit yet), unless zero.
-    fn emission(&mut self, p: &mut Bag, what: &str, names: &[&str]) -> Result<()> {
-        for n in names {
-            if let Some(q) = p.take(n) {
-                let zero = matches!(&q.values, Values::Nums(v) if v.iter().all(|x| *x == 0.0));
-                let scale_only =
-                    n.ends_with("scale") || n.ends_with("offset") || n.ends_with("cutoff");
-                if !zero && !scale_only {
-                    self.unsupported(
-                        &q.loc,
-                        what,
-                        &format!("{}: emitting media are not read yet", q.decl()),
-                    )?;
-                }
+    /// A grid's `temperature` (blackbody emission): refused unless all zero (pbrt-v4
+    /// interpolates the temperature and then takes its blackbody, which a colour grid cannot
+    /// reproduce).
+    fn temperature(&mut self, p: &mut Bag, what: &str) -> Result<()> {
+        for n in [
+            "temperature",
+            "temperatureoffset",
+            "temperaturecutoff",
+            "temperaturescale",
+        ] {
+            if let Some(q) = p.take(n)
+                && n == "temperature"
+                && !matches!(&q.values, Values::Nums(v) if v.iter().all(|x| *x == 0.0))
+            {
+                self.unsupported(
+                    &q.loc,
+                    what,
+                    &format!(
+                        "{}: media emitting by temperature are not read yet",
+                        q.decl()
+                    ),
+                )?;
             }
         }
         Ok(())
@@ -356,6 +389,24 @@ impl Reader {
             ("exterior", self.string(&o, loc)),
         ]
     }
+}
+
+/// `values` (`channels` per sample) on `n` samples with a border of zeros: (n + 2) samples
+/// per axis at the centres of cells of the same size, the first one a cell before the grid's.
+fn bordered(n: [usize; 3], values: &[f64], channels: usize) -> ([usize; 3], Vec<f64>) {
+    let padded = n.map(|x| x + 2);
+    let mut out = vec![0.0; padded[0] * padded[1] * padded[2] * channels];
+    for z in 0..n[2] {
+        for y in 0..n[1] {
+            for x in 0..n[0] {
+                let to = ((z + 1) * padded[1] + y + 1) * padded[0] + x + 1;
+                let from = (z * n[1] + y) * n[0] + x;
+                out[to * channels..(to + 1) * channels]
+                    .copy_from_slice(&values[from * channels..(from + 1) * channels]);
+            }
+        }
+    }
+    (padded, out)
 }
 
 /// A measured medium (`core/data/media/measured.csv`, pbrt-v4's presets): sigma_s and

@@ -1123,3 +1123,65 @@ fn rgb_grid_media_are_an_rgb_extinction_and_albedo() {
     );
     assert_eq!(text(&t, "media.m.albedo.outside"), "clamp");
 }
+
+#[test]
+fn emitting_media_read_le_times_its_scale() {
+    let t = doc(&format!(
+        "{WORLD}MakeNamedMedium \"h\" \"string type\" \"homogeneous\" \"rgb Le\" [1 2 3] \"float Lescale\" 2\n\
+         MakeNamedMedium \"g\" \"string type\" \"uniformgrid\" \"integer nx\" 2 \"float density\" [1 1] \"rgb Le\" [1 0.5 0] \"float Lescale\" [2 4]\n\
+         MakeNamedMedium \"c\" \"string type\" \"uniformgrid\" \"float density\" [1] \"rgb Le\" [3 3 3]\n\
+         MakeNamedMedium \"r\" \"string type\" \"rgbgrid\" \"integer nx\" 2 \"rgb sigma_a\" [1 1 1  1 1 1] \"rgb Le\" [1 0 0  0 1 0] \"float Lescale\" 3\n\
+         MakeNamedMedium \"n\" \"string type\" \"uniformgrid\" \"float density\" [1] \"float Lescale\" [5]\n"
+    ));
+    assert!(close(&nums(&t, "media.h.emission"), &[2.0, 4.0, 6.0]));
+    // Le x Lescale per sample (3 channels), bordered by zeros as the density.
+    assert!(close(
+        &nums(&t, "media.g.emission.resolution"),
+        &[4.0, 3.0, 3.0]
+    ));
+    let v = nums(&t, "media.g.emission.values");
+    assert_eq!(
+        &v[(12 + 4 + 1) * 3..(12 + 4 + 3) * 3],
+        &[2.0, 1.0, 0.0, 4.0, 2.0, 0.0]
+    );
+    assert_eq!(text(&t, "media.g.emission.outside"), "zero");
+    // Without Lescale, Le on one sample at the box's centre (pbrt-v4's 1 x 1 x 1 grid).
+    assert!(close(
+        &nums(&t, "media.c.emission.resolution"),
+        &[3.0, 3.0, 3.0]
+    ));
+    assert_eq!(
+        nums(&t, "media.c.emission.values")[13 * 3..14 * 3],
+        [3.0, 3.0, 3.0]
+    );
+    let v = nums(&t, "media.r.emission.values");
+    assert_eq!(
+        &v[(12 + 4 + 1) * 3..(12 + 4 + 3) * 3],
+        &[3.0, 0.0, 0.0, 0.0, 3.0, 0.0]
+    );
+    // A scale without Le emits nothing.
+    assert!(!has(&t, "media.n.emission"));
+    // A grid of scales must have one per sample; an RGB grid's Le needs sigma_a; a
+    // temperature grid is not read.
+    for (params, words) in [
+        (
+            "\"uniformgrid\" \"integer nx\" 2 \"float density\" [1 1] \"rgb Le\" [1 1 1] \"float Lescale\" [2]",
+            "\"Lescale\" has 1 values",
+        ),
+        (
+            "\"rgbgrid\" \"rgb sigma_s\" [1 1 1] \"rgb Le\" [1 1 1]",
+            "needs \"sigma_a\"",
+        ),
+        (
+            "\"uniformgrid\" \"float density\" [1] \"float temperature\" [1500]",
+            "emitting by temperature are not read yet",
+        ),
+    ] {
+        let e = read(
+            &format!("{WORLD}MakeNamedMedium \"m\" \"string type\" {params}\n"),
+            false,
+        )
+        .unwrap_err();
+        assert!(e.contains(words), "{params}: {e}");
+    }
+}

@@ -1,0 +1,203 @@
+//! Media that emit (pbrt-v4's `Le`): sigma_a Le per metre along a ray, in the integrators
+//! that render it (`path`, `bdpt`), against closed forms; the photon mappers refuse it.
+
+use foton_core::Rgb;
+use foton_core::geometry::Ray;
+use foton_core::medium::Medium;
+use foton_tests::{header, region_mean, render_toml, repo_root};
+use glam::Vec3;
+
+/// A cube [-1, 1]^3 of `medium` (TOML of `[media.glow]`) behind a null boundary, seen by an
+/// orthographic camera along -z: every ray crosses 2 m of it, and nothing else.
+fn slab(integrator: &str, spp: u32, medium: &str) -> String {
+    header(integrator, spp, 8, 8, 8)
+        + &format!(
+            r#"
+[camera]
+type = "orthographic"
+position = [0.0, 0.0, 4.0]
+look_at = [0.0, 0.0, 0.0]
+up = [0.0, 1.0, 0.0]
+view_height = 1.0
+
+[materials.boundary]
+type = "null"
+
+[media.glow]
+{medium}
+
+[[shapes]]
+type = "mesh"
+file = "{cube}"
+material = "boundary"
+interior = "glow"
+
+[[lights]]
+type = "point"
+position = [0.0, 0.0, -40.0]
+intensity = [0.0, 0.0, 0.0]
+"#,
+            cube = repo_root().join("scenes/meshes/cube.obj").display()
+        )
+}
+
+/// The mean over the image and its standard error.
+fn image_mean(film: &foton_core::film::Film) -> (Vec3, Vec3) {
+    region_mean(film, 0, 0, film.width, film.height)
+}
+
+fn assert_within(what: &str, got: (Vec3, Vec3), want: Vec3, rel: f32) {
+    let (mean, se) = got;
+    for c in 0..3 {
+        let err = (mean[c] - want[c]).abs();
+        assert!(
+            err <= rel * want[c] + 4.0 * se[c],
+            "{what}: channel {c}: {} against {} (standard error {})",
+            mean[c],
+            want[c],
+            se[c]
+        );
+    }
+}
+
+/// A purely absorbing medium whose emission falls linearly from a + b where the rays enter to
+/// a where they leave, 2 m on: L = int_0^2 sigma e^(-sigma t) (a + b (1 - t/2)) dt
+/// = (a + b)(1 - e^(-2 sigma)) - (b / 2)(1 - e^(-2 sigma)(1 + 2 sigma)) / sigma, per channel
+/// (sigma coloured: the spectral MIS of the emission estimate).
+#[test]
+fn an_absorbing_slab_with_an_emission_gradient_shows_its_integral() {
+    let sigma = Vec3::new(0.3, 1.0, 2.0);
+    let (a, b) = (Vec3::new(1.0, 0.5, 2.0), Vec3::new(3.0, 1.0, 0.5));
+    let e2 = (-2.0 * sigma).exp();
+    let want =
+        (a + b) * (Vec3::ONE - e2) - b / 2.0 * (Vec3::ONE - e2 * (Vec3::ONE + 2.0 * sigma)) / sigma;
+    // Two samples along z on the cube's corners: z = -1 (where rays leave) and z = +1.
+    let lo = a;
+    let hi = a + b;
+    let medium = format!(
+        r#"type = "heterogeneous"
+sigma_t = [{}, {}, {}]
+density = 1.0
+albedo = 0.0
+emission = {{ resolution = [1, 1, 2], values = [{}, {}, {}, {}, {}, {}], samples = "corners", transform = {{ translate = [-1.0, -1.0, -1.0], scale = [2.0, 2.0, 2.0] }} }}
+"#,
+        sigma.x, sigma.y, sigma.z, lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+    );
+    for integrator in ["path", "bdpt"] {
+        let film = render_toml(
+            &format!("emission-slab-{integrator}"),
+            &slab(integrator, 1024, &medium),
+            &[],
+            2,
+        );
+        assert_within(
+            &format!("{integrator}, emission gradient"),
+            image_mean(&film),
+            want,
+            0.01,
+        );
+    }
+}
+
+/// In an emitting medium that fills all space, radiance is Le everywhere, whatever the
+/// albedo: L = int_0^inf e^(-sigma_t t) (sigma_s L + sigma_a Le) dt gives
+/// sigma_t L = sigma_s L + sigma_a Le, so L = Le (the furnace of emission). Coloured
+/// coefficients; the camera in the medium, scattered paths collecting emission at every
+/// event.
+#[test]
+fn an_emitting_medium_filling_space_is_in_equilibrium() {
+    let le = Vec3::new(1.0, 2.0, 0.5);
+    let toml = header("INTEGRATOR", 64, 400, 8, 8)
+        + r#"
+[scene]
+medium = "glow"
+
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+fov = 60.0
+
+[media.glow]
+type = "homogeneous"
+sigma_a = [0.5, 0.2, 1.0]
+sigma_s = [0.5, 0.8, 0.25]
+emission = [1.0, 2.0, 0.5]
+
+[[lights]]
+type = "point"
+position = [0.0, 0.0, -4.0]
+intensity = [0.0, 0.0, 0.0]
+"#;
+    for integrator in ["path", "bdpt"] {
+        let film = render_toml(
+            &format!("emission-furnace-{integrator}"),
+            &toml.replace("INTEGRATOR", integrator),
+            &[],
+            2,
+        );
+        assert_within(
+            &format!("{integrator}, emitting medium everywhere"),
+            image_mean(&film),
+            le,
+            0.01,
+        );
+    }
+}
+
+/// The estimate of one free-flight sample: emission weight times the integrand equals, in
+/// expectation, int_0^tmax Tr sigma_a Le dt; here checked exactly for the pieces it is made of
+/// (the medium's `emitted` at an event is Tr(t) sigma_a Le, zero when passing).
+#[test]
+fn a_free_flight_event_carries_the_emission_integrand() {
+    let m = foton_core::medium::Homogeneous {
+        sigma_a: Rgb::new(0.5, 1.0, 0.0),
+        sigma_s: Rgb::new(0.5, 0.0, 1.0),
+        phase: foton_core::medium::Phase::Isotropic,
+        emission: Rgb::new(2.0, 3.0, 4.0),
+    };
+    assert!(m.is_emissive());
+    let ray = Ray::new(Vec3::ZERO, Vec3::X);
+    let f = m.sample_free_flight(&ray, 100.0, 0, 0.5);
+    assert!(f.scattered);
+    let tr = (-(m.sigma_a + m.sigma_s) * f.t).exp();
+    let want = m.sigma_a * m.emission * tr;
+    assert!(
+        (f.emitted - want).abs().max_element() < 1e-6,
+        "{:?} against {want:?}",
+        f.emitted
+    );
+    let passed = m.sample_free_flight(&ray, 1e-3, 0, 0.5);
+    assert!(!passed.scattered);
+    assert_eq!(passed.emitted, Rgb::ZERO);
+    // Not emitting without absorption.
+    let clear = foton_core::medium::Homogeneous {
+        sigma_a: Rgb::ZERO,
+        ..m
+    };
+    assert!(!clear.is_emissive());
+}
+
+/// The photon mappers leave the lights only: a scene with an emitting medium is refused, with
+/// the medium's name and what renders it.
+#[test]
+fn photon_mappers_refuse_emitting_media() {
+    let medium = "type = \"homogeneous\"\nsigma_a = [1.0, 1.0, 1.0]\nemission = [1.0, 1.0, 1.0]\n";
+    for integrator in ["vpm", "ppb"] {
+        let dir = foton_tests::temp_dir(&format!("emission-refused-{integrator}"));
+        let path = foton_tests::write(&dir, "scene.toml", &slab(integrator, 1, medium));
+        let run = foton_tests::foton_with_plugins(&[
+            "render",
+            path.to_str().unwrap(),
+            "-o",
+            dir.join("out.exr").to_str().unwrap(),
+        ]);
+        let err = run.stderr;
+        assert_ne!(run.code, 0, "{integrator} rendered an emitting medium");
+        assert!(
+            err.contains("\"glow\" emits light") && err.contains("use `path` or `bdpt`"),
+            "{integrator}: {err}"
+        );
+        let _ = std::fs::remove_dir_all(dir);
+    }
+}
