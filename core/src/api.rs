@@ -61,8 +61,8 @@ pub use crate::walk::{
 
 // Sampling.
 pub use crate::sampling::{
-    Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, power_heuristic, russian_roulette,
-    splitmix64, uniform_sphere,
+    Distribution1D, Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, power_heuristic,
+    russian_roulette, splitmix64, uniform_sphere,
 };
 
 // The image.

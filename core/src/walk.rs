@@ -332,6 +332,16 @@ pub fn walk_to_diffuse(
     loop {
         let seg = walk.segment(scene, rays);
         if let Some(m) = seg.interacting_medium(scene) {
+            if m.is_emissive() {
+                // The medium's own emission along the segment, by one free-flight sample
+                // (the collision estimator, as `path` finds it).
+                let c = crate::medium::channel(sampler.next_f32());
+                let flight =
+                    m.sample_free_flight(&seg.start(), seg.length(), c, sampler.next_f32());
+                let e = beta * flight.emission_weight();
+                emitted += e;
+                emission += e;
+            }
             let scattered = beta * in_medium(&seg, m, bounces, sampler, rays);
             emitted += scattered;
             in_scattered += scattered;

@@ -42,6 +42,28 @@ impl Scene {
         )
     }
 
+    /// A box around the region medium `id` fills: the shapes on either side of which it is.
+    /// None if it is the scene's medium (it fills all space outside the shapes) or no shape
+    /// borders it. For sampling points of an emitting medium: within its region the medium at
+    /// a point is still [`Scene::medium_at`]'s.
+    pub fn medium_region(&self, id: u32) -> Option<(Vec3, Vec3)> {
+        if self.medium == Some(id) {
+            return None;
+        }
+        let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+        for prim in self.accel.primitives() {
+            let Some(Some(iface)) = self.interfaces.get(prim.object as usize) else {
+                continue;
+            };
+            if iface.inside == Some(id) || iface.outside == Some(id) {
+                let b = prim.shape.aabb();
+                lo = lo.min(Vec3::from(b.min));
+                hi = hi.max(Vec3::from(b.max));
+            }
+        }
+        lo.cmple(hi).all().then_some((lo, hi))
+    }
+
     /// The medium light `i` emits into (None: vacuum): the one the file puts it in (a point or
     /// spot light's `medium`, an area light's exterior when its shape names it), or the one
     /// found just off its emitting side (an area light is taken to lie in one medium). An

@@ -1,11 +1,13 @@
 //! foton-photonmap: the photon machinery that the photon-mapping integrators (`photon`,
 //! `sppm`, `vpm`, `ppb`) share, linked into each of them. An ordinary library crate, not a plugin.
 //!
-//! - [`trace`]: the photon pass: photons leave the lights in proportion to power, walk the
-//!   scene (surfaces and media, through core's `walk::RayWalk`, the one null-boundary crossing
-//!   loop) by BSDF and phase-function sampling with Russian roulette, and are offered for
-//!   storage at every non-delta surface and scattering event, classified by their path (L D,
-//!   L S+ D, the rest); the caller sorts them into its maps;
+//! - [`trace`]: the photon pass: photons leave the lights and emitting media in proportion to
+//!   power, walk the scene (surfaces and media, through core's `walk::RayWalk`, the one
+//!   null-boundary crossing loop) by BSDF and phase-function sampling with Russian roulette,
+//!   and are offered for storage at every non-delta surface and scattering event, classified
+//!   by their path (L D, L S+ D, the rest); the caller sorts them into its maps;
+//! - [`sources`]: where photons start: the lights, and media that emit (a point drawn over
+//!   a lattice of the medium's region, a direction over the sphere);
 //! - [`map`]: the compact photon (32 bytes) and the photon map (a balanced kd-tree) with its
 //!   k-nearest (`knn`), fixed-radius (`within`) and beam (`along_ray`) queries, and the
 //!   density estimates made from them: `radiance` (reflected radiance, the BSDF evaluated per
@@ -37,6 +39,7 @@ pub mod beams;
 pub mod map;
 pub mod progressive;
 pub mod screen;
+pub mod sources;
 pub mod surface;
 pub mod trace;
 pub mod twolevel;

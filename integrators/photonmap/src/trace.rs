@@ -1,34 +1,22 @@
-//! The photon pass shared by the photon-mapping integrators: photons leave the lights in
-//! proportion to power, walk the scene by BSDF sampling with Russian roulette, and are
+//! The photon pass shared by the photon-mapping integrators: photons leave the lights (and
+//! emitting media, `sources`) in proportion to power, walk the scene by BSDF sampling with Russian roulette, and are
 //! offered for storage at every diffuse (non-delta) surface they reach, classified by the
 //! path that brought them there (Jensen's L D, L S+ D and the rest).
 //!
 //! A photon leaving light l carries (power of l) / (pmf(l) x photons emitted); lights are
 //! chosen with pmf proportional to power, so that is (total power) / (photons emitted),
-//! counting the photons that hit nothing. Photon i draws from its own random stream, so the
+//! counting the photons that hit nothing (`sources` says the same of media). Photon i draws from its own random stream, so the
 //! maps are identical whatever the number of threads.
 
 use crate::beams::{Beam, BeamKind, exit_distance};
 use crate::map::Photon;
+use crate::sources::Sources;
 use foton_core::api::{
-    Error, HeroChannel, Ray, RayWalk, Reached, RenderContext, Result, Rgb, Rng, SOBOL_DIMENSIONS,
+    HeroChannel, Ray, RayWalk, Reached, RenderContext, Result, Rgb, Rng, SOBOL_DIMENSIONS,
     SamplerKind, Scene, SobolPoint, TransportMode, offset_origin, splitmix64, with_pool,
 };
 use glam::Vec2;
 use rayon::prelude::*;
-
-/// An error for a scene with an emitting medium: photons leave the lights only, so the
-/// photon mappers would miss what such a medium lights (`path` and `bdpt` render it).
-pub fn refuse_emissive_media(scene: &Scene, integrator: &str) -> Result<()> {
-    match scene.emissive_medium() {
-        Some(name) => Err(Error::Usage(format!(
-            "{}: medium {name:?} emits light, which `{integrator}` does not render yet (its \
-             photons leave the lights only): use `path` or `bdpt`",
-            scene.file().display()
-        ))),
-        None => Ok(()),
-    }
-}
 
 /// The path a photon took to reach a diffuse surface.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -90,7 +78,9 @@ pub enum Site {
 }
 
 /// Traces one photon, calling `store(photon, site, class)` at every diffuse surface hit and
-/// every scattering event in a medium. `light_media` is [`Scene::emission_media`].
+/// every scattering event in a medium, from one of `sources` (the lights, emitting media).
+/// A photon from an emitting medium is never in class `Direct` or `Caustic`: next-event
+/// estimation and the caustic pass's light paths start at lights.
 ///
 /// In a medium the photon samples a free-flight distance (spectral MIS over the colour
 /// channels along its whole path, as the path tracer); at a scattering event it is stored
@@ -101,11 +91,11 @@ pub enum Site {
 pub fn trace_one(
     scene: &Scene,
     opts: &TraceOptions,
-    light_media: &[Option<u32>],
+    sources: &Sources,
     index: u64,
     store: impl FnMut(Photon, Site, PathClass),
 ) {
-    trace_one_with_beams(scene, opts, light_media, index, None, store, |_, _| {});
+    trace_one_with_beams(scene, opts, sources, index, None, store, |_, _| {});
 }
 
 /// [`trace_one`], also calling `beam(beam, class)` for each flight through a medium that
@@ -115,7 +105,7 @@ pub fn trace_one(
 pub fn trace_one_with_beams(
     scene: &Scene,
     opts: &TraceOptions,
-    light_media: &[Option<u32>],
+    sources: &Sources,
     index: u64,
     beams: Option<BeamKind>,
     mut store: impl FnMut(Photon, Site, PathClass),
@@ -134,24 +124,26 @@ pub fn trace_one_with_beams(
     } else {
         u.iter_mut().for_each(|u| *u = rng.next_f32());
     }
-    let Some((light_id, pmf)) = scene.sample_light(u[0]) else {
+    let (u_pos, u_dir, uc) = (Vec2::new(u[1], u[2]), Vec2::new(u[3], u[4]), u[5]);
+    let Some(emitted) = sources.sample(scene, u[0], u_pos, u_dir, uc) else {
         return;
     };
-    let light = &scene.lights()[light_id];
-    let (u_pos, u_dir, uc) = (Vec2::new(u[1], u[2]), Vec2::new(u[3], u[4]), u[5]);
-    let emitted = light.sample_emission(u_pos, u_dir, uc);
-    let mut flux: Rgb = emitted.flux / (pmf * opts.photons as f32);
+    let mut flux: Rgb = emitted.power / (emitted.pdf * opts.photons as f32);
+    if emitted.from_medium && flux == Rgb::ZERO {
+        return; // a point of the region's box where another medium is
+    }
     let origin = if emitted.n == glam::Vec3::ZERO {
         emitted.origin
     } else {
         offset_origin(emitted.origin, emitted.n, emitted.dir)
     };
-    let mut walk = RayWalk::new(Ray::new(origin, emitted.dir), light_media[light_id]);
+    let mut walk = RayWalk::new(Ray::new(origin, emitted.dir), emitted.medium);
     let mut hero: Option<HeroChannel> = None;
     let mut hits = 0u32;
-    let mut specular_only = true;
+    let mut specular_only = !emitted.from_medium;
+    let from_light = !emitted.from_medium;
     let class_of = |hits: u32, specular_only: bool| {
-        if hits == 1 {
+        if hits == 1 && from_light {
             PathClass::Direct
         } else if specular_only {
             PathClass::Caustic
@@ -307,7 +299,7 @@ pub fn trace_photons_and_beams(
     beams: Option<BeamKind>,
     keep_beam: impl Fn(PathClass) -> bool + Sync,
 ) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
-    let media = scene.emission_media()?;
+    let sources = Sources::new(scene)?;
     ctx.progress.begin("photons", opts.photons);
     let chunk = chunk(opts.photons);
     let chunks = opts.photons.div_ceil(chunk);
@@ -326,7 +318,7 @@ pub fn trace_photons_and_beams(
                     trace_one_with_beams(
                         scene,
                         opts,
-                        &media,
+                        &sources,
                         i,
                         beams,
                         |p, site, class| {

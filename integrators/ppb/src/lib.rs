@@ -570,7 +570,6 @@ impl Integrator for Ppb {
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    foton_photonmap::trace::refuse_emissive_media(scene, "ppb")?;
     let diagonal = foton_photonmap::surface::diagonal(scene);
     let passes = PassBudget::read(props, 32, 2_500)?;
     let positive_opt = |key: &str| -> Result<Option<f32>> {

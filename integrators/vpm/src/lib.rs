@@ -617,7 +617,6 @@ const VOLUME: usize = 4;
 
 /// Reads the parameters (see the table above).
 pub fn create(props: &Properties<'_>, scene: &Scene) -> Result<Box<dyn Integrator>> {
-    foton_photonmap::trace::refuse_emissive_media(scene, "vpm")?;
     let diagonal = diagonal(scene);
     let pixels = scene.film().width as u64 * scene.film().height as u64;
     let defaults = SurfaceDefaults {

@@ -99,10 +99,10 @@ fn photons_deliver_irradiance_times_area() {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = scene.emission_media().unwrap();
+    let sources = foton_photonmap::sources::Sources::new(&scene).unwrap();
     let mut total = DVec3::ZERO;
     for i in 0..opts.photons {
-        trace_one(&scene, &opts, &media, i, |p, _, _| {
+        trace_one(&scene, &opts, &sources, i, |p, _, _| {
             // Those on the sphere's top were stored there: count the floor's only.
             if p.position.y.abs() < 1e-3 {
                 total += p.power().as_dvec3();

@@ -149,10 +149,10 @@ fn environment_photons(light: &str) {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = scene.emission_media().unwrap();
+    let sources = foton_photonmap::sources::Sources::new(&scene).unwrap();
     let mut total = DVec3::ZERO;
     for i in 0..opts.photons {
-        trace_one(&scene, &opts, &media, i, |p, _, _| {
+        trace_one(&scene, &opts, &sources, i, |p, _, _| {
             total += p.power().as_dvec3()
         });
     }

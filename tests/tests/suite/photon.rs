@@ -74,11 +74,11 @@ fn first_hits_in_a_closed_box_carry_all_the_power() {
         stop_at_diffuse: true,
         sobol_emission: false,
     };
-    let media = scene.emission_media().unwrap();
+    let sources = foton_photonmap::sources::Sources::new(&scene).unwrap();
     let mut sum = DVec3::ZERO;
     let mut count = 0;
     for i in 0..opts.photons {
-        trace_one(&scene, &opts, &media, i, |p, _, class| {
+        trace_one(&scene, &opts, &sources, i, |p, _, class| {
             assert_eq!(class, PathClass::Direct);
             sum += p.power().as_dvec3();
             count += 1;

@@ -55,11 +55,15 @@ fn balance(scene: &Scene, albedo: f64, photons: u64) -> (f64, f64, u64) {
         stop_at_diffuse: false,
         sobol_emission: false,
     };
-    let media = scene.emission_media().unwrap();
-    assert_eq!(media, vec![Some(0)], "the light is in the fog");
+    let sources = foton_photonmap::sources::Sources::new(scene).unwrap();
+    assert_eq!(
+        sources.light_media,
+        vec![Some(0)],
+        "the light is in the fog"
+    );
     let (mut escaped, mut absorbed, mut events) = (DVec3::ZERO, DVec3::ZERO, 0);
     for i in 0..photons {
-        trace_one(scene, &opts, &media, i, |p, site, class| match site {
+        trace_one(scene, &opts, &sources, i, |p, site, class| match site {
             Site::Surface => escaped += p.power().as_dvec3(),
             Site::Volume => {
                 absorbed += p.power().as_dvec3() * (1.0 - albedo) / albedo;
