@@ -9,10 +9,16 @@
 //! when a final gather replaces the indirect map's estimate at the visible point, in the
 //! caustic map, which is read there (`caustics_apart`).
 //! The **caustic** pass stores the L S+ D photons, traced to their first diffuse hit only.
-//! Each light path is thus counted once (docs/photon-mapping.md).
+//! Each light path is thus counted once (docs/photon-mapping.md). The global pass may also
+//! keep what its first photons do in media ([`VolumeShare`], `vpm`'s volume map): a volume
+//! pass that traces no photon of its own.
 
+use crate::beams::{Beam, BeamKind};
 use crate::map::{CLIP_PROBES, Disc, DiscClip, Estimate, Photon, PhotonMap};
-use crate::trace::{PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons};
+use crate::trace::{
+    PathClass, STREAM_CAUSTIC, STREAM_GLOBAL, Site, TraceOptions, trace_photons,
+    trace_photons_and_beams_indexed,
+};
 use foton_core::api::{
     Bsdf, Direct, Film, Hit, Mis, NormalizedKernel, Parameter, PhotonMapView, Properties, Ray,
     RenderContext, Result, Rgb, Sampler, Scatter, Scene, Techniques, Vec3, VisiblePoint,
@@ -42,6 +48,37 @@ pub fn trace_surface_photons(
     keep_direct: bool,
     caustics_apart: bool,
 ) -> Result<[Vec<Photon>; 3]> {
+    Ok(trace_surface_and_volume_photons(scene, ctx, budgets, keep_direct, caustics_apart, None)?.0)
+}
+
+/// What the photon passes store: the surface lists [direct, caustic, indirect], the volume
+/// photons and the photon beams.
+pub type PassLists = ([Vec<Photon>; 3], Vec<Photon>, Vec<Beam>);
+
+/// What the global pass also keeps in media: the volume photons (scattering events) and the
+/// beams (flights) of its first `photons` photons (at most the global budget), their flux
+/// scaled by global / `photons` so that they stand for a volume pass of that many photons.
+#[derive(Clone, Copy, Debug)]
+pub struct VolumeShare {
+    pub photons: u64,
+    /// Whether the scattering events are kept (the volume map's points).
+    pub points: bool,
+    /// The beams' kind (None: none).
+    pub beams: Option<BeamKind>,
+    /// Whether L M (first scattering events, a light's first flight) is kept.
+    pub keep_direct: bool,
+}
+
+/// [`trace_surface_photons`] and, with `volume`, the volume photons and beams the global
+/// pass's first photons leave in media.
+pub fn trace_surface_and_volume_photons(
+    scene: &Scene,
+    ctx: &RenderContext<'_>,
+    budgets: &Budgets,
+    keep_direct: bool,
+    caustics_apart: bool,
+    volume: Option<VolumeShare>,
+) -> Result<PassLists> {
     let pass = |photons, stream, stop_at_diffuse| TraceOptions {
         photons,
         max_depth: budgets.max_depth,
@@ -52,17 +89,45 @@ pub fn trace_surface_photons(
     };
     let caustic_map = budgets.caustic > 0;
     let global = pass(budgets.global, STREAM_GLOBAL, false);
-    let mut lists = trace_photons(scene, &global, ctx, 3, |site, class| {
-        if site != Site::Surface {
-            return None;
+    let share = volume.map(|v| VolumeShare {
+        photons: v.photons.min(budgets.global),
+        ..v
+    });
+    let in_share = |class: PathClass, i: u64| {
+        share.is_some_and(|v| i < v.photons && (class != PathClass::Direct || v.keep_direct))
+    };
+    let (mut lists, mut beams) = trace_photons_and_beams_indexed(
+        scene,
+        &global,
+        ctx,
+        4,
+        |site, class, i| {
+            if site == Site::Volume {
+                return (share.is_some_and(|v| v.points) && in_share(class, i)).then_some(3);
+            }
+            match class {
+                PathClass::Direct => keep_direct.then_some(0),
+                PathClass::Caustic if caustic_map => None,
+                PathClass::Caustic if caustics_apart => Some(1),
+                PathClass::Caustic | PathClass::Indirect => Some(2),
+            }
+        },
+        share.and_then(|v| v.beams),
+        in_share,
+    )?;
+    let mut volume_photons = lists.pop().unwrap();
+    if let Some(v) = share
+        && v.photons > 0
+        && v.photons < budgets.global
+    {
+        let scale = budgets.global as f32 / v.photons as f32;
+        for p in &mut volume_photons {
+            p.power = p.power.map(|c| c * scale);
         }
-        match class {
-            PathClass::Direct => keep_direct.then_some(0),
-            PathClass::Caustic if caustic_map => None,
-            PathClass::Caustic if caustics_apart => Some(1),
-            PathClass::Caustic | PathClass::Indirect => Some(2),
+        for b in &mut beams {
+            b.flux *= scale;
         }
-    })?;
+    }
     let indirect = lists.pop().unwrap();
     let global_caustic = lists.pop().unwrap();
     let direct = lists.pop().unwrap();
@@ -76,7 +141,7 @@ pub fn trace_surface_photons(
     } else {
         global_caustic
     };
-    Ok([direct, caustic, indirect])
+    Ok(([direct, caustic, indirect], volume_photons, beams))
 }
 
 /// The parameters of the surface maps and their estimate, which `photon` and `vpm` read

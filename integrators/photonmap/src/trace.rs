@@ -299,6 +299,28 @@ pub fn trace_photons_and_beams(
     beams: Option<BeamKind>,
     keep_beam: impl Fn(PathClass) -> bool + Sync,
 ) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
+    trace_photons_and_beams_indexed(
+        scene,
+        opts,
+        ctx,
+        lists,
+        |site, class, _| sort(site, class),
+        beams,
+        |class, _| keep_beam(class),
+    )
+}
+
+/// [`trace_photons_and_beams`] whose `sort` and `keep_beam` are also told the photon's index
+/// (its place in emission order, 0 to `opts.photons` - 1).
+pub fn trace_photons_and_beams_indexed(
+    scene: &Scene,
+    opts: &TraceOptions,
+    ctx: &RenderContext<'_>,
+    lists: usize,
+    sort: impl Fn(Site, PathClass, u64) -> Option<usize> + Sync,
+    beams: Option<BeamKind>,
+    keep_beam: impl Fn(PathClass, u64) -> bool + Sync,
+) -> Result<(Vec<Vec<Photon>>, Vec<Beam>)> {
     let sources = Sources::new(scene)?;
     ctx.progress.begin("photons", opts.photons);
     let chunk = chunk(opts.photons);
@@ -322,12 +344,12 @@ pub fn trace_photons_and_beams(
                         i,
                         beams,
                         |p, site, class| {
-                            if let Some(list) = sort(site, class) {
+                            if let Some(list) = sort(site, class, i) {
                                 out[list].push(p);
                             }
                         },
                         |b, class| {
-                            if keep_beam(class) {
+                            if keep_beam(class, i) {
                                 out_beams.push(b);
                             }
                         },

@@ -44,11 +44,15 @@
 //! fewer than k is not: its estimates take `max_radius`).
 //!
 //! **Photons** (foton-photonmap's photon pass through media, `foton_photonmap::trace`): three
-//! budgets, each with its own random stream. The global pass stores surface photons in the
-//! direct (only if `direct = "photons"`) and indirect maps; the caustic pass stores L S+ D
-//! surface photons; the volume pass stores photons at scattering events in media, the volume
-//! map (with `direct = "nee"` the first scattering events, L M, are not stored: shadow rays
-//! count them). `foton photons` draws the maps `global`, `caustic` and `volume`.
+//! budgets. The global pass stores surface photons in the direct (only if `direct =
+//! "photons"`) and indirect maps; the caustic pass stores L S+ D surface photons; the volume
+//! budget stores photons at scattering events in media, the volume map (with `direct = "nee"`
+//! the first scattering events, L M, are not stored: shadow rays count them). The volume
+//! budget is the global pass's first `volume_photons` photons when it is no larger (their
+//! volume photons' flux scaled by global / volume): the media are walked once for both maps,
+//! which took a third of the photon tracing on `fog_box.toml`; a larger volume budget is a
+//! pass of its own, with its own random stream. `foton photons` draws the maps `global`,
+//! `caustic` and `volume`.
 //!
 //! **Camera rays** are followed by core's camera walk (`foton_core::api::walk_to_diffuse`)
 //! through null boundaries and delta surfaces (murky glass included), tracking the medium.
@@ -125,12 +129,13 @@ use foton_core::api::{
     Vec3, Work, estimate_direct, walk_to_diffuse, with_pool,
 };
 use foton_photonmap::beams::{
-    Beam, BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
+    BeamKind, BeamMap, Kernel1d, default_beam_radius, exit_distance, read_beam_type,
 };
-use foton_photonmap::map::{Estimate, Photon, PhotonMap, with_scratch};
+use foton_photonmap::map::{Estimate, PhotonMap, with_scratch};
 use foton_photonmap::surface::{
-    SurfaceDefaults, SurfaceMaps, SurfaceParams, check_k, diagonal, read_k, read_positive,
-    render_with_maps, render_with_maps_techniques, surface_views, trace_surface_photons,
+    PassLists, SurfaceDefaults, SurfaceMaps, SurfaceParams, VolumeShare, check_k, diagonal, read_k,
+    read_positive, render_with_maps, render_with_maps_techniques, surface_views,
+    trace_surface_and_volume_photons, trace_surface_photons,
 };
 use foton_photonmap::trace::{
     PathClass, STREAM_VOLUME, Site, TraceOptions, trace_photons_and_beams,
@@ -192,10 +197,6 @@ pub struct Maps {
     pub bounds: (Vec3, Vec3),
 }
 
-/// What the photon passes store: the surface lists [direct, caustic, indirect], the volume
-/// photons and the photon beams.
-type PassLists = ([Vec<Photon>; 3], Vec<Photon>, Vec<Beam>);
-
 impl Vpm {
     /// The three photon passes: the surface maps' two (foton-photonmap's surface passes:
     /// [direct, caustic, indirect], the direct list only if `keep_direct`) and the volume
@@ -208,9 +209,30 @@ impl Vpm {
         keep_direct: bool,
     ) -> Result<PassLists> {
         let budgets = self.surface.budgets(self.max_depth);
-        let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
         let photons_direct = self.direct == Direct::Photons;
-        let (volume, beams) = if self.volume_photons > 0 && scene.has_media() {
+        let wants_volume = self.volume_photons > 0 && scene.has_media();
+        let beams = (self.estimate == VolumeEstimate::Beams).then_some(self.beam_type);
+        if wants_volume && self.volume_photons <= budgets.global {
+            // The global pass's first photons are the volume pass: their walks through the
+            // media are traced once for both maps.
+            let share = VolumeShare {
+                photons: self.volume_photons,
+                points: self.estimate != VolumeEstimate::Beams,
+                beams,
+                keep_direct: photons_direct,
+            };
+            let (surface, volume, beams) = trace_surface_and_volume_photons(
+                scene,
+                ctx,
+                &budgets,
+                keep_direct,
+                false,
+                Some(share),
+            )?;
+            return Ok((surface, volume, beams));
+        }
+        let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
+        let (volume, beams) = if wants_volume {
             let opts = TraceOptions {
                 photons: self.volume_photons,
                 max_depth: self.max_depth,
@@ -221,7 +243,6 @@ impl Vpm {
             };
             // Each light path once: L M by shadow rays unless direct = "photons".
             let keep = |class| class != PathClass::Direct || photons_direct;
-            let beams = (self.estimate == VolumeEstimate::Beams).then_some(self.beam_type);
             let (mut lists, beams) = trace_photons_and_beams(
                 scene,
                 &opts,
