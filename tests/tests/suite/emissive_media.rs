@@ -42,6 +42,38 @@ intensity = [0.0, 0.0, 0.0]
         )
 }
 
+/// A camera at the origin inside `medium` (TOML of `[media.glow]`), the scene's medium that
+/// fills all space, and a point light of `intensity` 4 m ahead.
+fn glow_everywhere(
+    integrator: &str,
+    spp: u32,
+    max_depth: u32,
+    medium: &str,
+    intensity: f32,
+) -> String {
+    header(integrator, spp, max_depth, 8, 8)
+        + &format!(
+            r#"
+[scene]
+medium = "glow"
+
+[camera]
+position = [0.0, 0.0, 0.0]
+look_at = [0.0, 0.0, -1.0]
+up = [0.0, 1.0, 0.0]
+fov = 60.0
+
+[media.glow]
+{medium}
+
+[[lights]]
+type = "point"
+position = [0.0, 0.0, -4.0]
+intensity = [{intensity}, {intensity}, {intensity}]
+"#
+        )
+}
+
 /// The mean over the image and its standard error.
 fn image_mean(film: &foton_core::film::Film) -> (Vec3, Vec3) {
     region_mean(film, 0, 0, film.width, film.height)
@@ -108,32 +140,11 @@ emission = {{ resolution = [1, 1, 2], values = [{}, {}, {}, {}, {}, {}], samples
 #[test]
 fn an_emitting_medium_filling_space_is_in_equilibrium() {
     let le = Vec3::new(1.0, 2.0, 0.5);
-    let toml = header("INTEGRATOR", 64, 400, 8, 8)
-        + r#"
-[scene]
-medium = "glow"
-
-[camera]
-position = [0.0, 0.0, 0.0]
-look_at = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-fov = 60.0
-
-[media.glow]
-type = "homogeneous"
-sigma_a = [0.5, 0.2, 1.0]
-sigma_s = [0.5, 0.8, 0.25]
-emission = [1.0, 2.0, 0.5]
-
-[[lights]]
-type = "point"
-position = [0.0, 0.0, -4.0]
-intensity = [0.0, 0.0, 0.0]
-"#;
+    let medium = "type = \"homogeneous\"\nsigma_a = [0.5, 0.2, 1.0]\nsigma_s = [0.5, 0.8, 0.25]\nemission = [1.0, 2.0, 0.5]";
     for integrator in ["path", "bdpt"] {
         let film = render_toml(
             &format!("emission-furnace-{integrator}"),
-            &toml.replace("INTEGRATOR", integrator),
+            &glow_everywhere(integrator, 64, 400, medium, 0.0),
             &[],
             2,
         );
@@ -339,27 +350,11 @@ intensity = [0.0, 0.0, 0.0]
 /// mappers refuse it, naming the medium and what renders it.
 #[test]
 fn photon_mappers_refuse_an_emitting_medium_around_everything() {
-    let toml = header("INTEGRATOR", 1, 8, 8, 8)
-        + r#"
-[scene]
-medium = "glow"
-[camera]
-position = [0.0, 0.0, 0.0]
-look_at = [0.0, 0.0, -1.0]
-up = [0.0, 1.0, 0.0]
-fov = 60.0
-[media.glow]
-type = "homogeneous"
-sigma_a = [1.0, 1.0, 1.0]
-emission = [1.0, 1.0, 1.0]
-[[lights]]
-type = "point"
-position = [0.0, 0.0, -4.0]
-intensity = [1.0, 1.0, 1.0]
-"#;
+    let medium = "type = \"homogeneous\"\nsigma_a = [1.0, 1.0, 1.0]\nemission = [1.0, 1.0, 1.0]";
     for integrator in ["vpm", "ppb"] {
         let dir = foton_tests::temp_dir(&format!("emission-refused-{integrator}"));
-        let path = foton_tests::write(&dir, "scene.toml", &toml.replace("INTEGRATOR", integrator));
+        let toml = glow_everywhere(integrator, 1, 8, medium, 1.0);
+        let path = foton_tests::write(&dir, "scene.toml", &toml);
         let run = foton_tests::foton_with_plugins(&[
             "render",
             path.to_str().unwrap(),
