@@ -155,13 +155,9 @@ impl Sources {
         u_dir: Vec2,
         uc: f32,
     ) -> Option<Start> {
-        if u_source < self.light_fraction || self.media.is_empty() {
-            let u = if self.media.is_empty() {
-                u_source
-            } else {
-                u_source / self.light_fraction
-            };
-            let (light_id, pmf) = scene.sample_light(u)?;
+        if u_source < self.light_fraction {
+            // Without emitting media the fraction is 1: u_source itself, the light's pmf as is.
+            let (light_id, pmf) = scene.sample_light(u_source / self.light_fraction)?;
             let emitted = scene.lights()[light_id].sample_emission(u_pos, u_dir, uc);
             return Some(Start {
                 origin: emitted.origin,

@@ -141,9 +141,8 @@ pub fn trace_one_with_beams(
     let mut hero: Option<HeroChannel> = None;
     let mut hits = 0u32;
     let mut specular_only = !emitted.from_medium;
-    let from_light = !emitted.from_medium;
     let class_of = |hits: u32, specular_only: bool| {
-        if hits == 1 && from_light {
+        if hits == 1 && !emitted.from_medium {
             PathClass::Direct
         } else if specular_only {
             PathClass::Caustic

@@ -221,15 +221,14 @@ impl Vpm {
                 beams,
                 keep_direct: photons_direct,
             };
-            let (surface, volume, beams) = trace_surface_and_volume_photons(
+            return trace_surface_and_volume_photons(
                 scene,
                 ctx,
                 &budgets,
                 keep_direct,
                 false,
                 Some(share),
-            )?;
-            return Ok((surface, volume, beams));
+            );
         }
         let surface = trace_surface_photons(scene, ctx, &budgets, keep_direct, false)?;
         let (volume, beams) = if wants_volume {
