@@ -372,8 +372,8 @@ fn build_range(photons: &mut [Photon], axis: &mut [u8], split: &mut [f32]) {
     }
 }
 
-/// The k best neighbours so far: a max-heap kept as an array, or for a small k an unsorted
-/// array (`offer_small`).
+/// The k best neighbours so far: a max-heap kept as an array (`offer`), or for a small k an
+/// unsorted array (`offer_small`).
 struct Candidates<'a> {
     items: &'a mut Vec<Neighbour>,
     k: usize,
@@ -386,9 +386,6 @@ struct Candidates<'a> {
 impl Candidates<'_> {
     #[inline]
     fn offer(&mut self, n: Neighbour) {
-        if self.k <= SMALL_K {
-            return self.offer_small(n);
-        }
         if self.items.len() < self.k {
             self.items.push(n);
             sift_up(self.items);
@@ -611,12 +608,22 @@ impl PhotonMap {
             worst: 0,
         };
         let mut r2 = cand.r2;
-        self.search(p, &mut r2, |i, d2, r2| {
-            if accept(&self.photons[i as usize], *r2) {
-                cand.offer(Neighbour { d2, index: i });
-                *r2 = cand.r2;
-            }
-        });
+        // One search loop per kind of candidate list, chosen once per query.
+        if k <= SMALL_K {
+            self.search(p, &mut r2, |i, d2, r2| {
+                if accept(&self.photons[i as usize], *r2) {
+                    cand.offer_small(Neighbour { d2, index: i });
+                    *r2 = cand.r2;
+                }
+            });
+        } else {
+            self.search(p, &mut r2, |i, d2, r2| {
+                if accept(&self.photons[i as usize], *r2) {
+                    cand.offer(Neighbour { d2, index: i });
+                    *r2 = cand.r2;
+                }
+            });
+        }
         cand.r2
     }
 
