@@ -129,6 +129,37 @@ fn path_folders_are_searched_for_files() {
     assert!(e.contains("wood.png"), "{e}");
 }
 
+/// A file named from a repository's root, as Mitsuba 0.6's test scenes name theirs (for a
+/// renderer run from that root), is found in a folder above the scene's, with a warning.
+#[test]
+fn files_named_from_a_folder_above_are_found_with_a_warning() {
+    let dir = temp_dir("mitsuba-above");
+    let tests = dir.join("data/tests");
+    std::fs::create_dir_all(&tests).unwrap();
+    write(&tests, "tri.obj", OBJ);
+    let body = format!(
+        r#"{SENSOR}
+<shape type="obj"><string name="filename" value="data/tests/tri.obj"/></shape>"#
+    );
+    let xml = write(&tests, "scene.xml", &scene("0.5.0", &body));
+    let (doc, report) = read(&xml, false).unwrap();
+    // The document's paths are relative to the scene's folder.
+    let found = tests.join(text(&doc.root, "shapes.0.file")).canonicalize().unwrap();
+    assert_eq!(found, tests.join("tri.obj").canonicalize().unwrap());
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("data/tests/tri.obj") && w.contains("above the scene's")),
+        "{:?}",
+        report.warnings
+    );
+    // A name found nowhere stays an error.
+    let xml = write(&tests, "scene.xml", &scene("0.5.0", &body.replace("tri.obj", "no.obj")));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("no such file"), "{e}");
+}
+
 /// An include is found from the folder of the file that includes it, a nested one from
 /// its own includer's; what fails in an included file is reported at that file's line; and
 /// the document keeps no line of an included file (its lines are the scene file's).

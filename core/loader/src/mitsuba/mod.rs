@@ -83,6 +83,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         v1: false,
         used: RefCell::default(),
         unresolved: RefCell::default(),
+        found_above: RefCell::default(),
         declared: HashSet::new(),
         integrator: None,
         search: vec![path.parent().map(Path::to_path_buf).unwrap_or_default()],
@@ -96,6 +97,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
     r.read_file(path, &text)?;
     r.make_objects()?;
     r.report.left_out.append(&mut r.unresolved.borrow_mut());
+    r.report.warnings.append(&mut r.found_above.borrow_mut());
     r.check_defines(path)?;
     // No sensor, or (lenient) none foton reads.
     if r.root.get("camera").is_none() {
@@ -264,6 +266,9 @@ struct Reader {
     /// With `lenient`, the properties left out for a `$name` with no value (what the report
     /// says of each), gathered while reading elements and added to the report at the end.
     unresolved: RefCell<Vec<String>>,
+    /// Files found only in a folder above the scene's ([`Reader::resolve`]): what the report
+    /// says of each.
+    found_above: RefCell<Vec<String>>,
     /// The `<default>`s declared.
     declared: HashSet<String>,
     /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
@@ -409,9 +414,12 @@ impl Reader {
 
     /// A relative file name written in `from`, looked for in `from`'s folder, then in the
     /// resolver's folders, the last added first (Mitsuba's `<path>` and `<include>` prepend
-    /// theirs; the scene's folder is the last resort). Mitsuba 3 resolves the files of an
-    /// included scene from the main scene's folder and Mitsuba 0.6 from the included file's:
-    /// both are searched. Err: the folders looked in.
+    /// theirs; the scene's folder is the last resort), then in the working folder, which
+    /// Mitsuba's resolver holds from the start. Mitsuba 3 resolves the files of an included
+    /// scene from the main scene's folder and Mitsuba 0.6 from the included file's: both are
+    /// searched. Files written relative to a repository's root (as Mitsuba 0.6's test scenes
+    /// are, for a renderer run from there) are found in the scene folder's ancestors, with a
+    /// warning. Err: the folders looked in.
     fn resolve(&self, from: &Path, name: &str) -> std::result::Result<PathBuf, Vec<PathBuf>> {
         let name = Path::new(name);
         if name.is_absolute() {
@@ -422,8 +430,12 @@ impl Reader {
             };
         }
         let own = from.parent().unwrap_or(Path::new("")).to_path_buf();
+        let cwd = std::env::current_dir().ok();
         let mut looked: Vec<PathBuf> = Vec::new();
-        for dir in std::iter::once(&own).chain(self.search.iter().rev()) {
+        for dir in std::iter::once(&own)
+            .chain(self.search.iter().rev())
+            .chain(cwd.as_ref())
+        {
             if looked.contains(dir) {
                 continue;
             }
@@ -432,6 +444,22 @@ impl Reader {
                 return Ok(candidate);
             }
             looked.push(dir.clone());
+        }
+        let main = std::path::absolute(&self.dir).unwrap_or_else(|_| self.dir.clone());
+        if let Some(candidate) = main
+            .ancestors()
+            .skip(1)
+            .map(|dir| dir.join(name))
+            .find(|c| c.exists())
+        {
+            self.found_above.borrow_mut().push(format!(
+                "{}: {:?} found as {}, in a folder above the scene's: Mitsuba finds it there \
+                 only when run from that folder",
+                from.display(),
+                name,
+                candidate.display()
+            ));
+            return Ok(candidate);
         }
         Err(looked)
     }
