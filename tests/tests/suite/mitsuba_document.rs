@@ -740,6 +740,94 @@ fn moment_renders_the_wrapped_integrator() {
         e.contains("empty.xml:2") && e.contains("without the integrator it wraps"),
         "{e}"
     );
+    // `stokes` wraps one too: its Stokes layers are not written.
+    let stokes = body.replace("\"moment\"", "\"stokes\"");
+    let xml = write(&dir, "stokes.xml", &scene("3.0.0", &stokes));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "render.integrator"), "bdpt");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("stokes.xml:2") && w.contains("Stokes layers")),
+        "{:?}",
+        report.warnings
+    );
+}
+
+/// A plugin named in another case (`Rectangle`, which Mitsuba finds where the file system
+/// ignores case) is read as Mitsuba's, with a warning; a name no plugin has in any case is
+/// still unknown.
+#[test]
+fn plugin_names_in_another_case() {
+    let dir = temp_dir("mitsuba-case");
+    let body = format!("{SENSOR}\n<shape type=\"Sphere\"><bsdf type=\"Diffuse\"/></shape>");
+    let xml = write(&dir, "case.xml", &scene("3.0.0", &body));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "shapes.0.type"), "sphere");
+    for needle in ["case.xml:6: <shape type=\"Sphere\">", "case.xml:6: <bsdf type=\"Diffuse\">"] {
+        assert!(
+            report.warnings.iter().any(|w| w.contains(needle)),
+            "{needle}: {:?}",
+            report.warnings
+        );
+    }
+    let xml = write(
+        &dir,
+        "case.xml",
+        &scene("3.0.0", &body.replace("Sphere", "Spheroid")),
+    );
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("unknown shape type `Spheroid`"), "{e}");
+}
+
+/// Mitsuba 3's RGB variants render a linear polarizer as a null surface passing half its
+/// transmittance straight through: seen through one, a uniform sky of radiance 1 is 0.5,
+/// through two 0.25 (whatever their angles: no polarisation is tracked), through one of
+/// transmittance 0.5 0.25.
+#[test]
+fn polarizers_pass_half_their_transmittance() {
+    let dir = temp_dir("mitsuba-polarizer");
+    let sensor = r#"<sensor type="orthographic">
+    <transform name="to_world"><lookat origin="0, 0, -5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="16"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+</sensor>"#;
+    let sheet = |z: f32, extra: &str| {
+        format!(
+            "<shape type=\"rectangle\"><transform name=\"to_world\"><scale value=\"5\"/><translate z=\"{z}\"/></transform><bsdf type=\"polarizer\">{extra}</bsdf></shape>"
+        )
+    };
+    let cases = [
+        (sheet(0.0, ""), 0.5),
+        (
+            format!("{}{}", sheet(0.0, ""), sheet(1.0, "<float name=\"theta\" value=\"90\"/>")),
+            0.25,
+        ),
+        (sheet(0.0, "<float name=\"transmittance\" value=\"0.5\"/>"), 0.25),
+    ];
+    for (i, (sheets, expected)) in cases.iter().enumerate() {
+        let body = format!(
+            "<integrator type=\"path\"/>{sensor}\n{sheets}\n<emitter type=\"constant\"><rgb name=\"radiance\" value=\"1\"/></emitter>"
+        );
+        let xml = write(&dir, "polarizer.xml", &scene("3.0.0", &body));
+        let (_, report) = read(&xml, false).unwrap();
+        assert!(
+            report.notes.iter().any(|w| w.contains("no polarisation")),
+            "{:?}",
+            report.notes
+        );
+        let film = foton_tests::render_file(&xml, &[], 2);
+        let (mean, se) = foton_tests::region_mean(&film, 0, 0, 8, 8);
+        for c in 0..3 {
+            assert!(
+                (mean[c] - expected).abs() < 4.0 * se[c] + 1e-4,
+                "case {i}: {mean} +- {se}, expected {expected}"
+            );
+        }
+        // Noise, not an exact value: the cut-out is stochastic.
+        assert!(se[0] > 0.0, "case {i}");
+    }
 }
 
 /// What `--lenient` gets past that Mitsuba refuses or foton lacks, each said in the report:

@@ -107,6 +107,41 @@ impl Reader {
                 }
                 return Ok(name);
             }
+            "polarizer" => {
+                // foton does not track polarisation. Mitsuba 3's RGB variants render a linear
+                // polarizer as a null surface passing half its `transmittance` straight
+                // through (its `theta` is unused there): as foton reads it, a black surface
+                // cut out by alpha = 1 - transmittance / 2, whose expectation is the same.
+                let tr = self.constant(&mut o, "transmittance", DVec3::ONE)?;
+                o.take("theta");
+                o.take("polarizing");
+                self.leftovers(&o)?;
+                let mean = (tr.x + tr.y + tr.z) / 3.0;
+                if (tr - DVec3::splat(mean)).abs().max_element() > 1e-6 {
+                    self.unsupported(
+                        &o,
+                        "`transmittance`: a coloured transmittance where foton's cut-out takes one number: rendered with its mean",
+                    )?;
+                }
+                self.note(
+                    &o,
+                    "rendered as Mitsuba 3's RGB variants render it (no polarisation): half the transmittance passes straight through",
+                );
+                put("type", Value::Str("diffuse".into()));
+                put(
+                    "reflectance",
+                    Value::Array(vec![at(Value::Float(0.0), line); 3]),
+                );
+                put("twosided", Value::Bool(true));
+                let name = self.new_name("bsdf", &o.id);
+                if let Some(id) = &o.id {
+                    self.bsdfs.insert(id.clone(), name.clone());
+                }
+                table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
+                let alpha = (1.0 - 0.5 * mean).clamp(0.0, 1.0);
+                self.masks.insert(name.clone(), at(Value::Float(alpha), line));
+                return Ok(Some(name));
+            }
             "normalmap" => {
                 // The BSDF it wraps, with the map as its `normal_map`: nested, it is read
                 // with the map; referenced, a copy of it gets the map (the original may be

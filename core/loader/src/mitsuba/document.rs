@@ -8,7 +8,7 @@
 
 use super::object::{Obj, Prop};
 use super::upgrade::upgrade_v1;
-use super::{Reader, forget_line, forget_lines, shown};
+use super::{Reader, forget_line, forget_lines, plugins, shown};
 use foton_core::error::{Error, Location, Result};
 use foton_core::spectrum::{self, Quantity, Spectrum};
 use foton_core::value::{Node, Table, Value};
@@ -394,6 +394,19 @@ impl Reader {
         let ty = match n.attribute("type") {
             Some(t) if self.lenient && self.unresolved(t).is_some() => t.to_string(),
             _ => get("type")?.unwrap_or_default(),
+        };
+        // Mitsuba finds a plugin by its file's name: `Rectangle` loads `rectangle` where the
+        // file system ignores case (Windows, macOS), as the files' authors saw it do.
+        let ty = match plugins::in_another_case(n.tag_name().name(), &ty) {
+            Some(name) => {
+                self.late_warnings.borrow_mut().push(format!(
+                    "{}:{line}: <{} type=\"{ty}\">: read as `{name}` (Mitsuba's plugin names are lower case; a file system that ignores case finds `{ty}` as `{name}`)",
+                    file.display(),
+                    n.tag_name().name()
+                ));
+                name.to_string()
+            }
+            None => ty,
         };
         let mut obj = Obj {
             tag: n.tag_name().name().to_string(),

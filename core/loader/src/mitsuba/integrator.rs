@@ -18,8 +18,8 @@ impl Reader {
         for (name, _, _) in &mut o.props {
             *name = camel_to_snake(name);
         }
-        if o.ty == "moment" {
-            return self.moment(o);
+        if o.ty == "moment" || o.ty == "stokes" {
+            return self.wrapper(o);
         }
         let has_media = !self.media.is_empty();
         let Some(name) = foton_integrator(&o.ty, has_media) else {
@@ -235,16 +235,21 @@ impl Reader {
 
 /// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
 impl Reader {
-    /// Mitsuba's `moment`: the integrators it wraps render the image, and it adds their
-    /// second moments as layers of the film. foton renders the first it wraps; the moment
+    /// Mitsuba's `moment` and `stokes`, which wrap integrators: the wrapped ones render the
+    /// image, and `moment` adds their second moments as layers of the film, `stokes` the
+    /// Stokes components S1 to S3 (zero in Mitsuba 3's RGB variants, which track no
+    /// polarisation; foton tracks none either). foton renders the first it wraps; the extra
     /// layers are not written (a warning says so).
-    fn moment(&mut self, mut o: Obj) -> Result<()> {
+    fn wrapper(&mut self, mut o: Obj) -> Result<()> {
         let nested = o
             .props
             .iter()
             .position(|(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "integrator"));
         let Some(i) = nested else {
-            return Err(o.error("a moment integrator without the integrator it wraps"));
+            return Err(o.error(format!(
+                "a {} integrator without the integrator it wraps",
+                o.ty
+            )));
         };
         let (_, Prop::Object(inner), _) = o.props.remove(i) else {
             unreachable!("the position of an object")
@@ -258,14 +263,21 @@ impl Reader {
             .retain(|(_, p, _)| !matches!(p, Prop::Object(n) if n.tag == "integrator"));
         self.leftovers(&o)?;
         let line = o.line;
+        let layers = if o.ty == "stokes" {
+            "the Stokes layers S1 to S3 (foton tracks no polarisation) are"
+        } else if more > 0 {
+            "the second-moment layers are"
+        } else {
+            "its second-moment layer is"
+        };
         let what = if more > 0 {
             format!(
-                "renders the image of the first integrator it wraps (<integrator type=\"{}\">); the other {more} and the second-moment layers are not written",
+                "renders the image of the first integrator it wraps (<integrator type=\"{}\">); the other {more} and {layers} not written",
                 inner.ty
             )
         } else {
             format!(
-                "renders the image of the integrator it wraps (<integrator type=\"{}\">); its second-moment layer is not written",
+                "renders the image of the integrator it wraps (<integrator type=\"{}\">); {layers} not written",
                 inner.ty
             )
         };

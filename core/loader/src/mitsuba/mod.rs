@@ -83,7 +83,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         v1: false,
         used: RefCell::default(),
         unresolved: RefCell::default(),
-        found_above: RefCell::default(),
+        late_warnings: RefCell::default(),
         declared: HashSet::new(),
         integrator: None,
         search: vec![path.parent().map(Path::to_path_buf).unwrap_or_default()],
@@ -97,7 +97,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
     r.read_file(path, &text)?;
     r.make_objects()?;
     r.report.left_out.append(&mut r.unresolved.borrow_mut());
-    r.report.warnings.append(&mut r.found_above.borrow_mut());
+    r.report.warnings.append(&mut r.late_warnings.borrow_mut());
     r.check_defines(path)?;
     // No sensor, or (lenient) none foton reads.
     if r.root.get("camera").is_none() {
@@ -266,9 +266,10 @@ struct Reader {
     /// With `lenient`, the properties left out for a `$name` with no value (what the report
     /// says of each), gathered while reading elements and added to the report at the end.
     unresolved: RefCell<Vec<String>>,
-    /// Files found only in a folder above the scene's ([`Reader::resolve`]): what the report
-    /// says of each.
-    found_above: RefCell<Vec<String>>,
+    /// Warnings of what is read where the reader holds itself unchanged (a file found only in
+    /// a folder above the scene's, a plugin name in another case), added to the report at the
+    /// end.
+    late_warnings: RefCell<Vec<String>>,
     /// The `<default>`s declared.
     declared: HashSet<String>,
     /// The `<integrator>`, read last: which plugin renders a photon mapper depends on whether
@@ -452,7 +453,7 @@ impl Reader {
             .map(|dir| dir.join(name))
             .find(|c| c.exists())
         {
-            self.found_above.borrow_mut().push(format!(
+            self.late_warnings.borrow_mut().push(format!(
                 "{}: {:?} found as {}, in a folder above the scene's: Mitsuba finds it there \
                  only when run from that folder",
                 from.display(),

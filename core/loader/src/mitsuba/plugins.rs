@@ -145,6 +145,19 @@ const MITSUBA_PLUGINS: &[(&str, &[&str])] = &[
 
 /// The message for a plugin type foton does not read: `supported` (with `not supported`
 /// wording) when Mitsuba has it, "unknown" with the close name otherwise.
+/// The plugin of Mitsuba's `kind` that `ty` names in another case (`Rectangle`), if `ty` is
+/// none of them as written.
+pub(super) fn in_another_case(kind: &str, ty: &str) -> Option<&'static str> {
+    let names = MITSUBA_PLUGINS
+        .iter()
+        .filter(|(k, _)| *k == kind)
+        .flat_map(|(_, names)| names.iter().copied());
+    if names.clone().any(|n| n == ty) {
+        return None;
+    }
+    names.into_iter().find(|n| n.eq_ignore_ascii_case(ty))
+}
+
 pub(super) fn not_read(kind: &str, ty: &str, supported: &str) -> String {
     let known = MITSUBA_PLUGINS
         .iter()
