@@ -144,7 +144,10 @@ fn files_named_from_a_folder_above_are_found_with_a_warning() {
     let xml = write(&tests, "scene.xml", &scene("0.5.0", &body));
     let (doc, report) = read(&xml, false).unwrap();
     // The document's paths are relative to the scene's folder.
-    let found = tests.join(text(&doc.root, "shapes.0.file")).canonicalize().unwrap();
+    let found = tests
+        .join(text(&doc.root, "shapes.0.file"))
+        .canonicalize()
+        .unwrap();
     assert_eq!(found, tests.join("tri.obj").canonicalize().unwrap());
     assert!(
         report
@@ -155,7 +158,11 @@ fn files_named_from_a_folder_above_are_found_with_a_warning() {
         report.warnings
     );
     // A name found nowhere stays an error.
-    let xml = write(&tests, "scene.xml", &scene("0.5.0", &body.replace("tri.obj", "no.obj")));
+    let xml = write(
+        &tests,
+        "scene.xml",
+        &scene("0.5.0", &body.replace("tri.obj", "no.obj")),
+    );
     let e = read(&xml, false).unwrap_err();
     assert!(e.contains("no such file"), "{e}");
 }
@@ -765,7 +772,10 @@ fn plugin_names_in_another_case() {
     let xml = write(&dir, "case.xml", &scene("3.0.0", &body));
     let (doc, report) = read(&xml, false).unwrap();
     assert_eq!(text(&doc.root, "shapes.0.type"), "sphere");
-    for needle in ["case.xml:6: <shape type=\"Sphere\">", "case.xml:6: <bsdf type=\"Diffuse\">"] {
+    for needle in [
+        "case.xml:6: <shape type=\"Sphere\">",
+        "case.xml:6: <bsdf type=\"Diffuse\">",
+    ] {
         assert!(
             report.warnings.iter().any(|w| w.contains(needle)),
             "{needle}: {:?}",
@@ -801,10 +811,17 @@ fn polarizers_pass_half_their_transmittance() {
     let cases = [
         (sheet(0.0, ""), 0.5),
         (
-            format!("{}{}", sheet(0.0, ""), sheet(1.0, "<float name=\"theta\" value=\"90\"/>")),
+            format!(
+                "{}{}",
+                sheet(0.0, ""),
+                sheet(1.0, "<float name=\"theta\" value=\"90\"/>")
+            ),
             0.25,
         ),
-        (sheet(0.0, "<float name=\"transmittance\" value=\"0.5\"/>"), 0.25),
+        (
+            sheet(0.0, "<float name=\"transmittance\" value=\"0.5\"/>"),
+            0.25,
+        ),
     ];
     for (i, (sheets, expected)) in cases.iter().enumerate() {
         let body = format!(

@@ -139,7 +139,8 @@ impl Reader {
                 }
                 table_mut(&mut self.root, "materials").insert(&name, at(Value::Table(t), line));
                 let alpha = (1.0 - 0.5 * mean).clamp(0.0, 1.0);
-                self.masks.insert(name.clone(), at(Value::Float(alpha), line));
+                self.masks
+                    .insert(name.clone(), at(Value::Float(alpha), line));
                 return Ok(Some(name));
             }
             "normalmap" => {
