@@ -45,7 +45,7 @@ pub use glam::{DVec3, Vec2, Vec3};
 // The scene and its queries.
 pub use crate::accel::{Accel, BoxBvh, median_parts, median_split};
 pub use crate::bsdf::Bsdf;
-pub use crate::camera::Camera;
+pub use crate::camera::{Camera, Meter};
 pub use crate::geometry::{Hit, NO_ATTRS, Primitive, Ray, Shape, offset_origin};
 pub use crate::light::{Light, LightType};
 pub use crate::material::{Lobe, TransportMode};

@@ -25,9 +25,30 @@
 //! the pinhole to the point of the image it projects to; summed over one light path per camera
 //! sample, and divided by the camera samples per pixel, that is the image
 //! ([`crate::film::Film`]'s splats).
+//!
+//! **Meters.** Mitsuba's `radiancemeter` and `irradiancemeter` measure instead of imaging,
+//! on a film of one pixel ([`Meter`]). Light paths cannot reach them (their `we` is None): only
+//! integrators that trace from the camera render them ([`crate::integrator::Integrator::renders_meters`]).
 
-use crate::geometry::Ray;
+use crate::geometry::{Ray, Shape, offset_origin};
+use crate::sampling::{Distribution1D, cosine_hemisphere, to_world};
 use glam::{Vec2, Vec3};
+use std::sync::Arc;
+
+/// A sensor that measures a single value (a film of one pixel).
+#[derive(Clone, Debug)]
+pub enum Meter {
+    /// The radiance arriving at the camera's position from along its optical axis: every
+    /// ray is the one from the position along the axis (Mitsuba's `radiancemeter`).
+    Radiance,
+    /// The irradiance averaged over a surface (Mitsuba's `irradiancemeter`): rays from
+    /// uniform points of the shapes (by area), cosine-distributed about the normal there,
+    /// each weighted by pi, so that the mean is (1/A) int_A int_H L cos dw dA.
+    Irradiance {
+        shapes: Vec<Shape>,
+        by_area: Distribution1D,
+    },
+}
 
 /// A connection from a point to the camera ([`Camera::sample_wi`]).
 #[derive(Clone, Copy, Debug)]
@@ -70,6 +91,8 @@ pub struct Camera {
     lens_radius: f32,
     /// Distance from the lens to the plane of focus, along the optical axis.
     focal_distance: f32,
+    /// A meter instead of an image ([`Meter`]); None for a camera.
+    meter: Option<Arc<Meter>>,
 }
 
 impl Camera {
@@ -97,6 +120,69 @@ impl Camera {
             height,
             lens_radius: 0.0,
             focal_distance: 1.0,
+            meter: None,
+        }
+    }
+
+    /// A radiance meter at `position` looking towards `look_at` (Mitsuba's
+    /// `radiancemeter`): a film of one pixel holding the radiance arriving along that ray.
+    pub fn radiance_meter(position: Vec3, look_at: Vec3, up: Vec3) -> Camera {
+        let mut camera = Camera::new(position, look_at, up, 1.0, 1, 1);
+        camera.meter = Some(Arc::new(Meter::Radiance));
+        camera
+    }
+
+    /// An irradiance meter over `shapes` (Mitsuba's `irradiancemeter`): a film of one pixel
+    /// holding the irradiance on their normal side, averaged over their area. None if the
+    /// shapes have no area.
+    pub fn irradiance_meter(shapes: Vec<Shape>) -> Option<Camera> {
+        let areas: Vec<f32> = shapes.iter().map(Shape::area).collect();
+        let total: f32 = areas.iter().sum();
+        if total.is_nan() || total <= 0.0 {
+            return None;
+        }
+        // Where its rays start, for what asks where the camera is (the medium around it).
+        let (p, n) = shapes[0].sample_area(Vec2::splat(0.5));
+        let position = offset_origin(p, n, n);
+        let up = if n.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+        let mut camera = Camera::new(position, position + n, up, 1.0, 1, 1);
+        camera.meter = Some(Arc::new(Meter::Irradiance {
+            by_area: Distribution1D::new(&areas),
+            shapes,
+        }));
+        Some(camera)
+    }
+
+    /// The meter this sensor is, if it is one.
+    #[inline]
+    pub fn meter(&self) -> Option<&Meter> {
+        self.meter.as_deref()
+    }
+
+    /// The factor of every camera ray's contribution: pi for an irradiance meter (its rays'
+    /// cosine-weighted directions), one otherwise.
+    #[inline]
+    pub fn ray_weight(&self) -> f32 {
+        match self.meter() {
+            Some(Meter::Irradiance { .. }) => std::f32::consts::PI,
+            _ => 1.0,
+        }
+    }
+
+    /// A meter's ray: the film point's place in its pixel chooses the point of the surface,
+    /// `u_dir` the direction.
+    fn meter_ray(&self, meter: &Meter, film: Vec2, u_dir: Vec2) -> Ray {
+        match meter {
+            Meter::Radiance => Ray::new(self.position, self.forward),
+            Meter::Irradiance { shapes, by_area } => {
+                let u = film - film.floor();
+                let (x, _, i) = by_area.sample_continuous(u.x);
+                let ux = (x * shapes.len() as f32 - i as f32)
+                    .clamp(0.0, crate::sampling::ONE_MINUS_EPSILON);
+                let (p, n) = shapes[i].sample_area(Vec2::new(ux, u.y));
+                let dir = to_world(cosine_hemisphere(u_dir), n);
+                Ray::new(offset_origin(p, n, dir), dir)
+            }
         }
     }
 
@@ -185,6 +271,9 @@ impl Camera {
     /// The ray from the pinhole (the lens's centre) through a point on the film in pixel
     /// units: (0, 0) is the top-left corner.
     pub fn generate_ray(&self, film: Vec2) -> Ray {
+        if let Some(meter) = self.meter() {
+            return self.meter_ray(meter, film, Vec2::splat(0.5));
+        }
         if self.orthographic {
             let (sx, sy) = self.screen(film);
             return Ray::new(self.position + sx * self.right + sy * self.up, self.forward);
@@ -195,7 +284,13 @@ impl Camera {
     /// The camera ray through a point on the film: from the lens point that `lens` (a uniform
     /// sample of the unit square, drawn only if the camera has a lens) gives, through the
     /// point of the plane of focus [`Camera::generate_ray`]'s ray reaches.
+    ///
+    /// A meter's ray: an irradiance meter's direction from `lens` (always drawn), its point on
+    /// the surface from where the film point lies in the pixel (uniform for a box filter).
     pub fn generate_ray_lens(&self, film: Vec2, lens: impl FnOnce() -> Vec2) -> Ray {
+        if let Some(meter) = self.meter() {
+            return self.meter_ray(meter, film, lens());
+        }
         if self.lens_radius <= 0.0 {
             return self.generate_ray(film);
         }
@@ -247,7 +342,7 @@ impl Camera {
     #[inline]
     pub fn we(&self, ray: &Ray, margin: f32) -> Option<(f32, Vec2)> {
         let cos = ray.dir.dot(self.forward);
-        if cos <= 0.0 || self.orthographic {
+        if cos <= 0.0 || self.orthographic || self.meter.is_some() {
             return None;
         }
         let film = self.film_of(ray, cos, margin)?;
@@ -323,6 +418,9 @@ impl Camera {
         margin: f32,
         lens: impl FnOnce() -> Vec2,
     ) -> Option<CameraSample> {
+        if self.meter.is_some() {
+            return None;
+        }
         if self.orthographic {
             // Seen along -forward only, from the point of the view p projects to.
             let d = p - self.position;
@@ -375,6 +473,9 @@ impl Camera {
 
     /// [`Camera::project`] into the image widened by `margin` pixels on every side.
     pub fn project_within(&self, p: Vec3, margin: f32) -> Option<Vec2> {
+        if self.meter.is_some() {
+            return None;
+        }
         let d = p - self.position;
         let z = d.dot(self.forward);
         if z <= 0.0 {

@@ -260,6 +260,13 @@ pub trait Integrator: Send + Sync {
         Vec::new()
     }
 
+    /// Whether it renders a meter ([`crate::camera::Meter`]: Mitsuba's radiance and irradiance
+    /// meters), which only paths traced from the camera reach. False (the default): the host
+    /// refuses a scene whose sensor is one.
+    fn renders_meters(&self) -> bool {
+        false
+    }
+
     /// The configured integrator, for logs and labels (Mitsuba's `to_string`).
     fn describe(&self) -> String {
         describe(self.name(), &self.parameters())

@@ -381,6 +381,7 @@ where
         ));
     }
     let filter = &scene.film.filter;
+    let ray_weight = scene.camera.ray_weight();
     let mut done = first;
     while done < spp && !ctx.cancelled() {
         let batch = (done - first).max(1).min(spp - done);
@@ -448,10 +449,12 @@ where
                                         }
                                     }
                                     // The filter's weight, after the check (it may be
-                                    // negative); exactly 1.0 for a positive filter.
-                                    l *= at.weight;
+                                    // negative); exactly 1.0 for a positive filter and a
+                                    // camera (a meter's rays may weigh more).
+                                    let weight = at.weight * ray_weight;
+                                    l *= weight;
                                     if LAYERS {
-                                        techniques.sample.iter_mut().for_each(|v| *v *= at.weight);
+                                        techniques.sample.iter_mut().for_each(|v| *v *= weight);
                                     }
                                     sum.add(l);
                                     if LAYERS {

@@ -173,7 +173,16 @@ impl Integrator for PanicGuard {
         catch("parameters", || Ok(self.0.parameters())).unwrap_or_default()
     }
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
+        if scene.camera().meter().is_some() && !self.renders_meters() {
+            return Err(Error::Usage(format!(
+                "{}: the scene's sensor is a meter (a radiance or irradiance meter), which only paths traced from the camera reach; render it with `path`",
+                self.name()
+            )));
+        }
         catch("render", || self.0.render(scene, ctx))
+    }
+    fn renders_meters(&self) -> bool {
+        catch("renders_meters", || Ok(self.0.renders_meters())).unwrap_or(false)
     }
     fn budget(&self) -> Budget {
         catch("budget", || Ok(self.0.budget())).unwrap_or(Budget {

@@ -196,6 +196,10 @@ impl PathTracer {
 }
 
 impl Integrator for PathTracer {
+    fn renders_meters(&self) -> bool {
+        true
+    }
+
     fn render(&self, scene: &Scene, ctx: &RenderContext<'_>) -> Result<Film> {
         render_pixels(scene, ctx, |ray, sampler, rays| {
             self.li(scene, *ray, sampler, rays)

@@ -41,6 +41,7 @@ mod materials_classic;
 mod media;
 mod media_sides;
 mod medium_kind;
+mod meters;
 mod mitsuba;
 mod mitsuba05;
 mod mitsuba_document;

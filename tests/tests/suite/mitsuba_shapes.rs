@@ -432,9 +432,9 @@ fn a_ref_or_object_in_a_shape_is_taken_for_what_it_names() {
             "a second BSDF",
         ),
         (
-            "<shape type=\"sphere\">\n<sensor type=\"irradiancemeter\"/></shape>",
+            "<shape type=\"sphere\">\n<sensor type=\"perspective\"/></shape>",
             "scene.xml:7",
-            "a sensor attached to a shape is not supported",
+            "a sensor other than an irradiancemeter attached to a shape is not supported",
         ),
     ];
     for (shape, line, expected) in cases {
@@ -445,7 +445,7 @@ fn a_ref_or_object_in_a_shape_is_taken_for_what_it_names() {
     // --lenient renders the sphere without its sensor.
     let path = xml(
         &dir,
-        &format!("{defs}\n<shape type=\"sphere\">\n<sensor type=\"irradiancemeter\"/></shape>"),
+        &format!("{defs}\n<shape type=\"sphere\">\n<sensor type=\"perspective\"/></shape>"),
     );
     let scene = foton_loader::load_with(&path, &[], &[], true).unwrap();
     assert!(trace(&scene, Vec3::new(0.0, 0.0, 5.0), -Vec3::Z).is_some());

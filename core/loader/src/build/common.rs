@@ -5,7 +5,7 @@
 use crate::texture::{Bitmaps, load_bitmap, read_texture_param};
 use foton_core::Rgb;
 use foton_core::error::Result;
-use foton_core::geometry::{Primitive, TriangleAttrs};
+use foton_core::geometry::{Primitive, Shape, TriangleAttrs};
 use foton_core::light::Light;
 use foton_core::props::{Properties, Unused};
 use foton_core::registry::Resources;
@@ -78,6 +78,10 @@ pub(super) struct Geometry {
     pub(super) lights: Vec<Light>,
     /// Per light: the medium the file puts it in (None: found from where it lies).
     pub(super) light_media: Vec<Option<Option<u32>>>,
+    /// Whether the camera is an irradiance meter, whose surface a shape marks (`sensor`).
+    pub(super) meter_wanted: bool,
+    /// The shapes of those marked `sensor = true`: the irradiance meter's surface.
+    pub(super) sensor: Option<Vec<Shape>>,
 }
 
 pub(super) fn undefined(kind: &str, name: &str, known: &HashMap<String, u32>) -> String {

@@ -23,6 +23,7 @@ use medium::read_media;
 use settings::{read_camera, read_film, read_render};
 use shape::read_shapes;
 
+use foton_core::camera::Camera;
 use foton_core::error::{Error, Result};
 use foton_core::props::{Properties, Unused};
 use foton_core::scene::{Scene, SceneParts};
@@ -70,6 +71,15 @@ pub fn from_document(doc: Document) -> Result<Scene> {
     let (camera, camera_medium) = read_camera(&root, &film, &medium_index, &mut ld)?;
 
     let mut geometry = Geometry::default();
+    let camera_table = root.table("camera")?;
+    geometry.meter_wanted = matches!(
+        camera_table
+            .as_ref()
+            .map(|t| t.string_opt("type"))
+            .transpose()?
+            .flatten(),
+        Some("irradiancemeter")
+    );
     read_shapes(
         &root,
         &mut ld,
@@ -80,6 +90,23 @@ pub fn from_document(doc: Document) -> Result<Scene> {
         &mut geometry,
     )?;
     read_lights(&root, &mut ld, &medium_index, &mut geometry)?;
+    let camera = match (geometry.meter_wanted, geometry.sensor.take()) {
+        (true, Some(shapes)) => Camera::irradiance_meter(shapes).ok_or_else(|| {
+            error_at(
+                &camera_table,
+                "type",
+                "the irradiance meter's surface has no area",
+            )
+        })?,
+        (true, None) => {
+            return Err(error_at(
+                &camera_table,
+                "type",
+                "an irradiancemeter measures over the shapes marked `sensor = true`, and none is",
+            ));
+        }
+        _ => camera,
+    };
 
     let mut medium = None;
     if let Some(scene) = root.table("scene")? {
@@ -136,4 +163,12 @@ pub fn from_document(doc: Document) -> Result<Scene> {
         },
         other => other,
     })
+}
+
+/// An error at `key` of the `[camera]` table (present wherever this is called).
+fn error_at(t: &Option<Properties<'_>>, key: &str, message: &str) -> Error {
+    match t {
+        Some(t) => t.error(key, message),
+        None => Error::Usage(message.to_string()),
+    }
 }

@@ -244,11 +244,23 @@ pub(super) fn read_camera(
             "missing section [camera]; expected position, look_at, up, fov",
         ));
     };
+    let ty = t.choice(
+        "type",
+        &[
+            "perspective",
+            "orthographic",
+            "radiancemeter",
+            "irradiancemeter",
+        ],
+        "perspective",
+    )?;
+    if ty.ends_with("meter") {
+        return read_meter(&t, ty, film, media, ld);
+    }
     let position = t.vec3_required("position")?;
     let look_at = t.vec3_required("look_at")?;
     let up = t.vec3("up", Vec3::Y)?;
-    let orthographic =
-        t.choice("type", &["perspective", "orthographic"], "perspective")? == "orthographic";
+    let orthographic = ty == "orthographic";
     if orthographic {
         for key in ["fov", "fov_axis", "lens_radius", "focus_distance"] {
             if t.has(key) {
@@ -359,5 +371,80 @@ pub(super) fn read_camera(
     if mirror {
         camera = camera.mirrored();
     }
+    Ok((camera, medium))
+}
+
+/// A meter ([`foton_core::camera::Meter`]) as the camera: a radiance meter's ray (`position`,
+/// `look_at`), or an irradiance meter, whose surface is the shapes marked `sensor = true`
+/// (attached once the shapes are read: here a placeholder). Either measures on a film of one
+/// pixel with the box filter.
+fn read_meter(
+    t: &Properties<'_>,
+    ty: &str,
+    film: &FilmSettings,
+    media: &Index,
+    ld: &mut Loader,
+) -> Result<(Camera, Option<Option<u32>>)> {
+    for key in [
+        "fov",
+        "fov_axis",
+        "lens_radius",
+        "focus_distance",
+        "view_height",
+        "view_width",
+        "shift",
+        "mirror",
+    ] {
+        if t.has(key) {
+            return Err(t.error(key, format!("has no meaning for a {ty}")));
+        }
+    }
+    if (film.width, film.height) != (1, 1) {
+        return Err(t.error(
+            "type",
+            format!(
+                "a {ty} measures one value: its film must be 1x1 pixels, found {}x{}",
+                film.width, film.height
+            ),
+        ));
+    }
+    if *film.filter.filter() != Filter::Box {
+        return Err(t.error(
+            "type",
+            format!("a {ty}'s film of one pixel takes the box filter (`[film] filter = \"box\"`)"),
+        ));
+    }
+    let camera = if ty == "radiancemeter" {
+        let position = t.vec3_required("position")?;
+        let look_at = t.vec3_required("look_at")?;
+        let up = t.vec3("up", Vec3::Y)?;
+        let forward = look_at - position;
+        if forward.length_squared() == 0.0 {
+            return Err(t.error("look_at", "is the same point as position"));
+        }
+        let up = if forward.normalize().cross(up).length_squared() < 1e-12 {
+            // The meter has no image to orient: any other axis does.
+            if forward.x.abs() < 0.9 {
+                Vec3::X
+            } else {
+                Vec3::Y
+            }
+        } else {
+            up
+        };
+        Camera::radiance_meter(position, look_at, up)
+    } else {
+        for key in ["position", "look_at", "up"] {
+            if t.has(key) {
+                return Err(t.error(
+                    key,
+                    "has no meaning for an irradiancemeter: it measures over the shapes marked `sensor = true`",
+                ));
+            }
+        }
+        Camera::new(Vec3::ZERO, Vec3::Z, Vec3::Y, 1.0, 1, 1)
+    };
+    let medium = medium_ref(t, "medium", media)?;
+    ld.done(t);
     Ok((camera, medium))
 }

@@ -180,6 +180,17 @@ pub(super) fn read_shapes(
                 ),
             ));
         }
+        if s.bool("sensor", false)? {
+            if !g.meter_wanted {
+                return Err(s.error(
+                    "sensor",
+                    "marks the surface of an irradiance meter, and the camera is not one (`[camera] type = \"irradiancemeter\"`)",
+                ));
+            }
+            g.sensor
+                .get_or_insert_default()
+                .extend(shapes.iter().cloned());
+        }
         let material_name = s.string_required("material")?;
         let material = *materials
             .get(material_name)

@@ -22,11 +22,11 @@ impl Reader {
             return self.wrapper(o);
         }
         let has_media = !self.media.is_empty();
-        let Some(name) = foton_integrator(&o.ty, has_media) else {
+        let Some(mapped) = foton_integrator(&o.ty, has_media) else {
             o.props.clear();
             let message = if MITSUBA_INTEGRATORS.contains(&o.ty.as_str()) {
                 format!(
-                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm and bdpt",
+                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm, bdpt and ptracer",
                     o.ty
                 )
             } else {
@@ -39,7 +39,29 @@ impl Reader {
             return self.unsupported(&o, &message);
         };
         let line = o.line;
+        // A meter is reached only by paths traced from it: the path tracer measures what the
+        // others converge to.
+        let name = match self.meter {
+            Some(meter) if mapped != "path" => {
+                let meter = super::sensor::a_meter(meter);
+                self.note(
+                    &o,
+                    &format!(
+                        "rendered by path: the sensor is {meter}, which foton measures with paths traced from it (the value {} converges to)",
+                        o.ty
+                    ),
+                );
+                "path"
+            }
+            _ => mapped,
+        };
         table_mut(&mut self.root, "render").insert("integrator", at(Value::Str(name.into()), line));
+        if o.ty == "ptracer" && name == "bdpt" {
+            self.note(
+                &o,
+                "rendered by bdpt, whose light-tracing strategy is the particle tracer's (with the others it converges to the same image)",
+            );
+        }
         if o.ty == "ppm" {
             self.note(
                 &o,
@@ -112,7 +134,9 @@ impl Reader {
             &|p| matches!(p, Prop::Float(t) if *t < 0.0),
             "ignored (foton renders every sample; a time limit would stop Mitsuba with fewer)",
         );
-        match o.ty.as_str() {
+        // The parameters of an integrator foton renders by another (a meter's): ignored.
+        let own = if name == mapped { o.ty.as_str() } else { "" };
+        match own {
             "direct" => {
                 for k in ["emitter_samples", "bsdf_samples", "shading_samples"] {
                     self.ignored(&mut o, k, &same, noise);
@@ -223,6 +247,20 @@ impl Reader {
                     "ignored",
                 );
             }
+            "ptracer" => {
+                for k in ["granularity", "brute_force"] {
+                    self.ignored(&mut o, k, &|_| true, "");
+                }
+            }
+            "" => {
+                for (k, p, l) in std::mem::take(&mut o.props) {
+                    self.warn(
+                        &o,
+                        l,
+                        &format!("`{k}` = {}: ignored (path renders the meter)", show(&p)),
+                    );
+                }
+            }
             _ => {}
         }
         let t = table_mut(table_mut(&mut self.root, "integrators"), name);
@@ -324,7 +362,7 @@ fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
         "photonmapper" if has_media => "vpm",
         "photonmapper" => "photon",
         "sppm" | "ppm" => "sppm",
-        "bdpt" => "bdpt",
+        "bdpt" | "ptracer" => "bdpt",
         _ => return None,
     })
 }

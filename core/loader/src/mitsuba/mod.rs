@@ -89,6 +89,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
         search: vec![path.parent().map(Path::to_path_buf).unwrap_or_default()],
         objects: HashMap::new(),
         sensor: false,
+        meter: None,
         crop: None,
         pending: Vec::new(),
         left_out_ids: HashSet::new(),
@@ -285,6 +286,8 @@ struct Reader {
     /// Whether the file has a `<sensor>` (without one, Mitsuba places its own; with one
     /// foton does not read, `lenient` places Mitsuba's default).
     sensor: bool,
+    /// The sensor when it is a meter: `radiancemeter` or `irradiancemeter`.
+    meter: Option<&'static str>,
     /// The film's crop window, read with the film, applied to the sensor's camera.
     crop: Option<sensor::Crop>,
     /// The top-level objects (and aliases) read, made once the whole file is read.
@@ -491,6 +494,15 @@ impl Reader {
                     return Err(obj.error("a second <integrator>: a scene has one"));
                 }
                 self.integrator = Some(obj);
+                Ok(())
+            }
+            // Mitsuba's render takes the first sensor of the file.
+            "sensor" if self.sensor => {
+                self.warn(
+                    &obj,
+                    obj.line,
+                    "a second sensor: not rendered (foton renders the file's first sensor, as Mitsuba's render does)",
+                );
                 Ok(())
             }
             "sensor" => {

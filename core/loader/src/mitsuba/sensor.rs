@@ -1,8 +1,9 @@
 //! `<sensor>` and what it holds: the camera (a perspective or thinlens sensor's to_world, fov
-//! or focal length, aperture and focus distance, medium), `<film>` (size, format, `ldrfilm`'s tone curve, a crop window) with its
-//! `<rfilter>`, and `<sampler>` (which foton sampler renders Mitsuba's, sample count, seed);
-//! Mitsuba's defaults for a sensor without a film or a sampler, and for a file without a
-//! sensor.
+//! or focal length, aperture and focus distance, medium; a radiance meter's ray; an
+//! irradiance meter nested in a shape), `<film>` (size, format, `ldrfilm`'s tone curve, a crop
+//! window; a meter's one pixel) with its `<rfilter>`, and `<sampler>` (which foton sampler
+//! renders Mitsuba's, sample count, seed); Mitsuba's defaults for a sensor without a film or
+//! a sampler, and for a file without a sensor.
 
 use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
@@ -27,12 +28,21 @@ impl Reader {
     }
 
     pub(super) fn sensor(&mut self, mut o: Obj) -> Result<()> {
+        match o.ty.as_str() {
+            "radiancemeter" => return self.radiance_meter(o),
+            "irradiancemeter" => {
+                return Err(o.error(
+                    "an irradiancemeter measures over the shape it is nested in (<shape ...><sensor type=\"irradiancemeter\"/></shape>), as Mitsuba reads it; alone it has no surface",
+                ));
+            }
+            _ => {}
+        }
         if !["perspective", "thinlens", "orthographic"].contains(&o.ty.as_str()) {
             o.props.clear();
             let m = not_read(
                 "sensor",
                 &o.ty,
-                "only the perspective, thinlens and orthographic sensors are supported",
+                "foton reads the perspective, thinlens, orthographic, radiancemeter and irradiancemeter sensors",
             );
             return self.unsupported(&o, &m);
         }
@@ -140,6 +150,73 @@ impl Reader {
             camera.insert("focus_distance", at(Value::Float(focus), line));
         }
         self.sensor_contents(o)
+    }
+
+    /// Mitsuba's `radiancemeter`: the radiance arriving at a point from one direction, its
+    /// `origin` and `direction` (Mitsuba 3) or its `to_world`'s origin and +z.
+    fn radiance_meter(&mut self, mut o: Obj) -> Result<()> {
+        let line = o.line;
+        let has = |o: &Obj, name: &str| o.props.iter().any(|(n, _, _)| n == name);
+        let (origin, direction) = if has(&o, "to_world") {
+            if has(&o, "origin") || has(&o, "direction") {
+                return Err(o.error(
+                    "give either `to_world` or `origin` and `direction`, not both (as Mitsuba 3 says)",
+                ));
+            }
+            let m = o.transform("to_world")?;
+            (
+                m.transform_point3(DVec3::ZERO),
+                m.transform_vector3(DVec3::Z),
+            )
+        } else {
+            match (o.point("origin")?, o.point("direction")?) {
+                (Some(p), Some(d)) => (p, d),
+                (None, None) => (DVec3::ZERO, DVec3::Z),
+                _ => {
+                    return Err(o.error(
+                        "give both `origin` and `direction` (or neither), as Mitsuba 3 says",
+                    ));
+                }
+            }
+        };
+        let direction = direction.try_normalize().ok_or_else(|| {
+            o.error("the meter's direction has no length (a zero `direction` or a degenerate `to_world`)")
+        })?;
+        let camera = table_mut(&mut self.root, "camera");
+        camera.insert("type", at(Value::Str("radiancemeter".into()), line));
+        camera.insert("position", vec3(origin, line));
+        camera.insert("look_at", vec3(origin + direction, line));
+        camera.insert("up", vec3(direction.any_orthonormal_vector(), line));
+        self.meter = Some("radiancemeter");
+        self.sensor_contents(o)
+    }
+
+    /// Mitsuba's `irradiancemeter`, nested in the shape `shape_line` reads: the mean
+    /// irradiance over that shape's surface (its `[[shapes]]` entries are marked `sensor`).
+    /// False: the file has a sensor already, which is the one rendered.
+    pub(super) fn irradiance_meter(&mut self, mut o: Obj) -> Result<bool> {
+        if self.sensor {
+            self.warn(
+                &o,
+                o.line,
+                "a second sensor: not rendered (foton renders the file's first sensor, as Mitsuba's render does)",
+            );
+            return Ok(false);
+        }
+        if o.props.iter().any(|(n, _, _)| n == "to_world") {
+            return Err(o.error(
+                "`to_world`: an irradiancemeter is where its shape is (Mitsuba refuses its own transform too)",
+            ));
+        }
+        for t in ["shutter_open", "shutter_close"] {
+            o.take(t);
+        }
+        self.sensor = true;
+        self.meter = Some("irradiancemeter");
+        table_mut(&mut self.root, "camera")
+            .insert("type", at(Value::Str("irradiancemeter".into()), o.line));
+        self.sensor_contents(o)?;
+        Ok(true)
     }
 
     /// A sensor's medium, film, reconstruction filter and sampler.
@@ -354,6 +431,19 @@ impl Reader {
         let ldr = match o.ty.as_str() {
             "hdrfilm" | "tiledhdrfilm" => false,
             "ldrfilm" => true,
+            // Mitsuba 0.6's film for measurements: a text file of the values (one pixel by
+            // default).
+            "mfilm" => {
+                for name in ["file_format", "fileFormat", "digits", "variable"] {
+                    o.take(name);
+                }
+                self.warn(
+                    &o,
+                    line,
+                    "an mfilm writes the values as text: foton writes them as an OpenEXR image",
+                );
+                false
+            }
             _ => {
                 o.props.clear();
                 return self.unsupported(
@@ -370,8 +460,31 @@ impl Reader {
         for (name, _, _) in &mut o.props {
             *name = camel_to_snake(name);
         }
-        let width = o.int("width", 768)?;
-        let height = o.int("height", 576)?;
+        let (w, h) = if o.ty == "mfilm" { (1, 1) } else { (768, 576) };
+        let mut width = o.int("width", w)?;
+        let mut height = o.int("height", h)?;
+        if let Some(meter) = self.meter.map(a_meter)
+            && (width, height) != (1, 1)
+        {
+            // Mitsuba 3 refuses any other film; 0.6's radiance meter measures the same
+            // ray in every pixel, its irradiance meter a part of the shape's uv square.
+            if !o.v1 {
+                return Err(o.error(format!(
+                    "{meter} measures one value: its film is 1 x 1 pixels (Mitsuba 3 takes no other), found {width} x {height}"
+                )));
+            }
+            let why = if self.meter == Some("irradiancemeter") {
+                "Mitsuba 0.6 measures a part of the shape's uv square in each: foton measures the whole surface, their mean, on one pixel"
+            } else {
+                "each the same ray: foton measures it on one pixel"
+            };
+            self.warn(
+                &o,
+                line,
+                &format!("a film of {width} x {height} pixels for {meter} ({why})"),
+            );
+            (width, height) = (1, 1);
+        }
         self.crop_window(&mut o, width, height)?;
         if ldr {
             self.ldr_film(&mut o)?;
@@ -482,6 +595,12 @@ impl Reader {
                 filter.insert("type", at(Value::Str("gaussian".into()), line));
                 filter.insert("stddev", at(Value::Float(0.5), line));
             }
+        }
+        // A meter weighs its samples alike: the mean over its surface (or its ray), which
+        // another filter over one pixel only weighs otherwise.
+        if self.meter.is_some() {
+            filter = Table::default();
+            filter.insert("type", at(Value::Str("box".into()), rf_line));
         }
         if filter.get("type").is_some() {
             table_mut(&mut self.root, "film").insert("filter", at(Value::Table(filter), rf_line));
@@ -673,4 +792,13 @@ fn foton_sampler(mitsuba: &str) -> Option<(&'static str, bool)> {
         "orthogonal" | "ldsampler" | "halton" | "hammersley" => ("sobol", false),
         _ => return None,
     })
+}
+
+/// A meter's plugin name with its article, for messages.
+pub(super) fn a_meter(meter: &str) -> String {
+    if meter.starts_with('i') {
+        format!("an {meter}")
+    } else {
+        format!("a {meter}")
+    }
 }

@@ -55,6 +55,8 @@ impl Reader {
         // Mitsuba's interior (behind the normal) and exterior (in front of it).
         let mut interior = None;
         let mut exterior = None;
+        // Whether the shape is the surface of the irradiance meter that renders the file.
+        let mut measured = false;
         let props = std::mem::take(&mut o.props);
         for (name, p, l) in props {
             // Errors at the property's own line.
@@ -108,13 +110,18 @@ impl Reader {
                     ),
                 },
                 Prop::Object(sensor) if sensor.tag == "sensor" => {
-                    self.unsupported(
-                        &Obj {
-                            props: Vec::new(),
-                            ..sensor.clone()
-                        },
-                        "a sensor attached to a shape is not supported (foton renders through the scene's one <sensor>)",
-                    )?;
+                    if sensor.ty == "irradiancemeter" {
+                        once(measured, "sensor")?;
+                        measured = self.irradiance_meter(sensor)?;
+                    } else {
+                        self.unsupported(
+                            &Obj {
+                                props: Vec::new(),
+                                ..sensor.clone()
+                            },
+                            "a sensor other than an irradiancemeter attached to a shape is not supported",
+                        )?;
+                    }
                 }
                 Prop::Ref(id) if name == "interior" || name == "exterior" => {
                     let Some(found) = self.media.get(&id).cloned() else {
@@ -410,6 +417,9 @@ impl Reader {
             }
             if let Some(e) = &emission {
                 t.insert("emission", e.clone());
+            }
+            if measured {
+                t.insert("sensor", at(Value::Bool(true), line));
             }
             // Both sides, as Mitsuba crosses them: a side without a medium is vacuum.
             if interior.is_some() || exterior.is_some() {
