@@ -1,4 +1,4 @@
-//! Lights: point, spot and area lights (any emissive shape), and lights at infinity
+//! Lights: point, spot, projector and area lights (any emissive shape), and lights at infinity
 //! (directional, constant and environment-mapped), one file per kind, each listed on one line
 //! of the `lights!` invocation below.
 //!
@@ -23,6 +23,7 @@ lights! {
         Envmap(envmap::EnvmapLight),
         Area(area::AreaLight),
         SunSky(sunsky::SunSkyLight),
+        Projector(projector::ProjectorLight),
     }
 }
 

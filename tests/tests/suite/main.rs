@@ -62,6 +62,7 @@ mod ply;
 mod ppb;
 mod pplastic;
 mod principled;
+mod projector;
 mod rough_texture;
 mod samplers;
 mod sampling;

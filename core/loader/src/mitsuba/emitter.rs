@@ -1,5 +1,6 @@
-//! `<emitter>` outside a shape: point, spot, directional, constant, envmap and sun-and-sky
-//! lights as `[[lights]]` entries (a point or spot light with the medium it sits in).
+//! `<emitter>` outside a shape: point, spot, projector, directional, constant, envmap and
+//! sun-and-sky lights as `[[lights]]` entries (a point, spot or projector light with the
+//! medium it sits in).
 
 use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
@@ -31,8 +32,8 @@ impl Reader {
                     )));
                 }
             };
-            if !matches!(o.ty.as_str(), "point" | "spot") {
-                return Err(o.error("only point and spot emitters sit in a medium"));
+            if !matches!(o.ty.as_str(), "point" | "spot" | "projector") {
+                return Err(o.error("only point, spot and projector emitters sit in a medium"));
             }
             t.insert("medium", at(Value::Str(name), l));
         }
@@ -61,6 +62,22 @@ impl Reader {
                     t.insert("texture", tex);
                     t.insert("up", vec3(m.transform_vector3(DVec3::Y), line));
                 }
+            }
+            // The reverse of a perspective camera of the same to_world and field of view.
+            "projector" => {
+                t.insert("position", vec3(m.transform_point3(DVec3::ZERO), line));
+                t.insert("direction", vec3(m.transform_vector3(DVec3::Z), line));
+                t.insert("up", vec3(m.transform_vector3(DVec3::Y), line));
+                if m.determinant() < 0.0 {
+                    t.insert("mirror", at(Value::Bool(true), line));
+                }
+                let (fov, axis) = super::sensor::field_of_view(&mut o)?;
+                t.insert("fov", at(Value::Float(fov), line));
+                t.insert("fov_axis", at(Value::Str(axis), line));
+                if let Some(tex) = self.texture(&mut o, "irradiance", DVec3::ONE)? {
+                    t.insert("irradiance", tex);
+                }
+                t.insert("scale", at(Value::Float(o.float("scale", 1.0)?), line));
             }
             "directional" => {
                 let d = match o.take("direction") {

@@ -83,34 +83,7 @@ impl Reader {
             camera.insert("up", vec3(up, line));
             return self.sensor_contents(o);
         }
-        let has_fov = o.props.iter().any(|(n, _, _)| n == "fov");
-        let (fov, fov_axis) = if has_fov {
-            if o.props.iter().any(|(n, _, _)| n == "focal_length") {
-                return Err(o.error("give either `fov` or `focal_length`, not both"));
-            }
-            let fov = o.float("fov", 45.0)?;
-            (fov, o.string("fov_axis")?.unwrap_or_else(|| "x".into()))
-        } else {
-            // Mitsuba's default: a focal length on 35 mm film (36 x 24 mm), whose diagonal
-            // field of view is 2 atan(43.27 / 2f).
-            let f = o.string("focal_length")?.unwrap_or_else(|| "50mm".into());
-            let mm: f64 = f
-                .strip_suffix("mm")
-                .unwrap_or(&f)
-                .trim()
-                .parse()
-                .ok()
-                .filter(|x: &f64| *x > 0.0)
-                .ok_or_else(|| {
-                    o.error(format!(
-                        "`focal_length` = {f:?}: expected a positive length in millimetres, such as \"50mm\""
-                    ))
-                })?;
-            let diagonal = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt();
-            let fov = 2.0 * (diagonal / (2.0 * mm)).atan().to_degrees();
-            o.take("fov_axis");
-            (fov, "diagonal".to_string())
-        };
+        let (fov, fov_axis) = field_of_view(&mut o)?;
         // A thin lens focuses at `focus_distance` along the view, by default at the far clip
         // plane (Mitsuba's ProjectiveCamera); the clip planes change nothing else foton
         // renders, and a pinhole's focus distance nothing at all.
@@ -745,6 +718,39 @@ impl Reader {
         }
         self.leftovers(&o)
     }
+}
+
+/// A perspective sensor's or projector's field of view and the axis it spans (Mitsuba's
+/// `fov` and `fov_axis`, or `focal_length` on 35 mm film, along the diagonal).
+pub(super) fn field_of_view(o: &mut Obj) -> Result<(f64, String)> {
+    let has_fov = o.props.iter().any(|(n, _, _)| n == "fov");
+    Ok(if has_fov {
+        if o.props.iter().any(|(n, _, _)| n == "focal_length") {
+            return Err(o.error("give either `fov` or `focal_length`, not both"));
+        }
+        let fov = o.float("fov", 45.0)?;
+        (fov, o.string("fov_axis")?.unwrap_or_else(|| "x".into()))
+    } else {
+        // Mitsuba's default: a focal length on 35 mm film (36 x 24 mm), whose diagonal
+        // field of view is 2 atan(43.27 / 2f).
+        let f = o.string("focal_length")?.unwrap_or_else(|| "50mm".into());
+        let mm: f64 = f
+            .strip_suffix("mm")
+            .unwrap_or(&f)
+            .trim()
+            .parse()
+            .ok()
+            .filter(|x: &f64| *x > 0.0)
+            .ok_or_else(|| {
+                o.error(format!(
+                    "`focal_length` = {f:?}: expected a positive length in millimetres, such as \"50mm\""
+                ))
+            })?;
+        let diagonal = (36.0f64 * 36.0 + 24.0 * 24.0).sqrt();
+        let fov = 2.0 * (diagonal / (2.0 * mm)).atan().to_degrees();
+        o.take("fov_axis");
+        (fov, "diagonal".to_string())
+    })
 }
 
 /// Mitsuba's field of view when a file gives none.
