@@ -712,7 +712,8 @@ fn unread_parameters_of_0x_files_warn_as_mitsuba_0_6_does() {
 }
 
 /// `moment` renders the integrator it wraps, with a warning that the moment layer is not
-/// written; an emitter's `sampling_weight` (noise, not the image) is read without a word.
+/// written (as are `stokes`'s and `aov`'s layers); an emitter's `sampling_weight` (noise, not
+/// the image) is read without a word.
 #[test]
 fn moment_renders_the_wrapped_integrator() {
     let dir = temp_dir("mitsuba-moment");
@@ -760,6 +761,33 @@ fn moment_renders_the_wrapped_integrator() {
         "{:?}",
         report.warnings
     );
+    // So does `aov` (its AOVs not written); without one it writes only AOVs: refused, and
+    // --lenient renders with foton's default.
+    let aov = body.replace(
+        "<integrator type=\"moment\">",
+        "<integrator type=\"aov\"><string name=\"aovs\" value=\"dd.y:depth\"/>",
+    );
+    let xml = write(&dir, "aov.xml", &scene("3.0.0", &aov));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert_eq!(text(&doc.root, "render.integrator"), "bdpt");
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("aov.xml:2") && w.contains("AOV layers (dd.y:depth)")),
+        "{:?}",
+        report.warnings
+    );
+    let alone = format!(
+        "<integrator type=\"aov\"><string name=\"aovs\" value=\"dd.y:depth\"/></integrator>\n{SENSOR}"
+    );
+    let xml = write(&dir, "aov_alone.xml", &scene("3.0.0", &alone));
+    let e = read(&xml, false).unwrap_err();
+    assert!(
+        e.contains("aov_alone.xml:2") && e.contains("only its AOVs"),
+        "{e}"
+    );
+    assert!(read(&xml, true).is_ok());
 }
 
 /// A plugin named in another case (`Rectangle`, which Mitsuba finds where the file system
@@ -1082,5 +1110,30 @@ fn manifold_sampling_hints_are_noted() {
         noted("caustic_caster_single") && noted("caustic_emitter_single"),
         "{:?}",
         report.notes
+    );
+}
+
+/// Mitsuba 3's `has_spectral_extinction` = false: a hint its volpath takes to treat sigma_t as
+/// one value, exact where sigma_t is grey (read silently), not otherwise (a warning).
+#[test]
+fn the_spectral_extinction_hint_warns_only_where_it_changes_mitsubas_image() {
+    let dir = temp_dir("mitsuba-spectral-extinction");
+    let medium = |sigma_t: &str| {
+        format!(
+            "<medium type=\"homogeneous\" id=\"fog\"><rgb name=\"sigma_t\" value=\"{sigma_t}\"/>\n<boolean name=\"has_spectral_extinction\" value=\"false\"/></medium>\n{SENSOR}\n<shape type=\"sphere\"><ref name=\"interior\" id=\"fog\"/><bsdf type=\"null\"/></shape>"
+        )
+    };
+    let xml = write(&dir, "grey.xml", &scene("3.0.0", &medium("0.5")));
+    let (_, report) = read(&xml, false).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let xml = write(&dir, "coloured.xml", &scene("3.0.0", &medium("0.5, 1, 2")));
+    let (_, report) = read(&xml, false).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("coloured.xml:3") && w.contains("has_spectral_extinction")),
+        "{:?}",
+        report.warnings
     );
 }

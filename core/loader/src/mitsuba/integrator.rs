@@ -18,7 +18,7 @@ impl Reader {
         for (name, _, _) in &mut o.props {
             *name = camel_to_snake(name);
         }
-        if o.ty == "moment" || o.ty == "stokes" {
+        if matches!(o.ty.as_str(), "moment" | "stokes" | "aov") {
             return self.wrapper(o);
         }
         let has_media = !self.media.is_empty();
@@ -273,17 +273,30 @@ impl Reader {
 
 /// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
 impl Reader {
-    /// Mitsuba's `moment` and `stokes`, which wrap integrators: the wrapped ones render the
-    /// image, and `moment` adds their second moments as layers of the film, `stokes` the
+    /// Mitsuba's `moment`, `stokes` and `aov`, which wrap integrators: the wrapped ones render
+    /// the image, and `moment` adds their second moments as layers of the film, `stokes` the
     /// Stokes components S1 to S3 (zero in Mitsuba 3's RGB variants, which track no
-    /// polarisation; foton tracks none either). foton renders the first it wraps; the extra
-    /// layers are not written (a warning says so).
+    /// polarisation; foton tracks none either), `aov` the arbitrary output variables it names.
+    /// foton renders the first it wraps; the extra layers are not written (a warning says so).
     fn wrapper(&mut self, mut o: Obj) -> Result<()> {
+        // Mitsuba 3's aov without an integrator writes the AOVs alone: no image to render.
+        let aovs = if o.ty == "aov" {
+            o.string("aovs")?.unwrap_or_default()
+        } else {
+            String::new()
+        };
         let nested = o
             .props
             .iter()
             .position(|(_, p, _)| matches!(p, Prop::Object(n) if n.tag == "integrator"));
         let Some(i) = nested else {
+            if o.ty == "aov" {
+                o.props.clear();
+                return self.unsupported(
+                    &o,
+                    &format!("an aov integrator without an integrator writes only its AOVs ({aovs}), which foton does not render"),
+                );
+            }
             return Err(o.error(format!(
                 "a {} integrator without the integrator it wraps",
                 o.ty
@@ -301,8 +314,11 @@ impl Reader {
             .retain(|(_, p, _)| !matches!(p, Prop::Object(n) if n.tag == "integrator"));
         self.leftovers(&o)?;
         let line = o.line;
+        let aov_layers = format!("the AOV layers ({aovs}) are");
         let layers = if o.ty == "stokes" {
             "the Stokes layers S1 to S3 (foton tracks no polarisation) are"
+        } else if o.ty == "aov" {
+            aov_layers.as_str()
         } else if more > 0 {
             "the second-moment layers are"
         } else {

@@ -94,6 +94,20 @@ impl Reader {
         let scale = o.float("scale", scale)?;
         // Whether a medium samples emitters changes noise, not the image.
         o.take("sample_emitters");
+        // Mitsuba 3's hint that sigma_t is the same in every channel: its volpath then
+        // samples and weighs distances as if it were, which is exact when it is.
+        if let Some((p, l)) = o.take("has_spectral_extinction") {
+            let sigma_t = (sigma_s + sigma_a) * scale;
+            let grey =
+                sigma_t.max_element() - sigma_t.min_element() <= 1e-6 * sigma_t.max_element();
+            if matches!(p, Prop::Bool(false)) && !grey {
+                self.warn(
+                    &o,
+                    l,
+                    "`has_spectral_extinction` = false with a sigma_t that differs between channels: foton renders the extinction of each channel (Mitsuba 3's volpath takes it as one, and its image differs)",
+                );
+            }
+        }
         let mut t = Table::default();
         t.insert("type", at(Value::Str("homogeneous".into()), line));
         t.insert("sigma_s", vec3(sigma_s * scale, line));
