@@ -165,6 +165,32 @@ Shape "trianglemesh" "point3 P" [-2 -2 0  2 -2 0  2 2 0  -2 2 0]
         "Mitsuba: tilted / flat {ratio}, expected {}",
         want * g
     );
+
+    // Mitsuba 2's specular manifold sampling fork names the image itself (`filename`),
+    // repeated `tiles` times: the image of Mitsuba's normalmap of it with that to_uv.
+    for tiles in [1, 2] {
+        let fork = ortho_rectangle_xml(
+            2.0,
+            a,
+            &format!(
+                "  <bsdf type=\"normalmap\"><string name=\"filename\" value=\"n.png\"/><float name=\"tiles\" value=\"{tiles}\"/><ref id=\"grey\"/></bsdf>\n"
+            ),
+        );
+        let mitsuba = ortho_rectangle_xml(
+            2.0,
+            a,
+            &format!(
+                "  <bsdf type=\"normalmap\"><texture name=\"normalmap\" type=\"bitmap\"><boolean name=\"raw\" value=\"true\"/><string name=\"filename\" value=\"n.png\"/><transform name=\"to_uv\"><scale value=\"{tiles}\"/></transform></texture><ref id=\"grey\"/></bsdf>\n"
+            ),
+        );
+        let fork = foton_tests::render_file(&foton_tests::write(&dir, "fork.xml", &fork), &[], 2);
+        let mitsuba =
+            foton_tests::render_file(&foton_tests::write(&dir, "m.xml", &mitsuba), &[], 2);
+        assert!(
+            fork.pixels() == mitsuba.pixels(),
+            "tiles {tiles}: the fork's normal map renders otherwise"
+        );
+    }
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -147,8 +147,14 @@ impl Reader {
                 // The BSDF it wraps, with the map as its `normal_map`: nested, it is read
                 // with the map; referenced, a copy of it gets the map (the original may be
                 // used without it elsewhere).
-                let Some(map) = self.texture(&mut o, "normalmap", DVec3::new(0.5, 0.5, 1.0))?
-                else {
+                let fork = o.props.iter().any(|(n, _, _)| n == "filename")
+                    && !o.props.iter().any(|(n, _, _)| n == "normalmap");
+                let map = if fork {
+                    self.fork_normal_map(&mut o)?
+                } else {
+                    self.texture(&mut o, "normalmap", DVec3::new(0.5, 0.5, 1.0))?
+                };
+                let Some(map) = map else {
                     return Ok(None);
                 };
                 let mut entries = self.map_light(&mut o, "normal map")?;
@@ -983,4 +989,41 @@ enum Scalar {
     /// A texture left out (lenient).
     LeftOut,
     Given(foton_core::value::Node),
+}
+
+impl Reader {
+    /// The normal map of Mitsuba 2's specular manifold sampling fork (`filename`, `tiles`):
+    /// its image's normals, normalize(2 rgb - 1), repeated `tiles` times over the uv square,
+    /// as Mitsuba's `normalmap` of that image reads them (interpolated between texel centres
+    /// as normals, where the fork interpolates their slopes: the same normals at the
+    /// centres). Its LEAN fallback serves only its glint integrators.
+    fn fork_normal_map(&mut self, o: &mut Obj) -> Result<Option<Node>> {
+        let line = o.line;
+        let file = self.filename(o)?;
+        let tiles = o.float("tiles", 1.0)?;
+        for k in [
+            "use_slopes",
+            "lean_fallback",
+            "lean_fallback_alpha",
+            "lean_fallback_material",
+            "eta",
+            "k",
+        ] {
+            o.take(k);
+        }
+        self.note(
+            o,
+            "the normal map of Mitsuba 2's specular manifold sampling fork (`filename`, `tiles`): read as Mitsuba's normalmap of that image, repeated `tiles` times (its LEAN fallback, for its glint integrators, is not read)",
+        );
+        let mut t = Table::default();
+        t.insert("type", at(Value::Str("bitmap".into()), line));
+        t.insert("filename", file);
+        t.insert("raw", at(Value::Bool(true), line));
+        if tiles != 1.0 {
+            let mut to_uv = Table::default();
+            to_uv.insert("scale", at(Value::Float(tiles), line));
+            t.insert("to_uv", at(Value::Table(to_uv), line));
+        }
+        Ok(Some(at(Value::Table(t), line)))
+    }
 }
