@@ -12,7 +12,7 @@ use glam::{Affine2, DVec3, Mat2, Vec2};
 use std::path::Path;
 use std::sync::Arc;
 
-pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard"];
+pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard", "constant"];
 
 /// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR, BMP, TGA, PPM/PGM: Mitsuba's formats but
 /// PFM; the format is recognised by its content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
@@ -88,12 +88,16 @@ pub(crate) fn table_colour(table: &Table, key: &str, missing: f64) -> DVec3 {
 /// Multiplies a texture table's values by `s` (a bitmap's `scale`, a checkerboard's two
 /// colours), each new colour written by `node`: the readers' scale textures.
 pub(crate) fn scale_texture_table(table: &mut Table, s: DVec3, node: impl Fn(DVec3) -> Node) {
-    let is_checkerboard =
-        matches!(table.get("type"), Some(Node { value: Value::Str(k), .. }) if k == "checkerboard");
-    let keys: &[&str] = if is_checkerboard {
-        &["color0", "color1"]
-    } else {
-        &["scale"]
+    let keys: &[&str] = match table.get("type") {
+        Some(Node {
+            value: Value::Str(k),
+            ..
+        }) if k == "checkerboard" => &["color0", "color1"],
+        Some(Node {
+            value: Value::Str(k),
+            ..
+        }) if k == "constant" => &["value"],
+        _ => &["scale"],
     };
     for key in keys {
         let scaled = table_colour(table, key, 1.0) * s;
@@ -105,7 +109,7 @@ pub(crate) fn scale_texture_table(table: &mut Table, s: DVec3, node: impl Fn(DVe
 /// name is read once.
 pub type Bitmaps = std::collections::HashMap<(std::path::PathBuf, u64), Arc<Bitmap>>;
 
-/// A texture table (`type = "bitmap"` or `"checkerboard"` and its parameters, see
+/// A texture table (`type = "bitmap"`, `"checkerboard"` or `"constant"` and its parameters, see
 /// docs/scene-format.md); `filename` is relative to `base_dir`. Every error names the
 /// scene file, line and key; an image that cannot be read also names the image file.
 pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) -> Result<Texture> {
@@ -176,6 +180,7 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) 
                 to_uv,
             })
         }
+        "constant" => Ok(Texture::Constant(t.vec3_required("value")?)),
         "checkerboard" => Ok(Texture::Checkerboard {
             // Mitsuba's defaults.
             color0: t.rgb("color0", Rgb::splat(0.4))?,

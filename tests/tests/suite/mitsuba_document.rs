@@ -1137,3 +1137,31 @@ fn the_spectral_extinction_hint_warns_only_where_it_changes_mitsubas_image() {
         report.warnings
     );
 }
+
+/// Mitsuba 3's `rawconstant` texture (a float or a vector, no colour conversion) is foton's
+/// `constant` texture of that value.
+#[test]
+fn rawconstant_textures_are_constants() {
+    let dir = temp_dir("mitsuba-rawconstant");
+    for (value, want) in [
+        ("<float name=\"value\" value=\"0.25\"/>", [0.25, 0.25, 0.25]),
+        (
+            "<vector name=\"value\" value=\"0.5, 0.5, 1.0\"/>",
+            [0.5, 0.5, 1.0],
+        ),
+    ] {
+        let body = format!(
+            "{SENSOR}\n<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"rawconstant\" name=\"reflectance\">{value}</texture></bsdf></shape>"
+        );
+        let xml = write(&dir, "raw.xml", &scene("3.0.0", &body));
+        let (doc, _) = read(&xml, false).unwrap();
+        let material = text(&doc.root, "shapes.0.material");
+        let reflectance = format!("materials.{material}.reflectance");
+        assert_eq!(text(&doc.root, &format!("{reflectance}.type")), "constant");
+        let Value::Array(v) = &node(&doc.root, &format!("{reflectance}.value")).value else {
+            panic!("value")
+        };
+        let got: Vec<f64> = v.iter().map(|n| n.value.as_f64().unwrap()).collect();
+        assert_eq!(got, want);
+    }
+}

@@ -128,11 +128,13 @@ fn a_checkerboard_alternates_its_colours() {
 }
 
 /// Every colour field of every material takes a texture: a constant-colour checkerboard
-/// (both colours equal) renders exactly as the plain colour, bit for bit.
+/// (both colours equal) and a `constant` texture render exactly as the plain colour, bit for
+/// bit.
 #[test]
 fn every_colour_field_takes_a_texture() {
     let colour = "[0.7, 0.5, 0.3]";
     let tex = "{ type = \"checkerboard\", color0 = [0.7, 0.5, 0.3], color1 = [0.7, 0.5, 0.3] }";
+    let constant = "{ type = \"constant\", value = [0.7, 0.5, 0.3] }";
     for (ty, fields) in [
         ("diffuse", vec!["reflectance"]),
         ("mirror", vec!["reflectance"]),
@@ -181,6 +183,16 @@ fn every_colour_field_takes_a_texture() {
         assert!(
             plain.pixels() == textured.pixels(),
             "{ty}: the texture renders differently from its colour"
+        );
+        let constant = render_toml(
+            "texture-fields",
+            &textured_quad("path", &body(constant)),
+            &[],
+            2,
+        );
+        assert!(
+            plain.pixels() == constant.pixels(),
+            "{ty}: the constant texture renders differently from its colour"
         );
     }
 }

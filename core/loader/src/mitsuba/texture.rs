@@ -70,6 +70,7 @@ impl Reader {
             Some(Value::Str(ty)) if ty == "checkerboard" => {
                 Ok((colour("color0") + colour("color1")) * 0.5)
             }
+            Some(Value::Str(ty)) if ty == "constant" => Ok(colour("value")),
             Some(Value::Str(ty)) if ty == "bitmap" => {
                 let Some(Value::Str(file)) = t.get("filename").map(|n| &n.value) else {
                     return Ok(default);
@@ -148,6 +149,23 @@ impl Reader {
                 };
                 scale_texture_table(&mut inner, factor, |v| vec3(v, line));
                 return Ok(Some(inner));
+            }
+            // Mitsuba 3's value without colour conversion: foton's colours have none.
+            "rawconstant" => {
+                t.insert("type", at(Value::Str("constant".into()), line));
+                let value = match o.take("value") {
+                    Some((Prop::Float(x), _)) => DVec3::splat(x),
+                    Some((Prop::Int(i), _)) => DVec3::splat(i as f64),
+                    Some((Prop::Point(v) | Prop::Color(v), _)) => v,
+                    Some((p, _)) => {
+                        return Err(o.error(format!(
+                            "`value`: expected a float or a vector, found {}",
+                            show(&p)
+                        )));
+                    }
+                    None => return Err(o.error("a rawconstant texture needs its `value`")),
+                };
+                t.insert("value", vec3(value, line));
             }
             "checkerboard" => {
                 for (key, default) in [("color0", 0.4), ("color1", 0.2)] {
