@@ -1,7 +1,9 @@
 //! Microfacet normal distributions as Mitsuba 3 defines them (its `MicrofacetDistribution`):
 //! Beckmann and GGX (Trowbridge-Reitz), anisotropic with roughnesses alpha_u along x and
 //! alpha_v along y, and the sampling of visible normals (Heitz and d'Eon 2014) with Jakob's
-//! numerical inversion for Beckmann and Heitz's 2018 routine for GGX.
+//! numerical inversion for Beckmann and Heitz's 2018 routine for GGX; and Mitsuba 0.6's
+//! third, Phong's (anisotropic: Ashikhmin and Shirley's), whose normals are sampled from
+//! D(m) cos(theta_m) as 0.6 samples them (it has no visible-normal routine).
 //!
 //! Everything is in the local shading frame: z is the shading normal. Directions point away
 //! from the surface. As in Mitsuba, Smith's G1 of the Beckmann distribution is its rational
@@ -17,6 +19,10 @@ pub enum MicrofacetKind {
     Beckmann,
     /// GGX / Trowbridge-Reitz: long tails (Walter et al. 2007).
     Ggx,
+    /// Phong's cos^e (Walter et al. 2007), e = 2 / alpha^2 - 2; anisotropic, Ashikhmin and
+    /// Shirley's (2000) with e interpolated in phi (Mitsuba 0.6's `phong` and `as`). Its G1 is
+    /// Beckmann's of the same alpha, as in Mitsuba 0.6.
+    Phong,
 }
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -64,6 +70,14 @@ impl Microfacet {
         let d = match self.kind {
             MicrofacetKind::Beckmann => (-slope2 / cos2).exp() / (PI * au * av * cos2 * cos2),
             MicrofacetKind::Ggx => 1.0 / (PI * au * av * (slope2 + cos2).powi(2)),
+            MicrofacetKind::Phong => {
+                if m.z <= 0.0 {
+                    return 0.0;
+                }
+                let (eu, ev) = self.phong_exponents();
+                (eu + 2.0).sqrt() * (ev + 2.0).sqrt() / (2.0 * PI)
+                    * m.z.powf(self.phong_exponent(m))
+            }
         };
         // Mitsuba's cut-off: tiny values only make trouble further on (and NaN fails it too).
         if d * m.z > 1e-20 { d } else { 0.0 }
@@ -83,7 +97,7 @@ impl Microfacet {
         // tan^2 of v's angle to the normal, in the stretched (alpha = 1) configuration.
         let tan2 = xy_alpha2 / (v.z * v.z);
         match self.kind {
-            MicrofacetKind::Beckmann => {
+            MicrofacetKind::Beckmann | MicrofacetKind::Phong => {
                 // Mitsuba's rational fit of 2 / (1 + Lambda(a)), a = 1 / tan (Walter et al.
                 // 2007, eq. 27), rather than the erf form.
                 let a = 1.0 / tan2.sqrt();
@@ -103,12 +117,67 @@ impl Microfacet {
     }
 
     /// Density of visible normals seen from `wi` (wi.z > 0), D_wi(m) = G1(wi, m) max(0, wi.m)
-    /// D(m) / cos(theta_i): the solid-angle pdf of [`Microfacet::sample`].
+    /// D(m) / cos(theta_i): the solid-angle pdf of [`Microfacet::sample`]. Phong's: D(m)
+    /// cos(theta_m), whatever `wi` sees.
     pub fn pdf(&self, wi: Vec3, m: Vec3) -> f32 {
         if wi.z <= 0.0 || !wi.is_finite() || !m.is_finite() {
             return 0.0;
         }
+        if self.kind == MicrofacetKind::Phong {
+            return self.d(m) * m.z;
+        }
         self.d(m) * self.smith_g1(wi, m) * wi.dot(m).abs() / wi.z
+    }
+
+    /// Phong's exponents along x and y: 2 / alpha^2 - 2 (Mitsuba 0.6), at least 0.
+    #[inline]
+    fn phong_exponents(&self) -> (f32, f32) {
+        let e = |a: f32| (2.0 / (a * a) - 2.0).max(0.0);
+        (e(self.alpha_u), e(self.alpha_v))
+    }
+
+    /// Ashikhmin and Shirley's exponent towards `m`: e_u cos^2 phi + e_v sin^2 phi.
+    #[inline]
+    fn phong_exponent(&self, m: Vec3) -> f32 {
+        let (eu, ev) = self.phong_exponents();
+        let sin2 = m.x * m.x + m.y * m.y;
+        if self.is_isotropic() || sin2 <= f32::MIN_POSITIVE {
+            return eu;
+        }
+        (eu * m.x * m.x + ev * m.y * m.y) / sin2
+    }
+
+    /// A Phong normal with density D(m) cos(theta_m) (Mitsuba 0.6's `sampleAll`): phi by
+    /// quadrant from tan phi = sqrt((e_u + 2) / (e_v + 2)) tan(pi u / 2), then cos theta =
+    /// u^(1 / (e + 2)) with e that phi's exponent.
+    fn sample_phong(&self, u: Vec2) -> Vec3 {
+        let (eu, ev) = self.phong_exponents();
+        let (phi, e) = if self.is_isotropic() {
+            (2.0 * PI * u.y, eu)
+        } else {
+            let first = |u1: f32| {
+                let phi = (((eu + 2.0) / (ev + 2.0)).sqrt() * (PI * u1 * 0.5).tan()).atan();
+                let (s, c) = phi.sin_cos();
+                (phi, eu * c * c + ev * s * s)
+            };
+            let v = u.y;
+            if v < 0.25 {
+                first(4.0 * v)
+            } else if v < 0.5 {
+                let (p, e) = first(4.0 * (0.5 - v));
+                (PI - p, e)
+            } else if v < 0.75 {
+                let (p, e) = first(4.0 * (v - 0.5));
+                (PI + p, e)
+            } else {
+                let (p, e) = first(4.0 * (1.0 - v));
+                (2.0 * PI - p, e)
+            }
+        };
+        let cos_theta = u.x.powf(1.0 / (e + 2.0));
+        let sin_theta = (1.0 - cos_theta * cos_theta).max(0.0).sqrt();
+        let (s, c) = phi.sin_cos();
+        Vec3::new(sin_theta * c, sin_theta * s, cos_theta)
     }
 
     /// Samples a microfacet normal visible from `wi` (wi.z > 0) with density D_wi(m): stretch
@@ -131,19 +200,25 @@ impl Microfacet {
                 beckmann_slope_y(u.y),
             ),
             MicrofacetKind::Ggx => ggx_visible_slope(frame.0, u),
+            MicrofacetKind::Phong => {
+                let m = self.sample_phong(u);
+                return m.is_finite().then_some(m);
+            }
         };
         self.unstretch(frame, slope)
     }
 
-    /// The visible normals seen from `wi` at every point (nodes[i], nodes[j]) of a grid of
-    /// sample coordinates, passed to `f(i, j, m)` (for integrals over the sample space). For
-    /// Beckmann the x slope depends on u.x only and the y slope on u.y only, so each is
-    /// computed once per row or column: the inversion is what costs.
+    /// The normals [`Microfacet::sample`] gives from `wi` at every point (nodes[i], nodes[j])
+    /// of a grid of sample coordinates, passed to `f(i, j, m, w)` with the weight w that makes
+    /// the grid's rule an expectation over the visible normals (for integrals over the sample
+    /// space): 1 where the normals sampled are the visible ones, D_wi(m) / (D(m) cos theta_m)
+    /// for Phong's. For Beckmann the x slope depends on u.x only and the y slope on u.y only,
+    /// so each is computed once per row or column: the inversion is what costs.
     pub(crate) fn for_each_normal_on_grid(
         &self,
         wi: Vec3,
         nodes: &[f32],
-        mut f: impl FnMut(usize, usize, Vec3),
+        mut f: impl FnMut(usize, usize, Vec3, f32),
     ) {
         let Some(frame) = self.stretched_frame(wi) else {
             return;
@@ -153,16 +228,24 @@ impl Microfacet {
                 .iter()
                 .map(|&u| (beckmann_visible_slope_x(frame.0, u), beckmann_slope_y(u)))
                 .unzip(),
-            MicrofacetKind::Ggx => (Vec::new(), Vec::new()),
+            MicrofacetKind::Ggx | MicrofacetKind::Phong => (Vec::new(), Vec::new()),
         };
         for (i, &ux) in nodes.iter().enumerate() {
             for (j, &uy) in nodes.iter().enumerate() {
                 let slope = match self.kind {
                     MicrofacetKind::Beckmann => Vec2::new(xs[i], ys[j]),
                     MicrofacetKind::Ggx => ggx_visible_slope(frame.0, Vec2::new(ux, uy)),
+                    MicrofacetKind::Phong => {
+                        let m = self.sample_phong(Vec2::new(ux, uy));
+                        if m.is_finite() && m.z > 0.0 {
+                            let w = self.smith_g1(wi, m) * wi.dot(m).max(0.0) / (wi.z * m.z);
+                            f(i, j, m, w);
+                        }
+                        continue;
+                    }
                 };
                 if let Some(m) = self.unstretch(frame, slope) {
-                    f(i, j, m);
+                    f(i, j, m, 1.0);
                 }
             }
         }
@@ -581,7 +664,7 @@ pub(crate) mod chi2 {
     /// rational fit, the erf form 1 / (1 + Lambda) over the fit. A visible-normal pdf times
     /// this is the exact density of the (exact) sampling routine: the fit only rescales it.
     pub fn g1_correction(md: &super::Microfacet, v: Vec3) -> f64 {
-        if md.kind == super::MicrofacetKind::Ggx || v.z <= 0.0 {
+        if md.kind != super::MicrofacetKind::Beckmann || v.z <= 0.0 {
             return 1.0;
         }
         let xy =
@@ -606,13 +689,16 @@ mod tests {
     use super::*;
     use crate::sampling::Rng;
 
-    const DISTRIBUTIONS: [(MicrofacetKind, f32, f32); 6] = [
+    const DISTRIBUTIONS: [(MicrofacetKind, f32, f32); 9] = [
         (MicrofacetKind::Beckmann, 0.1, 0.1),
         (MicrofacetKind::Beckmann, 0.5, 0.5),
         (MicrofacetKind::Beckmann, 0.15, 0.6),
         (MicrofacetKind::Ggx, 0.1, 0.1),
         (MicrofacetKind::Ggx, 0.5, 0.5),
         (MicrofacetKind::Ggx, 0.6, 0.15),
+        (MicrofacetKind::Phong, 0.1, 0.1),
+        (MicrofacetKind::Phong, 0.5, 0.5),
+        (MicrofacetKind::Phong, 0.15, 0.6),
     ];
     /// Viewing directions: normal, oblique, grazing, off-axis in phi.
     fn views() -> [Vec3; 3] {
@@ -664,7 +750,7 @@ mod tests {
                 // Beckmann's G1 is Mitsuba's rational fit, within 0.35% of the exact one.
                 let tol = match kind {
                     MicrofacetKind::Beckmann => 6e-3,
-                    MicrofacetKind::Ggx => 2e-3,
+                    MicrofacetKind::Ggx | MicrofacetKind::Phong => 2e-3,
                 };
                 assert!((i - 1.0).abs() < tol, "{md:?} wi {wi}: {i}");
             }
@@ -726,7 +812,11 @@ mod tests {
     fn degenerate_input_gives_no_nan() {
         let md = Microfacet::isotropic(MicrofacetKind::Ggx, 0.0);
         assert_eq!(md.alpha_u, Microfacet::MIN_ALPHA);
-        for kind in [MicrofacetKind::Beckmann, MicrofacetKind::Ggx] {
+        for kind in [
+            MicrofacetKind::Beckmann,
+            MicrofacetKind::Ggx,
+            MicrofacetKind::Phong,
+        ] {
             let md = Microfacet::new(kind, f32::NAN, 0.3);
             for wi in [Vec3::ZERO, -Vec3::Z, Vec3::X, Vec3::splat(f32::NAN)] {
                 let (m, pdf) = md.sample(wi, Vec2::new(0.3, 0.7));

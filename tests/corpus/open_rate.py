@@ -77,6 +77,17 @@ def substitute(value, defaults):
     return re.sub(r"\$(\w+)", lambda m: defaults.get(m.group(1), m.group(0)), value)
 
 
+def parse(path):
+    """The file's element tree, as Mitsuba's parser (pugixml) reads it: a comment holding
+    `--`, which Python's parser refuses, is still a comment there."""
+    try:
+        return ET.parse(path)
+    except ET.ParseError:
+        with open(path, "rb") as f:
+            text = f.read()
+        return ET.ElementTree(ET.fromstring(re.sub(rb"<!--.*?-->", b"", text, flags=re.S)))
+
+
 def referenced_files(root):
     """(kind, value) pairs: every file a Mitsuba scene element names."""
     for el in root.iter():
@@ -113,7 +124,7 @@ def missing_assets(path, defaults=None, seen=None, search=None):
         return []
     seen.add(path)
     try:
-        root = ET.parse(path).getroot()
+        root = parse(path).getroot()
     except (ET.ParseError, OSError, ValueError):
         return []  # foton reports a malformed file itself; not an asset question
     defaults = dict(defaults or {})
@@ -217,7 +228,7 @@ def constructs(path, seen=None):
     top = not seen
     seen.add(os.path.abspath(path))
     try:
-        root = ET.parse(path).getroot()
+        root = parse(path).getroot()
     except (ET.ParseError, OSError, ValueError):
         return {"(malformed XML for Python's parser)"}
     found = set()
@@ -280,7 +291,7 @@ def peeled_copy(path):
     wavelength:value spectra (their mean, a grey), three-value spectra (as <rgb>), booleans spelled True/False. The copy is
     a survey aid: remove it after use."""
     try:
-        tree = ET.parse(path)
+        tree = parse(path)
     except (ET.ParseError, OSError, ValueError):
         return None
     root = tree.getroot()

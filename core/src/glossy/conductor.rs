@@ -2,7 +2,7 @@
 
 use super::{LocalSample, above};
 use crate::Rgb;
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::scattering::{TransportMode, fresnel_conductor, reflect};
 use glam::{Vec2, Vec3};
 
@@ -48,6 +48,10 @@ impl RoughConductor {
         if !above(wo) || !above(wi) || wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
             return 0.0;
         }
+        if self.distribution.kind == MicrofacetKind::Phong {
+            // D(h) cos(theta_h) / (4 wi.h): all normals, as Phong's are sampled.
+            return self.distribution.pdf(wo, h) / (4.0 * wo.dot(h));
+        }
         // D_wo(h) / (4 wi.h), with wo.h = wi.h.
         self.distribution.d(h) * self.distribution.smith_g1(wo, h) / (4.0 * wo.z)
     }
@@ -65,13 +69,17 @@ impl RoughConductor {
         if wi.z <= 0.0 || cos_im <= 0.0 {
             return None;
         }
-        // f cos_i / pdf: D G F / (4 cos_o) over D G1(wo) / (4 cos_o) leaves G1(wi) F.
-        let weight =
-            self.specular_reflectance * self.fresnel(wo.dot(m)) * self.distribution.smith_g1(wi, m);
+        let pdf = pdf_m / (4.0 * cos_im);
+        let weight = if self.distribution.kind == MicrofacetKind::Phong {
+            self.eval(wo, wi, TransportMode::Radiance) / pdf
+        } else {
+            // f cos_i / pdf: D G F / (4 cos_o) over D G1(wo) / (4 cos_o) leaves G1(wi) F.
+            self.specular_reflectance * self.fresnel(wo.dot(m)) * self.distribution.smith_g1(wi, m)
+        };
         Some(LocalSample {
             wi,
             weight,
-            pdf: pdf_m / (4.0 * cos_im),
+            pdf,
             delta: false,
         })
     }

@@ -2,7 +2,7 @@
 
 use super::{LocalSample, fresnel, positive, refract};
 use crate::Rgb;
-use crate::microfacet::Microfacet;
+use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::scattering::{TransportMode, reflect};
 use glam::{Vec2, Vec3};
 
@@ -144,9 +144,15 @@ impl RoughDielectric {
         if g1 <= 0.0 || !positive(pdf) || !wi.is_finite() {
             return None;
         }
+        let weight = if md.kind == MicrofacetKind::Phong {
+            // Phong's normals are not the visible ones: nothing cancels.
+            self.eval(wo, wi, mode) / pdf
+        } else {
+            weight * g1
+        };
         Some(LocalSample {
             wi,
-            weight: weight * g1,
+            weight,
             pdf,
             delta: false,
         })

@@ -168,6 +168,15 @@ impl RoughPlastic {
     pub(super) fn specular_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize_or_zero();
         let md = &self.distribution;
+        if md.kind == MicrofacetKind::Phong {
+            // All normals, as Phong's are sampled: D(h) cos(theta_h) / (4 wo.h).
+            let oh = wo.dot(h);
+            return if oh > 0.0 {
+                md.pdf(wo, h) / (4.0 * oh)
+            } else {
+                0.0
+            };
+        }
         md.d(h) * md.smith_g1(wo, h) / (4.0 * wo.z)
     }
 
@@ -213,11 +222,11 @@ fn gauss_legendre_unit(n: usize) -> Vec<(f32, f64)> {
 fn coat_reflectance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> f64 {
     let nodes: Vec<f32> = rule.iter().map(|r| r.0).collect();
     let mut sum = 0.0;
-    md.for_each_normal_on_grid(w, &nodes, |i, j, m| {
+    md.for_each_normal_on_grid(w, &nodes, |i, j, m, weight| {
         let r = reflect(w, m);
         if r.z > 0.0 {
             let (f, ..) = fresnel(w.dot(m), eta);
-            sum += rule[i].1 * rule[j].1 * (f * md.smith_g1(r, m)) as f64;
+            sum += rule[i].1 * rule[j].1 * (f * md.smith_g1(r, m) * weight) as f64;
         }
     });
     sum
@@ -229,11 +238,11 @@ fn coat_reflectance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> 
 fn coat_transmittance(md: &Microfacet, w: Vec3, eta: f32, rule: &[(f32, f64)]) -> f64 {
     let nodes: Vec<f32> = rule.iter().map(|r| r.0).collect();
     let mut sum = 0.0;
-    md.for_each_normal_on_grid(w, &nodes, |i, j, m| {
+    md.for_each_normal_on_grid(w, &nodes, |i, j, m, weight| {
         let (f, cos_t, _, eta_ti) = fresnel(w.dot(m), eta);
         let t = refract(w, m, cos_t, eta_ti);
         if t.z * w.z < 0.0 {
-            sum += rule[i].1 * rule[j].1 * ((1.0 - f) * md.smith_g1(t, m)) as f64;
+            sum += rule[i].1 * rule[j].1 * ((1.0 - f) * md.smith_g1(t, m) * weight) as f64;
         }
     });
     sum

@@ -11,13 +11,16 @@ use std::f64::consts::PI;
 
 const BECKMANN: MicrofacetKind = MicrofacetKind::Beckmann;
 const GGX: MicrofacetKind = MicrofacetKind::Ggx;
+const PHONG: MicrofacetKind = MicrofacetKind::Phong;
 
 /// Distributions of the sampling tests: narrow, anisotropic both ways, wide.
-const DISTRIBUTIONS: [(MicrofacetKind, f32, f32); 4] = [
+const DISTRIBUTIONS: [(MicrofacetKind, f32, f32); 6] = [
     (BECKMANN, 0.1, 0.1),
     (BECKMANN, 0.15, 0.6),
     (GGX, 0.4, 0.4),
     (GGX, 0.6, 0.15),
+    (PHONG, 0.3, 0.3),
+    (PHONG, 0.2, 0.5),
 ];
 /// Viewing directions above the surface: normal, oblique (off-axis in phi), grazing.
 fn views() -> [Vec3; 3] {
@@ -35,7 +38,7 @@ fn inside_views() -> [Vec3; 2] {
         Vec3::new(0.2, -0.85, -0.5).normalize(),
     ]
 }
-const ROUGH_PLASTICS: [(MicrofacetKind, f32); 2] = [(BECKMANN, 0.1), (GGX, 0.4)];
+const ROUGH_PLASTICS: [(MicrofacetKind, f32); 3] = [(BECKMANN, 0.1), (GGX, 0.4), (PHONG, 0.3)];
 const PLASTICS: [(f32, bool); 2] = [(1.5, false), (1.9, true)];
 
 /// All chi-square tests of this module, for the Sidak correction.
@@ -293,9 +296,22 @@ fn albedo(lobe: &Lobe, wo: Vec3, mode: TransportMode, n: usize, seed: u64) -> (R
 
 const ALPHAS: [f32; 5] = [0.01, 0.05, 0.2, 0.5, 1.0];
 
+/// The albedo above 1 that Phong's distribution may have: its G1 is Beckmann's of the same
+/// alpha (Walter et al. 2007's approximation, which Mitsuba 0.6 renders), not the exact
+/// masking of the cos^e distribution, and it masks too little near the horizon and at alpha
+/// 1, where the exponent is 0 and the normals are far from Beckmann's (+16 % at alpha 1 and
+/// cos 0.08, +5 % at alpha 1 and cos 0.76). Elsewhere none.
+fn phong_excess(kind: MicrofacetKind, alpha: f32, wo: Vec3) -> f32 {
+    if kind == PHONG && (alpha >= 1.0 || wo.z.abs() < 0.3) {
+        0.2
+    } else {
+        0.0
+    }
+}
+
 #[test]
 fn conductor_conserves_energy_and_tends_to_the_smooth_one() {
-    for kind in [BECKMANN, GGX] {
+    for kind in [BECKMANN, GGX, PHONG] {
         for alpha in ALPHAS {
             // eta = 0, k = 1 (Mitsuba's defaults) reflects everything: F = 1.
             let white = Lobe::Conductor(RoughConductor {
@@ -307,7 +323,7 @@ fn conductor_conserves_energy_and_tends_to_the_smooth_one() {
             for wo in views() {
                 let (a, se) = albedo(&white, wo, TransportMode::Radiance, 40_000, 1);
                 assert!(
-                    a.max_element() <= 1.0 + 4.0 * se + 1e-3,
+                    a.max_element() <= 1.0 + 4.0 * se + 1e-3 + phong_excess(kind, alpha, wo),
                     "{white:?} {wo}: {a}"
                 );
                 if alpha == 0.01 && wo.z > 0.5 {
@@ -338,14 +354,14 @@ fn conductor_conserves_energy_and_tends_to_the_smooth_one() {
 
 #[test]
 fn dielectric_conserves_energy_and_tends_to_the_smooth_one() {
-    for kind in [BECKMANN, GGX] {
+    for kind in [BECKMANN, GGX, PHONG] {
         for alpha in ALPHAS {
             for eta in [1.5, 1.0 / 1.33] {
                 let lobe = Lobe::Dielectric(dielectric(kind, alpha, alpha, eta));
                 for wo in views().into_iter().chain(inside_views()) {
                     let (a, se) = albedo(&lobe, wo, TransportMode::Importance, 40_000, 3);
                     assert!(
-                        a.max_element() <= 1.0 + 4.0 * se + 1e-3,
+                        a.max_element() <= 1.0 + 4.0 * se + 1e-3 + phong_excess(kind, alpha, wo),
                         "{lobe:?} {wo}: {a}"
                     );
                     if alpha == 0.01 && wo.z.abs() > 0.5 {

@@ -423,9 +423,10 @@ fn read_microfacet_kind(m: &Properties<'_>) -> Result<MicrofacetKind> {
     match m.string("distribution", "beckmann")? {
         "beckmann" => Ok(MicrofacetKind::Beckmann),
         "ggx" => Ok(MicrofacetKind::Ggx),
+        "phong" => Ok(MicrofacetKind::Phong),
         other => Err(m.error(
             "distribution",
-            format!("unknown distribution {other:?}; expected beckmann or ggx"),
+            format!("unknown distribution {other:?}; expected beckmann, ggx or phong"),
         )),
     }
 }

@@ -548,14 +548,9 @@ impl Reader {
             .unwrap_or_else(|| "beckmann".into());
         let distribution = match distribution.as_str() {
             "beckmann" | "ggx" => distribution,
-            // Mitsuba 0.6's other two, shaped much like Beckmann's at the same alpha.
-            "phong" | "as" => {
-                let what = format!(
-                    "`distribution` {distribution:?} is not supported; rendered with \"beckmann\" of the same roughness"
-                );
-                self.unsupported(o, &what)?;
-                "beckmann".to_string()
-            }
+            // Mitsuba 0.6's third, Phong's, which it calls `as` too (Ashikhmin and Shirley's
+            // where anisotropic): one distribution.
+            "phong" | "as" => "phong".to_string(),
             _ => {
                 return Err(o.error(format!(
                     "`distribution`: unknown {distribution:?}; expected beckmann or ggx (or, in Mitsuba 0.6, phong or as)"
