@@ -252,8 +252,8 @@ fn changes_to_the_surface_change_the_version() {
         (
             "registered",
             "light/mod.rs",
-            "        SunSky(sunsky::SunSkyLight),\n    }",
-            "        SunSky(sunsky::SunSkyLight),\n        Extra(point::PointLight),\n    }",
+            "        Projector(projector::ProjectorLight),\n    }",
+            "        Projector(projector::ProjectorLight),\n        Extra(point::PointLight),\n    }",
         ),
         // A field of a light kind, reached through the variant's path.
         (
