@@ -342,6 +342,37 @@ impl SceneSphere {
 /// The direction from `x` to `p`, the distance and its square (a point light's 1/r^2); None
 /// when they coincide.
 #[inline(always)]
+/// The unit axis of a light at `position` aimed by `look_at` or `direction` (exactly one):
+/// `what` names the light in the error of neither ("a spot light").
+fn read_axis(
+    l: &crate::props::Properties<'_>,
+    position: Vec3,
+    what: &str,
+) -> crate::error::Result<Vec3> {
+    let axis = match (l.vec3_opt("look_at")?, l.vec3_opt("direction")?) {
+        (Some(target), None) => target - position,
+        (None, Some(d)) => d,
+        (Some(_), Some(_)) => {
+            return Err(l.error("direction", "give either look_at or direction, not both"));
+        }
+        (None, None) => {
+            return Err(l.error(
+                "look_at",
+                format!("missing; {what} needs look_at = [x, y, z] or direction = [x, y, z]"),
+            ));
+        }
+    };
+    if axis.length_squared() == 0.0 {
+        let key = if l.has("look_at") {
+            "look_at"
+        } else {
+            "direction"
+        };
+        return Err(l.error(key, "gives no direction (zero length)"));
+    }
+    Ok(axis.normalize())
+}
+
 fn towards(x: Vec3, p: Vec3) -> Option<(Vec3, f32, f32)> {
     let d = p - x;
     let dist2 = d.length_squared();

@@ -24,7 +24,7 @@
 //! plane across the axis at distance d is pi scale E(uv) / d^2, constant for a constant image
 //! (Mitsuba 3's normalisation). The power is pi scale A mean(E), A = 4 tan_x tan_y.
 
-use super::{EmittedRay, LightSample, LightSource, LightType, towards};
+use super::{EmittedRay, LightSample, LightSource, LightType, read_axis, towards};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::texture::Texture;
@@ -168,28 +168,7 @@ pub const FACTORY: Factory<ProjectorLight> = Factory {
     description: "a point light projecting an image (Mitsuba 3's projector)",
     create: |l, _, resources| {
         let position = l.vec3_required("position")?;
-        let axis = match (l.vec3_opt("look_at")?, l.vec3_opt("direction")?) {
-            (Some(target), None) => target - position,
-            (None, Some(d)) => d,
-            (Some(_), Some(_)) => {
-                return Err(l.error("direction", "give either look_at or direction, not both"));
-            }
-            (None, None) => {
-                return Err(l.error(
-                    "look_at",
-                    "missing; a projector needs look_at = [x, y, z] or direction = [x, y, z]",
-                ));
-            }
-        };
-        if axis.length_squared() == 0.0 {
-            let key = if l.has("look_at") {
-                "look_at"
-            } else {
-                "direction"
-            };
-            return Err(l.error(key, "gives no direction (zero length)"));
-        }
-        let z = axis.normalize();
+        let z = read_axis(l, position, "a projector")?;
         let up = l.vec3("up", Vec3::Y)?;
         let left = up.cross(z);
         if left.length_squared() < 1e-12 {

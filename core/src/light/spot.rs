@@ -19,7 +19,7 @@
 //! in the light's frame (+z the axis, +x = up x axis, +y = axis x x, Mitsuba's look-at
 //! frame): the image spans the square of half-width tan(cutoff) at unit distance.
 
-use super::{EmittedRay, LightSample, LightSource, LightType, towards};
+use super::{EmittedRay, LightSample, LightSource, LightType, read_axis, towards};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::sampling::{to_world, uniform_cone};
@@ -259,27 +259,7 @@ pub const FACTORY: Factory<SpotLight> = Factory {
     create: |l, _, resources| {
         let position = l.vec3_required("position")?;
         let intensity = l.rgb("intensity", Rgb::ONE)?;
-        let axis = match (l.vec3_opt("look_at")?, l.vec3_opt("direction")?) {
-            (Some(target), None) => target - position,
-            (None, Some(d)) => d,
-            (Some(_), Some(_)) => {
-                return Err(l.error("direction", "give either look_at or direction, not both"));
-            }
-            (None, None) => {
-                return Err(l.error(
-                    "look_at",
-                    "missing; a spot light needs look_at = [x, y, z] or direction = [x, y, z]",
-                ));
-            }
-        };
-        if axis.length_squared() == 0.0 {
-            let key = if l.has("look_at") {
-                "look_at"
-            } else {
-                "direction"
-            };
-            return Err(l.error(key, "gives no direction (zero length)"));
-        }
+        let axis = read_axis(l, position, "a spot light")?;
         let cutoff = l.f32("cutoff_angle", 20.0)?;
         if !(cutoff > 0.0 && cutoff <= 90.0) {
             return Err(l.error(
@@ -300,7 +280,7 @@ pub const FACTORY: Factory<SpotLight> = Factory {
         };
         let spot = SpotLight {
             position,
-            axis: axis.normalize(),
+            axis,
             intensity,
             beam_width: beam_width.to_radians(),
             cutoff: cutoff.to_radians(),
