@@ -123,10 +123,18 @@ impl Microfacet {
         if wi.z <= 0.0 || !wi.is_finite() || !m.is_finite() {
             return 0.0;
         }
-        if self.kind == MicrofacetKind::Phong {
+        if !self.samples_visible_normals() {
             return self.d(m) * m.z;
         }
         self.d(m) * self.smith_g1(wi, m) * wi.dot(m).abs() / wi.z
+    }
+
+    /// Whether [`Microfacet::sample`] draws the normals visible from wi (all but Phong's):
+    /// then the lobes' densities are D G1(wo) / (4 cos_o) and their sample weights reduce to
+    /// G1(wi) times the rest; Phong's normals come from D cos theta_m, and nothing cancels.
+    #[inline]
+    pub fn samples_visible_normals(&self) -> bool {
+        self.kind != MicrofacetKind::Phong
     }
 
     /// Phong's exponents along x and y: 2 / alpha^2 - 2 (Mitsuba 0.6), at least 0.

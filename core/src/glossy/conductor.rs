@@ -2,7 +2,7 @@
 
 use super::{LocalSample, above};
 use crate::Rgb;
-use crate::microfacet::{Microfacet, MicrofacetKind};
+use crate::microfacet::Microfacet;
 use crate::scattering::{TransportMode, fresnel_conductor, reflect};
 use glam::{Vec2, Vec3};
 
@@ -48,8 +48,8 @@ impl RoughConductor {
         if !above(wo) || !above(wi) || wo.dot(h) <= 0.0 || wi.dot(h) <= 0.0 {
             return 0.0;
         }
-        if self.distribution.kind == MicrofacetKind::Phong {
-            // D(h) cos(theta_h) / (4 wi.h): all normals, as Phong's are sampled.
+        if !self.distribution.samples_visible_normals() {
+            // The sampler's density of h over 4 wi.h.
             return self.distribution.pdf(wo, h) / (4.0 * wo.dot(h));
         }
         // D_wo(h) / (4 wi.h), with wo.h = wi.h.
@@ -70,7 +70,7 @@ impl RoughConductor {
             return None;
         }
         let pdf = pdf_m / (4.0 * cos_im);
-        let weight = if self.distribution.kind == MicrofacetKind::Phong {
+        let weight = if !self.distribution.samples_visible_normals() {
             self.eval(wo, wi, TransportMode::Radiance) / pdf
         } else {
             // f cos_i / pdf: D G F / (4 cos_o) over D G1(wo) / (4 cos_o) leaves G1(wi) F.

@@ -2,7 +2,7 @@
 
 use super::{LocalSample, fresnel, positive, refract};
 use crate::Rgb;
-use crate::microfacet::{Microfacet, MicrofacetKind};
+use crate::microfacet::Microfacet;
 use crate::scattering::{TransportMode, reflect};
 use glam::{Vec2, Vec3};
 
@@ -144,8 +144,8 @@ impl RoughDielectric {
         if g1 <= 0.0 || !positive(pdf) || !wi.is_finite() {
             return None;
         }
-        let weight = if md.kind == MicrofacetKind::Phong {
-            // Phong's normals are not the visible ones: nothing cancels.
+        let weight = if !md.samples_visible_normals() {
+            // Nothing cancels when the normals are not the visible ones.
             self.eval(wo, wi, mode) / pdf
         } else {
             weight * g1

@@ -168,8 +168,8 @@ impl RoughPlastic {
     pub(super) fn specular_pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let h = (wo + wi).normalize_or_zero();
         let md = &self.distribution;
-        if md.kind == MicrofacetKind::Phong {
-            // All normals, as Phong's are sampled: D(h) cos(theta_h) / (4 wo.h).
+        if !md.samples_visible_normals() {
+            // The sampler's density of h over 4 wo.h.
             let oh = wo.dot(h);
             return if oh > 0.0 {
                 md.pdf(wo, h) / (4.0 * oh)
