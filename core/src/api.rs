@@ -61,8 +61,8 @@ pub use crate::walk::{
 
 // Sampling.
 pub use crate::sampling::{
-    Distribution1D, Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, power_heuristic,
-    russian_roulette, splitmix64, uniform_sphere,
+    Distribution1D, Rng, SOBOL_DIMENSIONS, Sampler, SamplerKind, SobolPoint, cosine_hemisphere,
+    power_heuristic, russian_roulette, splitmix64, to_world, uniform_hemisphere, uniform_sphere,
 };
 
 // The image.

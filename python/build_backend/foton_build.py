@@ -37,7 +37,7 @@ from typing import Any, Mapping
 import maturin
 
 HERE = Path(__file__).resolve().parent.parent  # python/
-PLUGIN_CRATES = ["foton-path", "foton-photon", "foton-sppm", "foton-vpm", "foton-ppb", "foton-bdpt", "foton-vcm", "foton-normals"]
+PLUGIN_CRATES = ["foton-path", "foton-photon", "foton-sppm", "foton-vpm", "foton-ppb", "foton-bdpt", "foton-vcm", "foton-normals", "foton-ao"]
 PLUGIN_DIR = HERE / "foton" / "plugins"
 
 # maturin's backend runs the `maturin` command: in a virtual environment that is not activated

@@ -11,7 +11,7 @@ import pytest
 import foton
 from conftest import ROOT, SCENES, TINY
 
-INTEGRATORS = {"path", "bdpt", "vcm", "photon", "sppm", "vpm", "ppb", "normals"}
+INTEGRATORS = {"path", "bdpt", "vcm", "photon", "sppm", "vpm", "ppb", "normals", "ao"}
 
 
 def test_the_package_carries_the_integrators():

@@ -36,7 +36,7 @@ pub use sampler::{PixelSamplers, SampleStart, Sampler, SamplerFactory, SamplerIm
 pub use stratified::{permutation_element, strata_2d};
 pub use warp::{
     UNIFORM_SPHERE_PDF, basis, concentric_disc, cosine_hemisphere, to_world, uniform_cone,
-    uniform_sphere, uniform_triangle,
+    uniform_hemisphere, uniform_sphere, uniform_triangle,
 };
 
 /// Russian roulette past `rr_depth` scattering events (the path tracer's rule, shared by every

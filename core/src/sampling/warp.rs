@@ -34,6 +34,15 @@ pub fn uniform_sphere(u: Vec2) -> Vec3 {
 
 pub const UNIFORM_SPHERE_PDF: f32 = 1.0 / (4.0 * PI);
 
+/// Uniform direction on the hemisphere around +z; pdf 1/(2 pi).
+#[inline]
+pub fn uniform_hemisphere(u: Vec2) -> Vec3 {
+    let z = u.x;
+    let r = (1.0 - z * z).max(0.0).sqrt();
+    let phi = 2.0 * PI * u.y;
+    Vec3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
 /// Concentric map of the square onto the unit disc (Shirley-Chiu).
 #[inline]
 pub fn concentric_disc(u: Vec2) -> Vec2 {
@@ -86,6 +95,46 @@ mod tests {
             let (s, t) = basis(n);
             assert!((s.length() - 1.0).abs() < 1e-4 && (t.length() - 1.0).abs() < 1e-4);
             assert!(s.dot(t).abs() < 1e-4 && s.dot(n).abs() < 1e-4 && t.dot(n).abs() < 1e-4);
+        }
+    }
+
+    /// Chi-square of the hemisphere warps against their densities, over 8 x 8 cells of
+    /// (cos theta, phi): a cell's probability is the density's integral over it (uniform: its
+    /// share of cos theta; cosine: its share of cos^2 theta), the threshold the statistic's
+    /// quantile at 5 standard deviations (Wilson-Hilferty).
+    #[test]
+    fn hemisphere_warps_follow_their_densities() {
+        const N: usize = 8;
+        let samples = 200_000;
+        type Warp = fn(Vec2) -> Vec3;
+        type Cdf = fn(f64) -> f64;
+        let warps: [(&str, Warp, Cdf); 2] = [
+            ("uniform", uniform_hemisphere, |c| c),
+            ("cosine", cosine_hemisphere, |c| c * c),
+        ];
+        for (name, warp, cdf) in warps {
+            let mut rng = Rng::new(&[7]);
+            let mut counts = [[0u32; N]; N];
+            for _ in 0..samples {
+                let w = warp(rng.next_2d());
+                assert!((w.length() - 1.0).abs() < 1e-4 && w.z >= 0.0, "{name}: {w}");
+                let phi = w.y.atan2(w.x).rem_euclid(2.0 * PI) / (2.0 * PI);
+                let i = ((w.z * N as f32) as usize).min(N - 1);
+                let j = ((phi * N as f32) as usize).min(N - 1);
+                counts[i][j] += 1;
+            }
+            let mut chi2 = 0.0;
+            for (i, row) in counts.iter().enumerate() {
+                let p = (cdf((i + 1) as f64 / N as f64) - cdf(i as f64 / N as f64)) / N as f64;
+                let expected = p * samples as f64;
+                for &c in row {
+                    chi2 += (c as f64 - expected).powi(2) / expected;
+                }
+            }
+            let k = (N * N - 1) as f64;
+            let v = 2.0 / (9.0 * k);
+            let limit = k * (1.0 - v + 5.0 * v.sqrt()).powi(3);
+            assert!(chi2 < limit, "{name}: chi2 {chi2} over {limit}");
         }
     }
 }

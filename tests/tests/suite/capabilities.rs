@@ -23,7 +23,7 @@ fn prepared(integrator: &str, sets: &[String]) -> foton_cli::Prepared {
 #[test]
 fn parameters_are_the_keys_of_the_integrators_table_and_round_trip() {
     for name in [
-        "path", "bdpt", "vcm", "photon", "sppm", "vpm", "ppb", "normals",
+        "path", "bdpt", "vcm", "photon", "sppm", "vpm", "ppb", "normals", "ao",
     ] {
         let p = prepared(name, &[]);
         assert_eq!(p.integrator.name(), name);
@@ -121,7 +121,7 @@ fn budgets_name_real_scene_keys() {
 /// is one of their parameters (so that `--set` takes it).
 #[test]
 fn biased_integrators_name_the_keys_that_shrink_their_bias() {
-    for name in ["path", "bdpt", "normals"] {
+    for name in ["path", "bdpt", "normals", "ao"] {
         assert_eq!(prepared(name, &[]).integrator.bias(), None, "{name}");
     }
     for mode in ["bpt", "lt"] {

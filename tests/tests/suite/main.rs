@@ -9,6 +9,7 @@
 //! render watches, and would stop the renders of tests running beside them.
 
 mod alpha;
+mod ao;
 mod bad_input;
 mod bad_input_output;
 mod bad_input_plugins;

@@ -94,7 +94,7 @@ fn the_panicking_fixture_is_not_found_beside_the_real_plugins() {
     assert_eq!(
         names,
         [
-            "bdpt", "normals", "path", "photon", "ppb", "sppm", "vcm", "vpm"
+            "ao", "bdpt", "normals", "path", "photon", "ppb", "sppm", "vcm", "vpm"
         ]
     );
     let built = plugin_dir().join(format!(

@@ -121,7 +121,7 @@ pub fn from_document(doc: Document) -> Result<Scene> {
 
     if geometry.lights.is_empty() {
         ld.warnings.push(format!(
-            "{}: the scene has no lights: the image will be black",
+            "{}: the scene has no lights: the image will be black (but for geometry passes such as ao and normals)",
             file.display()
         ));
     }

@@ -579,13 +579,53 @@ impl Reader {
                 table_mut(&mut self.root, "integrators").insert("sppm", t);
                 "sppm"
             }
-            "ambientocclusion" | "lightpath" | "simplepath" | "simplevolpath" | "randomwalk"
-            | "mlt" | "aov" => {
-                self.unsupported(loc, &d.what(), "not read yet (path, volpath, bdpt and sppm are); --lenient renders it with foton's path tracer")?;
+            "simplepath" | "simplevolpath" | "randomwalk" => {
+                // Estimators of the same image as path's by simpler means (simplepath's
+                // light and BSDF sampling may each be switched off, randomwalk samples
+                // directions uniformly, simplevolpath follows media with delta tracking).
+                p.bool("samplelights", true)?;
+                p.bool("samplebsdf", true)?;
+                self.note(
+                    loc,
+                    &d.what(),
+                    "rendered by foton's path tracer (the same image, with less noise)",
+                );
+                "path"
+            }
+            "lightpath" => {
+                self.note(
+                    loc,
+                    &d.what(),
+                    "rendered by foton's bdpt, whose light-tracing strategy is pbrt-v4's \
+                     lightpath; bdpt also renders what light tracing cannot reach (specular \
+                     surfaces seen directly, and what is seen in them)",
+                );
+                "bdpt"
+            }
+            "ambientocclusion" => {
+                let cosine = p.bool("cossample", true)?;
+                let max_distance = p.float_opt("maxdistance")?;
+                let mut entries = vec![("cosine", self.node(Value::Bool(cosine), loc))];
+                if let Some((r, l)) = max_distance {
+                    if r.is_nan() || r <= 0.0 {
+                        return Err(
+                            l.error(&d.what(), format!("\"maxdistance\" {r}: must be positive"))
+                        );
+                    }
+                    if r.is_finite() {
+                        entries.push(("max_distance", self.num(r, &l)));
+                    }
+                }
+                let t = self.table(entries, loc);
+                table_mut(&mut self.root, "integrators").insert("ao", t);
+                "ao"
+            }
+            "mlt" => {
+                self.unsupported(loc, &d.what(), "not rendered (foton has no Metropolis light transport); --lenient renders it with foton's path tracer")?;
                 "path"
             }
             other => {
-                return Err(loc.error(&d.what(), format!("unknown integrator {other:?}; pbrt-v4 has volpath, path, bdpt, sppm, mlt, lightpath, simplepath, simplevolpath, randomwalk, ambientocclusion and aov")));
+                return Err(loc.error(&d.what(), format!("unknown integrator {other:?}; pbrt-v4 has volpath, path, bdpt, sppm, mlt, lightpath, simplepath, simplevolpath, randomwalk and ambientocclusion")));
             }
         };
         self.finish(&mut p)?;

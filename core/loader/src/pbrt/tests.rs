@@ -156,6 +156,57 @@ fn film_sampler_integrator_and_their_defaults() {
     );
 }
 
+/// pbrt-v4's other integrators: the simpler estimators of path's image as path, lightpath as
+/// bdpt (a note says so), ambientocclusion as foton's `ao` with its two parameters; mlt refused.
+#[test]
+fn every_pbrt_integrator_maps_or_is_refused() {
+    for (pbrt, foton) in [
+        ("simplepath", "path"),
+        ("simplevolpath", "path"),
+        ("randomwalk", "path"),
+        ("lightpath", "bdpt"),
+        ("ambientocclusion", "ao"),
+    ] {
+        let extra = if pbrt == "simplepath" {
+            "\"bool samplelights\" false \"bool samplebsdf\" true"
+        } else {
+            ""
+        };
+        let (d, report) = read(
+            &format!("Integrator \"{pbrt}\" \"integer maxdepth\" 3 {extra}\n{WORLD}"),
+            false,
+        )
+        .unwrap_or_else(|e| panic!("{pbrt}: {e}"));
+        assert_eq!(text(&d.root, "render.integrator"), foton, "{pbrt}");
+        assert_eq!(node(&d.root, "render.max_depth").value, Value::Int(3));
+        if foton != "ao" {
+            assert!(
+                report.notes.iter().any(|n| n.contains(foton)),
+                "{pbrt}: {:?}",
+                report.notes
+            );
+        }
+    }
+    let t = doc(&format!("Integrator \"ambientocclusion\"\n{WORLD}"));
+    assert_eq!(node(&t, "integrators.ao.cosine").value, Value::Bool(true));
+    assert!(!has(&t, "integrators.ao.max_distance"));
+    let t = doc(&format!(
+        "Integrator \"ambientocclusion\" \"bool cossample\" false \"float maxdistance\" 2.5\n{WORLD}"
+    ));
+    assert_eq!(node(&t, "integrators.ao.cosine").value, Value::Bool(false));
+    assert_eq!(num(&t, "integrators.ao.max_distance"), 2.5);
+    let e = read(
+        &format!("Integrator \"ambientocclusion\" \"float maxdistance\" 0\n{WORLD}"),
+        false,
+    )
+    .unwrap_err();
+    assert!(e.contains("\"maxdistance\" 0: must be positive"), "{e}");
+    let e = read(&format!("Integrator \"mlt\"\n{WORLD}"), false).unwrap_err();
+    assert!(e.contains("Metropolis"), "{e}");
+    let (d, _) = read(&format!("Integrator \"mlt\"\n{WORLD}"), true).unwrap();
+    assert_eq!(text(&d.root, "render.integrator"), "path");
+}
+
 #[test]
 fn transforms_compose_as_pbrt_does() {
     // Translate then Scale: the scale applies first to the object.
