@@ -155,6 +155,10 @@ pub struct Film {
     /// Each technique's share of the image, when the render was asked for them
     /// (`RenderContext::techniques`); empty otherwise.
     layers: Vec<Layer>,
+    /// The camera's response, a matrix on each pixel's linear sRGB value (`[film]
+    /// white_balance`); None: the radiance as rendered. The sums stay unchanged: parts and
+    /// merges add them before the matrix applies.
+    pub color_matrix: Option<glam::DMat3>,
 }
 
 impl Film {
@@ -172,6 +176,7 @@ impl Film {
             iterations_planned: 0,
             photons: 0,
             layers: Vec::new(),
+            color_matrix: None,
         }
     }
 
@@ -298,7 +303,10 @@ impl Film {
         let scale = self.splat_scale();
         let layer = &self.layers[k];
         (0..self.sum.len())
-            .map(|i| value(&layer.sum[i], self.count[i], layer.splat.get(i), scale))
+            .map(|i| {
+                let v = value(&layer.sum[i], self.count[i], layer.splat.get(i), scale);
+                self.respond(v)
+            })
             .collect()
     }
 
@@ -343,7 +351,21 @@ impl Film {
     }
 
     fn pixel_at(&self, i: usize, splat_scale: f64) -> Rgb {
-        value(&self.sum[i], self.count[i], self.splat.get(i), splat_scale)
+        self.respond(value(
+            &self.sum[i],
+            self.count[i],
+            self.splat.get(i),
+            splat_scale,
+        ))
+    }
+
+    /// A pixel's value through the camera's response ([`Film::color_matrix`]).
+    #[inline]
+    fn respond(&self, v: glam::DVec3) -> Rgb {
+        match self.color_matrix {
+            Some(m) => (m * v).as_vec3(),
+            None => v.as_vec3(),
+        }
     }
 
     /// All pixels, row-major from the top-left.
@@ -365,7 +387,7 @@ impl Film {
 /// A pixel's value from its sum of `n` samples and its splat sum (if any): the mean sample
 /// plus the splats times `splat_scale`.
 #[inline]
-fn value(sum: &RadianceSum, n: u32, splat: Option<&RadianceSum>, splat_scale: f64) -> Rgb {
+fn value(sum: &RadianceSum, n: u32, splat: Option<&RadianceSum>, splat_scale: f64) -> glam::DVec3 {
     let mut v = [0.0f64; 3];
     if n > 0 {
         let s = sum.to_f64();
@@ -377,7 +399,7 @@ fn value(sum: &RadianceSum, n: u32, splat: Option<&RadianceSum>, splat_scale: f6
             v[c] += s[c] * splat_scale;
         }
     }
-    Rgb::new(v[0] as f32, v[1] as f32, v[2] as f32)
+    glam::DVec3::from(v)
 }
 
 /// How exposed radiance is squeezed into the [0, 1] an 8-bit image can hold.

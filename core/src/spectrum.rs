@@ -24,7 +24,7 @@
 //! The tables (`data/spectra/`) are the CIE's; the named conductors' indices of refraction
 //! are the measured spectra Mitsuba ships. `data/spectra/README.md` gives their sources.
 
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use std::sync::LazyLock;
 
 /// A spectrum given at increasing wavelengths (nm), linear between them.
@@ -285,6 +285,59 @@ fn to_xyz_v06(s: impl Fn(f64) -> f64, knots: &[f64]) -> DVec3 {
     xyz / y_integral
 }
 
+/// The chromaticity (x, y) of a spectrum `s`, sampled every 1 nm over the CIE tables.
+fn chromaticity(s: impl Fn(f64) -> f64) -> (f64, f64) {
+    let cie = &*CIE;
+    let xyz: DVec3 = cie
+        .xyz
+        .iter()
+        .enumerate()
+        .map(|(i, c)| *c * s(CIE_MIN + i as f64))
+        .sum();
+    let sum = xyz.x + xyz.y + xyz.z;
+    (xyz.x / sum, xyz.y / sum)
+}
+
+/// The white of a colour temperature as pbrt-v4's `Spectra::D` makes it: CIE daylight of
+/// correlated colour temperature `kelvin` x 1.4388 / 1.4380 (the second radiation constant's
+/// revision), from the CIE's polynomial in 1/T for x and the daylight locus for y; below
+/// 4000 K, where daylight is not defined, a black body's.
+pub fn daylight_chromaticity(kelvin: f64) -> (f64, f64) {
+    let t = kelvin * 1.4388 / 1.4380;
+    if t < 4000.0 {
+        return chromaticity(|lambda| blackbody(lambda, t));
+    }
+    let x = if t <= 7000.0 {
+        -4.607e9 / t.powi(3) + 2.9678e6 / t.powi(2) + 0.09911e3 / t + 0.244063
+    } else {
+        -2.0064e9 / t.powi(3) + 1.9018e6 / t.powi(2) + 0.24748e3 / t + 0.23704
+    };
+    (x, -3.0 * x * x + 2.870 * x - 0.275)
+}
+
+/// pbrt-v4's white balance (`Film "rgb" "float whitebalance"` with its default `cie1931`
+/// sensor; `WhiteBalance` in `util/color.cpp`) as a matrix on linear sRGB: von Kries
+/// adaptation in Bradford's cone space (LMS) from the white of `kelvin`
+/// ([`daylight_chromaticity`]) to sRGB's, D65's, so that a surface lit by that white is
+/// rendered white.
+pub fn white_balance(kelvin: f64) -> DMat3 {
+    // Bradford's XYZ to LMS, rows as written (glam's matrices are built from columns).
+    let lms_from_xyz = DMat3::from_cols_array(&[
+        0.8951, -0.7502, 0.0389, 0.2664, 1.7135, -0.0685, -0.1614, 0.0367, 1.0296,
+    ]);
+    let xyz = |(x, y): (f64, f64)| DVec3::new(x / y, 1.0, (1.0 - x - y) / y);
+    let d65 = chromaticity(|lambda| lerp_table(&CIE.d65, 1, lambda));
+    let source = lms_from_xyz * xyz(daylight_chromaticity(kelvin));
+    let target = lms_from_xyz * xyz(d65);
+    let adapt = lms_from_xyz.inverse() * DMat3::from_diagonal(target / source) * lms_from_xyz;
+    let srgb_from_xyz = DMat3::from_cols(
+        xyz_to_srgb(DVec3::X),
+        xyz_to_srgb(DVec3::Y),
+        xyz_to_srgb(DVec3::Z),
+    );
+    srgb_from_xyz * adapt * srgb_from_xyz.inverse()
+}
+
 /// Planck's law with Mitsuba 3's constants: the spectral radiance of a black body at
 /// `kelvin`, in W m⁻² sr⁻¹ nm⁻¹, at `lambda` nm.
 pub fn blackbody(lambda: f64, kelvin: f64) -> f64 {
@@ -419,6 +472,36 @@ mod tests {
 
     /// Mitsuba's normalisations make a flat spectrum of 1 emit a luminance Y of 1: Mitsuba
     /// 3's constant is its 1000-wavelength sum of ȳ, 0.6's the integral of its table.
+    #[test]
+    fn white_balance_maps_the_temperatures_white_to_srgbs() {
+        // D65 is daylight of 6504 K: 6500 K (6503.6 K after the constant's revision) is
+        // within 1e-3 of the identity.
+        let m = white_balance(6500.0);
+        for (c, axis) in [DVec3::X, DVec3::Y, DVec3::Z].into_iter().enumerate() {
+            let d = m * axis - axis;
+            assert!(d.abs().max_element() < 2e-3, "column {c}: {d}");
+        }
+        // The white of each temperature, as linear sRGB, becomes grey; warm whites are
+        // red in sRGB, cool ones blue.
+        let xyz = |(x, y): (f64, f64)| DVec3::new(x / y, 1.0, (1.0 - x - y) / y);
+        for kelvin in [2700.0, 3500.0, 4000.0, 5000.0, 8000.0, 12000.0] {
+            let white = xyz_to_srgb(xyz(daylight_chromaticity(kelvin)));
+            let balanced = white_balance(kelvin) * white;
+            let spread = balanced.max_element() / balanced.min_element() - 1.0;
+            assert!(spread < 1e-3, "{kelvin} K: {white} -> {balanced}");
+            let warm = kelvin < 6500.0;
+            assert_eq!(white.x > white.z, warm, "{kelvin} K: {white}");
+        }
+        // The daylight locus: CIE 15's D50 and D75 chromaticities (4 decimals).
+        for (kelvin, x, y) in [(5000.0, 0.3457, 0.3585), (7500.0, 0.2990, 0.3149)] {
+            let (dx, dy) = daylight_chromaticity(kelvin);
+            assert!(
+                (dx - x).abs() < 2e-4 && (dy - y).abs() < 2e-4,
+                "{kelvin} K: {dx} {dy}"
+            );
+        }
+    }
+
     #[test]
     fn a_flat_spectrum_has_unit_luminance() {
         let y = to_xyz(|_| Some(1.0), Quantity::Emission).y;

@@ -44,7 +44,8 @@ fn ctrl_c_and_checkpoints_hold_the_average_of_the_passes_done() {
         .collect();
     let prepared = prepare(&scene(), &overrides, &[plugin_dir()], true).unwrap();
     let every = 2;
-    let progress = TermProgress::new(true).with_checkpoint(every, out.clone(), Default::default());
+    let progress =
+        TermProgress::new(true).with_checkpoint(every, out.clone(), Default::default(), None);
     // Far too many passes to finish: only the interrupt ends it.
     let stopper = std::thread::spawn(|| {
         std::thread::sleep(Duration::from_millis(1500));

@@ -29,7 +29,8 @@ fn checkpoints_are_written_and_ctrl_c_keeps_the_estimate() {
         true,
     )
     .unwrap();
-    let progress = TermProgress::new(true).with_checkpoint(3, out.clone(), Default::default());
+    let progress =
+        TermProgress::new(true).with_checkpoint(3, out.clone(), Default::default(), None);
     // Far too many iterations to finish: only the interrupt ends it.
     let stopper = std::thread::spawn(|| {
         std::thread::sleep(Duration::from_millis(1500));

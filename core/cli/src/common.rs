@@ -354,10 +354,11 @@ pub fn render_part(
 /// the time the render took.
 pub fn render_with(p: &Prepared, ctx: &RenderContext<'_>) -> Result<(Film, Duration)> {
     let start = Instant::now();
-    let film = p
+    let mut film = p
         .integrator
         .render(&p.scene, ctx)
         .map_err(|e| blame_plugin(&p.plugin, e))?;
+    film.color_matrix = p.scene.film().color_matrix();
     if film.part != ctx.part {
         // A plugin that ignored the part rendered all of the work: merging such films would
         // count it N times.

@@ -95,6 +95,7 @@ pub(crate) fn run(
         let part = read_part_film(path, info)?;
         film.merge(&part);
     }
+    film.color_matrix = f.color_matrix;
     film.write(&a.output, &f.display())?;
     if !missing.is_empty() {
         let _ = writeln!(

@@ -25,8 +25,9 @@ use std::path::Path;
 
 /// The version of the part file layout (attribute `foton.format`).
 /// 2 added the splat channels: a foton that read only format 1 would merge a splatting part
-/// without its splats, so format 1 parts are refused (render them again).
-pub const FORMAT: &str = "foton-part 2";
+/// without its splats, so format 1 parts are refused (render them again); 3 added the film's
+/// colour matrix (`foton.colorMatrix`).
+pub const FORMAT: &str = "foton-part 3";
 
 const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
@@ -53,6 +54,8 @@ pub struct PartInfo {
     /// The scene's display transform, for a merged PNG.
     pub exposure: f32,
     pub tonemap: String,
+    /// The film's response (`[film] white_balance`), applied to the merged image.
+    pub color_matrix: Option<glam::DMat3>,
 }
 
 impl PartInfo {
@@ -85,6 +88,7 @@ impl PartInfo {
             done,
             exposure: display.exposure,
             tonemap: display.tonemap.name().into(),
+            color_matrix: scene.film().color_matrix(),
         })
     }
 
@@ -102,6 +106,14 @@ impl PartInfo {
             ("foton.done", self.done.to_string()),
             ("foton.exposure", self.exposure.to_string()),
             ("foton.tonemap", self.tonemap.clone()),
+            (
+                "foton.colorMatrix",
+                // Column-major, each number as Rust prints it back exactly.
+                self.color_matrix.map_or_else(
+                    || "none".into(),
+                    |m| m.to_cols_array().map(|x| format!("{x:?}")).join(" "),
+                ),
+            ),
         ]
     }
 
@@ -154,6 +166,22 @@ impl PartInfo {
             done: number("foton.done")?,
             exposure: field("foton.exposure")?.parse().unwrap_or(0.0),
             tonemap: field("foton.tonemap")?,
+            color_matrix: match field("foton.colorMatrix")?.as_str() {
+                "none" => None,
+                text => {
+                    let m: Vec<f64> = text
+                        .split_whitespace()
+                        .filter_map(|x| x.parse().ok())
+                        .collect();
+                    let m: [f64; 9] = m.try_into().map_err(|_| {
+                        Error::io(
+                            path,
+                            format!("damaged part: foton.colorMatrix = `{text}` is not 9 numbers"),
+                        )
+                    })?;
+                    Some(glam::DMat3::from_cols_array(&m))
+                }
+            },
         })
     }
 

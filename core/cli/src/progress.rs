@@ -68,7 +68,7 @@ pub struct TermProgress {
     start: Mutex<Instant>,
     /// Write the image every N iterations of a progressive integrator to this file, a PNG
     /// through this display transform (the scene's, as the final image).
-    checkpoint: Option<(u64, PathBuf, DisplayTransform)>,
+    checkpoint: Option<(u64, PathBuf, DisplayTransform, Option<glam::DMat3>)>,
     /// Checkpoint calls received (0 after a render: the integrator is not progressive).
     pub checkpoints: AtomicU64,
 }
@@ -91,10 +91,16 @@ impl TermProgress {
         }
     }
 
-    /// Writes the current image to `path` (atomically; a PNG through `display`) every `every`
-    /// iterations of a progressive integrator.
-    pub fn with_checkpoint(mut self, every: u64, path: PathBuf, display: DisplayTransform) -> Self {
-        self.checkpoint = Some((every.max(1), path, display));
+    /// Writes the current image to `path` (atomically, through the film's `color_matrix`; a
+    /// PNG through `display`) every `every` iterations of a progressive integrator.
+    pub fn with_checkpoint(
+        mut self,
+        every: u64,
+        path: PathBuf,
+        display: DisplayTransform,
+        color_matrix: Option<glam::DMat3>,
+    ) -> Self {
+        self.checkpoint = Some((every.max(1), path, display, color_matrix));
         self
     }
 
@@ -170,9 +176,13 @@ impl Progress for TermProgress {
     }
     fn checkpoint(&self, iteration: u64, image: &dyn Fn() -> Film) {
         self.checkpoints.fetch_add(1, Ordering::Relaxed);
-        if let Some((every, path, display)) = &self.checkpoint
+        if let Some((every, path, display, color_matrix)) = &self.checkpoint
             && iteration.is_multiple_of(*every)
-            && let Err(e) = image().write(path, display)
+            && let Err(e) = {
+                let mut film = image();
+                film.color_matrix = *color_matrix;
+                film.write(path, display)
+            }
         {
             self.warn(&format!("checkpoint at iteration {iteration}: {e}"));
         }

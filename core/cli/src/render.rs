@@ -104,7 +104,12 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
     warn(err, &p.warnings);
     let mut progress = TermProgress::new(a.run.quiet);
     if let Some(every) = a.checkpoint {
-        progress = progress.with_checkpoint(every, output.clone(), p.scene.film().display());
+        progress = progress.with_checkpoint(
+            every,
+            output.clone(),
+            p.scene.film().display(),
+            p.scene.film().color_matrix(),
+        );
     }
     INTERRUPTED.store(false, Ordering::SeqCst);
     let threads = a.run.threads();

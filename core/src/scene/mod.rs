@@ -59,9 +59,17 @@ pub struct FilmSettings {
     pub tonemap: ToneMap,
     /// The pixel filter, as camera samples are placed with it (filter importance sampling).
     pub filter: crate::filter::FilterSampler,
+    /// The colour temperature (K) rendered white (pbrt-v4's `whitebalance`); None: none.
+    pub white_balance: Option<f32>,
 }
 
 impl FilmSettings {
+    /// The camera's response the film applies to each pixel ([`crate::film::Film::color_matrix`]).
+    pub fn color_matrix(&self) -> Option<glam::DMat3> {
+        self.white_balance
+            .map(|k| crate::spectrum::white_balance(k as f64))
+    }
+
     /// The transform from radiance to the display values of a PNG.
     pub fn display(&self) -> DisplayTransform {
         DisplayTransform::new(self.exposure, self.tonemap)

@@ -3,7 +3,9 @@
 //! A geometry pass, not an estimate of light: each pixel is the fraction of the hemisphere
 //! above the first surface its camera rays meet that is open, weighted by the cosine,
 //!
-//!     A(p) = 1/pi ∫ V(p, w) |n · w| dw,
+//! ```text
+//! A(p) = 1/pi ∫ V(p, w) |n · w| dw,
+//! ```
 //!
 //! V being 1 where a ray from p along w meets nothing within `max_distance`. It is pbrt-v4's
 //! `ambientocclusion` integrator: the hemisphere is the geometric normal's, turned towards the

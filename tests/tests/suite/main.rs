@@ -90,3 +90,4 @@ mod twosided_emitter;
 mod vcm;
 mod volume_photons;
 mod vpm;
+mod white_balance;

@@ -329,7 +329,7 @@ fn checkpoints_go_through_the_display_transform() {
     let dir = temp_dir("tonemap-checkpoint");
     let png = dir.join("checkpoint.png");
     let display = DisplayTransform::new(-1.0, ToneMap::Filmic);
-    let progress = TermProgress::new(true).with_checkpoint(1, png.clone(), display);
+    let progress = TermProgress::new(true).with_checkpoint(1, png.clone(), display, None);
     let mut film = Film::new(2, 1);
     let radiance = [Rgb::new(0.1, 1.0, 3.0), Rgb::new(10.0, 0.5, 0.02)];
     film.set_pixel(0, 0, radiance[0]);

@@ -272,10 +272,18 @@ impl Reader {
                 &format!("\"string sensor\" {s:?}: only cie1931 (pbrt-v4's default) is read"),
             )?;
         }
+        // 0, the default of the cie1931 sensor, is no white balance.
         if let Some((w, l)) = p.float_opt("whitebalance")?
             && w != 0.0
         {
-            self.unsupported(&l, &d.what(), "\"whitebalance\" is not read yet")?;
+            if !(1000.0..=100_000.0).contains(&w) {
+                return Err(l.error(
+                    &d.what(),
+                    format!("\"whitebalance\" {w}: expected 0 (none) or a colour temperature between 1000 and 100000 K"),
+                ));
+            }
+            let n = self.num(w, &l);
+            table_mut(&mut self.root, "film").insert("white_balance", n);
         }
         // The pixels rendered (film.cpp): `pixelbounds` [x0 x1 y0 y1], or `cropwindow` in
         // [0, 1] (which wins), x0 = ceil(xres min(c0, c1)) and so on; the image written is

@@ -156,6 +156,19 @@ fn film_sampler_integrator_and_their_defaults() {
     );
 }
 
+/// `whitebalance` (a colour temperature; 0, the default, none) is the film's white balance.
+#[test]
+fn white_balance_is_the_films() {
+    let film = |wb: &str| format!("Film \"rgb\" \"float whitebalance\" {wb}\n{WORLD}");
+    assert_eq!(num(&doc(&film("5000")), "film.white_balance"), 5000.0);
+    assert!(!has(&doc(&film("0")), "film.white_balance"));
+    let e = read(&film("20"), false).unwrap_err();
+    assert!(
+        e.contains("\"whitebalance\" 20") && e.contains(":1:"),
+        "{e}"
+    );
+}
+
 /// pbrt-v4's other integrators: the simpler estimators of path's image as path, lightpath as
 /// bdpt (a note says so), ambientocclusion as foton's `ao` with its two parameters; mlt refused.
 #[test]
