@@ -249,7 +249,7 @@ const MITSUBA06_METER: &str = r#"<scene version="0.5.0">
 		<boolean name="flipNormals" value="true"/>
 		<bsdf type="diffuse"><spectrum name="reflectance" value="0"/></bsdf>
 		<transform name="toWorld"><translate z="1"/></transform>
-		<emitter type="area"><spectrum name="radiance" value="1"/></emitter>
+		<emitter type="area"><rgb name="radiance" value="1"/></emitter>
 	</shape>
 </scene>
 "#;

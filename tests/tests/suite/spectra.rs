@@ -1,7 +1,7 @@
-//! Spectra in Mitsuba scene files, reduced to RGB as each version's RGB renderer reduces them
-//! (issue 32): wavelength:value pairs and `.spd` files as Mitsuba 3's RGB variants read them
-//! (reflectances under D65 and clamped, emission unweighted), a flat emission's colour, three
-//! values as r, g, b in files older than 2.0, blackbodies, the named conductors' measured
+//! Spectra in Mitsuba scene files, reduced to RGB as Mitsuba 3's RGB variants reduce them in
+//! files of every version (issue 32): wavelength:value pairs and `.spd` files (reflectances
+//! under D65 and clamped, emission unweighted), a flat emission's colour; the forms only
+//! Mitsuba 0.6 reads (three values as r, g, b in files older than 2.0, `#rrggbb`), blackbodies, the named conductors' measured
 //! indices, and the errors of malformed spectra.
 //!
 //! The reference values are Mitsuba 3.9.1's (`pip install mitsuba`, variant `scalar_rgb`),
@@ -134,11 +134,13 @@ fn emission_spectra_are_mitsuba_3s_colours() {
     );
     close(emit("360:1, 830:1"), [1.20488, 0.948228, 0.909267], 1e-4);
     close(emit("10"), [12.0479, 9.48291, 9.08916], 1e-4);
-    // Mitsuba 0.6's RGB builds read one value as a grey.
+    // So in files older than 2.0, as Mitsuba 3 reads them (Mitsuba 0.6's RGB builds read one
+    // value as a grey; Mitsuba 3.9.1 loading a 0.6.0 file gives a point light's intensity 6
+    // the colour [7.22876, 5.68975, 5.4535]).
     close(
         radiance("0.6.0", "<spectrum name=\"radiance\" value=\"10\"/>"),
-        [10.0; 3],
-        1e-12,
+        [12.0479, 9.48291, 9.08916],
+        1e-4,
     );
 }
 
@@ -201,28 +203,23 @@ fn three_values_are_rgb_in_files_older_than_2() {
     );
 }
 
-/// Mitsuba 0.6 reduces spectra without D65 (a flat spectrum has the colour Mitsuba 3 gives
-/// it as an emission: [1.20488, 0.948228, 0.909267]), ramps them to zero one average spacing
-/// past their ends, and clamps only negative components.
+/// Spectra in files older than 2.0 are reduced as Mitsuba 3 reduces them, since it reads
+/// those files too (`mi.traverse` of a 0.6.0 file in 3.9.1 `scalar_rgb`: a diffuse
+/// reflectance `400:0.2, 500:0.5, 600:0.7, 700:0.8` is [0.757277, 0.591236, 0.328793]), not as
+/// Mitsuba 0.6 did (without D65, ramped to zero one average spacing past their ends).
 #[test]
-fn spectra_in_files_older_than_2_are_mitsuba_0_6s_colours() {
+fn spectra_in_files_older_than_2_are_mitsuba_3s_colours() {
     let flat = Spectrum::new(vec![360.0, 830.0], vec![1.0, 1.0]).unwrap();
     close(flat.to_srgb_v06(), [1.20488, 0.948228, 0.909267], 1e-4);
-    let pairs = "400:0.1, 500:0.5, 600:0.8, 700:0.3";
-    let spectrum = Spectrum::parse_pairs(pairs).unwrap();
-    let ramped = Spectrum::parse_pairs(&format!("300:0, {pairs}, 800:0")).unwrap();
+    let pairs = "400:0.2, 500:0.5, 600:0.7, 700:0.8";
     let got = reflectance(
         "0.6.0",
         &format!("<spectrum name=\"reflectance\" value=\"{pairs}\"/>"),
     );
-    close(got, ramped.to_srgb_v06().to_array(), 1e-12);
-    // Not Mitsuba 3's colour of the same pairs.
-    assert!(
-        (got - spectrum.to_srgb(Quantity::Reflectance))
-            .abs()
-            .max_element()
-            > 0.05
-    );
+    close(got, [0.757277, 0.591236, 0.328793], 1e-5);
+    // Not Mitsuba 0.6's colour of the same pairs.
+    let ramped = Spectrum::parse_pairs(&format!("300:0, {pairs}, 800:0")).unwrap();
+    assert!((got - ramped.to_srgb_v06()).abs().max_element() > 0.05);
 }
 
 /// Blackbodies: Mitsuba 0.6's `<blackbody temperature="5000K" scale="2"/>` (its RGB
@@ -321,20 +318,31 @@ fn named_conductors_are_their_spectra_reduced() {
     close(eta.as_dvec3(), [0.201005, 0.92375, 1.10222], 1e-4);
     close(k.as_dvec3(), [3.91326, 2.45305, 2.14209], 1e-4);
     assert_eq!(foton_core::material::conductor_ior("gold"), None);
-    // In a file older than 2.0 a conductor without `material` is Mitsuba 0.6's copper,
-    // reduced by 0.6's rule; in Mitsuba 3 a perfect mirror.
+    // A conductor without `material` is Mitsuba 3's perfect mirror, in a file older than 2.0
+    // too (Mitsuba 3.9.1 loads a 0.6.0 file's `<bsdf type="conductor"/>` as a
+    // SmoothConductor of eta 0, k 1; Mitsuba 0.6 made it copper).
     let body = "<shape type=\"sphere\"><bsdf type=\"conductor\"/></shape>";
-    let doc = read("conductor-v06", "0.6.0", body).unwrap();
-    let (eta, _) = spectrum::conductor("Cu").unwrap();
-    close(material(&doc, "eta"), eta.to_srgb_v06().to_array(), 1e-6);
-    let doc = read("conductor-v3", "3.0.0", body).unwrap();
-    let materials = table(&doc.root, "materials");
-    let Value::Table(m) = &materials.0[0].1.value else {
-        panic!()
-    };
-    assert_eq!(
-        m.get("material").map(|n| &n.value),
-        Some(&Value::Str("none".into()))
+    for version in ["0.6.0", "3.0.0"] {
+        let doc = read(&format!("conductor-{version}"), version, body).unwrap();
+        let materials = table(&doc.root, "materials");
+        let Value::Table(m) = &materials.0[0].1.value else {
+            panic!()
+        };
+        assert_eq!(
+            m.get("material").map(|n| &n.value),
+            Some(&Value::Str("none".into())),
+            "{version}"
+        );
+    }
+    // Mitsuba 0.6's `extEta` (Mitsuba 3 has none) divides Mitsuba 3's indices.
+    let body = "<shape type=\"sphere\"><bsdf type=\"conductor\">\
+                <string name=\"material\" value=\"Au\"/><float name=\"extEta\" value=\"1.5\"/>\
+                </bsdf></shape>";
+    let doc = read("conductor-ext", "0.6.0", body).unwrap();
+    close(
+        material(&doc, "eta"),
+        [0.143036 / 1.5, 0.375307 / 1.5, 1.44205 / 1.5],
+        1e-4,
     );
 }
 

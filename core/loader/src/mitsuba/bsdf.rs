@@ -261,9 +261,9 @@ impl Reader {
                 let (eta, k) = (o.take("eta"), o.take("k"));
                 match (eta, k) {
                     (None, None) => {
-                        // Mitsuba 0.6's conductor is copper unless told otherwise, Mitsuba 3's
-                        // a perfect mirror.
-                        let default = if o.v1 { "Cu" } else { "none" };
+                        // Mitsuba 3's conductor is a perfect mirror unless told otherwise, in
+                        // files of every version (Mitsuba 0.6's was copper).
+                        let default = "none";
                         let name = material.unwrap_or_else(|| default.into());
                         let spectra = foton_core::spectrum::conductor(&name);
                         // Mitsuba 0.6's index of the outside: the Fresnel terms take eta / ext
@@ -277,11 +277,12 @@ impl Reader {
                             t.insert("material", at(Value::Str("none".into()), line));
                         } else if spectra.is_none() {
                             return Err(o.error(format!("`material`: unknown conductor `{name}`")));
-                        } else if let (Some((eta, k)), true) = (spectra, o.v1) {
-                            // Mitsuba 0.6 reduces the measured spectra its own way (a
-                            // negative component, out of gamut, clamped as Mitsuba 3 does).
+                        } else if ext != 1.0 {
+                            // Mitsuba 0.6's `extEta` (Mitsuba 3 has none) divides the
+                            // indices Mitsuba 3 would reduce.
+                            let (eta, k) = spectra.expect("checked above");
                             let rgb = |s: foton_core::spectrum::Spectrum| {
-                                s.to_srgb_v06().max(DVec3::ZERO) / ext
+                                s.to_srgb(foton_core::spectrum::Quantity::Emission) / ext
                             };
                             t.insert("eta", vec3(rgb(eta), line));
                             t.insert("k", vec3(rgb(k), line));

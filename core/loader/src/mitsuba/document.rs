@@ -728,9 +728,9 @@ impl Place<'_> {
     }
 }
 
-/// Spectra, reduced to linear sRGB as each version's RGB renderer reduces them: Mitsuba 3's
-/// reduction for files of 2.0 and later, Mitsuba 0.6's for older ones (see
-/// `foton_core::spectrum`).
+/// Spectra, reduced to linear sRGB as Mitsuba 3's RGB variants reduce them, in files of every
+/// version Mitsuba 3 reads; the forms only Mitsuba 0.6 reads (three values, `#rrggbb`,
+/// `<blackbody>`, `<srgb>`) as 0.6 reads them (see `foton_core::spectrum`).
 impl Reader {
     /// `<spectrum value="..."/>` (one value, wavelength:value pairs, or in a file older than
     /// 2.0 three values: Mitsuba 0.6's RGB builds have three spectral samples, r, g and b)
@@ -748,8 +748,9 @@ impl Reader {
                 let xs = numbers(&v).ok_or_else(|| bad(&format!("`{v}` is not a number")))?;
                 return match (&xs[..], self.v1) {
                     // Mitsuba 3 gives a flat emission the colour of a flat spectrum in
-                    // sRGB, as its spectral variants render it; Mitsuba 0.6 a grey.
-                    ([x], false) if quantity == Quantity::Emission => {
+                    // sRGB, as its spectral variants render it, in files of every version
+                    // (Mitsuba 0.6 a grey).
+                    ([x], _) if quantity == Quantity::Emission => {
                         Ok(spectrum::uniform_emission(*x))
                     }
                     ([x], _) => Ok(DVec3::splat(*x)),
@@ -777,12 +778,9 @@ impl Reader {
             }
             _ => return Err(bad("expected either `value` or `filename`")),
         };
-        Ok(if self.v1 {
-            // Mitsuba 0.6's scene parser ramps the spectrum to zero past its ends.
-            spectrum.zero_extended().to_srgb_v06().max(DVec3::ZERO)
-        } else {
-            spectrum.to_srgb(quantity)
-        })
+        // Mitsuba 3 reduces the spectra of older files as its own (Mitsuba 0.6 ramped them
+        // to zero past their ends and weighted reflectances by no illuminant).
+        Ok(spectrum.to_srgb(quantity))
     }
 
     /// Mitsuba 0.6's `<blackbody temperature="5000K" scale="1"/>`: Planck's law in
