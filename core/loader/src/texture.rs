@@ -36,12 +36,23 @@ pub enum Decode {
 
 /// [`load_bitmap`] with the decoding of its values given.
 pub fn load_bitmap_decoded(path: &Path, decode: Decode) -> Result<Bitmap> {
-    let decoded = image::ImageReader::open(path)
-        .map_err(|e| Error::io(path, e))?
-        .with_guessed_format()
-        .map_err(|e| Error::io(path, e))?
-        .decode()
-        .map_err(|e| Error::io(path, format!("cannot decode the image: {e}")))?;
+    let is_pfm = path
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("pfm"));
+    let decoded = if is_pfm {
+        let bytes = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+        image::DynamicImage::ImageRgb32F(
+            read_pfm(&bytes)
+                .map_err(|e| Error::io(path, format!("cannot decode the PFM image: {e}")))?,
+        )
+    } else {
+        image::ImageReader::open(path)
+            .map_err(|e| Error::io(path, e))?
+            .with_guessed_format()
+            .map_err(|e| Error::io(path, e))?
+            .decode()
+            .map_err(|e| Error::io(path, format!("cannot decode the image: {e}")))?
+    };
     let float = matches!(
         decoded,
         image::DynamicImage::ImageRgb32F(_) | image::DynamicImage::ImageRgba32F(_)
@@ -69,6 +80,82 @@ pub fn load_bitmap_decoded(path: &Path, decode: Decode) -> Result<Bitmap> {
         });
     }
     Bitmap::new(width, height, texels).ok_or_else(|| Error::io(path, "the image is empty"))
+}
+
+/// A portable float map (PFM), which the image crate does not read: a text header (`PF`
+/// for RGB or `Pf` for grey, the width and height, then a scale whose sign gives the byte
+/// order, negative for little-endian), then 32-bit floats row by row from the bottom. The
+/// values are multiplied by the scale's magnitude, as pbrt-v4 and Mitsuba 3 read them.
+pub fn read_pfm(bytes: &[u8]) -> std::result::Result<image::Rgb32FImage, String> {
+    let mut at = 0;
+    let mut word = || -> std::result::Result<String, String> {
+        while at < bytes.len() && bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        let start = at;
+        while at < bytes.len() && !bytes[at].is_ascii_whitespace() {
+            at += 1;
+        }
+        if start == at {
+            return Err("the header ends early".into());
+        }
+        Ok(String::from_utf8_lossy(&bytes[start..at]).into_owned())
+    };
+    let channels = match word()?.as_str() {
+        "PF" => 3,
+        "Pf" => 1,
+        other => {
+            return Err(format!(
+                "expected `PF` or `Pf` at the start, found `{other}`"
+            ));
+        }
+    };
+    let size = |w: String| {
+        w.parse::<u32>()
+            .ok()
+            .filter(|n| (1..=1 << 16).contains(n))
+            .ok_or_else(|| format!("`{w}` is not an image size (1 to 65536)"))
+    };
+    let (width, height) = (size(word()?)?, size(word()?)?);
+    let w = word()?;
+    let scale: f32 = w
+        .parse()
+        .ok()
+        .filter(|s: &f32| s.is_finite())
+        .ok_or_else(|| format!("`{w}` is not a scale"))?;
+    // One whitespace character separates the header from the data.
+    let data = &bytes[(at + 1).min(bytes.len())..];
+    let n = width as usize * height as usize * channels;
+    if data.len() < 4 * n {
+        return Err(format!(
+            "{} bytes of pixels where {width} x {height} x {channels} floats need {}",
+            data.len(),
+            4 * n
+        ));
+    }
+    let value = |i: usize| {
+        let b: [u8; 4] = data[4 * i..4 * i + 4].try_into().expect("4 bytes");
+        let v = if scale < 0.0 {
+            f32::from_le_bytes(b)
+        } else {
+            f32::from_be_bytes(b)
+        };
+        v * scale.abs()
+    };
+    let (w, h) = (width as usize, height as usize);
+    let mut rgb = Vec::with_capacity(3 * w * h);
+    for y in 0..h {
+        let row = h - 1 - y;
+        for x in 0..w {
+            let i = (row * w + x) * channels;
+            if channels == 3 {
+                rgb.extend([value(i), value(i + 1), value(i + 2)]);
+            } else {
+                rgb.extend([value(i); 3]);
+            }
+        }
+    }
+    image::Rgb32FImage::from_raw(width, height, rgb).ok_or_else(|| "the image is empty".into())
 }
 
 /// A colour of a texture table: `key` as `[r, g, b]` or one number, `missing` per channel
@@ -530,5 +617,35 @@ mod tests {
             .to_string();
         assert!(e.contains("unknown texture type \"marble\""), "{e}");
         let _ = std::fs::remove_dir_all(dir);
+    }
+
+    /// PFM: RGB and grey, both byte orders, rows from the bottom, the scale's magnitude
+    /// applied; short or malformed files are errors.
+    #[test]
+    fn pfm_images_read_as_pbrt_and_mitsuba_read_them() {
+        let file = |head: &str, values: &[f32], little: bool| {
+            let mut b = head.as_bytes().to_vec();
+            for v in values {
+                b.extend(if little {
+                    v.to_le_bytes()
+                } else {
+                    v.to_be_bytes()
+                });
+            }
+            b
+        };
+        // 2 x 2 RGB, little-endian, scale 2: the bottom row is written first.
+        let values = [
+            1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0, 9.0, 10.0, 11.0, 12.0,
+        ];
+        let img = read_pfm(&file("PF\n2 2\n-2.0\n", &values, true)).unwrap();
+        assert_eq!(img.get_pixel(0, 0).0, [14.0, 16.0, 18.0]);
+        assert_eq!(img.get_pixel(1, 1).0, [8.0, 10.0, 12.0]);
+        // Grey, big-endian, scale 1.
+        let img = read_pfm(&file("Pf 2 1 1.0 ", &[0.5, 0.25], false)).unwrap();
+        assert_eq!(img.get_pixel(1, 0).0, [0.25; 3]);
+        assert!(read_pfm(&file("PF\n2 2\n-1\n", &values[..6], true)).is_err());
+        assert!(read_pfm(b"P6\n2 2\n255\n").is_err());
+        assert!(read_pfm(b"PF\n2").is_err());
     }
 }

@@ -45,11 +45,18 @@ impl Reader {
             "perspective" => false,
             "orthographic" => true,
             "realistic" | "spherical" => {
-                return self.unsupported(
+                self.unsupported(
                     loc,
                     &d.what(),
-                    "only the perspective and orthographic cameras are read",
-                );
+                    "only the perspective and orthographic cameras are read (--lenient: a perspective camera of pbrt-v4's default fov, 90 degrees, in its place)",
+                )?;
+                let stand_in = Directive {
+                    name: d.name.clone(),
+                    loc: loc.clone(),
+                    args: vec![Arg::Str("perspective".into())],
+                    params: Vec::new(),
+                };
+                return self.camera(&stand_in, camera_from_world, film);
             }
             other => {
                 return Err(loc.error(

@@ -114,6 +114,9 @@ struct State {
     interface: Option<Loc>,
     /// `Attribute` defaults per target, in the order written.
     attributes: Attributes,
+    /// `ActiveTransform EndTime`: the transform statements that follow change only the end
+    /// transform, which foton does not render (it renders the start transform).
+    end_only: bool,
 }
 
 /// The parameters `Attribute` gives the shapes, lights, materials, media and textures that
@@ -195,6 +198,7 @@ impl Reader {
                 outside: String::new(),
                 interface: None,
                 attributes: Attributes::default(),
+                end_only: false,
             },
             stack: Vec::new(),
             transforms: Vec::new(),
@@ -292,7 +296,23 @@ impl Reader {
     fn directive(&mut self, d: &Directive) -> Result<()> {
         let n = d.numbers();
         let ctm = self.state.ctm;
+        if self.state.end_only
+            && matches!(
+                d.name.as_str(),
+                "Translate"
+                    | "Scale"
+                    | "Rotate"
+                    | "LookAt"
+                    | "Transform"
+                    | "ConcatTransform"
+                    | "CoordSysTransform"
+                    | "Identity"
+            )
+        {
+            return Ok(());
+        }
         match d.name.as_str() {
+            "Identity" => self.state.ctm = DMat4::IDENTITY,
             "Translate" => self.state.ctm = ctm * DMat4::from_translation(vec(&n[0..3])),
             "Scale" => self.state.ctm = ctm * DMat4::from_scale(vec(&n[0..3])),
             "Rotate" => {
@@ -347,12 +367,15 @@ impl Reader {
                 }
             },
             "ActiveTransform" => {
+                // pbrt-v4 blurs between a start and an end transform over the shutter;
+                // foton renders the start transform.
+                self.state.end_only = d.string(0) == "EndTime";
                 if d.string(0) != "All" {
-                    self.unsupported(
+                    self.warn(
                         &d.loc,
                         &format!("ActiveTransform {}", d.string(0)),
-                        "motion blur (separate start and end transforms) is not supported",
-                    )?;
+                        "motion blur is not rendered: foton renders the start transform (the transforms written under ActiveTransform EndTime are not used)",
+                    );
                 }
             }
             "TransformTimes" => {}
@@ -407,7 +430,10 @@ impl Reader {
                 }
             }
             "Option" => {
-                let names: Vec<String> = d.params.iter().map(|p| p.decl()).collect();
+                let mut names: Vec<String> = d.params.iter().map(|p| p.decl()).collect();
+                if let Some(parse::Arg::Str(name)) = d.args.first() {
+                    names.push(format!("{name:?}"));
+                }
                 self.warn(
                     &d.loc,
                     "Option",

@@ -153,12 +153,15 @@ enum Shape {
     WithParams(usize),
     /// `Include` and `Import`.
     File,
+    /// `Option`: a name and one value, as pbrt-v4's parser reads it (`Option "seed" 3`), or a
+    /// typed parameter (`Option "bool disablepixeljitter" true`).
+    Option,
 }
 
 fn grammar(name: &str) -> Option<Shape> {
     Some(match name {
         "AttributeBegin" | "AttributeEnd" | "WorldBegin" | "ReverseOrientation" | "ObjectEnd"
-        | "TransformBegin" | "TransformEnd" | "WorldEnd" => Shape::Nothing,
+        | "TransformBegin" | "TransformEnd" | "WorldEnd" | "Identity" => Shape::Nothing,
         "Translate" | "Scale" => Shape::Numbers(3),
         "Rotate" => Shape::Numbers(4),
         "LookAt" => Shape::Numbers(9),
@@ -171,7 +174,7 @@ fn grammar(name: &str) -> Option<Shape> {
         "Shape" | "Material" | "LightSource" | "AreaLightSource" | "Camera" | "Film"
         | "Sampler" | "Integrator" | "PixelFilter" | "Accelerator" | "MakeNamedMaterial"
         | "MakeNamedMedium" | "Attribute" => Shape::WithParams(1),
-        "Option" => Shape::WithParams(0),
+        "Option" => Shape::Option,
         "Texture" => Shape::WithParams(3),
         "Include" | "Import" => Shape::File,
         _ => return None,
@@ -191,6 +194,7 @@ const DIRECTIVES: &[&str] = &[
     "CoordSysTransform",
     "CoordinateSystem",
     "Film",
+    "Identity",
     "Import",
     "Include",
     "Integrator",
@@ -459,6 +463,26 @@ fn parse_tokens(
                     d.args.push(Arg::Str(s));
                 }
                 d.params = params(&mut c)?;
+            }
+            Shape::Option => {
+                let typed = matches!(c.peek(), Some(Token { tok: Tok::Str(s), .. }) if s.split_whitespace().count() > 1);
+                if typed {
+                    d.params = params(&mut c)?;
+                } else {
+                    let name = c.string("the option's name after Option", &loc)?;
+                    d.args.push(Arg::Str(name));
+                    let t = c.take("the option's value", &loc)?;
+                    d.args.push(match &t.tok {
+                        Tok::Str(s) => Arg::Str(s.clone()),
+                        Tok::Word(w) => Arg::Word(w.clone()),
+                        _ => {
+                            return Err(t.loc.error(
+                                "syntax",
+                                format!("expected the option's value, found {}", t.shown()),
+                            ));
+                        }
+                    });
+                }
             }
             Shape::File => {
                 let name = c.string(&format!("the file name after {}", d.name), &loc)?;

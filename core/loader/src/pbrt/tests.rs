@@ -156,6 +156,62 @@ fn film_sampler_integrator_and_their_defaults() {
     );
 }
 
+/// `Identity` resets the transform; `Option` takes pbrt-v4's bare name and value as well as a
+/// typed parameter; `ActiveTransform` renders the start transform with a warning, the
+/// transforms written for the end time alone left unused.
+#[test]
+fn identity_option_and_active_transform() {
+    let (d, report) = read(
+        &format!(
+            "Option \"seed\" 3\nOption \"bool disablepixeljitter\" true\nOption \"msereferenceout\" \"x.txt\"\n{WORLD}\
+             Translate 5 0 0\nIdentity\nTranslate 1 0 0\n\
+             ActiveTransform EndTime\nTranslate 0 7 0\nIdentity\nActiveTransform All\n\
+             LightSource \"point\" \"point3 from\" [0 0 0]\n"
+        ),
+        false,
+    )
+    .unwrap();
+    let p = nums(&d.root, "lights.1.position");
+    assert!(close(&p, &[1.0, 0.0, 0.0]), "{p:?}");
+    assert!(
+        report.warnings.iter().any(|w| w.contains("motion blur")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("\"seed\"") && w.contains("ignored")),
+        "{:?}",
+        report.warnings
+    );
+    let e = read(&format!("{WORLD}Option \"seed\""), false).unwrap_err();
+    assert!(e.contains("the option's value"), "{e}");
+}
+
+/// A spherical or realistic camera is refused; `--lenient` renders a perspective camera of
+/// pbrt-v4's default fov in its place.
+#[test]
+fn other_cameras_are_refused_or_a_perspective_stand_in() {
+    let text = format!(
+        "LookAt 0 0 5  0 0 0  0 1 0\nCamera \"spherical\" \"string mapping\" \"equalarea\"\n{WORLD}"
+    );
+    let e = read(&text, false).unwrap_err();
+    assert!(e.contains("spherical") && e.contains(":2:"), "{e}");
+    let (d, report) = read(&text, true).unwrap();
+    assert_eq!(num(&d.root, "camera.fov"), 90.0);
+    assert!(close(&nums(&d.root, "camera.position"), &[0.0, 0.0, 5.0]));
+    assert!(
+        report
+            .left_out
+            .iter()
+            .any(|l| l.contains("perspective camera")),
+        "{:?}",
+        report.left_out
+    );
+}
+
 /// `whitebalance` (a colour temperature; 0, the default, none) is the film's white balance.
 #[test]
 fn white_balance_is_the_films() {
