@@ -647,7 +647,8 @@ fn unknown_plugin_types_suggest_the_close_one() {
 
 /// The 0.6 forms of a medium, colours and parameters, each as Mitsuba 0.6 means it: a
 /// medium as sigmaT and albedo with densityMultiplier, Henyey-Greenstein's default g (0 in
-/// 0.6), `<srgb>` colours (sRGB-decoded), a conductor's extEta, a texture's uscale and
+/// 0.6, for a medium Mitsuba 3 refuses; one of sigmaT and albedo alone, which Mitsuba 3 reads,
+/// takes its default, 0.8, as Mitsuba 3.9.1 loading such a 0.6.0 file does), `<srgb>` colours (sRGB-decoded), a conductor's extEta, a texture's uscale and
 /// uoffset (a to_uv transform), hdrfilm's componentFormat float16 (a warning: foton writes
 /// 32-bit floats), and a medium given both ways (an error).
 #[test]
@@ -660,6 +661,10 @@ fn old_media_colours_and_parameters() {
     <medium type="homogeneous" id="haze">
         <rgb name="sigmaS" value="1"/><rgb name="sigmaA" value="0"/><phase type="isotropic"/>
     </medium>
+    <medium type="homogeneous" id="mist">
+        <rgb name="sigmaT" value="2"/><rgb name="albedo" value="0.5"/><phase type="hg"/>
+    </medium>
+    <shape type="sphere"><point name="center" x="-3" y="0" z="0"/><bsdf type="null"/><ref name="interior" id="mist"/></shape>
     <shape type="sphere"><bsdf type="null"/><ref name="interior" id="fog"/></shape>
     <shape type="sphere"><point name="center" x="3" y="0" z="0"/><bsdf type="null"/><ref name="interior" id="haze"/></shape>
     <shape type="sphere"><point name="center" x="0" y="3" z="0"/>
@@ -690,6 +695,8 @@ fn old_media_colours_and_parameters() {
     assert_eq!(vector(&fog, "sigma_s"), [0.5, 0.5, 0.5], "{fog}");
     assert_eq!(vector(&fog, "sigma_a"), [0.5, 0.5, 0.5], "{fog}");
     assert_eq!(number(&fog, "g"), 0.0, "{fog}");
+    let mist = table("mist");
+    assert_eq!(number(&mist, "g"), 0.8, "{mist}");
     assert!(table("haze").contains("phase = \"isotropic\""), "{toml}");
     let orange = vector(&toml, "reflectance");
     assert_eq!(orange[0], 1.0);

@@ -11,6 +11,25 @@ use glam::DVec3;
 impl Reader {
     /// A medium into `[media]`; returns its name there.
     pub(super) fn medium(&mut self, mut o: Obj) -> Result<String> {
+        // Henyey-Greenstein's g defaults to 0.8 in Mitsuba 3 and to 0 in Mitsuba 0.6. Mitsuba
+        // 3 opens a file older than 2.0 (and takes its own default) only if each medium
+        // parameter is one of its own: a homogeneous medium of sigma_t and albedo. Any other
+        // (0.6's sigma_s and sigma_a, densityMultiplier, a measured material) it refuses, so
+        // that file is 0.6's alone.
+        let mitsuba3_reads = !self.v1
+            || (o.ty == "homogeneous"
+                && o.props.iter().all(|(n, _, _)| {
+                    matches!(
+                        n.as_str(),
+                        "sigma_t"
+                            | "albedo"
+                            | "scale"
+                            | "sample_emitters"
+                            | "has_spectral_extinction"
+                            | ""
+                    )
+                }));
+        let g_default = if mitsuba3_reads { 0.8 } else { 0.0 };
         if o.ty == "heterogeneous" {
             match self.grid_unsupported(&o) {
                 None => return self.heterogeneous(o),
@@ -112,13 +131,13 @@ impl Reader {
         t.insert("type", at(Value::Str("homogeneous".into()), line));
         t.insert("sigma_s", vec3(sigma_s * scale, line));
         t.insert("sigma_a", vec3(sigma_a * scale, line));
-        self.finish_medium(o, t)
+        self.finish_medium(o, t, g_default)
     }
 
     /// A medium's table `t` completed with its `<phase>`, checked for parameters nobody read
     /// and added to `[media]`; returns its name there.
-    fn finish_medium(&mut self, mut o: Obj, mut t: Table) -> Result<String> {
-        self.phase(&mut o, &mut t)?;
+    fn finish_medium(&mut self, mut o: Obj, mut t: Table, g_default: f64) -> Result<String> {
+        self.phase(&mut o, &mut t, g_default)?;
         self.leftovers(&o)?;
         let name = self.new_name("medium", &o.id);
         if let Some(id) = &o.id {
@@ -128,14 +147,14 @@ impl Reader {
         Ok(name)
     }
 
-    /// The `<phase>` nested in a medium, into its table `t`.
-    fn phase(&mut self, o: &mut Obj, t: &mut Table) -> Result<()> {
+    /// The `<phase>` nested in a medium, into its table `t` (`g_default`: Henyey-Greenstein's
+    /// g where the file gives none).
+    fn phase(&mut self, o: &mut Obj, t: &mut Table, g_default: f64) -> Result<()> {
         if let Some((Prop::Object(mut phase), l)) = o.take("") {
             match phase.ty.as_str() {
                 "isotropic" => t.insert("phase", at(Value::Str("isotropic".into()), l)),
                 "hg" => {
-                    // Mitsuba 0.6's default g is 0, Mitsuba 3's 0.8.
-                    let g = phase.float("g", if self.v1 { 0.0 } else { 0.8 })?;
+                    let g = phase.float("g", g_default)?;
                     let mut p = Table::default();
                     p.insert("type", at(Value::Str("hg".into()), l));
                     p.insert("g", at(Value::Float(g), l));
@@ -262,7 +281,7 @@ impl Reader {
         ] {
             o.take(k);
         }
-        self.finish_medium(o, t)
+        self.finish_medium(o, t, if self.v1 { 0.0 } else { 0.8 })
     }
 
     /// A medium's volume `key`: a grid as foton's volume table, or a constant (a
