@@ -50,7 +50,7 @@ def test_the_wheel_renders_in_a_clean_environment(tmp_path):
     assert out.returncode == 0, out.stderr
     module, plugins, digest = out.stdout.splitlines()[-3:]
     assert Path(module).resolve().is_relative_to(env_dir.resolve())
-    assert plugins == str(sorted(f"libfoton_{n}.so" for n in ("bdpt", "normals", "path", "photon", "ppb", "sppm", "vcm", "vpm")))
+    assert plugins == str(sorted(f"libfoton_{n}.so" for n in ("ao", "bdpt", "normals", "path", "photon", "ppb", "sppm", "vcm", "vpm")))
     # The same image as this process's foton renders.
     here = foton.load(SCENES / "cornell-box.toml", **TINY).render(
         integrator="path", spp=2, seed=1, progress=False)
