@@ -315,6 +315,10 @@ pub fn daylight_chromaticity(kelvin: f64) -> (f64, f64) {
     (x, -3.0 * x * x + 2.870 * x - 0.275)
 }
 
+/// The colour temperatures (K) [`white_balance`] takes: those of lights and skies (pbrt-v4
+/// adapts from CIE daylight, or a black body below 4000 K; 0 K has no colour).
+pub const WHITE_BALANCE_KELVIN: std::ops::RangeInclusive<f64> = 1000.0..=100_000.0;
+
 /// pbrt-v4's white balance (`Film "rgb" "float whitebalance"` with its default `cie1931`
 /// sensor; `WhiteBalance` in `util/color.cpp`) as a matrix on linear sRGB: von Kries
 /// adaptation in Bradford's cone space (LMS) from the white of `kelvin`

@@ -102,11 +102,9 @@ pub(super) fn read_film(root: &Properties<'_>, ld: &mut Loader) -> Result<FilmSe
     let tonemap =
         ToneMap::from_name(t.choice("tonemap", &ToneMap::NAMES, "clamp")?).unwrap_or_default();
     let filter = read_filter(&t, ld)?;
-    // pbrt-v4 adapts from CIE daylight (a black body below 4000 K): temperatures of lights
-    // and skies, not the 0 K to which Planck's law gives no colour.
     let white_balance = t.f32_opt("white_balance")?;
     if let Some(k) = white_balance
-        && !(1000.0..=100_000.0).contains(&k)
+        && !foton_core::spectrum::WHITE_BALANCE_KELVIN.contains(&(k as f64))
     {
         return Err(t.error(
             "white_balance",

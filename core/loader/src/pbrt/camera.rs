@@ -283,7 +283,7 @@ impl Reader {
         if let Some((w, l)) = p.float_opt("whitebalance")?
             && w != 0.0
         {
-            if !(1000.0..=100_000.0).contains(&w) {
+            if !foton_core::spectrum::WHITE_BALANCE_KELVIN.contains(&w) {
                 return Err(l.error(
                     &d.what(),
                     format!("\"whitebalance\" {w}: expected 0 (none) or a colour temperature between 1000 and 100000 K"),
