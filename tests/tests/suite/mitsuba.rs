@@ -357,7 +357,8 @@ fn unsupported_and_bad_xml_is_a_clear_error() {
 
     let cases: Vec<(String, Vec<&str>)> = vec![
         (
-            XML.replace("value=\"$spp\"", "value=\"$nothing\""),
+            // A reference's id without a value (a property's value is left out instead).
+            XML.replace("<ref id=\"white\"/>", "<ref id=\"$nothing\"/>"),
             vec!["$nothing", "-D nothing"],
         ),
         (

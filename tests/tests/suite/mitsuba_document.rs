@@ -876,7 +876,8 @@ fn polarizers_pass_half_their_transmittance() {
 }
 
 /// What `--lenient` gets past that Mitsuba refuses or foton lacks, each said in the report:
-/// a `$name` with no value (the property left out, its default standing). Mitsuba 0.6's
+/// a `$name` with no value (the property left out, its default standing; without
+/// `--lenient` a warning). Mitsuba 0.6's
 /// `phong` microfacet distribution and its other name `as` are foton's `phong`. Read as
 /// written: a top-level `<phase>` taken by `<ref>` from a medium, a filter beside the film in
 /// the sensor.
@@ -887,8 +888,15 @@ fn lenient_gets_past_unresolved_names_and_0_6_distributions() {
         "<sampler type=\"independent\" id=\"s\"><integer name=\"sample_count\" value=\"$spp\"/></sampler>\n<bsdf type=\"roughconductor\" id=\"b\"><string name=\"distribution\" value=\"phong\"/></bsdf>\n{SENSOR}"
     );
     let xml = write(&dir, "lenient.xml", &scene("0.6.0", &body));
-    let e = read(&xml, false).unwrap_err();
-    assert!(e.contains("lenient.xml:2") && e.contains("$spp"), "{e}");
+    let (_, report) = read(&xml, false).unwrap();
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("lenient.xml:2") && w.contains("$spp")),
+        "{:?}",
+        report.warnings
+    );
     let (doc, report) = read(&xml, true).unwrap();
     let said = |needle: &str| report.left_out.iter().any(|w| w.contains(needle));
     assert!(
@@ -1171,4 +1179,121 @@ fn rawconstant_textures_are_constants() {
         let got: Vec<f64> = v.iter().map(|n| n.value.as_f64().unwrap()).collect();
         assert_eq!(got, want);
     }
+}
+
+/// A property whose value is a `$name` no `<default>` or `-D` gives (Mitsuba's documentation
+/// scenes leave `$spp` to a script) is left out with a warning: its plugin's default stands.
+/// A plugin type without a value stays an error.
+#[test]
+fn a_value_without_a_default_leaves_its_default() {
+    let dir = temp_dir("mitsuba-unresolved-value");
+    let sensor = r#"<sensor type="perspective">
+<transform name="to_world"><lookat origin="0, 0, 5" target="0, 0, 0" up="0, 1, 0"/></transform>
+<sampler type="independent"><integer name="sample_count" value="$spp"/></sampler>
+<film type="hdrfilm"><integer name="width" value="8"/><integer name="height" value="8"/></film>
+</sensor>"#;
+    let xml = write(&dir, "spp.xml", &scene("3.0.0", sensor));
+    let (doc, report) = read(&xml, false).unwrap();
+    // Mitsuba's independent sampler takes 4 samples unless told.
+    assert_eq!(number(&doc.root, "render.spp"), 4.0);
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("spp.xml:") && w.contains("`$spp` has no <default>")),
+        "{:?}",
+        report.warnings
+    );
+    assert!(report.left_out.is_empty(), "{:?}", report.left_out);
+    let (doc, _) = read_xml(&xml, &["spp=3".to_string()], false).unwrap();
+    assert_eq!(number(&doc.root, "render.spp"), 3.0);
+    let xml = write(
+        &dir,
+        "type.xml",
+        &scene(
+            "3.0.0",
+            &format!("<bsdf type=\"$kind\" id=\"a\"/>\n{SENSOR}"),
+        ),
+    );
+    let err = read(&xml, false).unwrap_err();
+    assert!(err.contains("`$kind`: no <default"), "{err}");
+}
+
+/// The integrators of Mitsuba's forks that estimate the image of one of Mitsuba's own (path
+/// guiding, EARS, specular manifold sampling; a fork's VCM) open as written, rendered by the
+/// foton plugin that converges to the same image, with a note; their own parameters are
+/// warnings, the common ones read as Mitsuba's path tracer reads them.
+#[test]
+fn fork_integrators_render_by_the_estimator_they_share() {
+    let dir = temp_dir("mitsuba-fork-integrators");
+    let cases = [
+        (
+            r#"<integrator type="guided_path"><integer name="maxDepth" value="8"/><string name="budgetType" value="spp"/></integrator>"#,
+            "path",
+            Some(7.0),
+            "budget_type",
+        ),
+        (
+            r#"<integrator type="recursive_path"><float name="budget" value="60"/></integrator>"#,
+            "path",
+            None,
+            "budget",
+        ),
+        (
+            r#"<integrator type="vcm"><integer name="maxDepth" value="6"/><boolean name="enableVM" value="true"/></integrator>"#,
+            "vcm",
+            Some(5.0),
+            "",
+        ),
+        (
+            r#"<integrator type="vcm"><boolean name="enableVM" value="false"/></integrator>"#,
+            "bdpt",
+            None,
+            "",
+        ),
+    ];
+    for (i, (integrator, plugin, depth, own)) in cases.into_iter().enumerate() {
+        let xml = write(
+            &dir,
+            &format!("fork{i}.xml"),
+            &scene("0.6.0", &format!("{integrator}\n{SENSOR}")),
+        );
+        let (doc, report) = read(&xml, false).unwrap_or_else(|e| panic!("{integrator}: {e}"));
+        assert!(
+            matches!(&node(&doc.root, "render.integrator").value, Value::Str(p) if p == plugin),
+            "{integrator}"
+        );
+        if let Some(depth) = depth {
+            assert_eq!(number(&doc.root, "render.max_depth"), depth, "{integrator}");
+        }
+        assert!(
+            report
+                .notes
+                .iter()
+                .any(|n| n.contains("fork of Mitsuba") && n.contains(plugin)),
+            "{:?}",
+            report.notes
+        );
+        if !own.is_empty() {
+            assert!(
+                report
+                    .warnings
+                    .iter()
+                    .any(|w| w.contains(&format!("`{own}`")) && w.contains("fork's integrator")),
+                "{:?}",
+                report.warnings
+            );
+        }
+    }
+    // A fork's integrator that renders something else stays unknown.
+    let xml = write(
+        &dir,
+        "field.xml",
+        &scene(
+            "0.6.0",
+            &format!("<integrator type=\"meanCurvature\"/>\n{SENSOR}"),
+        ),
+    );
+    let err = read(&xml, false).unwrap_err();
+    assert!(err.contains("unknown integrator"), "{err}");
 }

@@ -355,25 +355,37 @@ impl Reader {
         })
     }
 
-    /// With `lenient`, an element whose attributes name a `$name` without a value is left
-    /// out (its plugin's default stands), and the report says so: true if `n` is left out.
+    /// A property whose value is a `$name` without a value (no `<default>`, no `-D`) is left
+    /// out, its plugin's default standing, with a warning: Mitsuba refuses such a file, but
+    /// its documentation's scenes are written so, for a script to give the values. With
+    /// `lenient`, any element whose attributes name one is left out, and the report says so.
+    /// True if `n` is left out.
     fn leave_out_unresolved(&self, n: roxmltree::Node<'_, '_>, file: &Path, pos: Pos) -> bool {
-        if !self.lenient {
-            return false;
-        }
         let Some(name) = n.attributes().find_map(|a| self.unresolved(a.value())) else {
             return false;
         };
+        let tag = n.tag_name().name();
+        let value_only = VALUE_TAGS.contains(&tag)
+            && n.attributes()
+                .all(|a| a.name() == "value" || self.unresolved(a.value()).is_none());
+        if !self.lenient && !value_only {
+            return false;
+        }
         self.used.borrow_mut().insert(name.clone());
         let what = match n.attribute("name") {
-            Some(p) => format!("<{} name=\"{p}\">", n.tag_name().name()),
-            None => format!("<{}>", n.tag_name().name()),
+            Some(p) => format!("<{tag} name=\"{p}\">"),
+            None => format!("<{tag}>"),
         };
-        self.unresolved.borrow_mut().push(format!(
+        let line = format!(
             "{}:{}: {what}: `${name}` has no <default> and no -D {name}=... (its plugin's default stands)",
             file.display(),
             pos.line
-        ));
+        );
+        if self.lenient {
+            self.unresolved.borrow_mut().push(line);
+        } else {
+            self.late_warnings.borrow_mut().push(line);
+        }
         true
     }
 
@@ -1011,6 +1023,11 @@ const PROPERTY_TAGS: &[&str] = &[
 const ONE_OF_A_KIND: &[&str] = &["rfilter", "sampler", "film", "phase"];
 
 /// The object elements of Mitsuba's parser.
+/// The properties that hold one value, in `value`.
+const VALUE_TAGS: &[&str] = &[
+    "float", "integer", "boolean", "string", "rgb", "spectrum", "srgb",
+];
+
 const OBJECT_TAGS: &[&str] = &[
     "bsdf",
     "emitter",

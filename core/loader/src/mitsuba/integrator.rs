@@ -22,7 +22,11 @@ impl Reader {
             return self.wrapper(o);
         }
         let has_media = !self.media.is_empty();
-        let Some(mapped) = foton_integrator(&o.ty, has_media) else {
+        let mitsuba = match self.fork_integrator(&mut o)? {
+            Some(m) => m,
+            None => o.ty.as_str(),
+        };
+        let Some(mapped) = foton_integrator(mitsuba, has_media) else {
             o.props.clear();
             let message = if MITSUBA_INTEGRATORS.contains(&o.ty.as_str()) {
                 format!(
@@ -271,6 +275,111 @@ impl Reader {
     }
 }
 
+impl Reader {
+    /// An integrator of one of Mitsuba's forks that estimates the image of one of Mitsuba's
+    /// own: noted, its own parameters ignored (each a warning), and the Mitsuba integrator
+    /// whose image it converges to returned, for its common parameters to be read as that
+    /// one's. None for every other integrator.
+    fn fork_integrator(&mut self, o: &mut Obj) -> Result<Option<&'static str>> {
+        let Some(&(_, what)) = FORK_INTEGRATORS.iter().find(|(name, _)| *name == o.ty) else {
+            return Ok(None);
+        };
+        let mitsuba = if o.ty == "vcm" {
+            // VCM without merging is bidirectional path tracing (Georgiev et al. 2012).
+            if o.boolean("enable_vm", true)? {
+                "vcm"
+            } else {
+                "bdpt"
+            }
+        } else {
+            "path"
+        };
+        self.note(
+            o,
+            &format!(
+                "{what}, from a fork of Mitsuba: rendered by foton's {mitsuba}, which converges to the image it estimates"
+            ),
+        );
+        const COMMON: [&str; 6] = [
+            "max_depth",
+            "rr_depth",
+            "hide_emitters",
+            "strict_normals",
+            "samples_per_pass",
+            "timeout",
+        ];
+        let own: Vec<_> = o
+            .props
+            .iter()
+            .filter(|(name, p, _)| {
+                !COMMON.contains(&name.as_str()) && !matches!(p, Prop::Object(_))
+            })
+            .map(|(name, _, _)| name.clone())
+            .collect();
+        for name in own {
+            self.ignored(
+                o,
+                &name,
+                &|_| false,
+                "ignored (a parameter of the fork's integrator: how it samples, not what it renders)",
+            );
+        }
+        Ok(Some(mitsuba))
+    }
+}
+
+/// Integrators of Mitsuba's forks, each an estimator of the image one of Mitsuba's own
+/// renders: path guiding, splitting and specular manifold sampling are path tracers that
+/// sample otherwise; `vcm` merges as foton's does.
+const FORK_INTEGRATORS: &[(&str, &str)] = &[
+    (
+        "guided_path",
+        "practical path guiding's path tracer (Müller et al. 2017)",
+    ),
+    ("guidedpath", "a path tracer with path guiding"),
+    ("path_guiding_integrator", "a path tracer with path guiding"),
+    (
+        "recursive_path",
+        "EARS's path tracer with splitting and Russian roulette (Rath et al. 2022)",
+    ),
+    (
+        "path_sms_ss",
+        "a path tracer with specular manifold sampling (Zeltner et al. 2020)",
+    ),
+    (
+        "path_sms_ms",
+        "a path tracer with specular manifold sampling (Zeltner et al. 2020)",
+    ),
+    (
+        "path_sms_teaser",
+        "a path tracer with specular manifold sampling (Zeltner et al. 2020)",
+    ),
+    (
+        "path_sms_glints",
+        "a path tracer with specular manifold sampling of glints (Zeltner et al. 2020)",
+    ),
+    (
+        "path_filtered_ss",
+        "specular manifold sampling's comparison path tracer, which leaves out the caustic paths its manifold sampler renders (foton's path renders them all)",
+    ),
+    (
+        "path_filtered_ms",
+        "specular manifold sampling's comparison path tracer, which leaves out the caustic paths its manifold sampler renders (foton's path renders them all)",
+    ),
+    (
+        "path_filtered_teaser",
+        "specular manifold sampling's comparison path tracer, which leaves out the caustic paths its manifold sampler renders (foton's path renders them all)",
+    ),
+    (
+        "restirgi",
+        "ReSTIR GI, a path tracer reusing samples across pixels (Ouyang et al. 2021)",
+    ),
+    (
+        "vcm",
+        "vertex connection and merging (Georgiev et al. 2012)",
+    ),
+];
+
 /// The integrators of Mitsuba 3 and 0.6 (for "not supported" against "unknown").
 impl Reader {
     /// Mitsuba's `moment`, `stokes` and `aov`, which wrap integrators: the wrapped ones render
@@ -379,6 +488,8 @@ fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
         "photonmapper" => "photon",
         "sppm" | "ppm" => "sppm",
         "bdpt" | "ptracer" => "bdpt",
+        // Only a fork's (`fork_integrator`).
+        "vcm" => "vcm",
         _ => return None,
     })
 }
