@@ -24,6 +24,7 @@ lights! {
         Area(area::AreaLight),
         SunSky(sunsky::SunSkyLight),
         Projector(projector::ProjectorLight),
+        Collimated(collimated::CollimatedLight),
     }
 }
 
@@ -37,6 +38,8 @@ pub use spot::{Falloff, smoothstep, spot_falloff, spot_solid_angle};
 pub enum LightType {
     DeltaPosition,
     DeltaDirection,
+    /// A delta in both (a collimated beam): next-event estimation never reaches it.
+    DeltaBeam,
     Area,
     Infinite,
 }
@@ -215,12 +218,12 @@ macro_rules! lights {
 use lights;
 
 impl Light {
-    /// A point, spot or directional light: a delta in position or direction.
+    /// A point, spot, directional or collimated light: a delta in position or direction.
     #[inline]
     pub fn is_delta(&self) -> bool {
         matches!(
             self.light_type(),
-            LightType::DeltaPosition | LightType::DeltaDirection
+            LightType::DeltaPosition | LightType::DeltaDirection | LightType::DeltaBeam
         )
     }
 

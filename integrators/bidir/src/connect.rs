@@ -154,6 +154,8 @@ impl Bidir {
                 LightType::DeltaDirection | LightType::Infinite => {
                     emission_pdf * cos_x / direct_pdf
                 }
+                // A beam gives next-event estimation no sample to weigh.
+                LightType::DeltaBeam => 0.0,
             };
             let hit_pdf = if ls.delta { 0.0 } else { c.pdf(c.wo, ls.wi) };
             weight_direct(

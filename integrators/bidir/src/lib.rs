@@ -416,6 +416,8 @@ impl Bidir {
                     * match e.light.light_type() {
                         LightType::Area => e.light.pdf_li(x, e.origin, e.n) * e.cos_light / dist2,
                         LightType::DeltaPosition | LightType::DeltaDirection => 1.0,
+                        // Next-event estimation never reaches a beam.
+                        LightType::DeltaBeam => 0.0,
                         LightType::Infinite => e.light.pdf_li(x, x - e.dir, Vec3::ZERO),
                     };
                 running.first_hit(direct, e.emission_pdf);

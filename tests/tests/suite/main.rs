@@ -22,6 +22,7 @@ mod build_id;
 mod capabilities;
 mod coated;
 mod coating;
+mod collimated;
 mod conductor;
 mod consistency;
 mod crossing_limit;

@@ -635,7 +635,7 @@ fn unknown_plugin_types_suggest_the_close_one() {
             "unknown shape type `spheer` (did you mean `sphere`?)",
         ),
         (
-            r#"<emitter type="collimated"/>"#,
+            r#"<emitter type="directionalarea"/>"#,
             "this emitter is not supported yet",
         ),
     ] {

@@ -252,8 +252,8 @@ fn changes_to_the_surface_change_the_version() {
         (
             "registered",
             "light/mod.rs",
-            "        Projector(projector::ProjectorLight),\n    }",
-            "        Projector(projector::ProjectorLight),\n        Extra(point::PointLight),\n    }",
+            "        Collimated(collimated::CollimatedLight),\n    }",
+            "        Collimated(collimated::CollimatedLight),\n        Extra(point::PointLight),\n    }",
         ),
         // A field of a light kind, reached through the variant's path.
         (

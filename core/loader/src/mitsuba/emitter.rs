@@ -1,4 +1,4 @@
-//! `<emitter>` outside a shape: point, spot, projector, directional, constant, envmap and
+//! `<emitter>` outside a shape: point, spot, projector, collimated, directional, constant, envmap and
 //! sun-and-sky lights as `[[lights]]` entries (a point, spot or projector light with the
 //! medium it sits in).
 
@@ -32,8 +32,10 @@ impl Reader {
                     )));
                 }
             };
-            if !matches!(o.ty.as_str(), "point" | "spot" | "projector") {
-                return Err(o.error("only point, spot and projector emitters sit in a medium"));
+            if !matches!(o.ty.as_str(), "point" | "spot" | "projector" | "collimated") {
+                return Err(
+                    o.error("only point, spot, projector and collimated emitters sit in a medium")
+                );
             }
             t.insert("medium", at(Value::Str(name), l));
         }
@@ -62,6 +64,13 @@ impl Reader {
                     t.insert("texture", tex);
                     t.insert("up", vec3(m.transform_vector3(DVec3::Y), line));
                 }
+            }
+            // Mitsuba 0.6's beam along the to_world's +z from its origin.
+            "collimated" => {
+                t.insert("position", vec3(m.transform_point3(DVec3::ZERO), line));
+                t.insert("direction", vec3(m.transform_vector3(DVec3::Z), line));
+                let p = o.color("power", DVec3::ONE)?;
+                t.insert("power", vec3(p, line));
             }
             // The reverse of a perspective camera of the same to_world and field of view.
             "projector" => {
