@@ -1297,3 +1297,39 @@ fn fork_integrators_render_by_the_estimator_they_share() {
     let err = read(&xml, false).unwrap_err();
     assert!(err.contains("unknown integrator"), "{err}");
 }
+
+/// lajolla's `disneybsdf` (a course renderer's Mitsuba 0.6 dialect) is Mitsuba 3's principled
+/// BSDF under other names: specularTransmission and specularTint are spec_trans and
+/// spec_tint; a specular that eta implies is dropped silently, another is a warning, and so is
+/// a subsurface blend (principled has none).
+#[test]
+fn lajolla_disney_bsdf_is_the_principled_bsdf() {
+    let dir = temp_dir("mitsuba-disney");
+    let bsdf = |specular: f64| {
+        format!(
+            "<bsdf type=\"disneybsdf\" id=\"d\"><rgb name=\"baseColor\" value=\"0.8 0.6 0.2\"/><float name=\"specularTransmission\" value=\"0.25\"/><float name=\"specularTint\" value=\"0.75\"/><float name=\"subsurface\" value=\"0.5\"/><float name=\"metallic\" value=\"0.5\"/><float name=\"eta\" value=\"1.5\"/><float name=\"specular\" value=\"{specular}\"/></bsdf>\n<shape type=\"sphere\"><ref id=\"d\"/></shape>\n{SENSOR}"
+        )
+    };
+    let xml = write(&dir, "disney.xml", &scene("0.5.0", &bsdf(0.5)));
+    let (doc, report) = read(&xml, false).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(text(&doc.root, "materials.d.type"), "principled");
+    assert_eq!(number(&doc.root, "materials.d.spec_trans"), 0.25);
+    assert_eq!(number(&doc.root, "materials.d.spec_tint"), 0.75);
+    assert_eq!(number(&doc.root, "materials.d.metallic"), 0.5);
+    assert_eq!(number(&doc.root, "materials.d.eta"), 1.5);
+    let warned = |r: &Report, needle: &str| r.warnings.iter().any(|w| w.contains(needle));
+    assert!(
+        warned(&report, "`subsurface` = 0.5"),
+        "{:?}",
+        report.warnings
+    );
+    assert!(!warned(&report, "`specular`"), "{:?}", report.warnings);
+    assert!(
+        report.notes.iter().any(|n| n.contains("principled")),
+        "{:?}",
+        report.notes
+    );
+    let xml = write(&dir, "disney-specular.xml", &scene("0.5.0", &bsdf(0.3)));
+    let (_, report) = read(&xml, false).unwrap_or_else(|e| panic!("{e}"));
+    assert!(warned(&report, "`specular` = 0.3"), "{:?}", report.warnings);
+}

@@ -476,6 +476,12 @@ impl Reader {
                     return Ok(None);
                 }
             }
+            "disneybsdf" => {
+                put("type", Value::Str("principled".into()));
+                if !self.disney(&mut o, &mut t)? {
+                    return Ok(None);
+                }
+            }
             "null" => put("type", Value::Str("null".into())),
             "blendbsdf" | "mixturebsdf" => {
                 put("type", Value::Str("blend".into()));
@@ -914,6 +920,45 @@ const PRINCIPLED_THIN_RATES: &[&str] = &[
 impl Reader {
     /// `principled` and `principledthin`: foton's parameters have Mitsuba's names and
     /// defaults, so only those given are written. False: a texture was left out (lenient).
+    /// The Disney BSDF of lajolla (a course renderer's Mitsuba 0.6 dialect), the model
+    /// Mitsuba 3's principled BSDF implements (Burley 2015): its parameters under principled's
+    /// names. Its `subsurface` blend has no principled counterpart (a warning); `specular`
+    /// beside `eta` is dropped, since principled derives each from the other.
+    fn disney(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
+        self.note(
+            o,
+            "lajolla's Disney BSDF, read as Mitsuba 3's principled BSDF, which implements the same model (Burley 2015)",
+        );
+        for (from, to) in [
+            ("specular_transmission", "spec_trans"),
+            ("specular_tint", "spec_tint"),
+        ] {
+            if let Some((p, l)) = o.take(from) {
+                o.props.push((to.to_string(), p, l));
+            }
+        }
+        self.ignored(
+            o,
+            "subsurface",
+            &|p| matches!(p, Prop::Float(x) if *x == 0.0),
+            "ignored (the principled BSDF has no subsurface lobe: its diffuse lobe renders in its place)",
+        );
+        if o.props.iter().any(|(n, _, _)| n == "eta") {
+            let eta = o.float("eta", 1.5)?;
+            o.props.push(("eta".into(), Prop::Float(eta), o.line));
+            // Principled's specular is the reflectance at normal incidence of eta, scaled:
+            // specular = ((eta - 1) / (eta + 1))^2 / 0.08.
+            let implied = ((eta - 1.0) / (eta + 1.0)).powi(2) / 0.08;
+            self.ignored(
+                o,
+                "specular",
+                &|p| matches!(p, Prop::Float(x) if (x - implied).abs() < 1e-3),
+                &format!("ignored (eta = {eta} gives the specular reflectance, {implied:.3})"),
+            );
+        }
+        self.principled(o, t)
+    }
+
     fn principled(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
         let line = o.line;
         let thin = o.ty == "principledthin";
