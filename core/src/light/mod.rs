@@ -1,6 +1,6 @@
-//! Lights: point, spot, projector and area lights (any emissive shape), and lights at infinity
-//! (directional, constant and environment-mapped), one file per kind, each listed on one line
-//! of the `lights!` invocation below.
+//! Lights: point, spot, projector, collimated and area lights (any emissive shape), and lights
+//! at infinity (directional, constant and environment-mapped), one file per kind, each listed
+//! on one line of the `lights!` invocation below.
 //!
 //! A kind implements [`LightSource`]; [`Light`] is the tagged union of the kinds (pbrt-v4's
 //! `Light`), which the integrators hold and call without a virtual call, since light

@@ -1022,12 +1022,12 @@ const PROPERTY_TAGS: &[&str] = &[
 /// Nested objects a parent has at most one of and finds by kind, not by name.
 const ONE_OF_A_KIND: &[&str] = &["rfilter", "sampler", "film", "phase"];
 
-/// The object elements of Mitsuba's parser.
 /// The properties that hold one value, in `value`.
 const VALUE_TAGS: &[&str] = &[
     "float", "integer", "boolean", "string", "rgb", "spectrum", "srgb",
 ];
 
+/// The object elements of Mitsuba's parser.
 const OBJECT_TAGS: &[&str] = &[
     "bsdf",
     "emitter",
