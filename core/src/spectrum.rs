@@ -474,8 +474,8 @@ mod tests {
         }
     }
 
-    /// Mitsuba's normalisations make a flat spectrum of 1 emit a luminance Y of 1: Mitsuba
-    /// 3's constant is its 1000-wavelength sum of ȳ, 0.6's the integral of its table.
+    /// pbrt-v4's white balance: the identity at D65's temperature, each temperature's white
+    /// made grey, and CIE daylight on its locus.
     #[test]
     fn white_balance_maps_the_temperatures_white_to_srgbs() {
         // D65 is daylight of 6504 K: 6500 K (6503.6 K after the constant's revision) is
@@ -506,6 +506,8 @@ mod tests {
         }
     }
 
+    /// Mitsuba's normalisations make a flat spectrum of 1 emit a luminance Y of 1: Mitsuba
+    /// 3's constant is its 1000-wavelength sum of ȳ, 0.6's the integral of its table.
     #[test]
     fn a_flat_spectrum_has_unit_luminance() {
         let y = to_xyz(|_| Some(1.0), Quantity::Emission).y;
