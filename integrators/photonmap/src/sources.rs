@@ -18,7 +18,7 @@
 //! sigma_a Le is zero at every corner of its lattice, an emitter smaller than a cell between
 //! them, emits no photons.)
 
-use foton_core::api::{Distribution1D, Error, Result, Rgb, Scene, uniform_sphere};
+use foton_core::api::{Distribution1D, Error, LightType, Result, Rgb, Scene, uniform_sphere};
 use glam::{Vec2, Vec3};
 
 /// Cells per axis of an emitting medium's lattice.
@@ -56,9 +56,12 @@ pub struct Start {
     pub pdf: f32,
     /// The medium it starts in.
     pub medium: Option<u32>,
-    /// Whether it leaves an emitting medium (next-event estimation never samples one, so its
-    /// light's first bounce is no direct lighting).
+    /// Whether it leaves an emitting medium.
     pub from_medium: bool,
+    /// Whether next-event estimation samples its source: not an emitting medium nor a
+    /// collimated beam, whose light's first bounce the estimators' direct lighting never
+    /// reaches, so that the photons must render it.
+    pub nee: bool,
 }
 
 impl Sources {
@@ -167,6 +170,7 @@ impl Sources {
                 pdf: pmf * self.light_fraction,
                 medium: self.light_media[light_id],
                 from_medium: false,
+                nee: scene.lights()[light_id].light_type() != LightType::DeltaBeam,
             });
         }
         let u = ((u_source - self.light_fraction) / (1.0 - self.light_fraction)).min(0.99999994);
@@ -196,6 +200,7 @@ impl Sources {
             pdf: pdf * pick * (1.0 - self.light_fraction),
             medium: Some(source.medium),
             from_medium: true,
+            nee: false,
         })
     }
 }

@@ -142,7 +142,7 @@ pub fn trace_one_with_beams(
     let mut hits = 0u32;
     let mut specular_only = !emitted.from_medium;
     let class_of = |hits: u32, specular_only: bool| {
-        if hits == 1 && !emitted.from_medium {
+        if hits == 1 && emitted.nee {
             PathClass::Direct
         } else if specular_only {
             PathClass::Caustic

@@ -153,3 +153,38 @@ fn mitsuba_collimated_is_the_beam_along_to_world() {
     );
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// The photons of a beam's first bounce carry all of its power to the spot, and are not
+/// classed as direct lighting: next-event estimation never reaches a beam, so the photon
+/// mappers render that bounce from photons (as they do an emitting medium's) even where
+/// their direct lighting is next-event estimation.
+#[test]
+fn a_beams_first_bounce_is_left_to_the_photons() {
+    use foton_photonmap::trace::{PathClass, STREAM_GLOBAL, TraceOptions, trace_one};
+    let dir = foton_tests::temp_dir("collimated-photons");
+    let path = foton_tests::write(&dir, "scene.toml", &scene("sppm", 1));
+    let scene = foton_loader::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    let _ = std::fs::remove_dir_all(dir);
+    let opts = TraceOptions {
+        photons: 1000,
+        max_depth: 1,
+        seed: 4,
+        stream: STREAM_GLOBAL,
+        stop_at_diffuse: true,
+        sobol_emission: false,
+    };
+    let sources = foton_photonmap::sources::Sources::new(&scene).unwrap();
+    let mut total = glam::DVec3::ZERO;
+    for i in 0..opts.photons {
+        trace_one(&scene, &opts, &sources, i, |p, _, class| {
+            assert_ne!(class, PathClass::Direct);
+            assert!(p.position.length() < 1e-4, "{}", p.position);
+            total += p.power().as_dvec3();
+        });
+    }
+    let want = glam::DVec3::from(POWER);
+    assert!(
+        (total - want).abs().max_element() < 1e-3 * want.x,
+        "{total} against {want}"
+    );
+}
