@@ -20,6 +20,7 @@ use crate::material::diffuse::DiffuseBxdf;
 use crate::material::{Lobe, Material};
 use crate::sampling::basis;
 use crate::scattering::TransportMode;
+use crate::texture::TextureEvalContext;
 use glam::{Vec2, Vec3};
 
 pub use crate::scattering::LocalSample;
@@ -319,7 +320,7 @@ impl Material {
                 Frame::from_normal_tangent(sp.ns, sp.dpdu)
             }
         };
-        self.bsdf_in(sp.p, sp.uv, sp.ng, frame)
+        self.bsdf_in(sp.p, sp.texture_ctx(), sp.ng, frame)
     }
 
     /// The BSDF at a point of a flat surface whose material needs no texture coordinates and
@@ -329,15 +330,23 @@ impl Material {
     /// built without testing a tangent that is known to be zero.)
     #[inline]
     pub fn flat_bsdf(&self, ng: Vec3) -> Option<Bsdf> {
-        self.bsdf_in(Vec3::ZERO, Vec2::ZERO, ng, || Frame::from_normal(ng))
+        self.bsdf_in(Vec3::ZERO, TextureEvalContext::default(), ng, || {
+            Frame::from_normal(ng)
+        })
     }
 
-    /// The BSDF at point `p` (which only a blend reads) with its textures looked up at `uv`,
+    /// The BSDF at point `p` (which only a blend reads) with its textures looked up at `ctx`,
     /// the geometric normal `ng`, and the shading frame `frame` makes (not made for the null
     /// material).
     #[inline(always)]
-    fn bsdf_in(&self, p: Vec3, uv: Vec2, ng: Vec3, frame: impl FnOnce() -> Frame) -> Option<Bsdf> {
-        let (lobe, twosided) = self.lobe_at(p, uv)?;
+    fn bsdf_in(
+        &self,
+        p: Vec3,
+        ctx: TextureEvalContext,
+        ng: Vec3,
+        frame: impl FnOnce() -> Frame,
+    ) -> Option<Bsdf> {
+        let (lobe, twosided) = self.lobe_at(p, ctx)?;
         Some(Bsdf {
             lobe,
             frame: frame(),

@@ -4,6 +4,8 @@
 //! normalize(e1 x e2) for triangles. [`SurfacePoint`] adds what shading needs: the shading
 //! normal, texture coordinates and the tangent dp/du, with Mitsuba 3's parameterisations.
 
+use crate::Rgb;
+use crate::texture::TextureEvalContext;
 use glam::{Mat3, Vec2, Vec3};
 use obvhs::aabb::Aabb;
 
@@ -99,6 +101,19 @@ pub struct SurfacePoint {
     pub dpdu: Vec3,
     /// Tangent dp/dv (zero where dp/du is): with dp/du, the frame a bump map tilts.
     pub dpdv: Vec3,
+    /// The value of the mesh attribute the surface carries (zero where none).
+    pub attribute: Rgb,
+}
+
+impl SurfacePoint {
+    /// Where the surface's textures are looked up.
+    #[inline]
+    pub fn texture_ctx(&self) -> TextureEvalContext {
+        TextureEvalContext {
+            uv: self.uv,
+            attribute: self.attribute,
+        }
+    }
 }
 
 /// A shape instance in the scene: geometry plus the index of the scene object it belongs to
@@ -329,7 +344,7 @@ impl Shape {
     /// disk: u = r, v = phi / 2 pi; triangle: interpolated, else the barycentrics (b1, b2)),
     /// and the shading normal from a triangle's vertex normals.
     pub fn surface(&self, p: Vec3, attrs: Option<&TriangleAttrs>) -> SurfacePoint {
-        self.surface_at(p, self.normal(p), attrs, true)
+        self.surface_at(p, self.normal(p), attrs, None, true)
     }
 
     /// [`Shape::surface`] at a point whose geometric normal `ng` is known (a hit's: not
@@ -342,6 +357,7 @@ impl Shape {
         p: Vec3,
         ng: Vec3,
         attrs: Option<&TriangleAttrs>,
+        attribute: Option<&[Rgb; 3]>,
         coordinates: bool,
     ) -> SurfacePoint {
         if !coordinates
@@ -360,8 +376,10 @@ impl Shape {
                 uv: Vec2::ZERO,
                 dpdu: Vec3::ZERO,
                 dpdv: Vec3::ZERO,
+                attribute: Rgb::ZERO,
             };
         }
+        let mut value = Rgb::ZERO;
         let (uv, dpdu, dpdv, ns) = match *self {
             Shape::Sphere {
                 center,
@@ -428,6 +446,9 @@ impl Shape {
                 let b1 = q.cross(e2).dot(n) * inv;
                 let b2 = e1.cross(q).dot(n) * inv;
                 let b0 = 1.0 - b1 - b2;
+                if let Some(c) = attribute {
+                    value = b0 * c[0] + b1 * c[1] + b2 * c[2];
+                }
                 let mut uv = Vec2::new(b1, b2);
                 let (mut dpdu, mut dpdv) = (Vec3::ZERO, Vec3::ZERO);
                 let mut ns = ng;
@@ -459,6 +480,7 @@ impl Shape {
             uv,
             dpdu,
             dpdv,
+            attribute: value,
         }
     }
 

@@ -1,6 +1,7 @@
 //! Textures: spatially varying colours looked up by surface (u, v), as Mitsuba 3's `bitmap` and
-//! `checkerboard` textures, and the [`Bitmap`] image they and the environment map
-//! ([`crate::envmap`]) share, with its one bilinear lookup.
+//! `checkerboard` textures, or read from the mesh (Mitsuba 3's `mesh_attribute`), and the
+//! [`Bitmap`] image they and the environment map ([`crate::envmap`]) share, with its one
+//! bilinear lookup.
 //!
 //! Mitsuba's conventions, checked against Mitsuba 3.9.1 itself:
 //! - texel (i, j) is column i of row j, row 0 the image's top row (the file's first row), and
@@ -19,6 +20,26 @@
 use crate::Rgb;
 use glam::{Affine2, Vec2};
 use std::sync::Arc;
+
+/// Where a texture is looked up (pbrt-v4's `TextureEvalContext`): the surface's texture
+/// coordinates and, on a mesh that carries one, the value there of the mesh attribute its
+/// material's textures read (interpolated between the vertices of a vertex attribute).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TextureEvalContext {
+    pub uv: Vec2,
+    /// The mesh attribute's value; zero where the surface has none.
+    pub attribute: Rgb,
+}
+
+impl From<Vec2> for TextureEvalContext {
+    #[inline(always)]
+    fn from(uv: Vec2) -> TextureEvalContext {
+        TextureEvalContext {
+            uv,
+            attribute: Rgb::ZERO,
+        }
+    }
+}
 
 /// How a lookup between texels combines them (Mitsuba's `filter_type`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -254,14 +275,23 @@ pub enum Texture {
         color1: Rgb,
         to_uv: Affine2,
     },
+    /// A mesh's attribute (Mitsuba 3's `mesh_attribute`): `name` (`vertex_...` or `face_...`)
+    /// names it, and the shapes that use the texture's material carry it to the surface
+    /// ([`TextureEvalContext::attribute`]), scaled here by `scale`.
+    MeshAttribute {
+        name: Arc<str>,
+        scale: Rgb,
+    },
 }
 
 impl Texture {
-    /// The colour at surface coordinates `uv`.
+    /// The colour at `ctx` (its texture coordinates, or its mesh attribute).
     #[inline]
-    pub fn eval(&self, uv: Vec2) -> Rgb {
+    pub fn eval(&self, ctx: TextureEvalContext) -> Rgb {
+        let uv = ctx.uv;
         match self {
             Texture::Constant(c) => *c,
+            Texture::MeshAttribute { scale, .. } => ctx.attribute * *scale,
             Texture::Bitmap {
                 bitmap,
                 filter,
@@ -320,17 +350,27 @@ impl Texture {
     /// cost about 1% of the path tracer's instructions on the Cornell box). Materials look
     /// their textures up with this.
     #[inline(always)]
-    pub fn at(&self, uv: Vec2) -> Rgb {
+    pub fn at(&self, ctx: TextureEvalContext) -> Rgb {
         match self {
             Texture::Constant(c) => *c,
-            _ => self.eval(uv),
+            _ => self.eval(ctx),
         }
     }
 
-    /// The mean colour over the unit square of uv (of the image, of the two colours).
+    /// The name of the mesh attribute the texture reads, if it is a `MeshAttribute`.
+    pub fn mesh_attribute(&self) -> Option<&str> {
+        match self {
+            Texture::MeshAttribute { name, .. } => Some(name),
+            _ => None,
+        }
+    }
+
+    /// The mean colour over the unit square of uv (of the image, of the two colours). A mesh
+    /// attribute's is not known to the texture: taken as mid-grey (times its scale).
     pub fn mean(&self) -> Rgb {
         match self {
             Texture::Constant(c) => *c,
+            Texture::MeshAttribute { scale, .. } => 0.5 * *scale,
             Texture::Bitmap { bitmap, .. } => bitmap.mean(),
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
         }
@@ -338,9 +378,12 @@ impl Texture {
 
     /// A per-channel bound of every value `eval` returns (for checking that a reflectance
     /// stays within 1, or bounding Russian roulette).
+    /// A mesh attribute's is taken as its scale (a colour in [0, 1]), since the texture does
+    /// not know the meshes that carry it.
     pub fn max(&self) -> Rgb {
         match self {
             Texture::Constant(c) => *c,
+            Texture::MeshAttribute { scale, .. } => *scale,
             Texture::Bitmap { bitmap, .. } => bitmap.max(),
             Texture::Checkerboard { color0, color1, .. } => color0.max(*color1),
         }
@@ -399,7 +442,7 @@ mod tests {
             if offsets.iter().any(|&o| cell(uv + o) != cell(uv)) {
                 continue;
             }
-            let f = |uv| scalar(texture.eval(uv));
+            let f = |uv: Vec2| scalar(texture.eval(uv.into()));
             let fd = Vec2::new(
                 (f(uv + offsets[0]) - f(uv + offsets[1])) / (2.0 * d),
                 (f(uv + offsets[2]) - f(uv + offsets[3])) / (2.0 * d),

@@ -12,7 +12,7 @@ use glam::{Affine2, DVec3, Mat2, Vec2};
 use std::path::Path;
 use std::sync::Arc;
 
-pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard", "constant"];
+pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard", "constant", "mesh_attribute"];
 
 /// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR, BMP, TGA, PPM/PGM: Mitsuba's formats but
 /// PFM; the format is recognised by its content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
@@ -196,7 +196,8 @@ pub(crate) fn scale_texture_table(table: &mut Table, s: DVec3, node: impl Fn(DVe
 /// name is read once.
 pub type Bitmaps = std::collections::HashMap<(std::path::PathBuf, u64), Arc<Bitmap>>;
 
-/// A texture table (`type = "bitmap"`, `"checkerboard"` or `"constant"` and its parameters, see
+/// A texture table (`type = "bitmap"`, `"checkerboard"`, `"constant"` or `"mesh_attribute"`
+/// and its parameters, see
 /// docs/scene-format.md); `filename` is relative to `base_dir`. Every error names the
 /// scene file, line and key; an image that cannot be read also names the image file.
 pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) -> Result<Texture> {
@@ -268,6 +269,24 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) 
             })
         }
         "constant" => Ok(Texture::Constant(t.vec3_required("value")?)),
+        "mesh_attribute" => {
+            let name = t.string_required("name")?;
+            if !(name.starts_with("vertex_") || name.starts_with("face_")) {
+                return Err(t.error(
+                    "name",
+                    format!("{name:?}: a mesh attribute's name starts with `vertex_` or `face_`"),
+                ));
+            }
+            let scale = match t.node("scale").map(|n| &n.value) {
+                None => Rgb::ONE,
+                Some(Value::Array(_)) => t.rgb("scale", Rgb::ONE)?,
+                Some(_) => Rgb::splat(t.f32_required("scale")?),
+            };
+            Ok(Texture::MeshAttribute {
+                name: name.into(),
+                scale,
+            })
+        }
         "checkerboard" => Ok(Texture::Checkerboard {
             // Mitsuba's defaults.
             color0: t.rgb("color0", Rgb::splat(0.4))?,
@@ -440,22 +459,25 @@ mod tests {
         for j in 0..2 {
             for i in 0..3 {
                 let want = linear(j * 3 + i);
-                assert!(close(t.eval(centre(i, j)), want), "texel ({i}, {j})");
+                assert!(close(t.eval(centre(i, j).into()), want), "texel ({i}, {j})");
                 // Repeat: whole periods further, either way.
                 let far = centre(i, j) + Vec2::new(2.0, -3.0);
-                assert!(close(t.eval(far), want), "texel ({i}, {j}) + (2, -3)");
+                assert!(
+                    close(t.eval(far.into()), want),
+                    "texel ({i}, {j}) + (2, -3)"
+                );
             }
         }
         // Half-way between texel centres: the average of the two (four) texels.
-        let mid = t.eval(Vec2::new(1.0 / 3.0, 0.25));
+        let mid = t.eval(Vec2::new(1.0 / 3.0, 0.25).into());
         assert!(close(mid, 0.5 * (linear(0) + linear(1))));
-        let mid4 = t.eval(Vec2::new(1.0 / 3.0, 0.5));
+        let mid4 = t.eval(Vec2::new(1.0 / 3.0, 0.5).into());
         assert!(close(
             mid4,
             0.25 * (linear(0) + linear(1) + linear(3) + linear(4))
         ));
         // uv = (0, 0), the top-left corner, averages the four corner texels (repeat).
-        let corner = t.eval(Vec2::ZERO);
+        let corner = t.eval(Vec2::ZERO.into());
         assert!(close(
             corner,
             0.25 * (linear(0) + linear(2) + linear(3) + linear(5))
@@ -466,8 +488,8 @@ mod tests {
             "[t]\ntype = \"bitmap\"\nfilename = \"t.png\"\nfilter_type = \"nearest\"\n",
         )
         .unwrap();
-        assert_eq!(n.eval(Vec2::new(0.34, 0.49)), linear(1));
-        assert_eq!(n.eval(Vec2::new(0.99, 0.51)), linear(5));
+        assert_eq!(n.eval(Vec2::new(0.34, 0.49).into()), linear(1));
+        assert_eq!(n.eval(Vec2::new(0.99, 0.51).into()), linear(5));
         // raw: the bytes over 255, not decoded.
         let raw = read(
             &dir,
@@ -475,7 +497,7 @@ mod tests {
         )
         .unwrap();
         let want = Rgb::from_array(PIXELS[4].map(|b| b as f32 / 255.0));
-        assert!(close(raw.eval(centre(1, 1)), want));
+        assert!(close(raw.eval(centre(1, 1).into()), want));
         assert!(close(t.mean(), (0..6).map(linear).sum::<Rgb>() / 6.0));
         let _ = std::fs::remove_dir_all(dir);
     }
@@ -489,18 +511,18 @@ mod tests {
             read(&dir, &format!("{head}\n{extra}\n")).unwrap()
         };
         let clamp = with("wrap_mode = \"clamp\"");
-        assert_eq!(clamp.eval(Vec2::new(-5.0, 0.2)), linear(0));
-        assert_eq!(clamp.eval(Vec2::new(7.0, 9.0)), linear(5));
+        assert_eq!(clamp.eval(Vec2::new(-5.0, 0.2).into()), linear(0));
+        assert_eq!(clamp.eval(Vec2::new(7.0, 9.0).into()), linear(5));
         let mirror = with("wrap_mode = \"mirror\"");
         // Just past the right edge: the last column again, then going back.
-        assert_eq!(mirror.eval(Vec2::new(1.1, 0.2)), linear(2));
-        assert_eq!(mirror.eval(Vec2::new(1.5, 0.2)), linear(1));
-        assert_eq!(mirror.eval(Vec2::new(-0.1, 0.2)), linear(0));
-        assert_eq!(mirror.eval(Vec2::new(0.2, -0.1)), linear(0));
-        assert_eq!(mirror.eval(Vec2::new(0.2, 1.2)), linear(3));
+        assert_eq!(mirror.eval(Vec2::new(1.1, 0.2).into()), linear(2));
+        assert_eq!(mirror.eval(Vec2::new(1.5, 0.2).into()), linear(1));
+        assert_eq!(mirror.eval(Vec2::new(-0.1, 0.2).into()), linear(0));
+        assert_eq!(mirror.eval(Vec2::new(0.2, -0.1).into()), linear(0));
+        assert_eq!(mirror.eval(Vec2::new(0.2, 1.2).into()), linear(3));
         // to_uv scales then offsets: uv' = 2 uv + (0.5, 0).
         let scaled = with("to_uv = { scale = 2.0, offset = [0.5, 0.0] }");
-        assert_eq!(scaled.eval(Vec2::new(0.1, 0.1)), linear(2));
+        assert_eq!(scaled.eval(Vec2::new(0.1, 0.1).into()), linear(2));
         let m9 = with("to_uv = { matrix = [2, 0, 0.5, 0, 2, 0, 0, 0, 1] }");
         let m16 = with("to_uv = { matrix = [2, 0, 0, 0.5, 0, 2, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1] }");
         for uv in [
@@ -508,8 +530,8 @@ mod tests {
             Vec2::new(0.3, 0.7),
             Vec2::new(-0.4, 0.2),
         ] {
-            assert_eq!(m9.eval(uv), scaled.eval(uv));
-            assert_eq!(m16.eval(uv), scaled.eval(uv));
+            assert_eq!(m9.eval(uv.into()), scaled.eval(uv.into()));
+            assert_eq!(m16.eval(uv.into()), scaled.eval(uv.into()));
         }
         let _ = std::fs::remove_dir_all(dir);
     }
@@ -566,17 +588,17 @@ mod tests {
         )
         .unwrap();
         let (c0, c1) = (Rgb::X, Rgb::Z);
-        assert_eq!(t.eval(Vec2::new(0.25, 0.25)), c0);
-        assert_eq!(t.eval(Vec2::new(0.75, 0.75)), c0);
-        assert_eq!(t.eval(Vec2::new(0.75, 0.25)), c1);
-        assert_eq!(t.eval(Vec2::new(0.25, 0.75)), c1);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.25).into()), c0);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.75).into()), c0);
+        assert_eq!(t.eval(Vec2::new(0.75, 0.25).into()), c1);
+        assert_eq!(t.eval(Vec2::new(0.25, 0.75).into()), c1);
         // 1/2 itself belongs to the low half; negative uv repeats.
-        assert_eq!(t.eval(Vec2::new(0.5, 0.5)), c0);
-        assert_eq!(t.eval(Vec2::new(-0.25, 0.25)), c1);
+        assert_eq!(t.eval(Vec2::new(0.5, 0.5).into()), c0);
+        assert_eq!(t.eval(Vec2::new(-0.25, 0.25).into()), c1);
         assert_eq!(t.mean(), Rgb::new(0.5, 0.0, 0.5));
         let d = read(&dir, "[t]\ntype = \"checkerboard\"\n").unwrap();
-        assert_eq!(d.eval(Vec2::splat(0.1)), Rgb::splat(0.4));
-        assert_eq!(d.eval(Vec2::new(0.6, 0.1)), Rgb::splat(0.2));
+        assert_eq!(d.eval(Vec2::splat(0.1).into()), Rgb::splat(0.4));
+        assert_eq!(d.eval(Vec2::new(0.6, 0.1).into()), Rgb::splat(0.2));
         let _ = std::fs::remove_dir_all(dir);
     }
 

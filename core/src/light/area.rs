@@ -143,20 +143,20 @@ impl AreaLight {
 impl EmissionTexture {
     /// The texture coordinates at point `p` (normal `n`) of `shape`, the light's `i`-th.
     fn uv(&self, shape: &Shape, i: usize, p: Vec3, n: Vec3) -> Vec2 {
-        shape.surface_at(p, n, self.attrs.get(i), true).uv
+        shape.surface_at(p, n, self.attrs.get(i), None, true).uv
     }
 
     /// The radiance's factor where a ray meets the surface at `uv`.
     #[inline]
     fn seen(&self, uv: Vec2) -> Rgb {
-        self.texture.as_ref().map_or(Rgb::ONE, |t| t.eval(uv))
+        self.texture.as_ref().map_or(Rgb::ONE, |t| t.eval(uv.into()))
     }
 
     /// The cut-out's opacity at `uv` (1 without one).
     fn opacity(&self, uv: Vec2) -> f32 {
         self.alpha
             .as_ref()
-            .map_or(1.0, |a| crate::texture::scalar(a.eval(uv)).clamp(0.0, 1.0))
+            .map_or(1.0, |a| crate::texture::scalar(a.eval(uv.into())).clamp(0.0, 1.0))
     }
 
     /// The radiance's factor at a sampled point: times the opacity there.

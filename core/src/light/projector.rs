@@ -69,7 +69,7 @@ impl ProjectorLight {
     #[inline]
     fn intensity(&self, d: Vec3) -> Rgb {
         match self.uv(d) {
-            Some((uv, cos)) => self.image.eval(uv) * (PI * self.scale / (cos * cos * cos)),
+            Some((uv, cos)) => self.image.eval(uv.into()) * (PI * self.scale / (cos * cos * cos)),
             None => Rgb::ZERO,
         }
     }
@@ -122,7 +122,7 @@ impl LightSource for ProjectorLight {
         );
         let dir = (self.x * local.x + self.y * local.y + self.z).normalize();
         let cos = 1.0 / local.length();
-        let e = self.image.eval(u_dir) * (PI * self.scale);
+        let e = self.image.eval(u_dir.into()) * (PI * self.scale);
         EmittedRay {
             origin: self.position,
             dir,

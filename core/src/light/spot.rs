@@ -249,7 +249,7 @@ impl SpotTexture {
         let z = d.dot(axis);
         let k = 0.5 * self.inv_tan_cutoff / z;
         self.texture
-            .eval(Vec2::new(0.5 + d.dot(self.x) * k, 0.5 + d.dot(self.y) * k))
+            .eval(Vec2::new(0.5 + d.dot(self.x) * k, 0.5 + d.dot(self.y) * k).into())
     }
 }
 

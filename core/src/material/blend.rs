@@ -23,6 +23,7 @@ use crate::props::Properties;
 use crate::registry::Factory;
 use crate::sampling::splitmix64;
 use crate::texture::Texture;
+use crate::texture::TextureEvalContext;
 use crate::value::Value;
 use glam::{Vec2, Vec3};
 
@@ -61,14 +62,14 @@ pub fn hit_hash(p: Vec3, uv: Vec2) -> u64 {
 }
 
 impl BlendMaterial {
-    /// The component a number `u` in [0, 1) chooses at `uv`: the second of a blend when
+    /// The component a number `u` in [0, 1) chooses at `ctx`: the second of a blend when
     /// u < w, the i-th of a mixture when u falls in its share of [0, 1) (each share its
     /// weight long); None when u falls beyond the weights' sum (absorbed).
     #[inline]
-    pub fn choose(&self, u: f32, uv: Vec2) -> Option<&Material> {
+    pub fn choose(&self, u: f32, ctx: TextureEvalContext) -> Option<&Material> {
         match &self.weights {
             BlendWeights::Blend(w) => {
-                let w = channel_mean(w.at(uv));
+                let w = channel_mean(w.at(ctx));
                 Some(&self.components[usize::from(u < w)])
             }
             BlendWeights::Mixture(weights) => {
@@ -87,11 +88,11 @@ impl BlendMaterial {
     /// The material a hit at `p` with texture coordinates `uv` takes: nested blends resolved,
     /// each by a hash of its own (the outer hash hashed again), so that their choices are
     /// independent. None: absorbed.
-    pub fn resolve(&self, p: Vec3, uv: Vec2) -> Option<&Material> {
-        let mut h = hit_hash(p, uv);
+    pub fn resolve(&self, p: Vec3, ctx: TextureEvalContext) -> Option<&Material> {
+        let mut h = hit_hash(p, ctx.uv);
         let mut blend = self;
         loop {
-            match blend.choose(unit(h), uv)? {
+            match blend.choose(unit(h), ctx)? {
                 Material::Blend(inner) => {
                     blend = inner;
                     h = splitmix64(h);
@@ -104,9 +105,9 @@ impl BlendMaterial {
     /// The lobe the hit takes and whether it is mirrored from below (see
     /// [`Material::lobe_at`]); an absorbed hit takes a black diffuse lobe.
     #[inline(never)]
-    pub(crate) fn lobe_at(&self, p: Vec3, uv: Vec2) -> Option<(Lobe, bool)> {
-        match self.resolve(p, uv) {
-            Some(m) => m.lobe_at(p, uv),
+    pub(crate) fn lobe_at(&self, p: Vec3, ctx: TextureEvalContext) -> Option<(Lobe, bool)> {
+        match self.resolve(p, ctx) {
+            Some(m) => m.lobe_at(p, ctx),
             None => Some((
                 Lobe::Diffuse(super::diffuse::DiffuseBxdf {
                     reflectance: Rgb::ZERO,

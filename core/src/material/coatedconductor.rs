@@ -13,13 +13,13 @@
 //! | `conductor_roughness`      | number / texture | the metal's roughness (or `conductor_uroughness`, `conductor_vroughness`) | `0` |
 //! | `remaproughness`, `thickness`, `albedo`, `g`, `maxdepth`, `nsamples` | | as for `coateddiffuse` | |
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use super::conductor::conductor_ior;
 use super::layered::{self, Conductor, Dielectric, Layered};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::texture::Texture;
-use glam::Vec2;
 
 /// The lobe: pbrt's `LayeredBxDF<DielectricBxDF, ConductorBxDF, true>`.
 pub type CoatedConductorBxdf = Layered<Conductor>;
@@ -48,17 +48,17 @@ impl SurfaceMaterial for CoatedConductorMaterial {
     type Bxdf = CoatedConductorBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> CoatedConductorBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> CoatedConductorBxdf {
         let mut lobe = self.lobe;
-        lobe.albedo = self.albedo.at(uv).clamp(Rgb::ZERO, Rgb::ONE);
+        lobe.albedo = self.albedo.at(ctx).clamp(Rgb::ZERO, Rgb::ONE);
         if let Some(r) = &self.reflectance {
-            (lobe.base.eta, lobe.base.k) = index_of_reflectance(r.at(uv), lobe.top.eta);
+            (lobe.base.eta, lobe.base.k) = index_of_reflectance(r.at(ctx), lobe.top.eta);
         }
         if let Some(r) = &self.roughness[0] {
-            lobe.top.ggx = r.ggx_at(uv);
+            lobe.top.ggx = r.ggx_at(ctx);
         }
         if let Some(r) = &self.roughness[1] {
-            lobe.base.ggx = r.ggx_at(uv);
+            lobe.base.ggx = r.ggx_at(ctx);
         }
         lobe
     }

@@ -14,12 +14,12 @@
 //! | `maxdepth`       | integer       | events per random walk                           | `10`    |
 //! | `nsamples`       | integer       | random walks per evaluation                      | `1`     |
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use super::layered::{self, Diffuse, Dielectric, Layered};
 use crate::Rgb;
 use crate::registry::Factory;
 use crate::texture::Texture;
-use glam::Vec2;
 
 /// The lobe: pbrt's `LayeredBxDF<DielectricBxDF, DiffuseBxDF, true>`.
 pub type CoatedDiffuseBxdf = Layered<Diffuse>;
@@ -38,18 +38,18 @@ impl SurfaceMaterial for CoatedDiffuseMaterial {
     type Bxdf = CoatedDiffuseBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> CoatedDiffuseBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> CoatedDiffuseBxdf {
         let clamp = |c: Rgb| c.clamp(Rgb::ZERO, Rgb::ONE);
         let mut top = self.lobe.top;
         if let Some(r) = &self.roughness {
-            top.ggx = r.ggx_at(uv);
+            top.ggx = r.ggx_at(ctx);
         }
         Layered {
             top,
             base: Diffuse {
-                reflectance: clamp(self.reflectance.at(uv)),
+                reflectance: clamp(self.reflectance.at(ctx)),
             },
-            albedo: clamp(self.albedo.at(uv)),
+            albedo: clamp(self.albedo.at(ctx)),
             ..self.lobe
         }
     }

@@ -17,6 +17,7 @@
 //! layer's underside reflects back onto the base is lost, as in Mitsuba 0.6. Over a smooth
 //! metal every part is a mirror reflection: F(cos) + (1 - F(cos))^2 F_metal(cos') A.
 
+use crate::texture::TextureEvalContext;
 use super::mirror::delta_sample;
 use super::{Material, SurfaceMaterial, nested_material, read_ior};
 use crate::Rgb;
@@ -253,17 +254,17 @@ impl SurfaceMaterial for CoatingMaterial {
     type Bxdf = CoatingBxdf;
 
     #[inline]
-    fn bxdf(&self, uv: Vec2) -> CoatingBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> CoatingBxdf {
         let base = self
             .base
-            .lobe_at(Vec3::ZERO, uv)
+            .lobe_at(Vec3::ZERO, ctx)
             .and_then(|(lobe, _)| CoatBase::of(lobe))
             .expect("a coating's base is checked when it is read");
         CoatingBxdf {
             base,
             eta: self.eta,
             depth: self.depth,
-            specular_reflectance: self.specular_reflectance.at(uv),
+            specular_reflectance: self.specular_reflectance.at(ctx),
             specular_weight: self.specular_weight,
         }
     }
@@ -292,7 +293,7 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
         let base = nested_material(&bag, nested, resources)?;
         let ty = bag.string_opt("type")?.unwrap_or_default();
         let supported = base
-            .lobe_at(Vec3::ZERO, Vec2::ZERO)
+            .lobe_at(Vec3::ZERO, TextureEvalContext::default())
             .and_then(|(lobe, _)| CoatBase::of(lobe))
             .is_some();
         if !supported || matches!(base, Material::Blend(_)) {
@@ -301,7 +302,7 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
                 format!("a coating lies on a diffuse, conductor, roughconductor, roughplastic or roughdiffuse material, not on `{ty}`"),
             ));
         }
-        let base_twosided = base.lobe_at(Vec3::ZERO, Vec2::ZERO).is_some_and(|(l, t)| {
+        let base_twosided = base.lobe_at(Vec3::ZERO, TextureEvalContext::default()).is_some_and(|(l, t)| {
             t || matches!(l, Lobe::Diffuse(DiffuseBxdf { twosided: true, .. }))
         });
         nested.push(bag);

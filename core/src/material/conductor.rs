@@ -7,6 +7,7 @@
 //! | `eta`, `k`             | RGB           | the complex index eta + i k, relative to the outside (both, or `material`) | |
 //! | `specular_reflectance` | RGB / texture | scales the reflection                    | `1`            |
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use super::mirror::{delta_sample, reflect_local};
 use crate::Rgb;
@@ -40,11 +41,11 @@ impl SurfaceMaterial for ConductorMaterial {
     type Bxdf = ConductorBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> ConductorBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> ConductorBxdf {
         ConductorBxdf {
             eta: self.eta,
             k: self.k,
-            specular_reflectance: self.specular_reflectance.at(uv),
+            specular_reflectance: self.specular_reflectance.at(ctx),
         }
     }
 

@@ -6,6 +6,7 @@
 //! |-----------------|---------------|------------------------------------------|---------|
 //! | `transmittance` | RGB / texture | the fraction of the light passed through | `0.5`   |
 
+use crate::texture::TextureEvalContext;
 use super::{SurfaceMaterial, reflectance};
 use crate::Rgb;
 use crate::registry::Factory;
@@ -32,9 +33,9 @@ impl SurfaceMaterial for DiffTransMaterial {
     type Bxdf = DiffTransBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> DiffTransBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> DiffTransBxdf {
         DiffTransBxdf {
-            transmittance: self.transmittance.at(uv),
+            transmittance: self.transmittance.at(ctx),
         }
     }
 

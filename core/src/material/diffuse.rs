@@ -5,6 +5,7 @@
 //! | `reflectance` | RGB / texture | the albedo                                   | `0.5`        |
 //! | `twosided`    | bool          | false: black from behind (a Mitsuba BSDF not wrapped in `twosided`) | `true` |
 
+use crate::texture::TextureEvalContext;
 use super::{SurfaceMaterial, reflectance};
 use crate::Rgb;
 use crate::registry::Factory;
@@ -33,9 +34,9 @@ impl SurfaceMaterial for DiffuseMaterial {
     type Bxdf = DiffuseBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> DiffuseBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> DiffuseBxdf {
         DiffuseBxdf {
-            reflectance: self.reflectance.at(uv),
+            reflectance: self.reflectance.at(ctx),
             twosided: self.twosided,
         }
     }

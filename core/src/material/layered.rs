@@ -44,6 +44,7 @@ use crate::registry::Resources;
 use crate::sampling::{Rng, cosine_hemisphere};
 use crate::scattering::{Bxdf, LocalSample, TransportMode, fresnel_conductor, reflect};
 use crate::texture::Texture;
+use crate::texture::TextureEvalContext;
 use glam::{Vec2, Vec3};
 use std::f32::consts::{FRAC_1_PI, PI};
 
@@ -998,8 +999,8 @@ pub fn read_ggx(m: &Properties<'_>, prefix: &str) -> Result<Ggx> {
 impl super::RoughnessTextures {
     /// A coat's or a base's distribution at surface coordinates `uv`.
     #[inline]
-    pub fn ggx_at(&self, uv: Vec2) -> Ggx {
-        let (u, v) = self.values(uv);
+    pub fn ggx_at(&self, ctx: TextureEvalContext) -> Ggx {
+        let (u, v) = self.values(ctx);
         Ggx::new(u, v, self.remap)
     }
 }

@@ -4,6 +4,7 @@
 //! |---------------|---------------|------------------------------|---------|
 //! | `reflectance` | RGB / texture | what fraction is reflected   | `1`     |
 
+use crate::texture::TextureEvalContext;
 use super::{SurfaceMaterial, reflectance};
 use crate::Rgb;
 use crate::registry::Factory;
@@ -26,9 +27,9 @@ impl SurfaceMaterial for MirrorMaterial {
     type Bxdf = MirrorBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> MirrorBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> MirrorBxdf {
         MirrorBxdf {
-            reflectance: self.reflectance.at(uv),
+            reflectance: self.reflectance.at(ctx),
         }
     }
 

@@ -23,6 +23,7 @@ use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::registry::{self, Factory, Resources};
 use crate::scattering::Bxdf;
+use crate::texture::TextureEvalContext;
 use crate::texture::{Texture, scalar};
 use glam::{Vec2, Vec3};
 
@@ -71,9 +72,9 @@ pub trait SurfaceMaterial {
     /// Its scattering at a point.
     type Bxdf: Bxdf;
 
-    /// The lobe at surface coordinates `uv`, its textures looked up there
-    /// ([`Texture::at`]).
-    fn bxdf(&self, uv: Vec2) -> Self::Bxdf;
+    /// The lobe at `ctx` (the surface's coordinates and mesh attribute), its textures looked
+    /// up there ([`Texture::at`]).
+    fn bxdf(&self, ctx: TextureEvalContext) -> Self::Bxdf;
 
     /// Whether the lobe depends on the surface's texture coordinates or tangent: a texture
     /// that varies, or an anisotropic lobe. Without them the BSDF is built in any frame
@@ -179,11 +180,11 @@ macro_rules! materials {
             /// directions from below (see [`SurfaceMaterial`]); None for the null material,
             /// which does not scatter. Only a blend reads `p` (to choose its component).
             #[inline(always)]
-            pub(crate) fn lobe_at(&self, p: Vec3, uv: Vec2) -> Option<(Lobe, bool)> {
+            pub(crate) fn lobe_at(&self, p: Vec3, ctx: TextureEvalContext) -> Option<(Lobe, bool)> {
                 match self {
-                    $(Material::$variant(m) => Some((Lobe::$variant(m.bxdf(uv)), m.twosided())),)*
+                    $(Material::$variant(m) => Some((Lobe::$variant(m.bxdf(ctx)), m.twosided())),)*
                     Material::Null => None,
-                    Material::Blend(b) => b.lobe_at(p, uv),
+                    Material::Blend(b) => b.lobe_at(p, ctx),
                 }
             }
         }
@@ -329,8 +330,8 @@ pub struct RoughnessTextures {
 impl RoughnessTextures {
     /// The values along u and v at surface coordinates `uv`, before any remapping.
     #[inline]
-    pub fn values(&self, uv: Vec2) -> (f32, f32) {
-        (scalar(self.u.at(uv)), scalar(self.v.at(uv)))
+    pub fn values(&self, ctx: TextureEvalContext) -> (f32, f32) {
+        (scalar(self.u.at(ctx)), scalar(self.v.at(ctx)))
     }
 
     /// The textures' mean values, for what asks of the material as a whole.
@@ -340,8 +341,8 @@ impl RoughnessTextures {
 
     /// The distribution at surface coordinates `uv`, of the kind of `d`.
     #[inline]
-    pub fn at(&self, d: Microfacet, uv: Vec2) -> Microfacet {
-        let (u, v) = self.values(uv);
+    pub fn at(&self, d: Microfacet, ctx: TextureEvalContext) -> Microfacet {
+        let (u, v) = self.values(ctx);
         Microfacet::new(d.kind, self.alpha(u), self.alpha(v))
     }
 

@@ -16,6 +16,7 @@
 //!
 //! Mitsuba 3 has no `phong`; the values are tested against 0.6's formulas.
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use crate::Rgb;
 use crate::error::Result;
@@ -54,11 +55,11 @@ impl SurfaceMaterial for PhongMaterial {
     type Bxdf = PhongBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> PhongBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> PhongBxdf {
         PhongBxdf {
-            diffuse_reflectance: self.diffuse_reflectance.at(uv) * self.scale,
-            specular_reflectance: self.specular_reflectance.at(uv) * self.scale,
-            exponent: channel_mean(self.exponent.at(uv)),
+            diffuse_reflectance: self.diffuse_reflectance.at(ctx) * self.scale,
+            specular_reflectance: self.specular_reflectance.at(ctx) * self.scale,
+            exponent: channel_mean(self.exponent.at(ctx)),
             specular_sampling_weight: self.specular_sampling_weight,
         }
     }

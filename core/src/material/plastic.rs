@@ -9,6 +9,7 @@
 //! | `nonlinear`            | bool          | the base's colour shifts with its internal reflections | `false` |
 //! | `twosided`             | bool          | the same seen from behind                 | `true`   |
 
+use crate::texture::TextureEvalContext;
 use super::{SurfaceMaterial, read_ior, reflectance};
 use crate::Rgb;
 use crate::glossy::Plastic;
@@ -31,10 +32,10 @@ impl SurfaceMaterial for PlasticMaterial {
     type Bxdf = Plastic;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> Plastic {
+    fn bxdf(&self, ctx: TextureEvalContext) -> Plastic {
         Plastic {
-            diffuse_reflectance: self.diffuse_reflectance.at(uv),
-            specular_reflectance: self.specular_reflectance.at(uv),
+            diffuse_reflectance: self.diffuse_reflectance.at(ctx),
+            specular_reflectance: self.specular_reflectance.at(ctx),
             ..self.lobe
         }
     }

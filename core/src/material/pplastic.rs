@@ -16,6 +16,7 @@
 //! microfacet lobe (visible normals) with probability s / (s + d), s and d the mean specular
 //! and diffuse reflectances, the cosine-weighted hemisphere otherwise.
 
+use crate::texture::TextureEvalContext;
 use super::{RoughnessTextures, SurfaceMaterial, read_ior, read_roughness, reflectance};
 use crate::Rgb;
 use crate::microfacet::Microfacet;
@@ -115,14 +116,14 @@ impl SurfaceMaterial for PPlasticMaterial {
     type Bxdf = PPlasticBxdf;
 
     #[inline]
-    fn bxdf(&self, uv: Vec2) -> PPlasticBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> PPlasticBxdf {
         PPlasticBxdf {
             distribution: match &self.roughness {
-                Some(r) => r.at(self.lobe.distribution, uv),
+                Some(r) => r.at(self.lobe.distribution, ctx),
                 None => self.lobe.distribution,
             },
-            diffuse_reflectance: self.diffuse_reflectance.at(uv),
-            specular_reflectance: self.specular_reflectance.at(uv),
+            diffuse_reflectance: self.diffuse_reflectance.at(ctx),
+            specular_reflectance: self.specular_reflectance.at(ctx),
             ..self.lobe
         }
     }

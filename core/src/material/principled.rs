@@ -43,6 +43,7 @@
 //! wherever its terms say (Mitsuba's vectorised variants); Mitsuba's `scalar_rgb` adds it
 //! only where the diffuse lobe is on, which differs when `spec_trans` is 1.
 
+use crate::texture::TextureEvalContext;
 use super::principled_common::{
     Scalar, compatible, diffuse, distribution, fresnel, lerp, read_rate, read_scalar, refract,
     schlick_fresnel, schlick_fresnel_weight, schlick_r0, schlick_weight, sheen_color, tint,
@@ -106,26 +107,26 @@ impl SurfaceMaterial for PrincipledMaterial {
     type Bxdf = PrincipledBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> PrincipledBxdf {
-        let metallic = self.metallic.at(uv);
-        let spec_trans = self.spec_trans.at(uv);
-        let clearcoat = self.clearcoat.at(uv);
+    fn bxdf(&self, ctx: TextureEvalContext) -> PrincipledBxdf {
+        let metallic = self.metallic.at(ctx);
+        let spec_trans = self.spec_trans.at(ctx);
+        let clearcoat = self.clearcoat.at(ctx);
         let p_diffuse = (1.0 - metallic) * (1.0 - spec_trans) * self.diffuse_rate;
         let p_clearcoat = 0.25 * clearcoat * self.clearcoat_rate;
         let total = p_diffuse + p_clearcoat + self.specular_rate;
         let norm = if total > 0.0 { 1.0 / total } else { 0.0 };
         PrincipledBxdf {
-            base_color: self.base_color.at(uv),
-            roughness: self.roughness.at(uv),
-            anisotropic: self.anisotropic.at(uv),
+            base_color: self.base_color.at(ctx),
+            roughness: self.roughness.at(ctx),
+            anisotropic: self.anisotropic.at(ctx),
             metallic,
             spec_trans,
-            spec_tint: self.spec_tint.at(uv),
-            sheen: self.sheen.at(uv),
-            sheen_tint: self.sheen_tint.at(uv),
-            flatness: self.flatness.at(uv),
+            spec_tint: self.spec_tint.at(ctx),
+            sheen: self.sheen.at(ctx),
+            sheen_tint: self.sheen_tint.at(ctx),
+            flatness: self.flatness.at(ctx),
             clearcoat,
-            clearcoat_alpha: lerp(0.1, 0.001, self.clearcoat_gloss.at(uv)),
+            clearcoat_alpha: lerp(0.1, 0.001, self.clearcoat_gloss.at(ctx)),
             eta: self.eta,
             p_diffuse: p_diffuse * norm,
             p_specular: self.specular_rate * norm,

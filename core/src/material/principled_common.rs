@@ -9,9 +9,10 @@ use crate::error::Result;
 use crate::microfacet::{Microfacet, MicrofacetKind};
 use crate::props::Properties;
 use crate::registry::Resources;
+use crate::texture::TextureEvalContext;
 use crate::texture::{Texture, luminance};
 use crate::value::Value;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// A number that may vary over the surface: a constant, or a texture read as its luminance
 /// (Mitsuba's `eval_1` of an RGB bitmap).
@@ -24,10 +25,10 @@ pub enum Scalar {
 impl Scalar {
     /// The value at surface coordinates `uv`.
     #[inline(always)]
-    pub fn at(&self, uv: Vec2) -> f32 {
+    pub fn at(&self, ctx: TextureEvalContext) -> f32 {
         match self {
             Scalar::Constant(x) => *x,
-            Scalar::Texture(t) => luminance(t.eval(uv)),
+            Scalar::Texture(t) => luminance(t.eval(ctx)),
         }
     }
 

@@ -34,6 +34,7 @@
 //! lobe is black, which makes it non-reciprocal over part of the sphere (the light's and the
 //! viewer's directions swapped give different values there).
 
+use crate::texture::TextureEvalContext;
 use super::principled_common::{
     Scalar, compatible, diffuse, distribution, fresnel, read_rate, read_scalar, schlick_fresnel,
     schlick_r0, schlick_weight, sheen_color, tint,
@@ -90,9 +91,9 @@ impl SurfaceMaterial for PrincipledThinMaterial {
     type Bxdf = PrincipledThinBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> PrincipledThinBxdf {
-        let spec_trans = self.spec_trans.at(uv);
-        let diff_trans = self.diff_trans.at(uv) / 2.0;
+    fn bxdf(&self, ctx: TextureEvalContext) -> PrincipledThinBxdf {
+        let spec_trans = self.spec_trans.at(ctx);
+        let diff_trans = self.diff_trans.at(ctx) / 2.0;
         let r = self.rates;
         let mut p = [
             spec_trans * r[0] / 2.0,
@@ -106,15 +107,15 @@ impl SurfaceMaterial for PrincipledThinMaterial {
             *x *= norm;
         }
         PrincipledThinBxdf {
-            base_color: self.base_color.at(uv),
-            roughness: self.roughness.at(uv),
-            anisotropic: self.anisotropic.at(uv),
+            base_color: self.base_color.at(ctx),
+            roughness: self.roughness.at(ctx),
+            anisotropic: self.anisotropic.at(ctx),
             spec_trans,
-            eta: self.eta.at(uv),
-            spec_tint: self.spec_tint.at(uv),
-            sheen: self.sheen.at(uv),
-            sheen_tint: self.sheen_tint.at(uv),
-            flatness: self.flatness.at(uv),
+            eta: self.eta.at(ctx),
+            spec_tint: self.spec_tint.at(ctx),
+            sheen: self.sheen.at(ctx),
+            sheen_tint: self.sheen_tint.at(ctx),
+            flatness: self.flatness.at(ctx),
             diff_trans,
             p,
         }

@@ -10,6 +10,7 @@
 //! | `specular_reflectance` | RGB / texture | scales the reflection                    | `1`            |
 //! | `twosided`             | bool          | the same seen from behind                | `true`         |
 
+use crate::texture::TextureEvalContext;
 use super::conductor::read_conductor_ior;
 use super::{RoughnessTextures, SurfaceMaterial, read_roughness};
 use crate::Rgb;
@@ -33,13 +34,13 @@ impl SurfaceMaterial for RoughConductorMaterial {
     type Bxdf = RoughConductor;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> RoughConductor {
+    fn bxdf(&self, ctx: TextureEvalContext) -> RoughConductor {
         let distribution = match &self.roughness {
-            Some(r) => r.at(self.lobe.distribution, uv),
+            Some(r) => r.at(self.lobe.distribution, ctx),
             None => self.lobe.distribution,
         };
         RoughConductor {
-            specular_reflectance: self.specular_reflectance.at(uv),
+            specular_reflectance: self.specular_reflectance.at(ctx),
             distribution,
             ..self.lobe
         }

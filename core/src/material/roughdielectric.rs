@@ -11,6 +11,7 @@
 //! | `specular_reflectance`   | RGB / texture | scales the reflection                  | `1`        |
 //! | `specular_transmittance` | RGB / texture | scales the refraction                  | `1`        |
 
+use crate::texture::TextureEvalContext;
 use super::{RoughnessTextures, SurfaceMaterial, read_ior, read_roughness};
 use crate::Rgb;
 use crate::glossy::RoughDielectric;
@@ -33,14 +34,14 @@ impl SurfaceMaterial for RoughDielectricMaterial {
     type Bxdf = RoughDielectric;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> RoughDielectric {
+    fn bxdf(&self, ctx: TextureEvalContext) -> RoughDielectric {
         let distribution = match &self.roughness {
-            Some(r) => r.at(self.lobe.distribution, uv),
+            Some(r) => r.at(self.lobe.distribution, ctx),
             None => self.lobe.distribution,
         };
         RoughDielectric {
-            specular_reflectance: self.specular_reflectance.at(uv),
-            specular_transmittance: self.specular_transmittance.at(uv),
+            specular_reflectance: self.specular_reflectance.at(ctx),
+            specular_transmittance: self.specular_transmittance.at(ctx),
             distribution,
             ..self.lobe
         }

@@ -16,6 +16,7 @@
 //!
 //! Mitsuba 3 has no `roughdiffuse`; the values are tested against 0.6's formulas.
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use super::phong::{channel_mean, energy_conserving_scale, scalar_texture};
 use crate::Rgb;
@@ -49,10 +50,10 @@ impl SurfaceMaterial for RoughDiffuseMaterial {
     type Bxdf = RoughDiffuseBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> RoughDiffuseBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> RoughDiffuseBxdf {
         RoughDiffuseBxdf {
-            reflectance: self.reflectance.at(uv) * self.scale,
-            alpha: channel_mean(self.alpha.at(uv)),
+            reflectance: self.reflectance.at(ctx) * self.scale,
+            alpha: channel_mean(self.alpha.at(ctx)),
             fast_approx: self.fast_approx,
         }
     }

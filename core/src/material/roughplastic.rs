@@ -7,6 +7,7 @@
 //! | `distribution` | string | `beckmann` or `ggx`                        | `beckmann` |
 //! | `alpha`        | number | the coat's roughness (isotropic)           | `0.1`      |
 
+use crate::texture::TextureEvalContext;
 use super::plastic::read_coated;
 use super::{SurfaceMaterial, read_microfacet};
 use crate::Rgb;
@@ -29,10 +30,10 @@ impl SurfaceMaterial for RoughPlasticMaterial {
     type Bxdf = RoughPlastic;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> RoughPlastic {
+    fn bxdf(&self, ctx: TextureEvalContext) -> RoughPlastic {
         let mut l = self.lobe;
-        l.diffuse_reflectance = self.diffuse_reflectance.at(uv);
-        l.specular_reflectance = self.specular_reflectance.at(uv);
+        l.diffuse_reflectance = self.diffuse_reflectance.at(ctx);
+        l.specular_reflectance = self.specular_reflectance.at(ctx);
         l
     }
 

@@ -8,6 +8,7 @@
 //! | `specular_reflectance`   | RGB / texture | scales the reflection (Mitsuba's)   | `1`     |
 //! | `specular_transmittance` | RGB / texture | scales the transmission (Mitsuba's) | `1`     |
 
+use crate::texture::TextureEvalContext;
 use super::mirror::{delta_sample, reflect_local};
 use super::{SurfaceMaterial, read_ior};
 use crate::Rgb;
@@ -37,11 +38,11 @@ impl SurfaceMaterial for ThinDielectricMaterial {
     type Bxdf = ThinDielectricBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> ThinDielectricBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> ThinDielectricBxdf {
         ThinDielectricBxdf {
             ior: self.ior,
-            specular_reflectance: self.specular_reflectance.at(uv),
-            specular_transmittance: self.specular_transmittance.at(uv),
+            specular_reflectance: self.specular_reflectance.at(ctx),
+            specular_transmittance: self.specular_transmittance.at(ctx),
         }
     }
 

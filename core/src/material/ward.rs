@@ -24,6 +24,7 @@
 //!
 //! Mitsuba 3 has no `ward`; the values are tested against 0.6's formulas.
 
+use crate::texture::TextureEvalContext;
 use super::SurfaceMaterial;
 use super::phong::{
     channel_mean, energy_conserving_scale, scalar_texture, specular_sampling_weight,
@@ -75,13 +76,13 @@ impl SurfaceMaterial for WardMaterial {
     type Bxdf = WardBxdf;
 
     #[inline(always)]
-    fn bxdf(&self, uv: Vec2) -> WardBxdf {
+    fn bxdf(&self, ctx: TextureEvalContext) -> WardBxdf {
         WardBxdf {
             variant: self.variant,
-            alpha_u: channel_mean(self.alpha_u.at(uv)),
-            alpha_v: channel_mean(self.alpha_v.at(uv)),
-            diffuse_reflectance: self.diffuse_reflectance.at(uv) * self.scale,
-            specular_reflectance: self.specular_reflectance.at(uv) * self.scale,
+            alpha_u: channel_mean(self.alpha_u.at(ctx)),
+            alpha_v: channel_mean(self.alpha_v.at(ctx)),
+            diffuse_reflectance: self.diffuse_reflectance.at(ctx) * self.scale,
+            specular_reflectance: self.specular_reflectance.at(ctx) * self.scale,
             specular_sampling_weight: self.specular_sampling_weight,
         }
     }
@@ -208,6 +209,12 @@ fn roughness(
             .fold(f32::INFINITY, f32::min),
         Texture::Checkerboard { color0, color1, .. } => {
             channel_mean(*color0).min(channel_mean(*color1))
+        }
+        Texture::MeshAttribute { .. } => {
+            return Err(m.error(
+                key,
+                "a mesh attribute cannot give the roughness, which must be positive everywhere",
+            ));
         }
     };
     if least <= 0.0 || least.is_nan() {

@@ -51,7 +51,7 @@ impl Scene {
         };
         let a = match alpha {
             Texture::Constant(c) => scalar(*c),
-            t => scalar(t.eval(self.surface(hit).uv)),
+            t => scalar(t.eval(self.surface(hit).texture_ctx())),
         };
         if a >= 1.0 {
             false

@@ -157,6 +157,9 @@ pub struct Scene {
     pub(crate) accel: Accel,
     /// Vertex normals and texture coordinates of mesh triangles (`Primitive::attrs`).
     pub(crate) triangle_attrs: Vec<TriangleAttrs>,
+    /// The mesh attribute of each triangle's corners, indexed as `triangle_attrs` (empty when
+    /// no material reads one; zero for triangles of meshes that carry none).
+    pub(crate) triangle_attributes: Vec<[Rgb; 3]>,
     /// The medium filling free space, if any.
     pub(crate) medium: Option<u32>,
     /// Per object: its medium interface if it bounds a volume (see [`MediumInterface`]); all
@@ -210,6 +213,8 @@ pub struct SceneParts {
     pub objects: Vec<Object>,
     pub primitives: Vec<Primitive>,
     pub triangle_attrs: Vec<TriangleAttrs>,
+    /// The mesh attribute at each triangle's corners, as [`Scene`] keeps it.
+    pub triangle_attributes: Vec<[Rgb; 3]>,
     pub lights: Vec<Light>,
     /// Per light: the medium the file puts it in (None: found from where it lies).
     pub light_media: Vec<Option<Option<u32>>>,
@@ -238,6 +243,7 @@ impl Scene {
             objects,
             primitives: prims,
             triangle_attrs,
+            triangle_attributes,
             mut lights,
             light_media,
             medium,
@@ -330,6 +336,7 @@ impl Scene {
             environment,
             accel,
             triangle_attrs,
+            triangle_attributes,
             medium,
             interfaces,
             volumes,
@@ -462,7 +469,9 @@ impl Scene {
     fn surface_point(&self, hit: &Hit, coordinates: bool) -> SurfacePoint {
         let prim = self.primitive(hit);
         let attrs = self.triangle_attrs.get(prim.attrs as usize);
-        prim.shape.surface_at(hit.p, hit.ng, attrs, coordinates)
+        let attribute = self.triangle_attributes.get(prim.attrs as usize);
+        prim.shape
+            .surface_at(hit.p, hit.ng, attrs, attribute, coordinates)
     }
 
     /// The BSDF at a hit (None on a null boundary, which does not scatter).
@@ -519,7 +528,12 @@ impl Scene {
         if !coordinates && flat {
             return material.flat_bsdf(hit.ng);
         }
-        material.bsdf(&prim.shape.surface_at(hit.p, hit.ng, attrs, coordinates))
+        let attribute = self.triangle_attributes.get(prim.attrs as usize);
+        material.bsdf(
+            &prim
+                .shape
+                .surface_at(hit.p, hit.ng, attrs, attribute, coordinates),
+        )
     }
 
     /// The area light a hit lies on, if its object emits.
@@ -592,7 +606,7 @@ impl Scene {
 /// point's shading frame (Mitsuba 3's `normalmap`, pbrt-v4's `NormalMap`), turned to the
 /// geometric normal's side; the surface's own where the map gives no direction.
 fn normal_mapped(sp: &SurfacePoint, map: &Texture) -> Vec3 {
-    let local = 2.0 * map.eval(sp.uv) - Vec3::ONE;
+    let local = 2.0 * map.eval(sp.texture_ctx()) - Vec3::ONE;
     let n = Frame::from_normal_tangent(sp.ns, sp.dpdu)
         .to_world(local)
         .normalize_or_zero();

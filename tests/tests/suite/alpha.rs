@@ -263,7 +263,7 @@ fn mitsubas_mask_is_a_cut_out() {
         let scene = foton_loader::load(&file, &[]).unwrap();
         let alpha = scene.objects()[1].alpha.as_ref().expect("a cut-out");
         // uv (0.25, 0.25) lies in the check of color0.
-        let a = alpha.eval(glam::Vec2::splat(0.25)).x;
+        let a = alpha.eval(glam::Vec2::splat(0.25).into()).x;
         assert_eq!(a == 1.0, opaque_first, "{version}: alpha {a}");
     }
     // On an emitter: refused, or (lenient) the mask left out.

@@ -67,6 +67,7 @@ fn albedo_at(m: &Material, p: Vec3, uv: Vec2) -> f32 {
         uv,
         dpdu: Vec3::ZERO,
         dpdv: Vec3::ZERO,
+        attribute: Vec3::ZERO,
     };
     match m.bsdf(&sp).expect("a blend scatters").lobe {
         Lobe::Diffuse(d) => d.reflectance.x,
@@ -240,9 +241,9 @@ fn mitsuba_blendbsdf_and_mixturebsdf_are_read_as_blends() {
     let BlendWeights::Blend(w) = &b.weights else {
         panic!("{:?}", b.weights)
     };
-    assert_eq!(w.at(Vec2::ZERO), Vec3::splat(0.3));
+    assert_eq!(w.at(Vec2::ZERO.into()), Vec3::splat(0.3));
     let rho = |m: &Material| match m {
-        Material::Diffuse(d) => (d.reflectance.at(Vec2::ZERO).x, d.twosided),
+        Material::Diffuse(d) => (d.reflectance.at(Vec2::ZERO.into()).x, d.twosided),
         other => panic!("{other:?}"),
     };
     assert_eq!(rho(&b.components[0]), (0.2, false));

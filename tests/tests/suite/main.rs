@@ -43,6 +43,7 @@ mod materials_classic;
 mod media;
 mod media_sides;
 mod medium_kind;
+mod mesh_attribute;
 mod meters;
 mod mitsuba;
 mod mitsuba05;

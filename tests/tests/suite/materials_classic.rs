@@ -74,21 +74,21 @@ fn rgb(c: [f64; 3]) -> Value {
 
 fn phong(entries: &[(&str, Value)]) -> PhongBxdf {
     match material("phong", entries) {
-        Material::Phong(m) => m.bxdf(Vec2::ZERO),
+        Material::Phong(m) => m.bxdf(Vec2::ZERO.into()),
         m => panic!("{m:?}"),
     }
 }
 
 fn ward(entries: &[(&str, Value)]) -> WardBxdf {
     match material("ward", entries) {
-        Material::Ward(m) => m.bxdf(Vec2::ZERO),
+        Material::Ward(m) => m.bxdf(Vec2::ZERO.into()),
         m => panic!("{m:?}"),
     }
 }
 
 fn roughdiffuse(entries: &[(&str, Value)]) -> RoughDiffuseBxdf {
     match material("roughdiffuse", entries) {
-        Material::RoughDiffuse(m) => m.bxdf(Vec2::ZERO),
+        Material::RoughDiffuse(m) => m.bxdf(Vec2::ZERO.into()),
         m => panic!("{m:?}"),
     }
 }
@@ -526,6 +526,7 @@ fn the_classic_lobes_are_one_sided_unless_twosided() {
         uv: Vec2::ZERO,
         dpdu: Vec3::X,
         dpdv: Vec3::Y,
+        attribute: Vec3::ZERO,
     };
     let (wo, wi) = (dir(30.0, 0.0), dir(35.0, 170.0));
     let flip = |w: Vec3| Vec3::new(w.x, w.y, -w.z);
@@ -989,11 +990,11 @@ fn dielectric_factors_scale_reflection_and_transmission_only() {
         );
         let (got_r, got_t) = match m {
             Material::Dielectric(m) => {
-                let b = m.bxdf(Vec2::ZERO);
+                let b = m.bxdf(Vec2::ZERO.into());
                 (b.specular_reflectance, b.specular_transmittance)
             }
             Material::ThinDielectric(m) => {
-                let b = m.bxdf(Vec2::ZERO);
+                let b = m.bxdf(Vec2::ZERO.into());
                 (b.specular_reflectance, b.specular_transmittance)
             }
             m => panic!("{m:?}"),
@@ -1008,7 +1009,7 @@ fn dielectric_factors_scale_reflection_and_transmission_only() {
 
 fn difftrans(entries: &[(&str, Value)]) -> foton_core::material::difftrans::DiffTransBxdf {
     match material("difftrans", entries) {
-        Material::DiffTrans(m) => m.bxdf(Vec2::ZERO),
+        Material::DiffTrans(m) => m.bxdf(Vec2::ZERO.into()),
         m => panic!("{m:?}"),
     }
 }

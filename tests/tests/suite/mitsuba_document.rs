@@ -556,12 +556,12 @@ fn bitmap_filter_and_wrap_modes() {
     // A texture left out (--lenient) leaves out what takes it by reference, which says so.
     let dropped = format!(
         r#"{SENSOR}
-<texture type="mesh_attribute" id="tex"><string name="name" value="vertex_color"/></texture>
+<texture type="volume" id="tex"><float name="volume" value="0.5"/></texture>
 <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="tex"/></bsdf></shape>"#
     );
     let xml = write(&dir, "scene.xml", &scene("3.0.0", &dropped));
     let e = read(&xml, false).unwrap_err();
-    assert!(e.contains("mesh_attribute"), "{e}");
+    assert!(e.contains("volume"), "{e}");
     let (doc, report) = read(&xml, true).unwrap();
     assert!(doc.root.get("shapes").is_none());
     assert!(

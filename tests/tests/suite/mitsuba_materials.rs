@@ -88,7 +88,7 @@ fn glossy_materials_and_shapes_read_as_mitsuba_means_them() {
     };
     assert!(!*twosided && lobe.nonlinear);
     assert_eq!(
-        diffuse_reflectance.eval(glam::Vec2::ZERO),
+        diffuse_reflectance.eval(glam::Vec2::ZERO.into()),
         foton_core::Rgb::new(0.1, 0.2, 0.3)
     );
     assert!((lobe.eta - 1.49 / 1.000277).abs() < 1e-6);
@@ -312,7 +312,7 @@ fn dielectric_factors_and_difftrans_read_as_mitsuba_means_them() {
     let Material::Dielectric(m) = material(0) else {
         panic!("{:?}", material(0))
     };
-    let b = m.bxdf(glam::Vec2::ZERO);
+    let b = m.bxdf(glam::Vec2::ZERO.into());
     assert_eq!(
         (b.specular_reflectance, b.specular_transmittance),
         (Rgb::splat(0.5), Rgb::ONE)
@@ -322,16 +322,19 @@ fn dielectric_factors_and_difftrans_read_as_mitsuba_means_them() {
         panic!("{:?}", material(1))
     };
     assert!(m.needs_coordinates());
-    assert_eq!(m.bxdf(glam::Vec2::ZERO).specular_reflectance, Rgb::ONE);
+    assert_eq!(
+        m.bxdf(glam::Vec2::ZERO.into()).specular_reflectance,
+        Rgb::ONE
+    );
     let ts: Vec<Rgb> = [(0.25, 0.25), (0.75, 0.25)]
-        .map(|(u, v)| m.bxdf(glam::Vec2::new(u, v)).specular_transmittance)
+        .map(|(u, v)| m.bxdf(glam::Vec2::new(u, v).into()).specular_transmittance)
         .into();
     assert!(
         ts.contains(&Rgb::splat(0.2)) && ts.contains(&Rgb::splat(0.6)),
         "{ts:?}"
     );
     let transmittance = |i: usize| match material(i) {
-        Material::DiffTrans(m) => m.bxdf(glam::Vec2::ZERO).transmittance,
+        Material::DiffTrans(m) => m.bxdf(glam::Vec2::ZERO.into()).transmittance,
         m => panic!("{m:?}"),
     };
     assert_eq!(transmittance(2), Rgb::new(0.1, 0.2, 0.3));
@@ -356,7 +359,10 @@ fn dielectric_factors_and_difftrans_read_as_mitsuba_means_them() {
     else {
         panic!()
     };
-    assert_eq!(m.bxdf(glam::Vec2::ZERO).transmittance, Rgb::splat(0.25));
+    assert_eq!(
+        m.bxdf(glam::Vec2::ZERO.into()).transmittance,
+        Rgb::splat(0.25)
+    );
 }
 
 /// Mitsuba 0.6's bitmap `gamma` (1 linear, -1 sRGB, another a power law) and its `scale`
@@ -409,7 +415,7 @@ fn mitsuba_06_bitmap_gamma_and_scale_textures() {
             .materials()
             .iter()
             .find_map(|m| match &m.value {
-                Material::Diffuse(d) => Some(d.reflectance.eval(glam::Vec2::new(0.3, 0.3))),
+                Material::Diffuse(d) => Some(d.reflectance.eval(glam::Vec2::new(0.3, 0.3).into())),
                 _ => None,
             })
             .unwrap();

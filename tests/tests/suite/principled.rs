@@ -52,6 +52,7 @@ fn lobe(material: &Material) -> Lobe {
         uv: Vec2::new(0.3, 0.6),
         dpdu: Vec3::X,
         dpdv: Vec3::Y,
+        attribute: Vec3::ZERO,
     };
     material.bsdf(&sp).expect("a material that scatters").lobe
 }
@@ -439,15 +440,21 @@ fn mitsuba_files_with_principled_materials_open() {
         panic!("{:?}", material(0))
     };
     let at = |u: f32, v: f32| Vec2::new(u, v);
-    assert_eq!(a.base_color.eval(at(0.0, 0.0)), Rgb::new(0.8, 0.3, 0.2));
-    // The raw bitmap's texels (nearest to the texel centres): 1 and 0.
-    assert!((a.roughness.at(at(0.25, 0.25)) - 1.0).abs() < 1e-6);
-    assert!(a.roughness.at(at(0.75, 0.25)).abs() < 1e-6);
     assert_eq!(
-        (a.metallic.at(at(0.0, 0.0)), a.anisotropic.at(at(0.0, 0.0))),
+        a.base_color.eval(at(0.0, 0.0).into()),
+        Rgb::new(0.8, 0.3, 0.2)
+    );
+    // The raw bitmap's texels (nearest to the texel centres): 1 and 0.
+    assert!((a.roughness.at(at(0.25, 0.25).into()) - 1.0).abs() < 1e-6);
+    assert!(a.roughness.at(at(0.75, 0.25).into()).abs() < 1e-6);
+    assert_eq!(
+        (
+            a.metallic.at(at(0.0, 0.0).into()),
+            a.anisotropic.at(at(0.0, 0.0).into())
+        ),
         (0.3, 0.5)
     );
-    assert_eq!(a.clearcoat_gloss.at(at(0.0, 0.0)), 0.3);
+    assert_eq!(a.clearcoat_gloss.at(at(0.0, 0.0).into()), 0.3);
     // specular 0.6: eta = 2 / (1 - sqrt(0.08 x 0.6)) - 1.
     let eta = 2.0 / (1.0 - (0.08f32 * 0.6).sqrt()) - 1.0;
     assert!((a.eta - eta).abs() < 1e-6, "{}", a.eta);
@@ -473,14 +480,14 @@ fn mitsuba_files_with_principled_materials_open() {
     else {
         panic!("{:?}", material(2))
     };
-    let (e0, e1) = (eta.at(at(0.25, 0.25)), eta.at(at(0.75, 0.25)));
+    let (e0, e1) = (eta.at(at(0.25, 0.25).into()), eta.at(at(0.75, 0.25).into()));
     assert!(
         [(e0, e1), (e1, e0)]
             .iter()
             .any(|&(x, y)| (x - 1.2).abs() < 1e-6 && (y - 1.6).abs() < 1e-6),
         "{e0} {e1}"
     );
-    assert_eq!(diff_trans.at(at(0.0, 0.0)), 1.5);
+    assert_eq!(diff_trans.at(at(0.0, 0.0).into()), 1.5);
     assert_eq!(*rates, [1.0, 1.0, 1.0, 0.5]);
     // The converted TOML renders the same image.
     let toml = dir.join("scene.toml");

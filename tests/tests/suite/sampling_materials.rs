@@ -29,6 +29,7 @@ fn flat(mat: &Material, ng: Vec3) -> Bsdf {
         uv: glam::Vec2::ZERO,
         dpdu: Vec3::ZERO,
         dpdv: Vec3::ZERO,
+        attribute: Vec3::ZERO,
     };
     mat.bsdf(&sp).expect("a material that scatters")
 }

@@ -75,6 +75,9 @@ pub(super) struct Geometry {
     pub(super) objects: Vec<Object>,
     pub(super) primitives: Vec<Primitive>,
     pub(super) triangle_attrs: Vec<TriangleAttrs>,
+    /// The mesh attribute at each triangle's corners, aligned with `triangle_attrs` up to the
+    /// last mesh that carries one (empty if none does).
+    pub(super) triangle_attributes: Vec<[Rgb; 3]>,
     pub(super) lights: Vec<Light>,
     /// Per light: the medium the file puts it in (None: found from where it lies).
     pub(super) light_media: Vec<Option<Option<u32>>>,

@@ -146,6 +146,13 @@ pub fn from_document(doc: Document) -> Result<Scene> {
         media,
         objects: geometry.objects,
         primitives: geometry.primitives,
+        triangle_attributes: {
+            let mut a = geometry.triangle_attributes;
+            if !a.is_empty() {
+                a.resize(geometry.triangle_attrs.len(), [glam::Vec3::ZERO; 3]);
+            }
+            a
+        },
         triangle_attrs: geometry.triangle_attrs,
         lights: geometry.lights,
         light_media: geometry.light_media,

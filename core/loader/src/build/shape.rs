@@ -40,6 +40,16 @@ pub(super) fn read_shapes(
         let mut closed = ty == "sphere";
         let flip = s.bool("flip_normals", false)?;
         let mut attrs = Vec::new();
+        let mut attribute = Vec::new();
+        let attribute_name = mesh_attribute_of(root, &s)?;
+        if let Some(name) = &attribute_name
+            && ty != "mesh"
+        {
+            return Err(s.error(
+                "material",
+                format!("the material reads the mesh attribute `{name}`, which only a mesh carries (this shape is a {ty})"),
+            ));
+        }
         let mut shapes = match ty {
             "sphere" => {
                 let center = s.vec3_required("center")?;
@@ -120,7 +130,7 @@ pub(super) fn read_shapes(
                 } else {
                     let file = s.string_required("file")?;
                     let path = ld.dir.join(file);
-                    let mesh = load_mesh(&s, &path, transform, options)?;
+                    let mesh = load_mesh(&s, &path, transform, options, attribute_name.as_deref())?;
                     ld.sources.push(path);
                     mesh
                 };
@@ -137,6 +147,7 @@ pub(super) fn read_shapes(
                         });
                 closed = may_bound && mesh.closed();
                 attrs = mesh.attrs;
+                attribute = mesh.attribute;
                 mesh.triangles
             }
             other => {
@@ -231,6 +242,12 @@ pub(super) fn read_shapes(
         } else {
             None
         };
+        if let Some(name) = emission.as_ref().and_then(Texture::mesh_attribute) {
+            return Err(s.error(
+                "emission",
+                format!("the mesh attribute `{name}` as emitted radiance is not supported yet"),
+            ));
+        }
         if let Some(emission) = emission
             && emission.max().max_element() > 0.0
         {
@@ -270,6 +287,12 @@ pub(super) fn read_shapes(
         let first_attrs = g.triangle_attrs.len() as u32;
         let with_attrs = !attrs.is_empty();
         g.triangle_attrs.extend(attrs);
+        if !attribute.is_empty() {
+            // Aligned with `triangle_attrs`: zero for the triangles of meshes without one.
+            g.triangle_attributes
+                .resize(first_attrs as usize, [Vec3::ZERO; 3]);
+            g.triangle_attributes.extend(attribute);
+        }
         g.primitives
             .extend(shapes.into_iter().enumerate().map(|(i, shape)| Primitive {
                 shape,
@@ -283,6 +306,55 @@ pub(super) fn read_shapes(
         ld.done(&s);
     }
     Ok(())
+}
+
+/// The name of the mesh attribute that shape `s` reads (a `mesh_attribute` texture anywhere in
+/// its material's table under `[materials]`, or as its `alpha`), if any; a shape may read one.
+fn mesh_attribute_of(root: &Properties<'_>, s: &Properties<'_>) -> Result<Option<String>> {
+    fn scan(v: &Value, names: &mut Vec<String>) {
+        match v {
+            Value::Table(t) => {
+                let is_attribute = t
+                    .get("type")
+                    .is_some_and(|n| matches!(&n.value, Value::Str(ty) if ty == "mesh_attribute"));
+                if is_attribute
+                    && let Some(Value::Str(name)) = t.get("name").map(|n| &n.value)
+                    && !names.contains(name)
+                {
+                    names.push(name.clone());
+                }
+                for key in t.keys() {
+                    if let Some(n) = t.get(key) {
+                        scan(&n.value, names);
+                    }
+                }
+            }
+            Value::Array(items) => items.iter().for_each(|n| scan(&n.value, names)),
+            _ => {}
+        }
+    }
+    let mut names = Vec::new();
+    if let Some(alpha) = s.node("alpha") {
+        scan(&alpha.value, &mut names);
+    }
+    if let (Some(Value::Str(material)), Some(Value::Table(materials))) = (
+        s.node("material").map(|n| &n.value),
+        root.node("materials").map(|n| &n.value),
+    ) && let Some(m) = materials.get(material)
+    {
+        scan(&m.value, &mut names);
+    }
+    match names.len() {
+        0 => Ok(None),
+        1 => Ok(names.pop()),
+        _ => Err(s.error(
+            "material",
+            format!(
+                "the shape's material and alpha read the mesh attributes {}: foton carries one per shape",
+                names.join(" and ")
+            ),
+        )),
+    }
 }
 
 /// The shape's `alpha`: a number in [0, 1], an RGB or a texture table (its luminance); None

@@ -39,6 +39,9 @@ pub struct MeshOptions {
 pub struct Mesh {
     pub triangles: Vec<Shape>,
     pub attrs: Vec<TriangleAttrs>,
+    /// The mesh attribute at each triangle's corners (empty, or one per triangle), if the
+    /// scene asked for one.
+    pub attribute: Vec<[Vec3; 3]>,
     /// The triangles' corners as the file gives them (after the transform): closedness
     /// compares positions bit for bit, which corners rebuilt from `triangles` would not keep.
     pub corners: Vec<[Vec3; 3]>,
@@ -56,12 +59,14 @@ impl Mesh {
 }
 
 /// The mesh file `path` of shape `s` in the scene: OBJ or PLY by its extension, Mitsuba
-/// serialized by its extension or its first bytes (mesh number `shape_index` of `s`, default 0).
+/// serialized by its extension or its first bytes (mesh number `shape_index` of `s`, default 0),
+/// with the mesh attribute named `attribute` (which only a PLY file carries).
 pub(super) fn load_mesh(
     s: &Properties<'_>,
     path: &Path,
     transform: Mat4,
     options: MeshOptions,
+    attribute: Option<&str>,
 ) -> Result<Mesh> {
     let fail = |message: String| s.error("file", format!("{}: {message}", path.display()));
     let extension = path
@@ -99,6 +104,20 @@ pub(super) fn load_mesh(
                 bytes = plain;
             }
             let mut raw = ply::parse(&bytes).map_err(fail)?;
+            if let Some(name) = attribute {
+                raw.attribute = ply::attribute(&bytes, name).map_err(fail)?;
+                if raw.attribute.is_none() {
+                    let names = ply::attribute_names(&bytes);
+                    return Err(fail(format!(
+                        "the material reads the mesh attribute `{name}`, which the file does not have ({})",
+                        if names.is_empty() {
+                            "it has none".to_string()
+                        } else {
+                            format!("it has {}", names.join(", "))
+                        }
+                    )));
+                }
+            }
             // A PLY's texture coordinates are flipped only when the scene says so (Mitsuba 3's
             // default for PLY, unlike OBJ).
             if options.flip_tex_coords && s.has("flip_tex_coords") {
@@ -123,6 +142,11 @@ pub(super) fn load_mesh(
             serialized::parse(&bytes, s.u32("shape_index", 0)?).map_err(fail)?
         }
     };
+    if let (Some(name), None) = (attribute, &raw.attribute) {
+        return Err(fail(format!(
+            "the material reads the mesh attribute `{name}`: foton reads mesh attributes from PLY files only"
+        )));
+    }
     let options = MeshOptions {
         face_normals: if s.has("face_normals") {
             options.face_normals
@@ -363,8 +387,23 @@ fn triangles(
     };
     let smooth = !normals.is_empty();
     let textured = !raw.uv_triangles.is_empty();
+    let attribute = raw.attribute.as_ref();
+    if let Some(a) = attribute {
+        let expected = if a.per_face {
+            raw.triangles.len()
+        } else {
+            raw.positions.len()
+        };
+        if a.values.len() != expected {
+            return Err(format!(
+                "the mesh attribute has {} values for {expected} {}",
+                a.values.len(),
+                if a.per_face { "triangles" } else { "vertices" }
+            ));
+        }
+    }
     // Face f in the scene: None if it has zero area.
-    type Face = Option<(Shape, [Vec3; 3], TriangleAttrs)>;
+    type Face = Option<(Shape, [Vec3; 3], TriangleAttrs, [Vec3; 3])>;
     let face = |f: usize| -> std::result::Result<Face, String> {
         let mut v = [Vec3::ZERO; 3];
         for (slot, &i) in v.iter_mut().zip(&raw.triangles[f]) {
@@ -389,8 +428,17 @@ fn triangles(
             }
             a.uvs = Some(t);
         }
+        let mut c = [Vec3::ZERO; 3];
+        if let Some(at) = attribute {
+            c = if at.per_face {
+                [at.values[f]; 3]
+            } else {
+                raw.triangles[f].map(|i| at.values[i as usize])
+            };
+        }
         if swap {
             v.swap(1, 2);
+            c.swap(1, 2);
             if let Some(n) = &mut a.normals {
                 n.swap(1, 2);
             }
@@ -406,25 +454,39 @@ fn triangles(
             Shape::Triangle { p0: v[0], e1, e2 },
             v,
             a,
+            c,
         )))
     };
     // In chunks on every thread, each into its own arrays, kept in order; the first bad face
     // (in file order) is the one reported.
     const CHUNK: usize = 1 << 14;
-    type Part = (Vec<Shape>, Vec<[Vec3; 3]>, Vec<TriangleAttrs>);
+    type Part = (
+        Vec<Shape>,
+        Vec<[Vec3; 3]>,
+        Vec<TriangleAttrs>,
+        Vec<[Vec3; 3]>,
+    );
     let parts: Vec<std::result::Result<Part, String>> = (0..raw.triangles.len())
         .into_par_iter()
         .step_by(CHUNK)
         .map(|start| {
             let end = (start + CHUNK).min(raw.triangles.len());
-            let mut part: Part = (Vec::with_capacity(end - start), Vec::new(), Vec::new());
+            let mut part: Part = (
+                Vec::with_capacity(end - start),
+                Vec::new(),
+                Vec::new(),
+                Vec::new(),
+            );
             part.1.reserve(end - start);
             for f in start..end {
-                if let Some((shape, v, a)) = face(f)? {
+                if let Some((shape, v, a, c)) = face(f)? {
                     part.0.push(shape);
                     part.1.push(v);
-                    if smooth || textured {
+                    if smooth || textured || attribute.is_some() {
                         part.2.push(a);
+                    }
+                    if attribute.is_some() {
+                        part.3.push(c);
                     }
                 }
             }
@@ -433,17 +495,20 @@ fn triangles(
         .collect();
     let mut tris = Vec::with_capacity(raw.triangles.len());
     let mut attrs = Vec::new();
+    let mut values = Vec::new();
     let mut corners = Vec::with_capacity(raw.triangles.len());
     for part in parts {
-        let (t, c, a) = part?;
+        let (t, c, a, v) = part?;
         tris.extend(t);
         corners.extend(c);
         attrs.extend(a);
+        values.extend(v);
     }
     Ok(Mesh {
         dropped: raw.triangles.len() - tris.len(),
         triangles: tris,
         attrs,
+        attribute: values,
         corners,
     })
 }

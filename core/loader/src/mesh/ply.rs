@@ -1,7 +1,8 @@
 //! Stanford PLY meshes (ascii, binary little- and big-endian): vertex positions and faces.
 //!
-//! Only `x y z` of the vertices and the `vertex_indices` (or `vertex_index`) list of the faces
-//! are read; every other property and element is read past. Polygons are fan-triangulated,
+//! `x y z` (and normals and texture coordinates) of the vertices and the `vertex_indices` (or
+//! `vertex_index`) list of the faces are read; every other property and element is read past,
+//! but for the mesh attribute a scene asks for ([`attribute`], a pass of its own). Polygons are fan-triangulated,
 //! the same way tobj triangulates OBJ faces, so that an OBJ and a PLY of one model give the
 //! same triangles. Errors are plain text; the caller adds the file and the scene key.
 
@@ -450,6 +451,7 @@ pub fn parse(data: &[u8]) -> Result<RawMesh, String> {
         uvs: b.uvs,
         uv_triangles,
         face_normals: false,
+        attribute: None,
     })
 }
 
@@ -676,9 +678,283 @@ fn parse_binary(
     Ok(())
 }
 
+/// A mesh attribute of a PLY file: its values per vertex, or per triangle of the fan-triangulated
+/// faces (a face's value on each of its triangles).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Attribute {
+    pub per_face: bool,
+    /// One or three channels; a single channel is copied to all three.
+    pub values: Vec<Vec3>,
+}
+
+/// The names Mitsuba 3 gives the extra properties of element `prefix` (`vertex_` or `face_`),
+/// with the indices of the properties each reads: `r g b` (or `red green blue`) is
+/// `{prefix}color`; consecutive `{name}_{c}` with c running over `x y z`, `r g b`, `0 1 2` or
+/// `1 2 3` (one or three of them) is `{prefix}{name}`, `_color` added for `r g b`. Other
+/// properties (lists, `reserved` ones, any that break the scheme) belong to none.
+fn attribute_groups(
+    prefix: &str,
+    props: &[Property],
+    reserved: &[&str],
+) -> Vec<(String, Vec<usize>)> {
+    let scalar = |i: usize| matches!(props[i].kind, Kind::Scalar(_));
+    let find = |n: &str| {
+        props
+            .iter()
+            .position(|p| p.name == n)
+            .filter(|&i| scalar(i))
+    };
+    let mut groups = Vec::new();
+    let mut prefixes: Vec<&str> = Vec::new();
+    let mut taken = vec![false; props.len()];
+    for names in [["r", "g", "b"], ["red", "green", "blue"]] {
+        if let [Some(r), Some(g), Some(b)] = names.map(find) {
+            groups.push((format!("{prefix}color"), vec![r, g, b]));
+            for i in [r, g, b] {
+                taken[i] = true;
+            }
+            break;
+        }
+    }
+    const SCHEMES: [[char; 3]; 4] = [
+        ['x', 'y', 'z'],
+        ['r', 'g', 'b'],
+        ['0', '1', '2'],
+        ['1', '2', '3'],
+    ];
+    let split = |i: usize| -> Option<(&str, char)> {
+        let (name, c) = props[i].name.rsplit_once('_')?;
+        let mut cs = c.chars();
+        let c = cs.next()?;
+        cs.next().is_none().then_some((name, c))
+    };
+    let mut i = 0;
+    while i < props.len() {
+        if taken[i] || !scalar(i) || reserved.contains(&props[i].name.as_str()) {
+            i += 1;
+            continue;
+        }
+        let Some((name, c)) = split(i) else {
+            i += 1;
+            continue;
+        };
+        let Some(scheme) = SCHEMES.iter().position(|s| s[0] == c) else {
+            i += 1;
+            continue;
+        };
+        let mut members = vec![i];
+        while members.len() < 3 {
+            let j = i + members.len();
+            let next = (j < props.len() && scalar(j) && !taken[j])
+                .then(|| split(j))
+                .flatten();
+            match next {
+                Some((n, c)) if n == name && c == SCHEMES[scheme][members.len()] => members.push(j),
+                _ => break,
+            }
+        }
+        i += members.len();
+        // Mitsuba 3 keeps one or three channels, and the first group of a name.
+        if members.len() == 2 || prefixes.contains(&name) {
+            continue;
+        }
+        prefixes.push(name);
+        let color = if scheme == 1 { "_color" } else { "" };
+        groups.push((format!("{prefix}{name}{color}"), members));
+    }
+    groups
+}
+
+/// Reads the values of the PLY's scalar properties one record at a time, in ascii or binary.
+enum Cursor<'a> {
+    Ascii(std::str::SplitAsciiWhitespace<'a>),
+    Binary {
+        body: &'a [u8],
+        pos: usize,
+        big: bool,
+    },
+}
+
+impl Cursor<'_> {
+    fn next(&mut self, ty: Scalar, element: &Element, record: usize) -> Result<f64, String> {
+        match self {
+            Cursor::Ascii(tokens) => {
+                let token = tokens.next().ok_or_else(|| truncated(element, record))?;
+                ty.parse_value(token).ok_or_else(|| {
+                    format!("{} {record}: {token:?} is not a valid {ty:?}", element.name)
+                })
+            }
+            Cursor::Binary { body, pos, big } => {
+                let bytes = body
+                    .get(*pos..*pos + ty.size())
+                    .ok_or_else(|| truncated(element, record))?;
+                *pos += ty.size();
+                Ok(ty.read(bytes, *big))
+            }
+        }
+    }
+}
+
+/// The mesh attribute `name` of a PLY file (named as Mitsuba 3 names them: `vertex_color`,
+/// `face_weight`, ...; see [`attribute_groups`]), or None if the file has none of that name.
+/// Names it has are listed in the error of a caller that needs one.
+pub fn attribute(data: &[u8], name: &str) -> Result<Option<Attribute>, String> {
+    let header = parse_header(data)?;
+    let layout = layout(&header.elements)?;
+    let (vertex_groups, face_groups) = all_groups(&header, &layout);
+    let (per_face, members) = match (
+        vertex_groups.iter().find(|(n, _)| n == name),
+        face_groups.iter().find(|(n, _)| n == name),
+    ) {
+        (Some((_, m)), _) => (false, m.clone()),
+        (None, Some((_, m))) => (true, m.clone()),
+        (None, None) => return Ok(None),
+    };
+    let wanted = if per_face { layout.face } else { layout.vertex };
+    let body = &data[header.body..];
+    let mut cursor = match header.format {
+        Format::Ascii => Cursor::Ascii(
+            std::str::from_utf8(body)
+                .map_err(|e| {
+                    format!(
+                        "the ascii data is not text (byte {} after the header)",
+                        e.valid_up_to()
+                    )
+                })?
+                .split_ascii_whitespace(),
+        ),
+        Format::Binary { big } => Cursor::Binary { body, pos: 0, big },
+    };
+    let mut values = Vec::new();
+    for (e, element) in header.elements.iter().enumerate() {
+        for record in 0..element.count {
+            let mut v = [0.0f32; 3];
+            let mut corners = 0usize;
+            for (p, property) in element.properties.iter().enumerate() {
+                match property.kind {
+                    Kind::Scalar(ty) => {
+                        let x = cursor.next(ty, element, record)?;
+                        if e == wanted
+                            && let Some(k) = members.iter().position(|&m| m == p)
+                        {
+                            v[k] = x as f32;
+                        }
+                    }
+                    Kind::List { count, item } => {
+                        let n = cursor.next(count, element, record)?;
+                        if !(0.0..=1e9).contains(&n) {
+                            return Err(format!(
+                                "{} {record}: bad list length {n} for property `{}`",
+                                element.name, property.name
+                            ));
+                        }
+                        if e == layout.face && p == layout.indices {
+                            corners = n as usize;
+                        }
+                        for _ in 0..n as usize {
+                            cursor.next(item, element, record)?;
+                        }
+                    }
+                }
+            }
+            if e != wanted {
+                continue;
+            }
+            let value = if members.len() == 1 {
+                Vec3::splat(v[0])
+            } else {
+                Vec3::from(v)
+            };
+            if per_face {
+                // One value per triangle of the face's fan, as `Builder::end_face` makes them.
+                for _ in 2..corners.max(2) {
+                    values.push(value);
+                }
+            } else {
+                values.push(value);
+            }
+        }
+        if e == wanted {
+            break;
+        }
+    }
+    Ok(Some(Attribute { per_face, values }))
+}
+
+/// The names of the mesh attributes a PLY file has (for messages).
+pub fn attribute_names(data: &[u8]) -> Vec<String> {
+    let Ok(header) = parse_header(data) else {
+        return Vec::new();
+    };
+    let Ok(layout) = layout(&header.elements) else {
+        return Vec::new();
+    };
+    let (vertex, face) = all_groups(&header, &layout);
+    vertex.into_iter().chain(face).map(|(n, _)| n).collect()
+}
+
+/// The attribute groups of the vertex and of the face element ([`attribute_groups`]).
+type Groups = Vec<(String, Vec<usize>)>;
+fn all_groups(header: &Header, layout: &Layout) -> (Groups, Groups) {
+    // What the mesh itself reads of a vertex (`field_of`'s names).
+    let reserved: Vec<&str> = header.elements[layout.vertex]
+        .properties
+        .iter()
+        .map(|p| p.name.as_str())
+        .filter(|n| field_of(n).is_some())
+        .collect();
+    (
+        attribute_groups(
+            "vertex_",
+            &header.elements[layout.vertex].properties,
+            &reserved,
+        ),
+        attribute_groups("face_", &header.elements[layout.face].properties, &[]),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Mitsuba 3's grouping of extra properties into attributes, and their values: `red green
+    /// blue` is a colour, `NAME_x NAME_y NAME_z` and `NAME_r NAME_g NAME_b` three channels (the
+    /// latter `_color`), `NAME_1` one, two channels and unsuffixed names none; a quad face's
+    /// value goes to both of its triangles.
+    #[test]
+    fn extra_properties_group_into_mitsubas_attributes() {
+        let file = "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\n\
+            property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\n\
+            property float dir_x\nproperty float dir_y\nproperty float dir_z\nproperty float tint_r\n\
+            property float tint_g\nproperty float tint_b\nproperty float pair_0\nproperty float pair_1\n\
+            property float quality\nelement face 1\nproperty list uchar int vertex_indices\n\
+            property float age_1\nend_header\n\
+            0 0 0 255 0 10 1 2 3 .1 .2 .3 7 8 9\n1 0 0 0 0 0 0 0 0 0 0 0 0 0 0\n\
+            1 1 0 0 0 0 0 0 0 0 0 0 0 0 0\n0 1 0 0 0 0 0 0 0 0 0 0 0 0 0\n4 0 1 2 3 0.25\n";
+        let data = file.as_bytes();
+        assert_eq!(
+            attribute_names(data),
+            [
+                "vertex_color",
+                "vertex_dir",
+                "vertex_tint_color",
+                "face_age"
+            ]
+        );
+        let colour = attribute(data, "vertex_color").unwrap().unwrap();
+        assert!(!colour.per_face);
+        // Integer colours are taken as they are, as Mitsuba 3 takes them.
+        assert_eq!(colour.values[0], Vec3::new(255.0, 0.0, 10.0));
+        assert_eq!(
+            attribute(data, "vertex_dir").unwrap().unwrap().values[0],
+            Vec3::new(1.0, 2.0, 3.0)
+        );
+        let age = attribute(data, "face_age").unwrap().unwrap();
+        assert!(age.per_face);
+        assert_eq!(age.values, vec![Vec3::splat(0.25); 2]);
+        assert_eq!(attribute(data, "vertex_pair").unwrap(), None);
+        assert_eq!(attribute(data, "vertex_quality").unwrap(), None);
+    }
 
     /// A binary PLY of a `n` x `n` vertex grid (z = x y / n, with normals) and its triangles,
     /// each face `3 a b c` after a `uchar` flag, with `quad` written as one quad in place of

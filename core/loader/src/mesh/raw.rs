@@ -21,4 +21,6 @@ pub struct RawMesh {
     /// The file asks for face normals (a version 5 serialized mesh's flag), which a scene's
     /// own `face_normals` overrides.
     pub face_normals: bool,
+    /// The mesh attribute the scene reads, if it asked for one (see `ply::attribute`).
+    pub attribute: Option<super::ply::Attribute>,
 }

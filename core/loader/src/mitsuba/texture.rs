@@ -167,6 +167,16 @@ impl Reader {
                 };
                 t.insert("value", vec3(value, line));
             }
+            "mesh_attribute" => {
+                let Some(name) = o.string("name")? else {
+                    return Err(
+                        o.error("a mesh_attribute texture needs the `name` of the attribute")
+                    );
+                };
+                t.insert("name", at(Value::Str(name), line));
+                let scale = o.float("scale", 1.0)?;
+                t.insert("scale", at(Value::Float(scale), line));
+            }
             "checkerboard" => {
                 for (key, default) in [("color0", 0.4), ("color1", 0.2)] {
                     let c = o.color(key, DVec3::splat(default))?;
