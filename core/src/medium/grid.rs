@@ -35,6 +35,10 @@ pub enum Outside {
     /// in the scene, zero beyond it (Mitsuba 3's heterogeneous medium, which exists only in
     /// its extinction volume's bounding box).
     ClampInBox,
+    /// The grid tiles space, interpolating across the seam between the last and the first
+    /// sample (Mitsuba 3's `repeat` wrap mode). Lookups only: a density that repeats has no
+    /// majorant grid (a medium's density refuses it).
+    Repeat,
 }
 
 /// A lattice of `channels` (1 or 3) values per sample, x fastest, then y, then z.
@@ -291,10 +295,24 @@ impl Grid {
         for (a, o) in out.iter_mut().enumerate() {
             let last = (self.res[a] - 1) as f32;
             let mut x = q[a];
+            if self.outside == Outside::Repeat {
+                // drjit's tex_wrap of both neighbours: index modulo the resolution.
+                let n = self.res[a] as i64;
+                let f = x.floor();
+                let i = if f.is_finite() { f as i64 } else { 0 };
+                *o = (
+                    i.rem_euclid(n) as usize,
+                    (i + 1).rem_euclid(n) as usize,
+                    (x - f).clamp(0.0, 1.0),
+                );
+                continue;
+            }
             if !(0.0..=last).contains(&x) {
                 match self.outside {
                     Outside::Zero => return None,
-                    Outside::Clamp | Outside::ClampInBox => x = x.clamp(0.0, last),
+                    Outside::Clamp | Outside::ClampInBox | Outside::Repeat => {
+                        x = x.clamp(0.0, last)
+                    }
                 }
             }
             // x is in [0, last]; NaN (a degenerate ray) lands on sample 0.
@@ -734,6 +752,48 @@ mod tests {
         let to_world = Mat4::from_translation(Vec3::new(-1.0, 0.5, 0.0))
             * Mat4::from_scale(Vec3::new(2.0, 1.5, 3.0));
         Grid::new(res, channels, values, to_world, samples, outside).unwrap()
+    }
+
+    /// `repeat` tiles space with the grid: a lookup one period (the transformed unit cube's
+    /// edge) away reads the same, inside the grid it reads what `clamp` reads, and across the
+    /// seam it interpolates between the last sample and the first, as drjit's repeat wrap.
+    #[test]
+    fn a_repeating_grid_tiles_space() {
+        let mut rng = Lcg(11);
+        let repeat = random_grid(&mut rng, Samples::Centres, Outside::Repeat, 3);
+        let mut rng = Lcg(11);
+        let clamp = random_grid(&mut rng, Samples::Centres, Outside::Clamp, 3);
+        // The unit cube maps to [-1, 1] x [0.5, 2] x [0, 3]: periods 2, 1.5 and 3.
+        let period = Vec3::new(2.0, 1.5, 3.0);
+        for _ in 0..200 {
+            let p =
+                Vec3::new(-1.0, 0.5, 0.0) + period * Vec3::new(rng.next(), rng.next(), rng.next());
+            let inside = repeat.lookup(p);
+            for k in [-2.0, -1.0, 1.0, 3.0] {
+                let q = p + Vec3::new(k * period.x, -k * period.y, 2.0 * k * period.z);
+                assert!(
+                    (repeat.lookup(q) - inside).abs().max_element() < 1e-4,
+                    "{p} {q}"
+                );
+            }
+            // Between the first and last sample centres of every axis, clamp reads the same.
+            let u = (p - Vec3::new(-1.0, 0.5, 0.0)) / period;
+            let n = Vec3::new(3.0, 4.0, 2.0);
+            if (u * n).cmpge(Vec3::splat(0.5)).all() && (u * n).cmple(n - 0.5).all() {
+                assert!((clamp.lookup(p) - inside).abs().max_element() < 1e-5);
+            }
+        }
+        // On the cube's face x = -1 (lattice x = -1/2), halfway between sample 2 and sample 0.
+        let (j, k) = (1usize, 1usize);
+        let p = Vec3::new(
+            -1.0,
+            0.5 + (j as f32 + 0.5) / 4.0 * 1.5,
+            (k as f32 + 0.5) / 2.0 * 3.0,
+        );
+        for c in 0..3 {
+            let expected = 0.5 * (repeat.sample(2, j, k, c) + repeat.sample(0, j, k, c));
+            assert!((repeat.lookup(p)[c] - expected).abs() < 1e-5);
+        }
     }
 
     /// The integral by the midpoint rule over lookups, against which the exact one is checked.

@@ -21,7 +21,8 @@
 //! pbrt-v4; `"corners"`: at i / (n - 1), as Mitsuba 0.6) and `outside` (`"clamp"`: the nearest
 //! sample; `"zero"`, as Mitsuba 0.6; `"box"`: the nearest sample within the axis-aligned box
 //! around the grid's unit cube, zero beyond, as Mitsuba 3's medium, which exists only in
-//! its extinction volume's box).
+//! its extinction volume's box; `"repeat"`, an albedo or emission only: the grid tiles space,
+//! as Mitsuba 3's `repeat` wrap mode).
 
 use super::grid::{Grid, Outside, Samples, VolFile};
 use super::{FreeFlight, Medium, Phase};
@@ -217,9 +218,16 @@ fn volume<'a>(
         "corners" => Samples::Corners,
         _ => Samples::Centres,
     };
-    let outside = match v.choice("outside", &["clamp", "zero", "box"], "clamp")? {
+    let outside = match v.choice("outside", &["clamp", "zero", "box", "repeat"], "clamp")? {
         "zero" => Outside::Zero,
         "box" => Outside::ClampInBox,
+        "repeat" if key == "density" => {
+            return Err(v.error(
+                "outside",
+                "\"repeat\" is for an albedo or an emission: a density must be bounded (clamp, zero or box)",
+            ));
+        }
+        "repeat" => Outside::Repeat,
         _ => Outside::Clamp,
     };
     let grid = Grid::new(size, count, values, to_world, samples, outside)

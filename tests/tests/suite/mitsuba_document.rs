@@ -1014,14 +1014,28 @@ fn heterogeneous_media_read_their_grids() {
     let xml = write(&dir, "mirror-albedo.xml", &scene("3.0.0", &body));
     let e = read(&xml, false).unwrap_err();
     assert!(e.contains("albedo") && e.contains("wrap mode"), "{e}");
-    // A grid in a homogeneous medium (Mitsuba 3's textured albedo): its mean, said.
-    let body = format!(
-        "<medium type=\"homogeneous\" id=\"milk\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/></volume><rgb name=\"sigma_t\" value=\"1\"/></medium>\n{SENSOR}"
-    );
-    let xml = write(&dir, "milk.xml", &scene("3.0.0", &body));
+    // A grid in a homogeneous medium (Mitsuba 3's textured albedo): a heterogeneous medium of
+    // density 1 wherever the medium is (not only in the grid's box), the albedo looked up on
+    // the grid, its `repeat` kept.
+    let milk = |wrap: &str| {
+        format!(
+            "<medium type=\"homogeneous\" id=\"milk\"><volume name=\"albedo\" type=\"gridvolume\"><string name=\"filename\" value=\"smoke.vol\"/><string name=\"wrap_mode\" value=\"{wrap}\"/></volume><rgb name=\"sigma_t\" value=\"1\"/><float name=\"scale\" value=\"2\"/></medium>\n{SENSOR}"
+        )
+    };
+    let xml = write(&dir, "milk.xml", &scene("3.0.0", &milk("repeat")));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    assert_eq!(text(&doc.root, "media.milk.type"), "heterogeneous");
+    assert_eq!(number(&doc.root, "media.milk.density"), 1.0);
+    assert!((vector(&doc.root, "media.milk.sigma_t") - Vec3::splat(2.0)).length() < 1e-6);
+    assert!(text(&doc.root, "media.milk.albedo.file").ends_with("smoke.vol"));
+    assert_eq!(text(&doc.root, "media.milk.albedo.outside"), "repeat");
+    foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    // A wrap mode foton does not look an albedo up with: the grid's mean, said.
+    let xml = write(&dir, "milk.xml", &scene("3.0.0", &milk("mirror")));
     assert!(read(&xml, false).is_err());
     let (doc, report) = read(&xml, true).unwrap();
-    assert!((vector(&doc.root, "media.milk.sigma_s").x - 2.0).abs() < 1e-4);
+    assert!((vector(&doc.root, "media.milk.sigma_s").x - 4.0).abs() < 1e-4);
     assert!(
         report.left_out.iter().any(|w| w.contains("milk.xml:2")),
         "{:?}",

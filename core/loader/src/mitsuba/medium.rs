@@ -32,7 +32,7 @@ impl Reader {
         let g_default = if mitsuba3_reads { 0.8 } else { 0.0 };
         if o.ty == "heterogeneous" {
             match self.grid_unsupported(&o) {
-                None => return self.heterogeneous(o),
+                None => return self.heterogeneous(o, true),
                 Some(why) => self.unsupported(
                     &o,
                     &format!(
@@ -49,6 +49,21 @@ impl Reader {
             .props
             .iter()
             .any(|(_, p, _)| matches!(p, Prop::Object(v) if v.tag == "volume"));
+        // Mitsuba 3's homogeneous medium takes its albedo from a volume, looked up where light
+        // scatters; its extinction is constant: foton's heterogeneous medium of density 1
+        // everywhere.
+        let albedo_only = o
+            .props
+            .iter()
+            .all(|(n, p, _)| n == "albedo" || !matches!(p, Prop::Object(v) if v.tag == "volume"));
+        if o.ty == "homogeneous"
+            && textured
+            && !self.v1
+            && albedo_only
+            && self.grid_unsupported(&o).is_none()
+        {
+            return self.heterogeneous(o, false);
+        }
         if o.ty == "homogeneous" && textured {
             self.unsupported(
                 &o,
@@ -209,10 +224,17 @@ impl Reader {
             // 3) `mirror` reads what `clamp` reads: the sample beyond the first one,
             // mirrored, is the first. An albedo volume may be looked up beyond its box.
             let extinction = !self.v1 && (name == "sigma_t" || name == "density");
-            if value("wrap_mode").is_some_and(|w| w != "clamp" && !(w == "mirror" && extinction)) {
+            let read = |w: &str| {
+                w == "clamp" || (w == "mirror" && extinction) || (w == "repeat" && !extinction)
+            };
+            if value("wrap_mode").is_some_and(|w| !read(&w)) {
                 return Some(format!(
                     "`{name}`: only the `clamp` wrap mode is supported{}",
-                    if extinction { " (and `mirror`)" } else { "" }
+                    if extinction {
+                        " (and `mirror`)"
+                    } else {
+                        " (and `repeat`)"
+                    }
                 ));
             }
         }
@@ -221,7 +243,9 @@ impl Reader {
 
     /// A heterogeneous medium into `[media]` as foton's `heterogeneous`: the extinction
     /// (`sigma_t`, 0.6's `density`) and `albedo` volumes or constants, `scale`, the phase.
-    fn heterogeneous(&mut self, mut o: Obj) -> Result<String> {
+    /// Unless `bounded` (Mitsuba 3's homogeneous medium with an albedo volume), a constant
+    /// extinction fills all of the medium, not its volume's box.
+    fn heterogeneous(&mut self, mut o: Obj, bounded: bool) -> Result<String> {
         let line = o.line;
         let mut t = Table::default();
         t.insert("type", at(Value::Str("heterogeneous".into()), line));
@@ -248,7 +272,7 @@ impl Reader {
             }
             Volume::Constant(c, to_world) => {
                 sigma_t *= c;
-                if self.v1 {
+                if self.v1 || !bounded {
                     t.insert("density", at(Value::Float(1.0), line));
                 } else {
                     // A constant volume too has a box: its unit cube under its to_world.
@@ -312,7 +336,7 @@ impl Reader {
         };
         let mut to_world = v.transform("to_world")?;
         v.take("filter_type");
-        v.take("wrap_mode");
+        let repeat = matches!(v.take("wrap_mode"), Some((Prop::Str(w), _)) if w == "repeat");
         v.take("raw");
         v.take("send_data");
         let use_bbox = v.boolean("use_grid_bbox", false)?;
@@ -333,6 +357,9 @@ impl Reader {
                 g.insert("samples", at(Value::Str("corners".into()), line));
                 g.insert("outside", at(Value::Str("zero".into()), line));
             }
+        }
+        if repeat {
+            g.insert("outside", at(Value::Str("repeat".into()), line));
         }
         g.insert("file", file.clone());
         g.insert("transform", super::matrix_table(to_world, line));
