@@ -111,6 +111,7 @@ impl SurfacePoint {
     pub fn texture_ctx(&self) -> TextureEvalContext {
         TextureEvalContext {
             uv: self.uv,
+            p: self.p,
             attribute: self.attribute,
         }
     }

@@ -18,15 +18,19 @@
 //!   <= 1/2 or both > 1/2), `color1` elsewhere.
 
 use crate::Rgb;
-use glam::{Affine2, Vec2};
+use crate::medium::grid::Grid;
+use glam::{Affine2, Vec2, Vec3};
 use std::sync::Arc;
 
 /// Where a texture is looked up (pbrt-v4's `TextureEvalContext`): the surface's texture
-/// coordinates and, on a mesh that carries one, the value there of the mesh attribute its
-/// material's textures read (interpolated between the vertices of a vertex attribute).
+/// coordinates, its point in the scene and, on a mesh that carries one, the value there of the
+/// mesh attribute its material's textures read (interpolated between the vertices of a vertex
+/// attribute).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct TextureEvalContext {
     pub uv: Vec2,
+    /// The point in the scene (world space), which a volume texture reads.
+    pub p: Vec3,
     /// The mesh attribute's value; zero where the surface has none.
     pub attribute: Rgb,
 }
@@ -36,7 +40,7 @@ impl From<Vec2> for TextureEvalContext {
     fn from(uv: Vec2) -> TextureEvalContext {
         TextureEvalContext {
             uv,
-            attribute: Rgb::ZERO,
+            ..TextureEvalContext::default()
         }
     }
 }
@@ -282,6 +286,9 @@ pub enum Texture {
         name: Arc<str>,
         scale: Rgb,
     },
+    /// A volume grid looked up at the surface's point in the scene (Mitsuba 3's `volume`
+    /// texture): trilinear, as a medium's grids.
+    Volume(Arc<Grid>),
 }
 
 impl Texture {
@@ -292,6 +299,7 @@ impl Texture {
         match self {
             Texture::Constant(c) => *c,
             Texture::MeshAttribute { scale, .. } => ctx.attribute * *scale,
+            Texture::Volume(grid) => grid.lookup(ctx.p),
             Texture::Bitmap {
                 bitmap,
                 filter,
@@ -365,12 +373,14 @@ impl Texture {
         }
     }
 
-    /// The mean colour over the unit square of uv (of the image, of the two colours). A mesh
-    /// attribute's is not known to the texture: taken as mid-grey (times its scale).
+    /// The mean colour over the unit square of uv (of the image, of the two colours; a volume's
+    /// over its samples). A mesh attribute's is not known to the texture: taken as mid-grey
+    /// (times its scale).
     pub fn mean(&self) -> Rgb {
         match self {
             Texture::Constant(c) => *c,
             Texture::MeshAttribute { scale, .. } => 0.5 * *scale,
+            Texture::Volume(grid) => grid.mean(),
             Texture::Bitmap { bitmap, .. } => bitmap.mean(),
             Texture::Checkerboard { color0, color1, .. } => 0.5 * (*color0 + *color1),
         }
@@ -384,6 +394,7 @@ impl Texture {
         match self {
             Texture::Constant(c) => *c,
             Texture::MeshAttribute { scale, .. } => *scale,
+            Texture::Volume(grid) => Rgb::splat(grid.max()),
             Texture::Bitmap { bitmap, .. } => bitmap.max(),
             Texture::Checkerboard { color0, color1, .. } => color0.max(*color1),
         }

@@ -12,7 +12,13 @@ use glam::{Affine2, DVec3, Mat2, Vec2};
 use std::path::Path;
 use std::sync::Arc;
 
-pub const TEXTURE_TYPES: &[&str] = &["bitmap", "checkerboard", "constant", "mesh_attribute"];
+pub const TEXTURE_TYPES: &[&str] = &[
+    "bitmap",
+    "checkerboard",
+    "constant",
+    "mesh_attribute",
+    "volume",
+];
 
 /// Reads an image (PNG, JPEG, OpenEXR, Radiance HDR, BMP, TGA, PPM/PGM: Mitsuba's formats but
 /// PFM; the format is recognised by its content), as linear RGB. 8- and 16-bit images are sRGB-decoded unless `raw`; float
@@ -269,6 +275,11 @@ pub fn read_texture(t: &Properties<'_>, base_dir: &Path, bitmaps: &mut Bitmaps) 
             })
         }
         "constant" => Ok(Texture::Constant(t.vec3_required("value")?)),
+        // The scene loader reads a volume's grid (build::common's `texture`).
+        "volume" => Err(t.error(
+            "type",
+            "a volume texture is read where the scene is loaded, not here",
+        )),
         "mesh_attribute" => {
             let name = t.string_required("name")?;
             if !(name.starts_with("vertex_") || name.starts_with("face_")) {

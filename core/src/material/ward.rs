@@ -210,10 +210,10 @@ fn roughness(
         Texture::Checkerboard { color0, color1, .. } => {
             channel_mean(*color0).min(channel_mean(*color1))
         }
-        Texture::MeshAttribute { .. } => {
+        Texture::MeshAttribute { .. } | Texture::Volume(_) => {
             return Err(m.error(
                 key,
-                "a mesh attribute cannot give the roughness, which must be positive everywhere",
+                "a mesh attribute or a volume cannot give the roughness, which must be positive everywhere",
             ));
         }
     };

@@ -161,8 +161,8 @@ fn transmittance_of(sigma_t: Rgb, depth: glam::DVec3) -> Rgb {
 }
 
 /// A volume parameter: a number (the same everywhere) or a volume table (see the module
-/// comment); `channels` are the channel counts allowed.
-fn volume<'a>(
+/// comment); `channels` are the channel counts allowed. None where `key` is not a table.
+pub fn volume<'a>(
     m: &Properties<'a>,
     key: &str,
     channels: &[usize],

@@ -1031,6 +1031,22 @@ fn heterogeneous_media_read_their_grids() {
     assert!(text(&doc.root, "media.milk.albedo.file").ends_with("smoke.vol"));
     assert_eq!(text(&doc.root, "media.milk.albedo.outside"), "repeat");
     foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    // Mitsuba 3's volume texture: its grid, looked up where the surface is.
+    let body = format!(
+        "<shape type=\"sphere\"><bsdf type=\"diffuse\"><texture type=\"volume\" name=\"reflectance\"><volume type=\"gridvolume\" name=\"volume\"><string name=\"filename\" value=\"smoke.vol\"/></volume></texture></bsdf></shape>\n{SENSOR}"
+    );
+    let xml = write(&dir, "volume-texture.xml", &scene("3.0.0", &body));
+    let (doc, report) = read(&xml, false).unwrap();
+    assert!(report.warnings.is_empty(), "{:?}", report.warnings);
+    let m = text(&doc.root, "shapes.0.material");
+    assert_eq!(
+        text(&doc.root, &format!("materials.{m}.reflectance.type")),
+        "volume"
+    );
+    assert!(
+        text(&doc.root, &format!("materials.{m}.reflectance.volume.file")).ends_with("smoke.vol")
+    );
+    foton_loader::load_with(&xml, &[], &[], false).unwrap();
     // A wrap mode foton does not look an albedo up with: the grid's mean, said.
     let xml = write(&dir, "milk.xml", &scene("3.0.0", &milk("mirror")));
     assert!(read(&xml, false).is_err());

@@ -225,3 +225,25 @@ fn bad_textures_are_clear_errors() {
         }
     }
 }
+
+/// A volume texture (Mitsuba 3's `volume`) is its grid looked up at the surface's point in
+/// the scene: two samples along x over the quad's [-1, 1], at x = -1/2 and 1/2, clamped
+/// beyond them and linear between, so each column of 4 x 4 blocks has the grid's value at
+/// its centre (the block means a linear function at its middle).
+#[test]
+fn a_volume_texture_reads_its_grid_where_the_surface_is() {
+    let material = "type = \"diffuse\"\nreflectance = { type = \"volume\", volume = { resolution = [2, 1, 1], values = [0.2, 0.5, 0.9, 0.8, 0.1, 0.3], transform = { matrix = [2, 0, 0, -1, 0, 2, 0, -1, 0, 0, 2, -1, 0, 0, 0, 1] } } }";
+    let film = render_toml("volume-texture", &textured_quad("path", material), &[], 2);
+    let (a, b) = (Rgb::new(0.2, 0.5, 0.9), Rgb::new(0.8, 0.1, 0.3));
+    // x at the centres of the four columns of blocks, and where that lies between the samples.
+    for (i, t) in [0.0f32, 0.25, 0.75, 1.0].into_iter().enumerate() {
+        let want = a + (b - a) * t;
+        for j in 0..4 {
+            let (m, se) = region_mean(&film, 4 * i as u32, 4 * j, 4 * i as u32 + 4, 4 * j + 4);
+            assert!(
+                (m - want).abs().max_element() < 4.0 * se.max_element() + 0.01,
+                "block ({i}, {j}): {m} against {want}"
+            );
+        }
+    }
+}

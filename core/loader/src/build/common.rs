@@ -53,6 +53,33 @@ impl Resources for Loader {
     }
 
     fn texture(&mut self, bag: &Properties<'_>, key: &str, default: Rgb) -> Result<Texture> {
+        // A volume texture's grid is read as a medium's (its file through the loader).
+        let is_volume = matches!(
+            bag.node(key).map(|n| &n.value),
+            Some(Value::Table(t)) if t.get("type").is_some_and(|n| matches!(&n.value, Value::Str(s) if s == "volume"))
+        );
+        if is_volume && let Some(t) = bag.table(key)? {
+            t.string_required("type")?;
+            let mut nested = Vec::new();
+            let grid = foton_core::medium::heterogeneous::volume(
+                &t,
+                "volume",
+                &[1, 3],
+                &mut nested,
+                self,
+            )?
+            .ok_or_else(|| {
+                t.error(
+                    "volume",
+                    "missing: a volume table ({ file = ... } or resolution and values)",
+                )
+            })?;
+            for n in &nested {
+                self.done(n);
+            }
+            self.done(&t);
+            return Ok(Texture::Volume(std::sync::Arc::new(grid)));
+        }
         let (texture, table) = read_texture_param(bag, key, default, &self.dir, &mut self.bitmaps)?;
         if let Some(table) = table {
             self.done(&table);

@@ -310,7 +310,7 @@ impl Reader {
 
     /// A medium's volume `key`: a grid as foton's volume table, or a constant (a
     /// `constvolume`, a `<float>`, an `<rgb>`).
-    fn volume(&mut self, o: &mut Obj, key: &str) -> Result<Option<Volume>> {
+    pub(super) fn volume(&mut self, o: &mut Obj, key: &str) -> Result<Option<Volume>> {
         let v = match o.take(key) {
             None => return Ok(None),
             Some((Prop::Object(v), _)) if v.tag == "volume" => v,
@@ -730,7 +730,7 @@ const MEASURED_MEDIA: &[(&str, [f64; 3], [f64; 3], [f64; 3])] = &[
 ];
 
 /// A heterogeneous medium's volume parameter as the reader writes it.
-enum Volume {
+pub(super) enum Volume {
     /// A volume table (`file`, `transform`, and where they are not the defaults `samples`
     /// and `outside`).
     Grid(foton_core::value::Node),

@@ -167,6 +167,35 @@ impl Reader {
                 };
                 t.insert("value", vec3(value, line));
             }
+            "volume" => {
+                // Mitsuba 3's volume texture: its `volume` looked up at the surface's point.
+                let kind = o.props.iter().find_map(|(n, p, _)| match p {
+                    Prop::Object(v) if n == "volume" && v.tag == "volume" => Some(v.ty.clone()),
+                    _ => None,
+                });
+                if kind
+                    .as_deref()
+                    .is_some_and(|k| k != "gridvolume" && k != "constvolume")
+                {
+                    o.props.clear();
+                    let m = format!(
+                        "`volume`: volume type `{}` is not supported yet",
+                        kind.unwrap_or_default()
+                    );
+                    self.unsupported(&o, &m)?;
+                    return Ok(None);
+                }
+                match self.volume(&mut o, "volume")? {
+                    Some(super::medium::Volume::Grid(g)) => t.insert("volume", g),
+                    Some(super::medium::Volume::Constant(c, _)) => {
+                        t.insert("type", at(Value::Str("constant".into()), line));
+                        t.insert("value", vec3(c, line));
+                    }
+                    None => {
+                        return Err(o.error("a volume texture needs its `volume`"));
+                    }
+                }
+            }
             "mesh_attribute" => {
                 let Some(name) = o.string("name")? else {
                     return Err(
