@@ -201,6 +201,33 @@ reflectance = { type = "mesh_attribute", name = "colour" }"#,
         "{}",
         run.stderr
     );
+    // Nor a volume texture, or either as the cut-out of an emitting shape.
+    for (key, table) in [
+        (
+            "emission",
+            "{ type = \"volume\", volume = { resolution = [1, 1, 1], values = [1] } }",
+        ),
+        (
+            "alpha",
+            "{ type = \"mesh_attribute\", name = \"face_weight\" }",
+        ),
+    ] {
+        let extra = if key == "alpha" {
+            format!("emission = [1, 1, 1]\nalpha = {table}\n")
+        } else {
+            format!("emission = {table}\n")
+        };
+        let text = scene(r#"type = "diffuse""#)
+            .replace("material = \"m\"\n", &format!("material = \"m\"\n{extra}"));
+        let path = write(&dir, "scene.toml", &text);
+        let run = foton_with_plugins(&["check", path.to_str().unwrap()]);
+        assert_ne!(run.code, 0, "{key}: accepted");
+        assert!(
+            run.stderr.contains(key) && run.stderr.contains("not supported yet"),
+            "{key}: {}",
+            run.stderr
+        );
+    }
     // On a shape that is not a mesh.
     let sphere = scene(
         r#"type = "diffuse"

@@ -556,7 +556,7 @@ fn bitmap_filter_and_wrap_modes() {
     // A texture left out (--lenient) leaves out what takes it by reference, which says so.
     let dropped = format!(
         r#"{SENSOR}
-<texture type="volume" id="tex"><float name="volume" value="0.5"/></texture>
+<texture type="volume" id="tex"><volume type="openvdb" name="volume"/></texture>
 <shape type="sphere"><bsdf type="diffuse"><ref name="reflectance" id="tex"/></bsdf></shape>"#
     );
     let xml = write(&dir, "scene.xml", &scene("3.0.0", &dropped));

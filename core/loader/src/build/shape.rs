@@ -242,10 +242,27 @@ pub(super) fn read_shapes(
         } else {
             None
         };
-        if let Some(name) = emission.as_ref().and_then(Texture::mesh_attribute) {
+        // An area light looks its textures up by uv alone.
+        let by_point =
+            |t: &Texture| matches!(t, Texture::MeshAttribute { .. } | Texture::Volume(_));
+        if let Some(t) = emission.as_ref().filter(|t| by_point(t)) {
+            let what = match t.mesh_attribute() {
+                Some(name) => format!("the mesh attribute `{name}`"),
+                None => "a volume texture".to_string(),
+            };
             return Err(s.error(
                 "emission",
-                format!("the mesh attribute `{name}` as emitted radiance is not supported yet"),
+                format!("{what} as emitted radiance is not supported yet"),
+            ));
+        }
+        if emission
+            .as_ref()
+            .is_some_and(|e| e.max().max_element() > 0.0)
+            && alpha.as_ref().is_some_and(by_point)
+        {
+            return Err(s.error(
+                "alpha",
+                "a mesh attribute or a volume texture as the cut-out of an emitting shape is not supported yet",
             ));
         }
         if let Some(emission) = emission
