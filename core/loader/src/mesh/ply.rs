@@ -1033,8 +1033,11 @@ mod tests {
             .and_then(|v| v.parse().ok())
             .unwrap_or(20_000);
         let ascii = b"ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\nproperty float u\nproperty float v\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n0 0 0 0 0\n1 0 0 1 0\n1 1 0 1 1\n0 1 0 0 1\n3 0 1 2\n4 0 2 3 1\n".to_vec();
+        // With extra properties, which `attribute` reads.
+        let attributes = b"ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\nproperty list uchar int vertex_indices\nproperty float weight_0\nend_header\n0 0 0 255 0 0\n1 0 0 0 255 0\n0 1 0 0 0 255\n3 0 1 2 0.5\n".to_vec();
         let small = [
             ascii,
+            attributes,
             grid(6, false, true, None).0,
             grid(6, true, false, None).0,
         ];
@@ -1070,6 +1073,20 @@ mod tests {
             }
             let result = parse(&f);
             outcomes[result.is_ok() as usize] += 1;
+            for name in ["vertex_color", "face_weight"] {
+                if let Ok(Some(a)) = attribute(&f, name)
+                    && let Ok(raw) = &result
+                {
+                    let n = if a.per_face {
+                        raw.triangles.len()
+                    } else {
+                        raw.positions.len()
+                    };
+                    // Where both passes read the file, they agree on the element's size.
+                    assert_eq!(a.values.len(), n, "{name}");
+                }
+            }
+            let _ = attribute_names(&f);
             if let Ok(raw) = result {
                 let options = super::super::MeshOptions {
                     face_normals: next(2) == 0,
