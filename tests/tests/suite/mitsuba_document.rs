@@ -1047,6 +1047,14 @@ fn heterogeneous_media_read_their_grids() {
         text(&doc.root, &format!("materials.{m}.reflectance.volume.file")).ends_with("smoke.vol")
     );
     foton_loader::load_with(&xml, &[], &[], false).unwrap();
+    // Its grid's lookup is a medium's: a nearest lookup is refused (--lenient: left out).
+    let nearest = body.replace(
+        "value=\"smoke.vol\"/></volume>",
+        "value=\"smoke.vol\"/><string name=\"filter_type\" value=\"nearest\"/></volume>",
+    );
+    let xml = write(&dir, "volume-texture.xml", &scene("3.0.0", &nearest));
+    let e = read(&xml, false).unwrap_err();
+    assert!(e.contains("trilinear"), "{e}");
     // A wrap mode foton does not look an albedo up with: the grid's mean, said.
     let xml = write(&dir, "milk.xml", &scene("3.0.0", &milk("mirror")));
     assert!(read(&xml, false).is_err());

@@ -194,7 +194,7 @@ impl Reader {
     /// Why a heterogeneous medium cannot be read as foton's `heterogeneous` (None: it can):
     /// its volumes must be `gridvolume`s or `constvolume`s, interpolated trilinearly and
     /// clamped (Mitsuba 3) or zero (0.6) outside.
-    fn grid_unsupported(&self, o: &Obj) -> Option<String> {
+    pub(super) fn grid_unsupported(&self, o: &Obj) -> Option<String> {
         for (name, p, _) in &o.props {
             let Prop::Object(v) = p else { continue };
             if v.tag != "volume" {

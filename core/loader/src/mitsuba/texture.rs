@@ -173,15 +173,20 @@ impl Reader {
                     Prop::Object(v) if n == "volume" && v.tag == "volume" => Some(v.ty.clone()),
                     _ => None,
                 });
-                if kind
+                // A grid's lookup as a medium's grids have it (trilinear; clamp or repeat).
+                let why = if kind
                     .as_deref()
                     .is_some_and(|k| k != "gridvolume" && k != "constvolume")
                 {
-                    o.props.clear();
-                    let m = format!(
+                    Some(format!(
                         "`volume`: volume type `{}` is not supported yet",
                         kind.unwrap_or_default()
-                    );
+                    ))
+                } else {
+                    self.grid_unsupported(&o)
+                };
+                if let Some(m) = why {
+                    o.props.clear();
                     self.unsupported(&o, &m)?;
                     return Ok(None);
                 }
