@@ -68,7 +68,7 @@ pub enum WrapMode {
 impl WrapMode {
     /// The texel index that index `i` reads along an axis of `n` texels (drjit's `tex_wrap`).
     #[inline]
-    fn wrap(self, i: i64, n: usize) -> usize {
+    pub(crate) fn wrap(self, i: i64, n: usize) -> usize {
         let n = n as i64;
         (match self {
             WrapMode::Clamp => i.clamp(0, n - 1),

@@ -12,6 +12,7 @@
 
 use crate::Rgb;
 use crate::geometry::Ray;
+use crate::texture::WrapMode;
 use glam::{DVec3, Mat4, Vec3};
 
 /// Where the lattice's samples lie in its unit cube.
@@ -296,15 +297,11 @@ impl Grid {
             let last = (self.res[a] - 1) as f32;
             let mut x = q[a];
             if self.outside == Outside::Repeat {
-                // drjit's tex_wrap of both neighbours: index modulo the resolution.
-                let n = self.res[a] as i64;
+                // Both neighbours wrapped as a repeating bitmap's texels are.
                 let f = x.floor();
                 let i = if f.is_finite() { f as i64 } else { 0 };
-                *o = (
-                    i.rem_euclid(n) as usize,
-                    (i + 1).rem_euclid(n) as usize,
-                    (x - f).clamp(0.0, 1.0),
-                );
+                let wrap = |i| WrapMode::Repeat.wrap(i, self.res[a]);
+                *o = (wrap(i), wrap(i + 1), (x - f).clamp(0.0, 1.0));
                 continue;
             }
             if !(0.0..=last).contains(&x) {
