@@ -277,7 +277,8 @@ impl<'a> Properties<'a> {
 
     pub fn u32(&self, name: &str, default: u32) -> Result<u32> {
         let v = self.u64(name, default as u64)?;
-        u32::try_from(v).map_err(|_| self.error(name, format!("{v} is too large")))
+        u32::try_from(v)
+            .map_err(|_| self.error(name, format!("{v} is too large (at most {})", u32::MAX)))
     }
 
     pub fn bool(&self, name: &str, default: bool) -> Result<bool> {

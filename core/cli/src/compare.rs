@@ -4,7 +4,7 @@
 //! With `--time S` each integrator gets about S seconds (`budget`). With `--consistency N`
 //! each renders N times and the pairs are tested block by block (`consistency`).
 
-mod budget;
+pub(crate) mod budget;
 mod consistency;
 mod flip;
 pub(crate) mod json;
@@ -289,6 +289,21 @@ impl Session<'_> {
         let mut curve = Vec::new();
         let (p, film, elapsed, settings) = match a.time {
             None => {
+                // The scene's own time limit (render.time), where --time does not set one.
+                if let Some(seconds) = p.scene.render().time {
+                    let fitted =
+                        crate::time_limit::fit(&mut p, seconds.into(), self.threads, &|extra| {
+                            self.prepare(name, extra)
+                        })?;
+                    if let crate::time_limit::Fitted::Iterations { set, .. } = &fitted {
+                        p = self.prepare(name, std::slice::from_ref(set))?;
+                    }
+                    let _ = writeln!(
+                        err,
+                        "note: `{name}`: render.time = {seconds} s: {}",
+                        fitted.text()
+                    );
+                }
                 let (film, elapsed) = self.render(&p, a.run.quiet, err)?;
                 (p, film, elapsed, Vec::new())
             }

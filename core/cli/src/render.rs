@@ -3,7 +3,7 @@
 
 use crate::common::{INTERRUPTED, RunArgs, SceneArgs, render_with, warn};
 use crate::montage::{Image, Tile, grid};
-use crate::{TermProgress, part};
+use crate::{TermProgress, part, time_limit};
 use clap::Args;
 use foton_core::Rgb;
 use foton_core::error::{Error, Result};
@@ -54,8 +54,8 @@ pub(crate) struct RenderArgs {
 }
 
 pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Result<u8> {
-    let overrides = a.scene.overrides();
-    let p = a.scene.prepare(&overrides)?;
+    let mut overrides = a.scene.overrides();
+    let mut p = a.scene.prepare(&overrides)?;
     let output = match (&a.output, a.part) {
         (Some(o), _) => o.clone(),
         (None, Some(part)) => a
@@ -102,6 +102,34 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
         }
     }
     warn(err, &p.warnings);
+    if let Some(seconds) = p.scene.render().time {
+        if a.part.is_some() {
+            return Err(Error::Usage(
+                "--part and render.time: each part would fit its own samples to the time limit, and the parts would not merge; set render.spp instead".into(),
+            ));
+        }
+        let fitted = time_limit::fit(&mut p, seconds.into(), a.run.threads(), &|extra| {
+            let mut o = overrides.clone();
+            o.extend_from_slice(extra);
+            a.scene.prepare(&o)
+        })?;
+        if let time_limit::Fitted::Iterations { set, .. } = &fitted {
+            overrides.push(set.clone());
+            p = a.scene.prepare(&overrides)?;
+        }
+        let _ = match fitted.set() {
+            Some(set) => writeln!(
+                err,
+                "note: render.time = {seconds} s: {} fill it (`--set {set}` renders the same image)",
+                fitted.text()
+            ),
+            None => writeln!(
+                err,
+                "warning: render.time = {seconds} s: {} sets its own budget; the time limit does not apply",
+                p.integrator.describe()
+            ),
+        };
+    }
     let mut progress = TermProgress::new(a.run.quiet);
     if let Some(every) = a.checkpoint {
         progress = progress.with_checkpoint(

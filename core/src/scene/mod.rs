@@ -45,6 +45,10 @@ pub struct RenderSettings {
     pub hide_emitters: bool,
     /// The points camera samples draw (`[render] sampler`, and `jitter` for `stratified`).
     pub sampler: crate::sampling::SamplerKind,
+    /// A time limit in seconds (Mitsuba's `timeout`): the host renders the camera samples, or
+    /// a progressive integrator's iterations, that fill it, at most `spp`. Integrators render
+    /// `spp` and do not read it.
+    pub time: Option<f32>,
 }
 
 #[derive(Clone, Debug)]

@@ -85,6 +85,7 @@ mod textured_light;
 mod textures;
 mod thin_dielectric;
 mod thin_lens;
+mod time_limit;
 mod tonemap;
 mod tools;
 mod tools_bad_input;

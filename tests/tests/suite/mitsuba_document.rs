@@ -501,6 +501,54 @@ fn mitsuba_2_files_are_read() {
     }
 }
 
+/// Mitsuba 2 and 3 stop at an integrator's `timeout` (seconds; negative: none): foton's
+/// render.time. Their sample counts are 64-bit: 99999999999 with a timeout is a bound, which
+/// foton's largest count stands for; without one, `--lenient` clamps it with a warning and the
+/// file as written is refused.
+#[test]
+fn a_timeout_is_a_time_limit_and_bounds_a_64_bit_sample_count() {
+    let dir = temp_dir("mitsuba-timeout");
+    let body = |timeout: &str| {
+        format!(
+            r#"<integrator type="path"><float name="timeout" value="{timeout}"/></integrator>
+<sensor type="perspective">
+    <transform name="to_world"><lookat origin="0, 0, -5" target="0, 0, 0" up="0, 1, 0"/></transform>
+    <sampler type="independent"><integer name="sample_count" value="99999999999"/></sampler>
+    <film type="hdrfilm"><integer name="width" value="32"/><integer name="height" value="16"/></film>
+</sensor>"#
+        )
+    };
+    let xml = write(&dir, "timed.xml", &scene("2.0.0", &body("12")));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert_eq!(number(&doc.root, "render.time"), 12.0);
+    assert_eq!(number(&doc.root, "render.spp"), f64::from(u32::MAX));
+    let scene_of = |xml: &Path| foton_loader::load_with(xml, &[], &[], false);
+    assert_eq!(scene_of(&xml).unwrap().render().time, Some(12.0));
+    // No time limit: refused as written (at the count's line), clamped with --lenient.
+    let xml = write(&dir, "untimed.xml", &scene("2.0.0", &body("-1")));
+    let (doc, _) = read(&xml, false).unwrap();
+    assert!(matches!(&node(&doc.root, "render").value, Value::Table(t) if t.get("time").is_none()));
+    let Err(e) = scene_of(&xml) else {
+        panic!("a 64-bit sample count without a timeout opened as written")
+    };
+    let e = e.to_string();
+    assert!(
+        e.contains("untimed.xml:5") && e.contains("99999999999"),
+        "{e}"
+    );
+    let (doc, report) = read(&xml, true).unwrap();
+    assert_eq!(number(&doc.root, "render.spp"), f64::from(u32::MAX));
+    assert!(
+        report
+            .warnings
+            .iter()
+            .any(|w| w.contains("99999999999") && w.contains("timeout")),
+        "{:?}",
+        report.warnings
+    );
+    let _ = std::fs::remove_dir_all(dir);
+}
+
 /// Bitmap filter and wrap modes as foton's textures have them: Mitsuba 3's names kept,
 /// 0.6's camelCase and its mipmapped filters read (bilinear, a warning), a constant border
 /// clamped with `--lenient` (an error without).

@@ -49,22 +49,27 @@ impl CostModel {
 /// so that their times are not timer and scheduler noise.
 pub const CALIBRATION_SECONDS: f64 = 0.05;
 
+/// The most units `calibrate_cost` renders at (n; the second render is at 2n).
+pub(crate) const MAX_UNITS: u32 = 1 << 16;
+
 /// The cost model from renders at n and 2n units, n = 1 and then larger until the render at
-/// 2n takes `min_seconds` (n at most 2^16). `seconds_of(n)` renders at n and returns its time.
-fn calibrate_cost(
+/// 2n takes `min_seconds` (n at most `max_units`, at least 1). `seconds_of(n)` renders at n
+/// and returns its time.
+pub(crate) fn calibrate_cost(
     min_seconds: f64,
+    max_units: u32,
     mut seconds_of: impl FnMut(u32) -> Result<f64>,
 ) -> Result<CostModel> {
-    const MAX_UNITS: u32 = 1 << 16;
+    let max_units = max_units.max(1);
     let mut n = 1u32;
     loop {
         let t1 = seconds_of(n)?;
         let t2 = seconds_of(2 * n)?;
-        if t2 >= min_seconds || n >= MAX_UNITS || INTERRUPTED.load(Ordering::SeqCst) {
+        if t2 >= min_seconds || n >= max_units || INTERRUPTED.load(Ordering::SeqCst) {
             return Ok(CostModel::from_times(n, t1, t2));
         }
         let factor = (min_seconds / t2.max(1e-6)).ceil().clamp(2.0, 1024.0) as u32;
-        n = n.saturating_mul(factor).min(MAX_UNITS);
+        n = n.saturating_mul(factor).min(max_units);
     }
 }
 
@@ -167,7 +172,7 @@ pub(super) fn calibrate(
     let Budget { work, scaled } = p.integrator.budget();
     match work {
         Work::Iterations { key } => {
-            let cost = calibrate_cost(min_seconds, |n| {
+            let cost = calibrate_cost(min_seconds, MAX_UNITS, |n| {
                 let q = session.prepare(name, &[format!("{key}={n}")])?;
                 Ok(session.render(&q, true, err)?.1.as_secs_f64())
             })?;
@@ -186,7 +191,7 @@ pub(super) fn calibrate(
             Ok((Plan::Fixed, Some(shown)))
         }
         Work::Samples => {
-            let cost = calibrate_cost(min_seconds, |n| {
+            let cost = calibrate_cost(min_seconds, MAX_UNITS, |n| {
                 p.scene.render_mut().spp = n;
                 Ok(session.render(p, true, err)?.1.as_secs_f64())
             })?;

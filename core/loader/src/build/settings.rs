@@ -22,6 +22,12 @@ pub(super) fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<Rend
     if spp == 0 {
         return Err(t.error("spp", "must be at least 1"));
     }
+    let time = t.f32_opt("time")?;
+    if let Some(time) = time
+        && (time.is_nan() || time <= 0.0)
+    {
+        return Err(t.error("time", format!("must be above 0 seconds, not {time}")));
+    }
     let settings = RenderSettings {
         integrator,
         spp,
@@ -29,6 +35,7 @@ pub(super) fn read_render(root: &Properties<'_>, ld: &mut Loader) -> Result<Rend
         max_depth: t.u32("max_depth", 16)?,
         hide_emitters: t.bool("hide_emitters", false)?,
         sampler: read_sampler(&t, root.node("render"), ld)?,
+        time,
     };
     ld.done(&t);
     Ok(settings)

@@ -132,12 +132,15 @@ impl Reader {
         if !matches!(o.ty.as_str(), "sppm" | "ppm") {
             o.take("samples_per_pass");
         }
-        self.ignored(
-            &mut o,
-            "timeout",
-            &|p| matches!(p, Prop::Float(t) if *t < 0.0),
-            "ignored (foton renders every sample; a time limit would stop Mitsuba with fewer)",
-        );
+        // Mitsuba 2 and 3 stop rendering at `timeout` seconds (negative: none): render.time.
+        let timeout_line = (o.props.iter())
+            .find(|(n, _, _)| n == "timeout")
+            .map_or(o.line, |(_, _, l)| *l);
+        let timeout = o.float("timeout", -1.0)?;
+        if timeout > 0.0 {
+            table_mut(&mut self.root, "render")
+                .insert("time", at(Value::Float(timeout), timeout_line));
+        }
         // The parameters of an integrator foton renders by another (a meter's): ignored.
         let own = if name == mapped { o.ty.as_str() } else { "" };
         match own {
@@ -492,4 +495,33 @@ fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
         "vcm" => "vcm",
         _ => return None,
     })
+}
+
+impl Reader {
+    /// Mitsuba counts samples per pixel in 64 bits: files ask for 99999999999 with a
+    /// `timeout` that ends the render. With a time limit (render.time) the count is a bound
+    /// and foton's largest stands for it; without one, such a render would not end, and
+    /// `--lenient` renders foton's largest count (the TOML reader refuses it as written).
+    pub(super) fn samples_past_u32(&mut self) {
+        let render = table_mut(&mut self.root, "render");
+        let timed = render.get("time").is_some();
+        let Some(node) = render.get_mut("spp") else {
+            return;
+        };
+        let Value::Int(spp) = node.value else {
+            return;
+        };
+        if spp <= i64::from(u32::MAX) || !(timed || self.lenient) {
+            return;
+        }
+        node.value = Value::Int(u32::MAX.into());
+        if !timed {
+            let line = node.line;
+            self.report.warnings.push(format!(
+                "{}:{line}: `sample_count` = {spp}: more samples than foton counts, rendered with {} (no `timeout` ends the render)",
+                self.file.display(),
+                u32::MAX
+            ));
+        }
+    }
 }

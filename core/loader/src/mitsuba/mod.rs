@@ -116,6 +116,7 @@ pub fn read_xml(path: &Path, defines: &[String], lenient: bool) -> Result<(Docum
             }
         }
     }
+    r.samples_past_u32();
     let mut root = std::mem::take(&mut r.root);
     if !r.shapes.is_empty() {
         root.insert("shapes", at(Value::Array(std::mem::take(&mut r.shapes)), 0));
