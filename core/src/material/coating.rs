@@ -3,7 +3,7 @@
 //!
 //! | Parameter              | Type           | Meaning                                            | Default |
 //! |------------------------|----------------|----------------------------------------------------|---------|
-//! | `base`                 | material table | the material under the layer: `diffuse`, `conductor`, `roughconductor`, `roughplastic` or `roughdiffuse` | (required) |
+//! | `base`                 | material table | the material under the layer: `diffuse`, `conductor`, `roughconductor`, `roughplastic`, `roughdiffuse` or `dielectric` | (required) |
 //! | `ior`                  | number         | the layer's index relative to the outside          | `1.5046` (BK7 in air) |
 //! | `sigma_a`              | RGB            | absorption inside the layer, per unit of `thickness` | `0`   |
 //! | `thickness`            | number         | the layer's thickness, in the inverse units of `sigma_a` | `1` |
@@ -16,6 +16,12 @@
 //! and leaves: f = f_base(wo', wi') (1 - F(cos_o)) (1 - F(cos_i)) A / eta^2. Light that the
 //! layer's underside reflects back onto the base is lost, as in Mitsuba 0.6. Over a smooth
 //! metal every part is a mirror reflection: F(cos) + (1 - F(cos))^2 F_metal(cos') A.
+//!
+//! Over a smooth dielectric (a coated glass interface) every part is a delta and the layer
+//! lies on both sides, as in Mitsuba 0.6: from either side the layer reflects F(cos_o); the
+//! rest enters, is reflected or refracted by the dielectric, crosses the layer on the side it
+//! leaves (absorbed over both legs) and refracts out: weight (1 - F(cos_o)) (1 - F(cos_i))
+//! A w_base. The material then bounds a volume, as the dielectric does.
 
 use crate::texture::TextureEvalContext;
 use super::mirror::delta_sample;
@@ -23,6 +29,7 @@ use super::{Material, SurfaceMaterial, nested_material, read_ior};
 use crate::Rgb;
 use crate::glossy::{RoughConductor, RoughPlastic};
 use crate::material::conductor::ConductorBxdf;
+use crate::material::dielectric::DielectricBxdf;
 use crate::material::diffuse::DiffuseBxdf;
 use crate::material::roughdiffuse::RoughDiffuseBxdf;
 use crate::material::Lobe;
@@ -41,6 +48,8 @@ pub enum CoatBase {
     RoughConductor(RoughConductor),
     RoughPlastic(RoughPlastic),
     RoughDiffuse(RoughDiffuseBxdf),
+    /// A smooth dielectric: the coating is then all deltas, on both sides.
+    Dielectric(DielectricBxdf),
 }
 
 impl CoatBase {
@@ -51,6 +60,7 @@ impl CoatBase {
             Lobe::RoughConductor(l) => Some(CoatBase::RoughConductor(l)),
             Lobe::RoughPlastic(l) => Some(CoatBase::RoughPlastic(l)),
             Lobe::RoughDiffuse(l) => Some(CoatBase::RoughDiffuse(l)),
+            Lobe::Dielectric(l) => Some(CoatBase::Dielectric(l)),
             _ => None,
         }
     }
@@ -63,6 +73,7 @@ impl CoatBase {
             CoatBase::RoughConductor(l) => Bxdf::eval(l, wo, wi),
             CoatBase::RoughPlastic(l) => Bxdf::eval(l, wo, wi),
             CoatBase::RoughDiffuse(l) => Bxdf::eval(l, wo, wi),
+            CoatBase::Dielectric(l) => Bxdf::eval(l, wo, wi),
         }
     }
 
@@ -74,6 +85,7 @@ impl CoatBase {
             CoatBase::RoughConductor(l) => Bxdf::pdf(l, wo, wi),
             CoatBase::RoughPlastic(l) => Bxdf::pdf(l, wo, wi),
             CoatBase::RoughDiffuse(l) => Bxdf::pdf(l, wo, wi),
+            CoatBase::Dielectric(l) => Bxdf::pdf(l, wo, wi),
         }
     }
 
@@ -85,6 +97,7 @@ impl CoatBase {
             CoatBase::RoughConductor(l) => Bxdf::sample(l, wo, u, uc, mode),
             CoatBase::RoughPlastic(l) => Bxdf::sample(l, wo, u, uc, mode),
             CoatBase::RoughDiffuse(l) => Bxdf::sample(l, wo, u, uc, mode),
+            CoatBase::Dielectric(l) => Bxdf::sample(l, wo, u, uc, mode),
         }
     }
 
@@ -95,6 +108,7 @@ impl CoatBase {
             CoatBase::RoughConductor(l) => Bxdf::roughness(l),
             CoatBase::RoughPlastic(l) => Bxdf::roughness(l),
             CoatBase::RoughDiffuse(l) => Bxdf::roughness(l),
+            CoatBase::Dielectric(l) => Bxdf::roughness(l),
         }
     }
 }
@@ -114,7 +128,46 @@ pub struct CoatingBxdf {
     pub specular_weight: f32,
 }
 
+/// `w` with its z given the sign of `side`'s.
+#[inline]
+fn on_side_of(w: Vec3, side: f32) -> Vec3 {
+    Vec3::new(w.x, w.y, w.z.abs().copysign(side))
+}
+
 impl CoatingBxdf {
+    /// A coated dielectric, sampled (see the module): the layer's reflection, or the light
+    /// through the layer that the dielectric reflects or refracts, out on the side it leaves.
+    fn sample_coated_dielectric(
+        &self,
+        glass: &DielectricBxdf,
+        wo: Vec3,
+        u: Vec2,
+        uc: f32,
+        mode: TransportMode,
+    ) -> Option<LocalSample> {
+        if wo.z == 0.0 {
+            return None;
+        }
+        let (up, f_o) = self.inside(Vec3::new(wo.x, wo.y, wo.z.abs()));
+        let wo_in = on_side_of(up, wo.z);
+        let p_spec = self.prob_specular(f_o);
+        if uc < p_spec {
+            return delta_sample(
+                Vec3::new(-wo.x, -wo.y, wo.z),
+                self.specular_reflectance * (f_o / p_spec),
+                p_spec,
+            );
+        }
+        let uc = ((uc - p_spec) / (1.0 - p_spec)).min(1.0 - f32::EPSILON);
+        let s = glass.sample(wo_in, u, uc, mode)?;
+        let out = self.outside(Vec3::new(s.wi.x, s.wi.y, s.wi.z.abs()))?;
+        let f_i = fresnel_dielectric(out.z, self.eta);
+        let weight = s.weight
+            * self.attenuation(wo_in.z.abs(), s.wi.z.abs())
+            * ((1.0 - f_o) * (1.0 - f_i) / (1.0 - p_spec));
+        delta_sample(on_side_of(out, s.wi.z), weight, s.pdf * (1.0 - p_spec))
+    }
+
     /// `w` (above the surface) refracted into the layer, and the layer's Fresnel
     /// reflectance for it.
     #[inline]
@@ -161,7 +214,7 @@ impl CoatingBxdf {
 
 impl Bxdf for CoatingBxdf {
     fn is_delta(&self) -> bool {
-        matches!(self.base, CoatBase::Conductor(_))
+        matches!(self.base, CoatBase::Conductor(_) | CoatBase::Dielectric(_))
     }
 
     /// The light through the layer (the mirror reflection is a delta).
@@ -191,6 +244,9 @@ impl Bxdf for CoatingBxdf {
     }
 
     fn sample(&self, wo: Vec3, u: Vec2, uc: f32, mode: TransportMode) -> Option<LocalSample> {
+        if let CoatBase::Dielectric(glass) = &self.base {
+            return self.sample_coated_dielectric(glass, wo, u, uc, mode);
+        }
         if wo.z <= 0.0 {
             return None;
         }
@@ -229,6 +285,9 @@ impl Bxdf for CoatingBxdf {
     }
 
     fn delta_probability(&self, wo: Vec3) -> f32 {
+        if let CoatBase::Dielectric(_) = self.base {
+            return if wo.z == 0.0 { 0.0 } else { 1.0 };
+        }
         if wo.z <= 0.0 {
             return 0.0;
         }
@@ -278,7 +337,11 @@ impl SurfaceMaterial for CoatingMaterial {
     }
 
     fn is_delta(&self) -> bool {
-        matches!(*self.base, Material::Conductor(_))
+        matches!(*self.base, Material::Conductor(_) | Material::Dielectric(_))
+    }
+
+    fn encloses_volume(&self) -> bool {
+        self.base.encloses_volume()
     }
 }
 
@@ -299,12 +362,19 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
         if !supported || matches!(base, Material::Blend(_)) {
             return Err(bag.error(
                 "type",
-                format!("a coating lies on a diffuse, conductor, roughconductor, roughplastic or roughdiffuse material, not on `{ty}`"),
+                format!("a coating lies on a diffuse, conductor, roughconductor, roughplastic, roughdiffuse or dielectric material, not on `{ty}`"),
             ));
         }
         let base_twosided = base.lobe_at(Vec3::ZERO, TextureEvalContext::default()).is_some_and(|(l, t)| {
             t || matches!(l, Lobe::Diffuse(DiffuseBxdf { twosided: true, .. }))
         });
+        let twosided = m.bool("twosided", false)? || base_twosided;
+        if twosided && matches!(base, Material::Dielectric(_)) {
+            return Err(m.error(
+                "twosided",
+                "a coating over a dielectric lies on both sides of it already",
+            ));
+        }
         nested.push(bag);
         // Mitsuba 0.6's default: BK7 in air.
         let eta = read_ior(m, 1.5046 / 1.000277)?;
@@ -324,7 +394,7 @@ pub const FACTORY: Factory<CoatingMaterial> = Factory {
             depth,
             specular_reflectance: resources.texture(m, "specular_reflectance", Rgb::ONE)?,
             specular_weight: 1.0 / (mean_transmittance + 1.0),
-            twosided: m.bool("twosided", false)? || base_twosided,
+            twosided,
         }))
     },
 };

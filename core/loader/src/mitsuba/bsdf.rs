@@ -391,6 +391,7 @@ impl Reader {
                     "roughconductor",
                     "roughplastic",
                     "roughdiffuse",
+                    "dielectric",
                 ];
                 if !covered.contains(&kind.as_str())
                     || self.masks.contains_key(&base)
@@ -400,7 +401,7 @@ impl Reader {
                 {
                     self.unsupported(
                         &o,
-                        &format!("a coating over this BSDF (`{kind}`, or one with a mask or a normal or bump map): foton coats diffuse, conductor, roughconductor, roughplastic and roughdiffuse BSDFs (--lenient: the BSDF without the coating)"),
+                        &format!("a coating over this BSDF (`{kind}`, or one with a mask or a normal or bump map): foton coats diffuse, conductor, roughconductor, roughplastic, roughdiffuse and dielectric BSDFs (--lenient: the BSDF without the coating)"),
                     )?;
                     if let Some(id) = &o.id {
                         self.bsdfs.insert(id.clone(), base.clone());
