@@ -38,6 +38,7 @@ mod filter;
 mod glossy;
 mod heterogeneous;
 mod kernels;
+mod lajolla;
 mod lobes;
 mod materials_classic;
 mod media;

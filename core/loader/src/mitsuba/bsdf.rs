@@ -5,7 +5,7 @@
 //! defaults written out and
 //! its named indices of refraction.
 
-use super::object::{Obj, Prop};
+use super::object::{Obj, Prop, show};
 use super::plugins::not_read;
 use super::{Reader, at, table_mut, vec3};
 use foton_core::error::Result;
@@ -480,6 +480,18 @@ impl Reader {
             "disneybsdf" => {
                 put("type", Value::Str("principled".into()));
                 if !self.disney(&mut o, &mut t)? {
+                    return Ok(None);
+                }
+            }
+            "disneydiffuse" | "disneymetal" => {
+                put("type", Value::Str("principled".into()));
+                if !self.disney_lobe(&mut o, &mut t)? {
+                    return Ok(None);
+                }
+            }
+            "disneyglass" => {
+                put("type", Value::Str("roughdielectric".into()));
+                if !self.disney_glass(&mut o, &mut t)? {
                     return Ok(None);
                 }
             }
@@ -958,6 +970,114 @@ impl Reader {
             );
         }
         self.principled(o, t)
+    }
+
+    /// Takes the parameters lajolla's single-lobe BSDF `o` does not read (lajolla ignores
+    /// them): a warning each. `read` are the names it reads, snake_cased.
+    fn lajolla_reads_only(&mut self, o: &mut Obj, read: &[&str]) {
+        let other: Vec<String> = (o.props.iter())
+            .map(|(n, _, _)| n.clone())
+            .filter(|n| !read.contains(&n.as_str()))
+            .collect();
+        let why = format!("ignored (lajolla's `{}` does not read it)", o.ty);
+        for name in other {
+            self.ignored(o, &name, &|_| false, &why);
+        }
+    }
+
+    /// lajolla's `disneydiffuse` and `disneymetal`, lobes of its Disney BSDF on their own (the
+    /// course's homework formulas, Burley 2012 and 2015): Mitsuba 3's principled BSDF with
+    /// the others switched off. Its diffuse lobe (no specular: eta 1) is Burley's base
+    /// diffuse blended by `flatness` with the fake subsurface as lajolla's by `subsurface`;
+    /// at metallic 1 its only lobe is the GGX metal with Schlick's Fresnel of the base colour.
+    /// lajolla's defaults written out.
+    fn disney_lobe(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
+        let line = o.line;
+        let float = |x: f64| at(Value::Float(x), line);
+        match o.ty.as_str() {
+            "disneydiffuse" => {
+                self.lajolla_reads_only(o, &["base_color", "roughness", "subsurface"]);
+                if let Some((p, l)) = o.take("subsurface") {
+                    o.props.push(("flatness".into(), p, l));
+                }
+                if !self.principled(o, t)? {
+                    return Ok(false);
+                }
+                t.insert("specular", float(0.0));
+            }
+            "disneymetal" => {
+                self.lajolla_reads_only(o, &["base_color", "roughness", "anisotropic"]);
+                if !self.principled(o, t)? {
+                    return Ok(false);
+                }
+                t.insert("metallic", float(1.0));
+            }
+            _ => unreachable!("only lajolla's diffuse and metal lobes are read as principled"),
+        }
+        for k in ["roughness", "anisotropic"] {
+            if t.get(k).is_none() {
+                t.insert(k, float(if k == "roughness" { 0.5 } else { 0.0 }));
+            }
+        }
+        let alpha = if o.ty == "disneymetal" {
+            " (GGX alpha at least 0.001 where lajolla's is 0.0001: the same above roughness 0.032)"
+        } else {
+            ""
+        };
+        self.note(
+            o,
+            &format!(
+                "lajolla's single {} lobe of its Disney BSDF (a course renderer's), read as Mitsuba 3's principled BSDF with only that lobe on{alpha}",
+                o.ty.trim_start_matches("disney")
+            ),
+        );
+        Ok(true)
+    }
+
+    /// lajolla's `disneyglass`: Walter et al.'s rough dielectric with the anisotropic GGX of
+    /// Disney's roughness (alpha = roughness^2 over and times sqrt(1 - 0.9 anisotropic), at
+    /// least 0.0001), the reflection tinted by the base colour and the refraction by its
+    /// square root: a roughdielectric with those reflectance and transmittance.
+    fn disney_glass(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
+        let line = o.line;
+        self.lajolla_reads_only(o, &["base_color", "roughness", "anisotropic", "eta"]);
+        let number = |o: &mut Obj, k: &str, default: f64| match o.take(k) {
+            None => Ok(default),
+            Some((Prop::Float(x), _)) => Ok(x),
+            Some((Prop::Int(i), _)) => Ok(i as f64),
+            Some((p, l)) => Err(o.error(format!(
+                "line {l}: `{k}`: foton reads lajolla's glass with a constant {k}, not {}",
+                show(&p)
+            ))),
+        };
+        let roughness = number(o, "roughness", 0.5)?;
+        let anisotropic = number(o, "anisotropic", 0.0)?;
+        let eta = number(o, "eta", 1.5)?;
+        let base = match o.take("base_color") {
+            None => DVec3::splat(0.5),
+            Some((Prop::Color(c), _)) => c,
+            Some((Prop::Float(x), _)) => DVec3::splat(x),
+            Some((p, l)) => {
+                return Err(o.error(format!(
+                    "line {l}: `base_color`: foton reads lajolla's glass with a constant colour (its refraction takes the square root), not {}",
+                    show(&p)
+                )));
+            }
+        };
+        let aspect = (1.0 - 0.9 * anisotropic).sqrt();
+        let r2 = roughness * roughness;
+        let float = |x: f64| at(Value::Float(x), line);
+        t.insert("distribution", at(Value::Str("ggx".into()), line));
+        t.insert("alpha_u", float((r2 / aspect).max(1e-4)));
+        t.insert("alpha_v", float((r2 * aspect).max(1e-4)));
+        t.insert("ior", float(eta));
+        t.insert("specular_reflectance", vec3(base, line));
+        t.insert("specular_transmittance", vec3(base.map(f64::sqrt), line));
+        self.note(
+            o,
+            "lajolla's single glass lobe of its Disney BSDF (a course renderer's), read as a rough dielectric: anisotropic GGX, the reflection times the base colour, the refraction times its square root",
+        );
+        Ok(true)
     }
 
     fn principled(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
