@@ -59,6 +59,8 @@ materials! {
         CoatedConductor(coatedconductor::CoatedConductorMaterial, coatedconductor::CoatedConductorBxdf),
         Coating(coating::CoatingMaterial, coating::CoatingBxdf),
         PPlastic(pplastic::PPlasticMaterial, pplastic::PPlasticBxdf),
+        DisneySheen(disneysheen::DisneySheenMaterial, disneysheen::DisneySheenBxdf),
+        DisneyClearcoat(disneyclearcoat::DisneyClearcoatMaterial, disneyclearcoat::DisneyClearcoatBxdf),
     }
 
     /// A material's scattering at one point, its textures looked up: one variant per kind of

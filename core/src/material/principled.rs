@@ -45,7 +45,7 @@
 
 use crate::texture::TextureEvalContext;
 use super::principled_common::{
-    Scalar, compatible, diffuse, distribution, fresnel, lerp, read_rate, read_scalar, refract,
+    Gtr1, Scalar, clearcoat_g1, compatible, diffuse, distribution, fresnel, lerp, read_rate, read_scalar, refract,
     schlick_fresnel, schlick_fresnel_weight, schlick_r0, schlick_weight, sheen_color, tint,
 };
 use super::{SurfaceMaterial, reflectance};
@@ -55,7 +55,7 @@ use crate::sampling::cosine_hemisphere;
 use crate::scattering::{Bxdf, LocalSample, TransportMode, reflect};
 use crate::texture::Texture;
 use glam::{Vec2, Vec3};
-use std::f32::consts::{FRAC_1_PI, PI, TAU};
+use std::f32::consts::FRAC_1_PI;
 
 #[derive(Clone, Debug)]
 pub struct PrincipledMaterial {
@@ -161,46 +161,6 @@ impl SurfaceMaterial for PrincipledMaterial {
     fn encloses_volume(&self) -> bool {
         self.spec_trans.given()
     }
-}
-
-/// The clearcoat's microfacet distribution, Burley's GTR1 (Berry's), isotropic.
-#[derive(Clone, Copy)]
-struct Gtr1 {
-    alpha: f32,
-}
-
-impl Gtr1 {
-    fn d(&self, m: Vec3) -> f32 {
-        let a2 = self.alpha * self.alpha;
-        let d = (a2 - 1.0) / (PI * a2.ln() * (1.0 + (a2 - 1.0) * m.z * m.z));
-        if d * m.z > 1e-20 { d } else { 0.0 }
-    }
-
-    /// D(m) cos theta_m, the density of [`Gtr1::sample`].
-    fn pdf(&self, m: Vec3) -> f32 {
-        if m.z < 0.0 { 0.0 } else { m.z * self.d(m) }
-    }
-
-    fn sample(&self, u: Vec2) -> Vec3 {
-        let (sin_phi, cos_phi) = (TAU * u.x).sin_cos();
-        let a2 = self.alpha * self.alpha;
-        let cos2 = (1.0 - a2.powf(1.0 - u.y)) / (1.0 - a2);
-        let sin = (1.0 - cos2).max(0.0).sqrt();
-        Vec3::new(cos_phi * sin, sin_phi * sin, cos2.max(0.0).sqrt())
-    }
-}
-
-/// Smith's GGX masking of the clearcoat (roughness 0.25, isotropic), as Mitsuba writes it.
-fn clearcoat_g1(v: Vec3, m: Vec3) -> f32 {
-    if v.dot(m) * v.z <= 0.0 {
-        return 0.0;
-    }
-    if v.z == 1.0 {
-        return 1.0;
-    }
-    let cos2 = v.z * v.z;
-    let tan2 = (1.0 - cos2) / cos2;
-    2.0 / (1.0 + (1.0 + 0.0625 * tan2).sqrt())
 }
 
 impl PrincipledBxdf {

@@ -12,7 +12,8 @@ use crate::registry::Resources;
 use crate::texture::TextureEvalContext;
 use crate::texture::{Texture, luminance};
 use crate::value::Value;
-use glam::Vec3;
+use glam::{Vec2, Vec3};
+use std::f32::consts::{PI, TAU};
 
 /// A number that may vary over the surface: a constant, or a texture read as its luminance
 /// (Mitsuba's `eval_1` of an RGB bitmap).
@@ -209,4 +210,44 @@ pub fn sheen_color(base_color: Rgb, sheen_tint: f32) -> Rgb {
 #[inline]
 pub fn lerp(a: f32, b: f32, t: f32) -> f32 {
     a + (b - a) * t
+}
+
+/// The clearcoat's microfacet distribution, Burley's GTR1 (Berry's), isotropic.
+#[derive(Clone, Copy)]
+pub struct Gtr1 {
+    pub alpha: f32,
+}
+
+impl Gtr1 {
+    pub fn d(&self, m: Vec3) -> f32 {
+        let a2 = self.alpha * self.alpha;
+        let d = (a2 - 1.0) / (PI * a2.ln() * (1.0 + (a2 - 1.0) * m.z * m.z));
+        if d * m.z > 1e-20 { d } else { 0.0 }
+    }
+
+    /// D(m) cos theta_m, the density of [`Gtr1::sample`].
+    pub fn pdf(&self, m: Vec3) -> f32 {
+        if m.z < 0.0 { 0.0 } else { m.z * self.d(m) }
+    }
+
+    pub fn sample(&self, u: Vec2) -> Vec3 {
+        let (sin_phi, cos_phi) = (TAU * u.x).sin_cos();
+        let a2 = self.alpha * self.alpha;
+        let cos2 = (1.0 - a2.powf(1.0 - u.y)) / (1.0 - a2);
+        let sin = (1.0 - cos2).max(0.0).sqrt();
+        Vec3::new(cos_phi * sin, sin_phi * sin, cos2.max(0.0).sqrt())
+    }
+}
+
+/// Smith's GGX masking of the clearcoat (roughness 0.25, isotropic), as Mitsuba writes it.
+pub fn clearcoat_g1(v: Vec3, m: Vec3) -> f32 {
+    if v.dot(m) * v.z <= 0.0 {
+        return 0.0;
+    }
+    if v.z == 1.0 {
+        return 1.0;
+    }
+    let cos2 = v.z * v.z;
+    let tan2 = (1.0 - cos2) / cos2;
+    2.0 / (1.0 + (1.0 + 0.0625 * tan2).sqrt())
 }

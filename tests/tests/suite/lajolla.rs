@@ -1,9 +1,9 @@
 //! lajolla's single-lobe Disney BSDFs (a course renderer's Mitsuba-format scenes): the BSDF
 //! foton reads each as evaluates to the homework's formula for that lobe (UCSD CSE 272,
-//! homework 1, written out here independently), on a rectangle facing +z. Its clearcoat and
-//! sheen lobes are not read: Mitsuba 3's principled clearcoat, which foton's follows, has no
-//! 1 / (4 cos_i cos_o), and its sheen cannot be had without the diffuse lobe.
+//! homework 1, written out here independently), on a rectangle facing +z; the two lobes foton
+//! has as materials of their own (`disney_sheen`, `disney_clearcoat`) sample their pdf.
 
+use crate::lobes::check_lobe_sampling;
 use foton_core::api::{Ray, Rgb, Vec3};
 use foton_core::bsdf::Bsdf;
 use std::f32::consts::PI;
@@ -142,6 +142,75 @@ fn disney_glass_reflects_with_the_base_colour_and_refracts_with_its_square_root(
             &format!("glass refraction at {wo}, {below}"),
             tinted.eval(wo, below),
             through * bc.map(f32::sqrt),
+        );
+    }
+}
+
+#[test]
+fn disney_clearcoat_is_gtr1_with_schlicks_fresnel_of_index_1_5() {
+    let gloss = 0.5f32;
+    let bsdf = rectangle_bsdf(
+        "lajolla-clearcoat",
+        r#"<bsdf type="disneyclearcoat"><float name="clearcoatGloss" value="0.5"/></bsdf>"#,
+    );
+    let ag = (1.0 - gloss) * 0.1 + gloss * 0.001;
+    let a2 = ag * ag;
+    for (wo, wi) in pairs() {
+        let h = (wo + wi).normalize();
+        let f = 0.04 + 0.96 * schlick(h.dot(wi));
+        let d = (a2 - 1.0) / (PI * a2.ln() * (1.0 + (a2 - 1.0) * h.z * h.z));
+        let want = f * d * g1(wo, 0.25) * g1(wi, 0.25) / (4.0 * wo.z);
+        assert_close(
+            &format!("clearcoat at {wo}, {wi}"),
+            bsdf.eval(wo, wi),
+            Rgb::splat(want),
+        );
+    }
+    for (j, wo) in [Vec3::new(0.3, 0.1, 0.9), Vec3::new(-0.8, 0.2, 0.3)]
+        .into_iter()
+        .enumerate()
+    {
+        let wo = wo.normalize();
+        // A rough coat: its lobe spreads over many cells of the chi-square grid.
+        let rough = rectangle_bsdf(
+            "lajolla-clearcoat-rough",
+            r#"<bsdf type="disneyclearcoat"><float name="clearcoatGloss" value="0"/></bsdf>"#,
+        );
+        check_lobe_sampling(
+            &format!("clearcoat, wo = {wo}"),
+            &rough,
+            wo,
+            Vec3::Z,
+            &[41, j as u64],
+        );
+    }
+}
+
+#[test]
+fn disney_sheen_is_a_tinted_schlick_weight_at_grazing_angles() {
+    let (bc, tint) = (Rgb::new(0.82, 0.67, 0.16), 0.5f32);
+    let bsdf = rectangle_bsdf(
+        "lajolla-sheen",
+        r#"<bsdf type="disneysheen"><rgb name="baseColor" value="0.82 0.67 0.16"/><float name="sheenTint" value="0.5"/></bsdf>"#,
+    );
+    let luminance = 0.2126 * bc[0] + 0.7152 * bc[1] + 0.0722 * bc[2];
+    let c_sheen = Rgb::splat(1.0 - tint) + bc / luminance * tint;
+    for (wo, wi) in pairs() {
+        let h = (wo + wi).normalize();
+        let want = c_sheen * (schlick(h.dot(wi)) * wi.z);
+        assert_close(&format!("sheen at {wo}, {wi}"), bsdf.eval(wo, wi), want);
+    }
+    for (j, wo) in [Vec3::new(0.3, 0.1, 0.9), Vec3::new(-0.8, 0.2, 0.3)]
+        .into_iter()
+        .enumerate()
+    {
+        let wo = wo.normalize();
+        check_lobe_sampling(
+            &format!("sheen, wo = {wo}"),
+            &bsdf,
+            wo,
+            Vec3::Z,
+            &[43, j as u64],
         );
     }
 }

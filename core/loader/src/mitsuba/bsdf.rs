@@ -489,6 +489,28 @@ impl Reader {
                     return Ok(None);
                 }
             }
+            "disneysheen" => {
+                put("type", Value::Str("disney_sheen".into()));
+                self.lajolla_reads_only(&mut o, &["base_color", "sheen_tint"]);
+                let Some(c) = self.texture(&mut o, "base_color", DVec3::splat(0.5))? else {
+                    return Ok(None);
+                };
+                t.insert("base_color", c);
+                match self.principled_scalar(&mut o, "sheen_tint")? {
+                    Scalar::Absent => {}
+                    Scalar::LeftOut => return Ok(None),
+                    Scalar::Given(v) => t.insert("sheen_tint", v),
+                }
+            }
+            "disneyclearcoat" => {
+                put("type", Value::Str("disney_clearcoat".into()));
+                self.lajolla_reads_only(&mut o, &["clearcoat_gloss"]);
+                match self.principled_scalar(&mut o, "clearcoat_gloss")? {
+                    Scalar::Absent => {}
+                    Scalar::LeftOut => return Ok(None),
+                    Scalar::Given(v) => t.insert("clearcoat_gloss", v),
+                }
+            }
             "disneyglass" => {
                 put("type", Value::Str("roughdielectric".into()));
                 if !self.disney_glass(&mut o, &mut t)? {
