@@ -79,7 +79,7 @@ impl Bxdf for DisneyClearcoatBxdf {
             return None;
         }
         let pdf = self.pdf(wo, wi);
-        if !(pdf > 0.0) {
+        if pdf.is_nan() || pdf <= 0.0 {
             return None;
         }
         Some(LocalSample {
