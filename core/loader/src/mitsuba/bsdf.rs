@@ -962,7 +962,7 @@ impl Reader {
     fn disney(&mut self, o: &mut Obj, t: &mut Table) -> Result<bool> {
         self.note(
             o,
-            "lajolla's Disney BSDF, read as Mitsuba 3's principled BSDF, which implements the same model (Burley 2015)",
+            "lajolla's Disney BSDF, read as Mitsuba 3's principled BSDF, the same model (Burley 2015) in other details: Mitsuba's clearcoat leaves out the microfacet 1 / (4 cos_i cos_o), its dielectric reflection takes the Fresnel equations of eta where lajolla's takes Schlick's of `specular` R0(eta), and its glass reflection is not tinted by the base colour",
         );
         for (from, to) in [
             ("specular_transmission", "spec_trans"),
