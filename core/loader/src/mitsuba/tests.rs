@@ -4,7 +4,7 @@
 const RICH: &str = r#"<scene version="3.0.0">
 <default name="spp" value="4"/>
 <default name="res" value="16"/>
-<integrator type="volpath"><integer name="max_depth" value="6"/></integrator>
+<integrator type="volpath"><integer name="max_depth" value="6"/><float name="timeout" value="30"/></integrator>
 <sensor type="perspective">
 <float name="fov" value="40"/>
 <string name="fov_axis" value="x"/>
@@ -24,6 +24,11 @@ const RICH: &str = r#"<scene version="3.0.0">
 <bsdf type="twosided" id="two"><bsdf type="plastic"><rgb name="diffuse_reflectance" value="0.3, 0.5, 0.2"/></bsdf></bsdf>
 <bsdf type="blendbsdf" id="mix"><float name="weight" value="0.3"/><ref id="checks"/><ref id="gold"/></bsdf>
 <bsdf type="dielectric" id="glass"><string name="int_ior" value="bk7"/></bsdf>
+<bsdf type="coating" id="coated"><rgb name="sigma_a" value="0.1, 0.2, 0.3"/><bsdf type="dielectric"/></bsdf>
+<bsdf type="disneyglass" id="lj_glass"><rgb name="baseColor" value="0.8 0.6 0.2"/><float name="anisotropic" value="0.5"/></bsdf>
+<bsdf type="disneysheen" id="lj_sheen"><float name="sheenTint" value="0.3"/></bsdf>
+<bsdf type="disneyclearcoat" id="lj_coat"><float name="clearcoatGloss" value="0.2"/></bsdf>
+<bsdf type="disneymetal" id="lj_metal"><float name="roughness" value="0.3"/></bsdf>
 <medium type="homogeneous" id="fog"><rgb name="sigma_t" value="0.5"/><rgb name="albedo" value="0.8"/>
 <phase type="hg"><float name="g" value="0.4"/></phase></medium>
 <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="-90"/><scale value="3"/></transform><ref id="checks"/></shape>
@@ -31,6 +36,11 @@ const RICH: &str = r#"<scene version="3.0.0">
 <shape type="cube"><transform name="to_world"><scale value="0.3"/><translate x="1" y="0.3"/></transform>
 <bsdf type="null"/><ref name="interior" id="fog"/></shape>
 <shape type="disk"><transform name="to_world"><translate y="0.01" z="1"/></transform><ref id="two"/></shape>
+<shape type="sphere"><point name="center" x="1.5" y="0.3" z="1"/><float name="radius" value="0.2"/><ref id="coated"/></shape>
+<shape type="sphere"><point name="center" x="-1.5" y="0.3" z="1"/><float name="radius" value="0.2"/><ref id="lj_glass"/></shape>
+<shape type="sphere"><point name="center" x="0" y="0.3" z="1.5"/><float name="radius" value="0.2"/><ref id="lj_sheen"/></shape>
+<shape type="sphere"><point name="center" x="0.5" y="0.3" z="1.5"/><float name="radius" value="0.2"/><ref id="lj_coat"/></shape>
+<shape type="sphere"><point name="center" x="-0.5" y="0.3" z="1.5"/><float name="radius" value="0.2"/><ref id="lj_metal"/></shape>
 <shape type="cylinder"><point name="p0" x="0" y="0" z="-1"/><point name="p1" x="0" y="1" z="-1"/><float name="radius" value="0.2"/><ref id="glass"/></shape>
 <shape type="rectangle"><transform name="to_world"><rotate x="1" angle="90"/><translate y="2.5"/></transform>
 <emitter type="area"><rgb name="radiance" value="5"/></emitter></shape>
