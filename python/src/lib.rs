@@ -354,10 +354,28 @@ impl NativeScene {
         threads: Option<usize>,
         progress: Option<Bound<'py, PyAny>>,
     ) -> PyResult<(Bound<'py, PyAny>, Bound<'py, PyDict>)> {
-        let p = self.prepare(py, &overrides)?;
+        let mut overrides = overrides;
         let threads = threads
             .unwrap_or_else(|| std::thread::available_parallelism().map_or(1, |n| n.get()))
             .max(1);
+        // A time limit (render.time, Mitsuba's timeout): the samples or iterations that fill
+        // it, as `foton render` chooses them, set as an override.
+        if let Some(seconds) = self.prepare(py, &overrides)?.scene.render().time {
+            let fitted = py
+                .detach(|| {
+                    let owned = |extra: &[String]| {
+                        let mut o = self.overrides.clone();
+                        o.extend_from_slice(&overrides);
+                        o.extend_from_slice(extra);
+                        prepare_scene(self.source.load(&o)?, &self.search, self.strict)
+                    };
+                    let mut q = owned(&[])?;
+                    foton_cli::time_limit::fit(&mut q, seconds.into(), threads, &owned)
+                })
+                .map_err(|e| py_error(py, e))?;
+            overrides.extend(fitted.set());
+        }
+        let p = self.prepare(py, &overrides)?;
         let report = Report::default();
         let cancel = AtomicBool::new(false);
         let finished = (Mutex::new(false), Condvar::new());

@@ -130,3 +130,18 @@ def test_scene_attributes():
     assert scene.parameters["iterations"] == 64
     assert scene.output == SCENES / "caustics-area.png"
     assert "256x256" in repr(scene)
+
+
+def test_a_time_limit_chooses_the_samples_as_the_program_does(tmp_path):
+    # render.time (Mitsuba's timeout) bounds the samples: a million per pixel would take
+    # minutes, 0.3 s far fewer; never more than the scene's spp, which a minute leaves as it is.
+    scene = foton.load(SCENES / "cornell-box.toml", **{"film.width": 16, "film.height": 12, "render.time": 0.3})
+    image = scene.render(spp=1_000_000, progress=False)
+    spp = scene.last_render["spp"]
+    assert 1 <= spp < 1_000_000
+    # The image is the one that many samples render without the limit.
+    plain = foton.load(SCENES / "cornell-box.toml", **{"film.width": 16, "film.height": 12})
+    assert image.view(np.uint32).tobytes() == plain.render(spp=spp, progress=False).view(np.uint32).tobytes()
+    roomy = foton.load(SCENES / "cornell-box.toml", **{"film.width": 16, "film.height": 12, "render.time": 60})
+    roomy.render(spp=2, progress=False)
+    assert roomy.last_render["spp"] == 2

@@ -24,7 +24,7 @@ mod plugins;
 mod progress;
 mod render;
 pub mod sweep;
-mod time_limit;
+pub mod time_limit;
 
 pub use common::{
     INTERRUPTED, Prepared, install_interrupt_handler, prepare, prepare_scene, render_part,

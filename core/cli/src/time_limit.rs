@@ -12,7 +12,7 @@ use foton_core::integrator::{Budget, RenderContext, Work};
 
 /// What [`fit`] chose.
 #[derive(Debug, PartialEq)]
-pub(crate) enum Fitted {
+pub enum Fitted {
     /// The scene's camera samples per pixel, now `spp`.
     Samples { spp: u32 },
     /// A progressive integrator's iterations: the scene value `set` (`key=n`) chooses them;
@@ -50,7 +50,7 @@ fn units(cost: &CostModel, seconds: f64, most: u64) -> u64 {
 /// Fits `p`'s work to `seconds` (see the module): sets its spp in place, or says which
 /// iterations to prepare it with (`prepare(overrides)` makes the calibration renders'
 /// scenes). Renders on `threads` threads, quietly.
-pub(crate) fn fit(
+pub fn fit(
     p: &mut Prepared,
     seconds: f64,
     threads: usize,
