@@ -150,15 +150,10 @@ impl CoatingBxdf {
         }
         let (up, f_o) = self.inside(Vec3::new(wo.x, wo.y, wo.z.abs()));
         let wo_in = on_side_of(up, wo.z);
-        let p_spec = self.prob_specular(f_o);
-        if uc < p_spec {
-            return delta_sample(
-                Vec3::new(-wo.x, -wo.y, wo.z),
-                self.specular_reflectance * (f_o / p_spec),
-                p_spec,
-            );
-        }
-        let uc = ((uc - p_spec) / (1.0 - p_spec)).min(1.0 - f32::EPSILON);
+        let (uc, p_spec) = match self.layer_or_through(wo, f_o, uc) {
+            Ok(through) => through,
+            Err(layer) => return layer,
+        };
         let s = glass.sample(wo_in, u, uc, mode)?;
         let out = self.outside(Vec3::new(s.wi.x, s.wi.y, s.wi.z.abs()))?;
         let f_i = fresnel_dielectric(out.z, self.eta);
@@ -199,6 +194,27 @@ impl CoatingBxdf {
             (self.depth.y * d).exp(),
             (self.depth.z * d).exp(),
         )
+    }
+
+    /// The layer's mirror reflection of `wo` (Fresnel reflectance `f_o`), chosen with its
+    /// probability when `uc` falls below it (`Err`); else the light goes through the layer:
+    /// `uc` rescaled for the base, and the probability the reflection had.
+    #[inline]
+    fn layer_or_through(
+        &self,
+        wo: Vec3,
+        f_o: f32,
+        uc: f32,
+    ) -> Result<(f32, f32), Option<LocalSample>> {
+        let p_spec = self.prob_specular(f_o);
+        if uc < p_spec {
+            return Err(delta_sample(
+                Vec3::new(-wo.x, -wo.y, wo.z),
+                self.specular_reflectance * (f_o / p_spec),
+                p_spec,
+            ));
+        }
+        Ok((((uc - p_spec) / (1.0 - p_spec)).min(1.0 - f32::EPSILON), p_spec))
     }
 
     /// The probability of sampling the mirror reflection for `wo` (above the surface), whose
@@ -263,15 +279,10 @@ impl Bxdf for CoatingBxdf {
                 1.0,
             );
         }
-        let p_spec = self.prob_specular(f_o);
-        if uc < p_spec {
-            return delta_sample(
-                Vec3::new(-wo.x, -wo.y, wo.z),
-                self.specular_reflectance * (f_o / p_spec),
-                p_spec,
-            );
-        }
-        let uc = ((uc - p_spec) / (1.0 - p_spec)).min(1.0 - f32::EPSILON);
+        let (uc, _) = match self.layer_or_through(wo, f_o, uc) {
+            Ok(through) => through,
+            Err(layer) => return layer,
+        };
         let s = self.base.sample(wo_in, u, uc, mode)?;
         if s.delta || s.wi.z <= 0.0 {
             return None;
