@@ -390,7 +390,7 @@ fn unknown_material_type_lists_the_types() {
         "materials.white.type",
         &[
             "unknown material type \"velvet\"",
-            "diffuse, mirror, conductor, dielectric, thindielectric, roughconductor, roughdielectric, plastic, roughplastic, phong, ward, roughdiffuse, principled, principledthin, difftrans, coateddiffuse, coatedconductor, coating, pplastic, null, blend",
+            "diffuse, mirror, conductor, dielectric, thindielectric, roughconductor, roughdielectric, plastic, roughplastic, phong, ward, roughdiffuse, principled, principledthin, difftrans, coateddiffuse, coatedconductor, coating, pplastic, disney_sheen, disney_clearcoat, null, blend",
         ],
     );
 }
