@@ -108,11 +108,19 @@ pub(crate) fn run(a: RenderArgs, out: &mut dyn Write, err: &mut dyn Write) -> Re
                 "--part and render.time: each part would fit its own samples to the time limit, and the parts would not merge; set render.spp instead".into(),
             ));
         }
+        INTERRUPTED.store(false, Ordering::SeqCst);
         let fitted = time_limit::fit(&mut p, seconds.into(), a.run.threads(), &|extra| {
             let mut o = overrides.clone();
             o.extend_from_slice(extra);
             a.scene.prepare(&o)
         })?;
+        if INTERRUPTED.load(Ordering::SeqCst) {
+            let _ = writeln!(
+                err,
+                "interrupted while measuring the cost of a sample for render.time: nothing rendered"
+            );
+            return Ok(130);
+        }
         if let time_limit::Fitted::Iterations { set, .. } = &fitted {
             overrides.push(set.clone());
             p = a.scene.prepare(&overrides)?;
