@@ -147,6 +147,14 @@ struct NativeScene {
 }
 
 impl NativeScene {
+    /// The scene with `extra` overrides after its own, loaded again and its integrator
+    /// created (without the GIL: call inside `detach`).
+    fn load(&self, extra: &[String]) -> foton_core::error::Result<Prepared> {
+        let mut overrides = self.overrides.clone();
+        overrides.extend_from_slice(extra);
+        prepare_scene(self.source.load(&overrides)?, &self.search, self.strict)
+    }
+
     fn prepare(&self, py: Python<'_>, extra: &[String]) -> PyResult<Arc<Prepared>> {
         if extra.is_empty() {
             return Ok(self.base.clone());
@@ -156,13 +164,8 @@ impl NativeScene {
         {
             return Ok(p.clone());
         }
-        let mut overrides = self.overrides.clone();
-        overrides.extend_from_slice(extra);
         let prepared = py
-            .detach(|| {
-                let scene = self.source.load(&overrides)?;
-                prepare_scene(scene, &self.search, self.strict)
-            })
+            .detach(|| self.load(extra))
             .map_err(|e| py_error(py, e))?;
         let prepared = Arc::new(prepared);
         *self.last.lock().unwrap() = Some((extra.to_vec(), prepared.clone()));
@@ -364,10 +367,9 @@ impl NativeScene {
             let fitted = py
                 .detach(|| {
                     let owned = |extra: &[String]| {
-                        let mut o = self.overrides.clone();
-                        o.extend_from_slice(&overrides);
+                        let mut o = overrides.clone();
                         o.extend_from_slice(extra);
-                        prepare_scene(self.source.load(&o)?, &self.search, self.strict)
+                        self.load(&o)
                     };
                     let mut q = owned(&[])?;
                     foton_cli::time_limit::fit(&mut q, seconds.into(), threads, &owned)

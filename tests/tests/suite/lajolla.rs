@@ -3,6 +3,7 @@
 //! homework 1, written out here independently), on a rectangle facing +z; the two lobes foton
 //! has as materials of their own (`disney_sheen`, `disney_clearcoat`) sample their pdf.
 
+use crate::coating::fresnel;
 use crate::lobes::check_lobe_sampling;
 use foton_core::api::{Ray, Rgb, Vec3};
 use foton_core::bsdf::Bsdf;
@@ -40,17 +41,6 @@ fn g1(w: Vec3, alpha: f32) -> f32 {
 fn ggx(h: Vec3, alpha: f32) -> f32 {
     let a2 = alpha * alpha;
     1.0 / (PI * a2 * ((h.x * h.x + h.y * h.y) / a2 + h.z * h.z).powi(2))
-}
-
-fn dielectric_fresnel(cos_i: f32, eta: f32) -> f32 {
-    let sin_t2 = (1.0 - cos_i * cos_i) / (eta * eta);
-    if sin_t2 >= 1.0 {
-        return 1.0;
-    }
-    let cos_t = (1.0 - sin_t2).sqrt();
-    let rs = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
-    let rp = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
-    0.5 * (rs * rs + rp * rp)
 }
 
 /// Pairs of directions above the surface (wo towards the viewer, wi towards the light).
@@ -126,7 +116,7 @@ fn disney_glass_reflects_with_the_base_colour_and_refracts_with_its_square_root(
     let alpha = r * r;
     for (wo, wi) in pairs() {
         let h = (wo + wi).normalize();
-        let f = dielectric_fresnel(h.dot(wo), eta);
+        let f = fresnel(h.dot(wo) as f64, eta as f64) as f32;
         let want = bc * (f * ggx(h, alpha) * g1(wo, alpha) * g1(wi, alpha) / (4.0 * wo.z));
         assert_close(
             &format!("glass reflection at {wo}, {wi}"),
