@@ -322,6 +322,30 @@ fn max_depth_counts_segments() {
     let run = foton_with_plugins(&["check", s(&xml)]);
     ok(&run);
     assert!(run.stdout.contains("max_depth 1 "), "{}", run.stdout);
+    // Mitsuba 3's differentiable integrators render their primal image, the path tracer's
+    // (their max_depth defaults to 6), direct_projective's direct lighting's.
+    for (integrator, expected) in [
+        ("<integrator type=\"prb\"/>", "max_depth 5 "),
+        (
+            "<integrator type=\"prb_projective\"><integer name=\"max_depth\" value=\"3\"/><integer name=\"sppi\" value=\"0\"/></integrator>",
+            "max_depth 2 ",
+        ),
+        ("<integrator type=\"prbvolpath\"/>", "max_depth 5 "),
+        ("<integrator type=\"direct_projective\"/>", "max_depth 1 "),
+    ] {
+        let text = XML.replace(
+            "<integrator type=\"path\">\n        <integer name=\"max_depth\" value=\"4\"/>\n    </integrator>",
+            integrator,
+        );
+        write(&dir, "scene.xml", &text);
+        let run = foton_with_plugins(&["check", s(&xml)]);
+        ok(&run);
+        assert!(
+            run.stdout.contains(expected) && run.stdout.contains("path"),
+            "{integrator}: {}",
+            run.stdout
+        );
+    }
 }
 
 /// What foton cannot render is an error naming the element, its type and file:line;

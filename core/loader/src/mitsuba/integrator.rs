@@ -30,7 +30,7 @@ impl Reader {
             o.props.clear();
             let message = if MITSUBA_INTEGRATORS.contains(&o.ty.as_str()) {
                 format!(
-                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm, bdpt and ptracer",
+                    "integrator `{}` is not supported; foton renders path, volpath, volpath_simple, volpathmis, direct, photonmapper, sppm, ppm, bdpt, ptracer and the differentiable prb, prb_basic, prb_projective, prbvolpath and direct_projective",
                     o.ty
                 )
             } else {
@@ -75,11 +75,29 @@ impl Reader {
         // Mitsuba's max_depth counts path segments (1: emitters seen directly, 2: direct
         // light); foton's counts scattering events, one less. -1 is unbounded in both
         // Mitsubas: a cap no path reaches (Russian roulette ends them long before).
-        let max_depth = if o.ty == "direct" {
-            2
-        } else {
-            o.int("max_depth", -1)?
+        // Mitsuba 3's differentiable integrators default to 6 (direct_projective: always 2).
+        let max_depth = match o.ty.as_str() {
+            "direct" | "direct_projective" => 2,
+            ty if DIFFERENTIABLE.contains(&ty) => o.int("max_depth", 6)?,
+            _ => o.int("max_depth", -1)?,
         };
+        if DIFFERENTIABLE.contains(&o.ty.as_str()) {
+            self.note(
+                &o,
+                "a differentiable integrator (Mitsuba 3's AD variants): rendered by path, whose image is its primal one; its gradient parameters are ignored",
+            );
+            for k in [
+                "sppc",
+                "sppp",
+                "sppi",
+                "guiding",
+                "guiding_proj",
+                "guiding_rounds",
+                "project_seed",
+            ] {
+                self.ignored(&mut o, k, &|_| true, "");
+            }
+        }
         let bounces = match max_depth {
             -1 => 65_536,
             d if d >= 1 => d - 1,
@@ -452,7 +470,18 @@ impl Reader {
     }
 }
 
+/// Mitsuba 3's differentiable integrators (AD variants only), whose primal image is a path
+/// tracer's (direct_projective's: direct lighting's).
+const DIFFERENTIABLE: &[&str] = &[
+    "prb",
+    "prb_basic",
+    "prb_projective",
+    "prbvolpath",
+    "direct_projective",
+];
+
 const MITSUBA_INTEGRATORS: &[&str] = &[
+    "prb_basic",
     "path",
     "volpath",
     "volpath_simple",
@@ -487,6 +516,7 @@ const MITSUBA_INTEGRATORS: &[&str] = &[
 fn foton_integrator(mitsuba: &str, has_media: bool) -> Option<&'static str> {
     Some(match mitsuba {
         "path" | "volpath" | "volpath_simple" | "volpathmis" | "direct" => "path",
+        "prb" | "prb_basic" | "prb_projective" | "prbvolpath" | "direct_projective" => "path",
         "photonmapper" if has_media => "vpm",
         "photonmapper" => "photon",
         "sppm" | "ppm" => "sppm",
