@@ -16,6 +16,7 @@
 //! bitmaps; [`image`]: image files read and written).
 
 mod build;
+pub mod curve;
 pub mod document;
 pub mod formats;
 pub mod image;
@@ -26,6 +27,7 @@ pub mod mitsuba;
 mod mutations;
 pub mod pbrt;
 pub mod reader;
+pub mod sdfgrid;
 pub mod texture;
 
 pub use build::from_document;

@@ -248,6 +248,13 @@ fn distance_to(shape: &Shape, p: Vec3) -> f32 {
             .min(segment(origin + v, u)),
         // Never closed either; the distance to its plane is a lower bound.
         Shape::Disk { center, normal, .. } => (p - center).dot(normal).abs(),
+        // Never closed: the distance to the sphere of the nearest point on the axis, which
+        // is within the piece's taper of the distance to its surface.
+        Shape::Curve { p0, r0, p1, r1, .. } => {
+            let e = p1 - p0;
+            let s = ((p - p0).dot(e) / e.length_squared().max(f32::MIN_POSITIVE)).clamp(0.0, 1.0);
+            (p.distance(p0 + s * e) - (r0 + s * (r1 - r0))).abs()
+        }
     }
 }
 
@@ -282,6 +289,7 @@ fn point_inside(accel: &Accel, volume: &Volume) -> Vec3 {
             ..
         }) => origin + 0.5 * (u + v) - normal * 1e-3,
         Some(Shape::Disk { center, normal, .. }) => center - normal * 1e-3,
+        Some(Shape::Curve { p0, .. }) => p0,
         None => Vec3::ZERO,
     }
 }
@@ -316,7 +324,7 @@ pub(super) fn coincident_boundaries(
                 (origin + 0.5 * (u + v), [origin, origin + u + v, origin + u])
             }
             Shape::Disk { center, u, v, .. } => (center, [center + u, center + v, center - u]),
-            Shape::Sphere { .. } => continue,
+            Shape::Sphere { .. } | Shape::Curve { .. } => continue,
         };
         let n = prim.shape.normal(centre);
         let size = corners
@@ -331,7 +339,7 @@ pub(super) fn coincident_boundaries(
                 let q = other.object;
                 if q != o
                     && !null(q)
-                    && !matches!(other.shape, Shape::Sphere { .. })
+                    && other.shape.is_flat()
                     && other.shape.normal(p).dot(n).abs() > 0.99
                     && !pairs.iter().any(|&(a, b, _)| a == o && b == q)
                 {

@@ -10,7 +10,7 @@
 //! Built in parallel with rayon; the result does not depend on the number of threads.
 
 use foton_core::api::{
-    Bsdf, Lobe, NormalizedKernel, Phase, Primitive, Ray, Rgb, Scene, Shape, offset_origin,
+    Bsdf, Lobe, NormalizedKernel, Phase, Primitive, Ray, Rgb, Scene, offset_origin,
 };
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -205,8 +205,7 @@ impl DiscClip {
         let margin = 1e-3 * reach + 1e-5 * origin.abs().max_element();
         let wall = |prim: &Primitive| {
             // A plane's normal is the same everywhere on it: the one a probe hit would have.
-            let coplanar = !matches!(prim.shape, Shape::Sphere { .. })
-                && prim.shape.normal(Vec3::ZERO).dot(n).abs() > 0.9;
+            let coplanar = prim.shape.is_flat() && prim.shape.normal(Vec3::ZERO).dot(n).abs() > 0.9;
             !coplanar && !scene.material_of(prim).is_null()
         };
         if !scene.accel().any_near(origin, reach + margin, wall) {

@@ -366,7 +366,10 @@ fn unknown_shape_type_lists_the_types() {
         "type = \"sphere\"",
         "type = \"cube\"",
         "shapes[0].type",
-        &["unknown shape type \"cube\"", "sphere, quad, disk, mesh"],
+        &[
+            "unknown shape type \"cube\"",
+            "sphere, quad, disk, mesh, curve, sdfgrid",
+        ],
     );
 }
 
@@ -377,7 +380,7 @@ fn missing_shape_type_lists_the_types() {
     scene.check_fails(
         "[[shapes]]",
         "shapes[0].type",
-        &["missing", "sphere, quad, disk, mesh"],
+        &["missing", "sphere, quad, disk, mesh, curve, sdfgrid"],
     );
 }
 

@@ -216,7 +216,7 @@ fn changes_to_the_surface_change_the_version() {
         // A field of an exposed struct.
         (
             "field",
-            "geometry.rs",
+            "geometry/mod.rs",
             "pub struct Hit {",
             "pub struct Hit {\n    pub extra: u32,",
         ),

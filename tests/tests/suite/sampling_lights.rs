@@ -80,6 +80,7 @@ fn hit(shape: &Shape, x: DVec3, w: DVec3) -> Option<(f64, DVec3, DVec3)> {
             let (t, a, b, _) = plane(d(center), d(u), d(v))?;
             (a * a + b * b <= 1.0).then(|| (t, x + w * t, d(normal)))
         }
+        Shape::Curve { .. } => unreachable!("a curve is never a light"),
     }
 }
 
@@ -90,6 +91,7 @@ fn shape_area(shape: &Shape) -> f64 {
         Shape::Quad { u, v, .. } => d(u).cross(d(v)).length(),
         Shape::Triangle { e1, e2, .. } => 0.5 * d(e1).cross(d(e2)).length(),
         Shape::Disk { u, v, .. } => PI * d(u).cross(d(v)).length(),
+        Shape::Curve { .. } => unreachable!("a curve is never a light"),
     }
 }
 
@@ -131,6 +133,7 @@ fn on_shape(shape: &Shape, p: DVec3, tol: f64) -> Option<DVec3> {
             let (a, b, _) = plane(d(center), d(u), d(v))?;
             (a * a + b * b <= 1.0 + tol).then_some(d(normal))
         }
+        Shape::Curve { .. } => unreachable!("a curve is never a light"),
     }
 }
 
@@ -168,7 +171,7 @@ fn vertices(shape: &Shape) -> Vec<DVec3> {
             let (c, u, v) = (d(center), d(u), d(v));
             vec![c + u, c - u, c + v, c - v]
         }
-        Shape::Sphere { .. } => unreachable!(),
+        Shape::Sphere { .. } | Shape::Curve { .. } => unreachable!(),
     }
 }
 

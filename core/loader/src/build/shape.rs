@@ -1,26 +1,35 @@
-//! `[[shapes]]`: spheres, quads, disks and meshes (read through [`crate::mesh`]), each with its
-//! material, its emission (an area light) and the media on its two sides.
+//! `[[shapes]]`: spheres, quads, disks, meshes (read through [`crate::mesh`]), round curves
+//! (read through [`crate::curve`]) and the zero sets of signed distance grids (meshed by
+//! [`crate::sdfgrid`]), each with its material, its emission (an area light) and the media on
+//! its two sides.
 
 use super::common::{
     Geometry, Index, Loader, array_of_tables, read_transform_at, type_of, undefined,
 };
 use super::material::ShadingMaps;
 use super::medium::medium_ref;
+use crate::curve::Basis;
 use crate::mesh::{MeshOptions, inline_mesh, load_mesh};
+use crate::sdfgrid::{MAX_SUBDIVISIONS, SdfNormals, sdf_mesh};
 use foton_core::Rgb;
 use foton_core::error::Result;
-use foton_core::geometry::{NO_ATTRS, Primitive, Shape};
+use foton_core::geometry::{NO_ATTRS, Primitive, Shape, TriangleAttrs};
 use foton_core::light::Light;
 use foton_core::light::area::AreaLight;
 use foton_core::material::Material;
+use foton_core::medium::grid::VolFile;
 use foton_core::props::Properties;
 use foton_core::registry::Resources;
 use foton_core::scene::{Named, Object};
 use foton_core::texture::{Texture, luminance};
 use foton_core::value::Value;
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3};
 
-const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh"];
+/// Sub-cells per grid cell along each axis in which an `sdfgrid`'s surface is meshed: its
+/// trilinear zero set is followed to within a small fraction of a sub-cell.
+const SDF_SUBDIVISIONS: usize = 4;
+
+const SHAPE_TYPES: &[&str] = &["sphere", "quad", "disk", "mesh", "curve", "sdfgrid"];
 
 fn read_transform(s: &Properties<'_>, ld: &mut Loader) -> Result<Mat4> {
     read_transform_at(s, "transform", ld)
@@ -150,6 +159,81 @@ pub(super) fn read_shapes(
                 attribute = mesh.attribute;
                 mesh.triangles
             }
+            "curve" => {
+                let transform = read_transform(&s, ld)?;
+                let basis = match s.choice("basis", &["linear", "bspline"], "linear")? {
+                    "linear" => Basis::Linear,
+                    _ => Basis::BSpline,
+                };
+                if flip {
+                    return Err(s.error(
+                        "flip_normals",
+                        "a curve has no inside to turn out (nor has Mitsuba's)",
+                    ));
+                }
+                let file = s.string_required("file")?;
+                let path = ld.dir.join(file);
+                let text = std::fs::read_to_string(&path).map_err(|e| {
+                    s.error(
+                        "file",
+                        format!("cannot read curve file {}: {e}", path.display()),
+                    )
+                })?;
+                let curves = crate::curve::parse(&text, basis).map_err(|(line, message)| {
+                    let at = if line > 0 {
+                        format!("{}:{line}", path.display())
+                    } else {
+                        path.display().to_string()
+                    };
+                    s.error("file", format!("{at}: {message}"))
+                })?;
+                ld.sources.push(path);
+                crate::curve::pieces(&curves, basis, transform)
+            }
+            "sdfgrid" => {
+                let transform = read_transform(&s, ld)?;
+                let normals = match s.choice("normals", &["smooth", "analytic"], "smooth")? {
+                    "smooth" => SdfNormals::Smooth,
+                    _ => SdfNormals::Analytic,
+                };
+                let subdivisions = s.u32("subdivisions", SDF_SUBDIVISIONS as u32)?;
+                if !(1..=MAX_SUBDIVISIONS as u32).contains(&subdivisions) {
+                    return Err(s.error(
+                        "subdivisions",
+                        format!("expected 1 to {MAX_SUBDIVISIONS}, found {subdivisions}"),
+                    ));
+                }
+                let file = s.string_required("file")?;
+                let path = ld.dir.join(file);
+                let fail = |m: String| s.error("file", format!("{}: {m}", path.display()));
+                let bytes = std::fs::read(&path).map_err(|e| fail(format!("cannot read: {e}")))?;
+                let vol = VolFile::parse(&bytes).map_err(fail)?;
+                let mesh = sdf_mesh(&vol, normals, subdivisions as usize).map_err(fail)?;
+                ld.sources.push(path);
+                let normal_matrix = Mat3::from_mat4(transform).inverse().transpose();
+                let mirrored = transform.determinant() < 0.0;
+                let mut shapes = Vec::with_capacity(mesh.triangles.len());
+                for (tri, n) in mesh.triangles.iter().zip(&mesh.normals) {
+                    let mut p = tri.map(|q| transform.transform_point3(q));
+                    let mut n = n.map(|v| (normal_matrix * v).normalize_or_zero());
+                    // A mirroring reverses the winding: put the outside back in front.
+                    if mirrored {
+                        p.swap(1, 2);
+                        n.swap(1, 2);
+                    }
+                    let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+                    if e1.cross(e2).length_squared() == 0.0 {
+                        continue;
+                    }
+                    shapes.push(Shape::Triangle { p0: p[0], e1, e2 });
+                    // Mitsuba's sdfgrid has no texture coordinates: (0, 0) everywhere.
+                    attrs.push(TriangleAttrs {
+                        normals: Some(n),
+                        uvs: Some([Vec2::ZERO; 3]),
+                    });
+                }
+                shapes
+            }
             other => {
                 return Err(s.error(
                     "type",
@@ -190,6 +274,21 @@ pub(super) fn read_shapes(
                     Vec3::from(b.max)
                 ),
             ));
+        }
+        if ty == "curve" {
+            for (key, what) in [
+                ("sensor", "the surface of an irradiance meter"),
+                ("emission", "an area light"),
+            ] {
+                if s.has(key) && (key == "emission" || s.bool(key, false)?) {
+                    return Err(s.error(
+                        key,
+                        format!(
+                            "a curve cannot be {what} (nor can Mitsuba 3 sample a point on one)"
+                        ),
+                    ));
+                }
+            }
         }
         if s.bool("sensor", false)? {
             if !g.meter_wanted {

@@ -278,6 +278,51 @@ impl Reader {
                 }
                 shapes.push(t);
             }
+            "linearcurve" | "bsplinecurve" => {
+                let file = self.filename(&mut o)?;
+                let mut t = Table::default();
+                t.insert("type", at(Value::Str("curve".into()), line));
+                t.insert("file", file);
+                if o.ty == "bsplinecurve" {
+                    t.insert("basis", at(Value::Str("bspline".into()), line));
+                }
+                if m != DMat4::IDENTITY {
+                    t.insert("transform", matrix_table(m, line));
+                }
+                if flip_normals {
+                    self.warn(
+                        &o,
+                        line,
+                        "`flip_normals` on a curve is ignored: a curve is seen from outside only, as in Mitsuba 3",
+                    );
+                }
+                shapes.push(t);
+            }
+            "sdfgrid" => {
+                let file = self.filename(&mut o)?;
+                let mut t = Table::default();
+                t.insert("type", at(Value::Str("sdfgrid".into()), line));
+                t.insert("file", file);
+                if let Some(normals) = o.string("normals")? {
+                    if normals != "smooth" && normals != "analytic" {
+                        return Err(o.error(format!(
+                            "`normals` = {normals:?}: expected \"smooth\" or \"analytic\" (as Mitsuba 3)"
+                        )));
+                    }
+                    t.insert("normals", at(Value::Str(normals), line));
+                }
+                if m != DMat4::IDENTITY {
+                    t.insert("transform", matrix_table(m, line));
+                }
+                if flip_normals {
+                    self.warn(
+                        &o,
+                        line,
+                        "`flip_normals` on an sdfgrid is ignored, as Mitsuba 3 ignores it",
+                    );
+                }
+                shapes.push(t);
+            }
             "disk" => {
                 let mut t = Table::default();
                 t.insert("type", at(Value::Str("disk".into()), line));
@@ -598,7 +643,7 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
         _ => return true,
     };
     match ty.as_str() {
-        "mesh" => {
+        "mesh" | "curve" | "sdfgrid" => {
             let own = match t.get("transform").map(|n| &n.value) {
                 Some(Value::Table(tt)) => match tt.get("matrix").map(|n| &n.value) {
                     Some(Value::Array(xs)) if xs.len() == 16 => {

@@ -1,13 +1,16 @@
-//! Rays and the four kinds of primitive: analytic spheres, parallelograms ("quads") and
-//! (elliptic) discs, and triangles from meshes. Each primitive knows its orientation: the
-//! geometric normal is the outward normal for spheres, normalize(u x v) for quads and discs and
-//! normalize(e1 x e2) for triangles. [`SurfacePoint`] adds what shading needs: the shading
+//! Rays and the five kinds of primitive: analytic spheres, parallelograms ("quads") and
+//! (elliptic) discs, triangles from meshes, and pieces of round curves ([`curve`]). Each
+//! primitive knows its orientation: the geometric normal is the outward normal for spheres
+//! and curves, normalize(u x v) for quads and discs and normalize(e1 x e2) for triangles. [`SurfacePoint`] adds what shading needs: the shading
 //! normal, texture coordinates and the tangent dp/du, with Mitsuba 3's parameterisations.
 
 use crate::Rgb;
 use crate::texture::TextureEvalContext;
 use glam::{Mat3, Vec2, Vec3};
 use obvhs::aabb::Aabb;
+
+pub mod curve;
+use curve::Piece;
 
 #[derive(Clone, Copy, Debug)]
 pub struct Ray {
@@ -72,6 +75,19 @@ pub enum Shape {
         v: Vec3,
         w: Vec3,
         normal: Vec3,
+    },
+    /// A piece of a round curve ([`curve`]): the convex hull of the spheres (p0, r0) and
+    /// (p1, r1), closed by the spheres `caps` names ([`curve::START_CAP`],
+    /// [`curve::END_CAP`]) and open at the others, met only by rays from outside. `v0` and
+    /// `v1`: the curve's texture coordinate v at p0 and p1.
+    Curve {
+        p0: Vec3,
+        r0: f32,
+        p1: Vec3,
+        r1: f32,
+        v0: f32,
+        v1: f32,
+        caps: u8,
     },
 }
 
@@ -160,6 +176,26 @@ pub(crate) fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32,
 }
 
 impl Shape {
+    #[inline]
+    fn piece(p0: Vec3, r0: f32, p1: Vec3, r1: f32, caps: u8) -> Piece {
+        Piece {
+            p0,
+            r0,
+            p1,
+            r1,
+            caps,
+        }
+    }
+
+    /// Whether the surface is flat: the same normal everywhere on it.
+    #[inline]
+    pub fn is_flat(&self) -> bool {
+        matches!(
+            self,
+            Shape::Quad { .. } | Shape::Triangle { .. } | Shape::Disk { .. }
+        )
+    }
+
     pub fn quad(origin: Vec3, u: Vec3, v: Vec3) -> Shape {
         let n = u.cross(v);
         Shape::Quad {
@@ -210,6 +246,8 @@ impl Shape {
             Shape::Quad { normal, .. } | Shape::Disk { normal, .. } => *normal = -*normal,
             Shape::Triangle { e1, e2, .. } => std::mem::swap(e1, e2),
             Shape::Sphere { inward, .. } => *inward = !*inward,
+            // Mitsuba's curves have no `flip_normals`; the reader refuses it.
+            Shape::Curve { .. } => {}
         }
     }
 
@@ -228,6 +266,7 @@ impl Shape {
                 let half = (u * u + v * v).map(f32::sqrt);
                 (center - half, center + half)
             }
+            Shape::Curve { p0, r0, p1, r1, .. } => Shape::piece(p0, r0, p1, r1, 0).bounds(),
         };
         // Pad flat boxes: an axis-aligned quad has zero thickness.
         let pad = Vec3::splat(1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element()));
@@ -240,6 +279,14 @@ impl Shape {
             Shape::Quad { u, v, .. } => u.cross(v).length(),
             Shape::Triangle { e1, e2, .. } => 0.5 * e1.cross(e2).length(),
             Shape::Disk { u, v, .. } => std::f32::consts::PI * u.cross(v).length(),
+            Shape::Curve {
+                p0,
+                r0,
+                p1,
+                r1,
+                caps,
+                ..
+            } => Shape::piece(p0, r0, p1, r1, caps).area(),
         }
     }
 
@@ -323,6 +370,14 @@ impl Shape {
                 let b = w.dot(u.cross(q));
                 (a * a + b * b <= 1.0).then_some(t)
             }
+            Shape::Curve {
+                p0,
+                r0,
+                p1,
+                r1,
+                caps,
+                ..
+            } => Shape::piece(p0, r0, p1, r1, caps).intersect(ray, tmax),
         }
     }
 
@@ -337,6 +392,14 @@ impl Shape {
             Shape::Quad { normal, .. } => normal,
             Shape::Triangle { e1, e2, .. } => e1.cross(e2).normalize(),
             Shape::Disk { normal, .. } => normal,
+            Shape::Curve {
+                p0,
+                r0,
+                p1,
+                r1,
+                caps,
+                ..
+            } => Shape::piece(p0, r0, p1, r1, caps).normal(p),
         }
     }
 
@@ -473,6 +536,18 @@ impl Shape {
                 }
                 (uv, dpdu, dpdv, ns)
             }
+            Shape::Curve {
+                p0,
+                r0,
+                p1,
+                r1,
+                v0,
+                v1,
+                caps,
+            } => {
+                let (uv, dpdu, dpdv) = Shape::piece(p0, r0, p1, r1, caps).surface(p, ng, v0, v1);
+                (uv, dpdu, dpdv, ng)
+            }
         };
         SurfacePoint {
             p,
@@ -519,6 +594,14 @@ impl Shape {
                 let d = crate::sampling::concentric_disc(u);
                 (center + d.x * eu + d.y * ev, normal)
             }
+            Shape::Curve {
+                p0,
+                r0,
+                p1,
+                r1,
+                caps,
+                ..
+            } => Shape::piece(p0, r0, p1, r1, caps).sample_area(u),
         }
     }
 }
