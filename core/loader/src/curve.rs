@@ -292,4 +292,47 @@ mod tests {
         }
         assert!((last_v - 1.0).abs() < 1e-6);
     }
+
+    /// Mutated curve files (bytes, numbers, lines changed): an error with a line or pieces,
+    /// never a panic, and the pieces answer rays without one. FOTON_FUZZ_CURVE cases (2000).
+    #[test]
+    fn mutated_curve_files_are_errors_or_curves() {
+        use crate::mutations::{Cases, count, mutate};
+        use foton_core::geometry::Ray;
+        let base = "0 0 0 0.1\n1 0 0.5 0.1\n2 1 0 0.2\n3 0 0 0.05\n\n0 2 0 0.3\n1 2 1 0.3\n";
+        let n = count("FOTON_FUZZ_CURVE", 2000);
+        let mut cases = Cases::new(17);
+        let mut outcomes = [0usize; 2];
+        for _ in 0..n {
+            let text = mutate(base, b"0123456789 .-e\n#", &mut cases);
+            let basis = if cases.below(2) == 0 {
+                Basis::Linear
+            } else {
+                Basis::BSpline
+            };
+            let run = std::panic::catch_unwind(|| {
+                let curves = parse(&text, basis)?;
+                for shape in pieces(&curves, basis, Mat4::from_scale(Vec3::splat(1.5))) {
+                    let _ = shape.aabb();
+                    for dir in [Vec3::X, Vec3::NEG_Z, Vec3::new(1.0, 1.0, 1.0).normalize()] {
+                        let ray = Ray::new(Vec3::splat(-5.0) + Vec3::Y * 5.0, dir);
+                        if let Some(t) = shape.intersect(&ray, f32::INFINITY) {
+                            let p = ray.at(t);
+                            let n = shape.normal(p);
+                            let _ = shape.surface_at(p, n, None, None, true);
+                        }
+                    }
+                }
+                Ok::<_, (usize, String)>(())
+            });
+            match run {
+                Ok(r) => outcomes[r.is_ok() as usize] += 1,
+                Err(_) => panic!("panicked on:\n{text}"),
+            }
+        }
+        assert!(
+            outcomes[0] > n / 10 && outcomes[1] > n / 10,
+            "errors, curves: {outcomes:?}"
+        );
+    }
 }

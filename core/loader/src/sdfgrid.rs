@@ -883,4 +883,45 @@ mod tests {
             err(&sphere, 0)
         );
     }
+
+    /// Grids with values replaced by extremes (huge, tiny, zero, of either sign): a mesh or
+    /// an error, never a panic, and every vertex finite. FOTON_FUZZ_SDF cases (300).
+    #[test]
+    fn sdfgrid_extreme_values_are_meshes_or_errors() {
+        let n = std::env::var("FOTON_FUZZ_SDF")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(300);
+        let extremes = [0.0f32, -0.0, 1e30, -1e30, 1e-30, -1e-30, f32::MAX, f32::MIN];
+        let mut state = 5u64;
+        let mut outcomes = [0usize; 2];
+        for _ in 0..n {
+            let res = [2 + (uniform(&mut state) * 5.0) as usize, 3, 4];
+            let mut vol = grid(res, |p| (p - CENTRE).length() - RADIUS);
+            for _ in 0..1 + (uniform(&mut state) * 6.0) as usize {
+                let at = (uniform(&mut state) * vol.values.len() as f64) as usize;
+                vol.values[at] = extremes[(uniform(&mut state) * extremes.len() as f64) as usize];
+            }
+            let normals = if uniform(&mut state) < 0.5 {
+                SdfNormals::Smooth
+            } else {
+                SdfNormals::Analytic
+            };
+            let result = std::panic::catch_unwind(|| sdf_mesh(&vol, normals, 2));
+            match result {
+                Ok(Ok(mesh)) => {
+                    outcomes[1] += 1;
+                    assert!(
+                        mesh.triangles.iter().flatten().all(|v| v.is_finite())
+                            && mesh.normals.iter().flatten().all(|v| v.is_finite()),
+                        "a vertex or normal is not finite: {:?}",
+                        vol.values
+                    );
+                }
+                Ok(Err(_)) => outcomes[0] += 1,
+                Err(_) => panic!("panicked on {:?}", vol.values),
+            }
+        }
+        assert!(outcomes[1] > n / 10, "errors, meshes: {outcomes:?}");
+    }
 }
