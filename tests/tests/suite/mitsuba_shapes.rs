@@ -7,7 +7,7 @@
 use foton_core::geometry::Ray;
 use foton_core::scene::Scene;
 use foton_tests::{temp_dir, write};
-use glam::{Vec2, Vec3};
+use glam::{Mat3, Vec2, Vec3};
 use std::path::Path;
 
 /// A zlib stream of `data` in stored (uncompressed) deflate blocks: an encoder independent of
@@ -595,4 +595,81 @@ fn another_emitter_inside_a_shape_is_a_light_of_its_own() {
         said.contains("scene.xml:4") && said.contains("light of its own"),
         "{said}"
     );
+}
+
+/// A `cube` has Mitsuba 3's texture coordinates on every face, with its normals outward,
+/// under a rotation and non-uniform scale and under a mirroring to_world. Expected: Mitsuba
+/// 3's mesh itself (src/shapes/cube.cpp: `side_normals`, `side_uv`, `position_index`, corner c
+/// at (+-1, +-1, +-1) by the bits of c, triangles {4s, 4s+1, 4s+2} and {4s+3, 4s, 4s+2}),
+/// evaluated at points inside each triangle (checked with Mitsuba 3.9.1).
+#[test]
+fn cube_faces_have_mitsuba_3s_texture_coordinates_and_outward_normals() {
+    let side_normals = [
+        [0., -1., 0.],
+        [0., 1., 0.],
+        [1., 0., 0.],
+        [0., 0., 1.],
+        [-1., 0., 0.],
+        [0., 0., -1.],
+    ];
+    let side_uv = [[0., 1.], [1., 1.], [1., 0.], [0., 0.]];
+    let position_index = [
+        1, 5, 4, 0, 3, 2, 6, 7, 1, 3, 7, 5, 5, 7, 6, 4, 4, 6, 2, 0, 3, 1, 0, 2,
+    ];
+    let corner = |c: u32| {
+        let sign = |bit: u32| if c & bit != 0 { 1.0 } else { -1.0 };
+        Vec3::new(sign(1), sign(2), sign(4))
+    };
+    let dir = temp_dir("cube-uv");
+    let path = xml(
+        &dir,
+        r#"<shape type="cube"><transform name="to_world"><scale x="1.5" y="0.5" z="0.8"/>
+    <rotate x="1" angle="30"/><rotate y="1" angle="50"/></transform></shape>
+<shape type="cube"><transform name="to_world"><scale x="-1" y="0.7" z="1.2"/>
+    <rotate z="1" angle="40"/><translate x="20"/></transform></shape>"#,
+    );
+    let scene = load(&path);
+    let (x, y) = (30f32.to_radians(), 50f32.to_radians());
+    let turned = Mat3::from_rotation_y(y) * Mat3::from_rotation_x(x);
+    let cubes = [
+        (
+            turned * Mat3::from_diagonal(Vec3::new(1.5, 0.5, 0.8)),
+            Vec3::ZERO,
+        ),
+        (
+            Mat3::from_rotation_z(40f32.to_radians())
+                * Mat3::from_diagonal(Vec3::new(-1.0, 0.7, 1.2)),
+            Vec3::new(20.0, 0.0, 0.0),
+        ),
+    ];
+    for (m, offset) in cubes {
+        for s in 0..6 {
+            let normal = (m.inverse().transpose() * Vec3::from_array(side_normals[s])).normalize();
+            let vertex = |k: usize| {
+                (
+                    corner(position_index[4 * s + k]),
+                    Vec2::from_array(side_uv[k]),
+                )
+            };
+            // A point inside each of the face's two triangles, by its barycentric weights.
+            for (tri, w) in [([0, 1, 2], [0.2, 0.3, 0.5]), ([3, 0, 2], [0.6, 0.3, 0.1])] {
+                let (mut p, mut uv) = (Vec3::ZERO, Vec2::ZERO);
+                for (k, w) in tri.into_iter().zip(w) {
+                    let (q, t) = vertex(k);
+                    p += w * q;
+                    uv += w * t;
+                }
+                let at = m * p + offset;
+                let (t, ng, ns, got) = trace(&scene, at + 3.0 * normal, -normal)
+                    .unwrap_or_else(|| panic!("face {s} of {m}: missed {at}"));
+                let what = format!("face {s} of {m} at {p}: t {t} ng {ng} ns {ns} uv {got}");
+                assert!((t - 3.0).abs() < 1e-3, "{what}");
+                assert!((got - uv).length() < 1e-4, "{what}: uv {uv} expected");
+                assert!(
+                    close(ng, normal, 1e-4) && close(ns, normal, 1e-4),
+                    "{what}: {normal} expected"
+                );
+            }
+        }
+    }
 }

@@ -24,6 +24,23 @@ pub(super) const CYLINDER_FACETS: usize = 64;
 /// shape as the emitter itself: the document reader resolves it.)
 const GROUP_KEY: &str = "\0shapegroup:";
 
+/// The faces of Mitsuba 3's `cube` (src/shapes/cube.cpp: `side_normals`, `side_uv` and
+/// `position_index`), in its order: each its outward normal, then its corners with uv
+/// (0, 0), (1, 0) and (0, 1).
+#[rustfmt::skip]
+fn cube_faces() -> [[DVec3; 4]; 6] {
+    [
+        //  outward         uv (0, 0)        uv (1, 0)        uv (0, 1)
+        [[ 0., -1.,  0.], [-1., -1., -1.], [-1., -1.,  1.], [ 1., -1., -1.]],
+        [[ 0.,  1.,  0.], [ 1.,  1.,  1.], [-1.,  1.,  1.], [ 1.,  1., -1.]],
+        [[ 1.,  0.,  0.], [ 1., -1.,  1.], [ 1.,  1.,  1.], [ 1., -1., -1.]],
+        [[ 0.,  0.,  1.], [-1., -1.,  1.], [-1.,  1.,  1.], [ 1., -1.,  1.]],
+        [[-1.,  0.,  0.], [-1., -1., -1.], [-1.,  1., -1.], [-1., -1.,  1.]],
+        [[ 0.,  0., -1.], [-1.,  1., -1.], [-1., -1., -1.], [ 1.,  1., -1.]],
+    ]
+    .map(|face| face.map(DVec3::from_array))
+}
+
 impl Reader {
     /// What a `<ref id>` names, for messages about a reference of the wrong kind.
     fn named(&self, id: &str) -> Option<&'static str> {
@@ -425,15 +442,18 @@ impl Reader {
                 DVec3::new(0.0, 2.0, 0.0),
             )),
             "cube" => {
-                // Six outward-facing faces of [-1, 1]^3.
-                for axis in 0..3 {
-                    for side in [-1.0, 1.0] {
-                        let n = DVec3::AXES[axis] * side;
-                        let a = DVec3::AXES[(axis + 1) % 3] * 2.0;
-                        let b = DVec3::AXES[(axis + 2) % 3] * 2.0;
-                        let (a, b) = if side > 0.0 { (a, b) } else { (b, a) };
-                        shapes.push(rectangle(n - a / 2.0 - b / 2.0, a, b));
+                // The six faces of [-1, 1]^3 with Mitsuba 3's texture coordinates: a face's
+                // (s, t) is its uv in cube.cpp, so the quad runs from the corner with uv
+                // (0, 0) along u to the one with (1, 0) and along v to the one with (0, 1)
+                // (the fourth, (1, 1), is then origin + u + v, as in cube.cpp). Where u x v
+                // points inward the quad is flipped, on top of `flip`, so that it faces out.
+                for [outward, origin, u_end, v_end] in cube_faces() {
+                    let (u, v) = (u_end - origin, v_end - origin);
+                    let mut t = rectangle(origin, u, v);
+                    if u.cross(v).dot(outward) < 0.0 {
+                        t.insert("flip_normals", at(Value::Bool(!flip), line));
                     }
+                    shapes.push(t);
                 }
             }
             _ => {
