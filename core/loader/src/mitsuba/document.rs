@@ -663,7 +663,32 @@ impl Reader {
                     if axis.length_squared() == 0.0 {
                         return Err(syntax(file, lpos, "<rotate> about the zero vector"));
                     }
-                    DMat4::from_axis_angle(axis.normalize(), num("angle", 0.0)?.to_radians())
+                    let angle = num("angle", 0.0)?.to_radians();
+                    if self.v1 || axis.length_squared() == 1.0 {
+                        DMat4::from_axis_angle(axis.normalize(), angle)
+                    } else {
+                        // Mitsuba 2 and 3 do not normalise the axis: c I + (1 - c) a a^T +
+                        // s [a]x, which also scales and shears unless |a| = 1.
+                        if (axis.length() - 1.0).abs() > 1e-6 {
+                            self.late_warnings.borrow_mut().push(format!(
+                                "{}:{}: <rotate> about an axis of length {:.4}: Mitsuba 3 does not normalise it, so the rotation also scales; read as Mitsuba 3 reads it (write a unit axis for a rotation alone)",
+                                file.display(),
+                                lpos.line,
+                                axis.length()
+                            ));
+                        }
+                        let (s, c) = angle.sin_cos();
+                        let outer = |i: usize| axis * axis[i] * (1.0 - c);
+                        let cross = glam::DMat3::from_cols(
+                            DVec3::new(0.0, axis.z, -axis.y),
+                            DVec3::new(-axis.z, 0.0, axis.x),
+                            DVec3::new(axis.y, -axis.x, 0.0),
+                        );
+                        let m3 = glam::DMat3::from_diagonal(DVec3::splat(c))
+                            + glam::DMat3::from_cols(outer(0), outer(1), outer(2))
+                            + cross * s;
+                        DMat4::from_mat3(m3)
+                    }
                 }
                 "matrix" => {
                     let v = get("value")?.ok_or_else(|| bad(""))?;
