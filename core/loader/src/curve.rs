@@ -92,8 +92,14 @@ pub fn parse(text: &str, basis: Basis) -> Result<Vec<Vec<[f32; 4]>>, (usize, Str
     Ok(curves)
 }
 
-/// The pieces of the curves, their points moved by `transform` (radii as written).
-pub fn pieces(curves: &[Vec<[f32; 4]>], basis: Basis, transform: Mat4) -> Vec<Shape> {
+/// The pieces of the curves, their points moved by `transform`, their radii times
+/// `radius_scale`.
+pub fn pieces(
+    curves: &[Vec<[f32; 4]>],
+    basis: Basis,
+    transform: Mat4,
+    radius_scale: f32,
+) -> Vec<Shape> {
     let moved: Vec<Vec<(Vec3, f32)>> = curves
         .iter()
         .map(|c| {
@@ -101,7 +107,7 @@ pub fn pieces(curves: &[Vec<[f32; 4]>], basis: Basis, transform: Mat4) -> Vec<Sh
                 .map(|p| {
                     (
                         transform.transform_point3(Vec3::new(p[0], p[1], p[2])),
-                        p[3],
+                        p[3] * radius_scale,
                     )
                 })
                 .collect()
@@ -215,7 +221,12 @@ mod tests {
             Basis::Linear,
         )
         .unwrap();
-        let shapes = pieces(&curves, Basis::Linear, Mat4::from_scale(Vec3::splat(2.0)));
+        let shapes = pieces(
+            &curves,
+            Basis::Linear,
+            Mat4::from_scale(Vec3::splat(2.0)),
+            1.0,
+        );
         assert_eq!(shapes.len(), 3);
         let Shape::Curve {
             p0,
@@ -252,7 +263,7 @@ mod tests {
             [3.0, 1.0, 0.0, 0.05],
             [4.0, 0.0, 1.0, 0.05],
         ];
-        let shapes = pieces(&[points.to_vec()], Basis::BSpline, Mat4::IDENTITY);
+        let shapes = pieces(&[points.to_vec()], Basis::BSpline, Mat4::IDENTITY, 1.0);
         let p = |i: usize| Vec3::new(points[i][0], points[i][1], points[i][2]);
         // (1/6) [t^3 t^2 t 1] M [P0..P3] with the standard basis matrix.
         let curve = |span: usize, t: f32| {
@@ -312,7 +323,7 @@ mod tests {
             };
             let run = std::panic::catch_unwind(|| {
                 let curves = parse(&text, basis)?;
-                for shape in pieces(&curves, basis, Mat4::from_scale(Vec3::splat(1.5))) {
+                for shape in pieces(&curves, basis, Mat4::from_scale(Vec3::splat(1.5)), 1.0) {
                     let _ = shape.aabb();
                     for dir in [Vec3::X, Vec3::NEG_Z, Vec3::new(1.0, 1.0, 1.0).normalize()] {
                         let ray = Ray::new(Vec3::splat(-5.0) + Vec3::Y * 5.0, dir);

@@ -239,3 +239,35 @@ photons_per_iteration = 20000
     }
     let _ = std::fs::remove_dir_all(dir);
 }
+
+/// An instance moves a curve whole, radii too (Embree traces it in the group's space): a
+/// curve of radius 0.1 in a group instanced at scale 2 has radius 0.2 (its own `to_world`
+/// still leaves radii as written).
+#[test]
+fn an_instance_scales_a_curve_with_its_radii() {
+    let dir = temp_dir("curve-instance");
+    write(&dir, "curve.txt", "0 0 0 0.1\n1 0 0 0.1\n");
+    let xml = r#"<scene version="3.0.0">
+    <sensor type="perspective"><float name="fov" value="30"/></sensor>
+    <shape type="shapegroup" id="group">
+        <shape type="linearcurve">
+            <string name="filename" value="curve.txt"/>
+            <transform name="to_world"><scale value="3"/></transform>
+        </shape>
+    </shape>
+    <shape type="instance">
+        <ref id="group"/>
+        <transform name="to_world"><scale value="2"/></transform>
+    </shape>
+</scene>"#;
+    let path = write(&dir, "scene.xml", xml);
+    let scene = foton_loader::load(&path, &[]).unwrap_or_else(|e| panic!("{e}"));
+    // Points at x = 0 and 6; radius 0.1 x 2.
+    let hit = scene
+        .intersect(&Ray::new(Vec3::new(3.0, 0.0, 2.0), -Vec3::Z), f32::INFINITY)
+        .unwrap();
+    assert!((hit.t - 1.8).abs() < 1e-4, "t = {}", hit.t);
+    let end = Ray::new(Vec3::new(6.15, 0.0, 2.0), -Vec3::Z);
+    assert!(scene.intersect(&end, f32::INFINITY).is_some());
+    let _ = std::fs::remove_dir_all(dir);
+}

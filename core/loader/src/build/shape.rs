@@ -187,8 +187,15 @@ pub(super) fn read_shapes(
                     };
                     s.error("file", format!("{at}: {message}"))
                 })?;
+                let radius_scale = s.f32("radius_scale", 1.0)?;
+                if !(radius_scale > 0.0 && radius_scale.is_finite()) {
+                    return Err(s.error(
+                        "radius_scale",
+                        format!("must be positive, found {radius_scale}"),
+                    ));
+                }
                 ld.sources.push(path);
-                crate::curve::pieces(&curves, basis, transform)
+                crate::curve::pieces(&curves, basis, transform, radius_scale)
             }
             "sdfgrid" => {
                 let transform = read_transform(&s, ld)?;

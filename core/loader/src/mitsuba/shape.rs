@@ -597,7 +597,7 @@ impl Reader {
                 self.warn(
                     &o,
                     o.line,
-                    "`to_world` scales a sphere of the group non-uniformly, into an ellipsoid in Mitsuba 3: foton has none and renders the sphere of radius |to_world x|",
+                    "`to_world` scales a sphere or a curve of the group non-uniformly, into an ellipsoid or a tube of elliptic section in Mitsuba 3: foton has neither and renders the sphere of radius |to_world x|, or the curve with its radii times |to_world x|",
                 );
             }
             self.shapes.push(at(Value::Table(t), o.line));
@@ -635,7 +635,8 @@ fn node_vec3(n: &Node) -> Option<DVec3> {
 
 /// The shape table `t` (as [`Reader::shape`] writes it) moved by `m`, applied after its own
 /// placement, as Mitsuba 3's instance moves a shape; false if `m` turned a sphere into an
-/// ellipsoid (rendered as a sphere).
+/// ellipsoid (rendered as a sphere) or a curve's round section into an ellipse (rendered
+/// round, its radii scaled by |m x|).
 fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
     let point = |t: &mut Table, key: &str| {
         if let Some(p) = t.get(key).and_then(node_vec3) {
@@ -662,6 +663,19 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
         Some(Value::Str(s)) => s.clone(),
         _ => return true,
     };
+    // An instance moves the whole curve, its radii too (Embree traces it in the group's
+    // space): by the scale of a similarity.
+    if ty == "curve" {
+        let scale = m.transform_vector3(DVec3::X).length();
+        let before = match t.get("radius_scale").map(|n| &n.value) {
+            Some(Value::Float(r)) => *r,
+            _ => 1.0,
+        };
+        if scale != 1.0 {
+            t.insert("radius_scale", at(Value::Float(before * scale), line));
+        }
+    }
+    let similar = ty != "curve" || is_similarity(m);
     match ty.as_str() {
         "mesh" | "curve" | "sdfgrid" => {
             let own = match t.get("transform").map(|n| &n.value) {
@@ -675,7 +689,7 @@ fn place(t: &mut Table, m: DMat4, line: u32) -> bool {
                 _ => DMat4::IDENTITY,
             };
             t.insert("transform", matrix_table(m * own, line));
-            true
+            similar
         }
         "sphere" => {
             // Mitsuba 3 transforms the sphere's own normals by the instance's: a mirroring
