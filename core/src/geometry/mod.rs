@@ -176,8 +176,20 @@ pub(crate) fn sphere_roots(ray: &Ray, center: Vec3, radius: f32) -> Option<(f32,
 }
 
 impl Shape {
-    #[inline]
-    fn piece(p0: Vec3, r0: f32, p1: Vec3, r1: f32, caps: u8) -> Piece {
+    /// A curve's piece. Only the `Curve` arms of this type's matches call it.
+    #[inline(always)]
+    fn piece(&self) -> Piece {
+        let Shape::Curve {
+            p0,
+            r0,
+            p1,
+            r1,
+            caps,
+            ..
+        } = *self
+        else {
+            unreachable!("a curve's piece of another shape")
+        };
         Piece {
             p0,
             r0,
@@ -266,7 +278,7 @@ impl Shape {
                 let half = (u * u + v * v).map(f32::sqrt);
                 (center - half, center + half)
             }
-            Shape::Curve { p0, r0, p1, r1, .. } => Shape::piece(p0, r0, p1, r1, 0).bounds(),
+            Shape::Curve { .. } => self.piece().bounds(),
         };
         // Pad flat boxes: an axis-aligned quad has zero thickness.
         let pad = Vec3::splat(1e-5 * (1.0 + lo.abs().max(hi.abs()).max_element()));
@@ -279,14 +291,7 @@ impl Shape {
             Shape::Quad { u, v, .. } => u.cross(v).length(),
             Shape::Triangle { e1, e2, .. } => 0.5 * e1.cross(e2).length(),
             Shape::Disk { u, v, .. } => std::f32::consts::PI * u.cross(v).length(),
-            Shape::Curve {
-                p0,
-                r0,
-                p1,
-                r1,
-                caps,
-                ..
-            } => Shape::piece(p0, r0, p1, r1, caps).area(),
+            Shape::Curve { .. } => self.piece().area(),
         }
     }
 
@@ -370,14 +375,7 @@ impl Shape {
                 let b = w.dot(u.cross(q));
                 (a * a + b * b <= 1.0).then_some(t)
             }
-            Shape::Curve {
-                p0,
-                r0,
-                p1,
-                r1,
-                caps,
-                ..
-            } => Shape::piece(p0, r0, p1, r1, caps).intersect(ray, tmax),
+            Shape::Curve { .. } => self.piece().intersect(ray, tmax),
         }
     }
 
@@ -392,14 +390,7 @@ impl Shape {
             Shape::Quad { normal, .. } => normal,
             Shape::Triangle { e1, e2, .. } => e1.cross(e2).normalize(),
             Shape::Disk { normal, .. } => normal,
-            Shape::Curve {
-                p0,
-                r0,
-                p1,
-                r1,
-                caps,
-                ..
-            } => Shape::piece(p0, r0, p1, r1, caps).normal(p),
+            Shape::Curve { .. } => self.piece().normal(p),
         }
     }
 
@@ -536,16 +527,8 @@ impl Shape {
                 }
                 (uv, dpdu, dpdv, ns)
             }
-            Shape::Curve {
-                p0,
-                r0,
-                p1,
-                r1,
-                v0,
-                v1,
-                caps,
-            } => {
-                let (uv, dpdu, dpdv) = Shape::piece(p0, r0, p1, r1, caps).surface(p, ng, v0, v1);
+            Shape::Curve { v0, v1, .. } => {
+                let (uv, dpdu, dpdv) = self.piece().surface(p, ng, v0, v1);
                 (uv, dpdu, dpdv, ng)
             }
         };
@@ -594,14 +577,7 @@ impl Shape {
                 let d = crate::sampling::concentric_disc(u);
                 (center + d.x * eu + d.y * ev, normal)
             }
-            Shape::Curve {
-                p0,
-                r0,
-                p1,
-                r1,
-                caps,
-                ..
-            } => Shape::piece(p0, r0, p1, r1, caps).sample_area(u),
+            Shape::Curve { .. } => self.piece().sample_area(u),
         }
     }
 }

@@ -295,32 +295,22 @@ impl Reader {
                 }
                 shapes.push(t);
             }
-            "linearcurve" | "bsplinecurve" => {
+            "linearcurve" | "bsplinecurve" | "sdfgrid" => {
                 let file = self.filename(&mut o)?;
                 let mut t = Table::default();
-                t.insert("type", at(Value::Str("curve".into()), line));
+                let kind = if o.ty == "sdfgrid" {
+                    "sdfgrid"
+                } else {
+                    "curve"
+                };
+                t.insert("type", at(Value::Str(kind.into()), line));
                 t.insert("file", file);
                 if o.ty == "bsplinecurve" {
                     t.insert("basis", at(Value::Str("bspline".into()), line));
                 }
-                if m != DMat4::IDENTITY {
-                    t.insert("transform", matrix_table(m, line));
-                }
-                if flip_normals {
-                    self.warn(
-                        &o,
-                        line,
-                        "`flip_normals` on a curve is ignored: a curve is seen from outside only, as in Mitsuba 3",
-                    );
-                }
-                shapes.push(t);
-            }
-            "sdfgrid" => {
-                let file = self.filename(&mut o)?;
-                let mut t = Table::default();
-                t.insert("type", at(Value::Str("sdfgrid".into()), line));
-                t.insert("file", file);
-                if let Some(normals) = o.string("normals")? {
+                if o.ty == "sdfgrid"
+                    && let Some(normals) = o.string("normals")?
+                {
                     if normals != "smooth" && normals != "analytic" {
                         return Err(o.error(format!(
                             "`normals` = {normals:?}: expected \"smooth\" or \"analytic\" (as Mitsuba 3)"
@@ -331,11 +321,16 @@ impl Reader {
                 if m != DMat4::IDENTITY {
                     t.insert("transform", matrix_table(m, line));
                 }
+                // Neither has an inside to turn out in Mitsuba 3: a curve is seen from
+                // outside only, a grid's surface from both sides.
                 if flip_normals {
                     self.warn(
                         &o,
                         line,
-                        "`flip_normals` on an sdfgrid is ignored, as Mitsuba 3 ignores it",
+                        &format!(
+                            "`flip_normals` on {} is ignored, as Mitsuba 3 ignores it",
+                            o.ty
+                        ),
                     );
                 }
                 shapes.push(t);
