@@ -129,6 +129,7 @@ pub fn pieces(
                 Basis::Linear => {
                     let ((p0, r0), (p1, r1)) = (c[k], c[k + 1]);
                     let caps = END_CAP | if k == 0 { START_CAP } else { 0 };
+                    let next = c.get(k + 2).map_or(Vec3::ZERO, |&(p2, _)| axis(p1, p2));
                     shapes.push(Shape::Curve {
                         p0,
                         r0,
@@ -136,6 +137,7 @@ pub fn pieces(
                         r1,
                         v0: v_of(segment, 0.0),
                         v1: v_of(segment, 1.0),
+                        next,
                         caps,
                     });
                 }
@@ -151,17 +153,33 @@ pub fn pieces(
                             })
                     };
                     for j in 0..count {
-                        let (t0, t1) = (j as f32 / count as f32, (j + 1) as f32 / count as f32);
-                        let ((p0, r0), (p1, r1)) = (at(t0), at(t1));
+                        let t = |j: usize| j as f32 / count as f32;
+                        let ((p0, r0), (p1, r1)) = (at(t(j)), at(t(j + 1)));
                         // Spheres join the pieces; the curve's own ends stay open.
                         let last = k + 1 == n && j + 1 == count;
+                        // The next piece's start: in this span, or the next span's.
+                        let next = if j + 1 < count {
+                            axis(p1, at(t(j + 2)).0)
+                        } else if k + 1 < n {
+                            let w = bspline_weights(
+                                1.0 / pieces_of(&[c[k + 1], c[k + 2], c[k + 3], c[k + 4]]) as f32,
+                            );
+                            let q = [c[k + 1], c[k + 2], c[k + 3], c[k + 4]]
+                                .iter()
+                                .zip(w)
+                                .fold(Vec3::ZERO, |acc, (&(q, _), w)| acc + w * q);
+                            axis(p1, q)
+                        } else {
+                            Vec3::ZERO
+                        };
                         shapes.push(Shape::Curve {
                             p0,
                             r0,
                             p1,
                             r1,
-                            v0: v_of(segment, t0),
-                            v1: v_of(segment, t1),
+                            v0: v_of(segment, t(j)),
+                            v1: v_of(segment, t(j + 1)),
+                            next,
                             caps: if last { 0 } else { END_CAP },
                         });
                     }
@@ -171,6 +189,11 @@ pub fn pieces(
         first += n;
     }
     shapes
+}
+
+/// The unit direction from a to b (zero where they coincide).
+fn axis(a: Vec3, b: Vec3) -> Vec3 {
+    (b - a).normalize_or_zero()
 }
 
 /// The uniform cubic B-spline's weights of a span's four control points at t in [0, 1].
@@ -235,6 +258,7 @@ mod tests {
             r1,
             v0,
             v1,
+            next,
             caps,
         } = shapes[1]
         else {
@@ -248,6 +272,9 @@ mod tests {
         assert_eq!((r0, r1), (0.2, 0.1));
         assert_eq!((v0, v1), (1.0 / 3.0, 2.0 / 3.0));
         assert_eq!(caps, END_CAP);
+        // The last of its curve: nothing after it.
+        assert_eq!(next, Vec3::ZERO);
+        assert!(matches!(shapes[0], Shape::Curve { next: Vec3::Y, .. }));
         assert!(matches!(shapes[2], Shape::Curve { caps: 3, .. }));
     }
 
@@ -300,6 +327,22 @@ mod tests {
             assert!((v0 - last_v).abs() < 1e-6);
             last_v = v1;
             assert_eq!(caps, if i + 1 == shapes.len() { 0 } else { END_CAP });
+            // Each piece knows the direction of the one after it.
+            match shapes.get(i + 1) {
+                Some(&Shape::Curve { p0: q0, p1: q1, .. }) => {
+                    let Shape::Curve { next, .. } = *s else {
+                        panic!()
+                    };
+                    assert!((next - (q1 - q0).normalize()).length() < 1e-4, "{i}");
+                }
+                _ => assert!(matches!(
+                    *s,
+                    Shape::Curve {
+                        next: Vec3::ZERO,
+                        ..
+                    }
+                )),
+            }
         }
         assert!((last_v - 1.0).abs() < 1e-6);
     }

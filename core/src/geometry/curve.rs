@@ -12,7 +12,8 @@
 //! larger one on the second.
 //!
 //! Rays meet a piece only where they enter it: a ray starting inside passes out unseen, as
-//! through Embree's curves with back-face culling (Mitsuba 3's build).
+//! through Embree's curves with back-face culling (Mitsuba 3's build). The sphere that joins a
+//! piece to the next one stops at the plane where the next piece begins, as Embree's does.
 
 use super::{Ray, sphere_roots};
 use glam::{Vec2, Vec3};
@@ -28,6 +29,8 @@ pub(super) struct Piece {
     pub r0: f32,
     pub p1: Vec3,
     pub r1: f32,
+    /// The unit axis of the next piece of the curve, or zero.
+    pub next: Vec3,
     pub caps: u8,
 }
 
@@ -158,9 +161,15 @@ impl Piece {
             let x = oa + t * ray.dir;
             let y = x.dot(axis);
             let coordinate = y * cos - (x - y * axis).length() * sin;
+            // A joint's sphere ends where the next piece begins (Embree drops the hits
+            // beyond the next cone's plane): its part there lies inside that piece, and is
+            // seen only from inside the tube, through an open end.
             let on_cap = match part {
                 Part::Start => coordinate <= slack,
-                _ => coordinate >= len * cos - slack,
+                _ => {
+                    coordinate >= len * cos - slack
+                        && (oa + t * ray.dir - (self.p1 - self.p0)).dot(self.next) <= slack
+                }
             };
             if on_cap && best.is_none_or(|b| t < b) {
                 best = Some(t);
@@ -348,6 +357,7 @@ mod tests {
             r0,
             p1,
             r1,
+            next: Vec3::ZERO,
             caps: START_CAP | END_CAP,
         };
         [
@@ -461,6 +471,7 @@ mod tests {
             r0: 0.2,
             p1: Vec3::X,
             r1: 0.2,
+            next: Vec3::ZERO,
             caps: START_CAP | END_CAP,
         };
         let ray = Ray::new(Vec3::new(-1.0, 0.05, 0.0), Vec3::X);
@@ -471,6 +482,42 @@ mod tests {
         // From the side the open tube is hit as the closed one.
         let side = Ray::new(Vec3::new(0.5, 1.0, 0.0), Vec3::NEG_Y);
         assert!((piece.intersect(&side, f32::INFINITY).unwrap() - 0.8).abs() < 1e-5);
+    }
+
+    /// Inside a bent tube, seen through its open end: the sphere that joins two pieces does
+    /// not reach into the second, so a ray running back down the second piece meets nothing
+    /// (it met the sphere's far side before the sphere was cut there).
+    #[test]
+    fn a_joint_sphere_stops_where_the_next_piece_begins() {
+        let angle = 60f32.to_radians();
+        let bend = Vec3::new(angle.cos(), angle.sin(), 0.0);
+        let first = Piece {
+            p0: Vec3::ZERO,
+            r0: 0.2,
+            p1: Vec3::X,
+            r1: 0.2,
+            next: bend,
+            caps: END_CAP,
+        };
+        let second = Piece {
+            p0: Vec3::X,
+            r0: 0.2,
+            p1: Vec3::X + bend,
+            r1: 0.2,
+            next: Vec3::ZERO,
+            caps: 0,
+        };
+        let outward = Vec3::new(angle.sin(), -angle.cos(), 0.0);
+        let ray = Ray::new(second.p1 + 0.1 * bend + 0.15 * outward, -bend);
+        assert_eq!(first.intersect(&ray, f32::INFINITY), None);
+        assert_eq!(second.intersect(&ray, f32::INFINITY), None);
+        // The same sphere from outside, on the bend's outer side, is there.
+        let elbow = Ray::new(
+            Vec3::X + 2.0 * Vec3::new(1.0, -1.0, 0.0).normalize(),
+            Vec3::new(-1.0, 1.0, 0.0).normalize(),
+        );
+        let t = first.intersect(&elbow, f32::INFINITY).expect("the elbow");
+        assert!((elbow.at(t).distance(Vec3::X) - 0.2).abs() < 1e-5);
     }
 
     /// The area is the surface of revolution's, integrated numerically along its profile;

@@ -79,7 +79,9 @@ pub enum Shape {
     /// A piece of a round curve ([`curve`]): the convex hull of the spheres (p0, r0) and
     /// (p1, r1), closed by the spheres `caps` names ([`curve::START_CAP`],
     /// [`curve::END_CAP`]) and open at the others, met only by rays from outside. `v0` and
-    /// `v1`: the curve's texture coordinate v at p0 and p1.
+    /// `v1`: the curve's texture coordinate v at p0 and p1. `next`: the unit axis of the
+    /// piece after this one (zero at a curve's end), into which the sphere at p1 does not
+    /// reach.
     Curve {
         p0: Vec3,
         r0: f32,
@@ -87,6 +89,7 @@ pub enum Shape {
         r1: f32,
         v0: f32,
         v1: f32,
+        next: Vec3,
         caps: u8,
     },
 }
@@ -184,6 +187,7 @@ impl Shape {
             r0,
             p1,
             r1,
+            next,
             caps,
             ..
         } = *self
@@ -195,6 +199,7 @@ impl Shape {
             r0,
             p1,
             r1,
+            next,
             caps,
         }
     }
