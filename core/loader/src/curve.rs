@@ -123,13 +123,13 @@ pub fn pieces(
     let mut first = 0;
     for c in &moved {
         let n = per_curve(c);
+        let start = shapes.len();
         for k in 0..n {
             let segment = first + k;
             match basis {
                 Basis::Linear => {
                     let ((p0, r0), (p1, r1)) = (c[k], c[k + 1]);
                     let caps = END_CAP | if k == 0 { START_CAP } else { 0 };
-                    let next = c.get(k + 2).map_or(Vec3::ZERO, |&(p2, _)| axis(p1, p2));
                     shapes.push(Shape::Curve {
                         p0,
                         r0,
@@ -137,7 +137,7 @@ pub fn pieces(
                         r1,
                         v0: v_of(segment, 0.0),
                         v1: v_of(segment, 1.0),
-                        next,
+                        next: Vec3::ZERO,
                         caps,
                     });
                 }
@@ -157,21 +157,6 @@ pub fn pieces(
                         let ((p0, r0), (p1, r1)) = (at(t(j)), at(t(j + 1)));
                         // Spheres join the pieces; the curve's own ends stay open.
                         let last = k + 1 == n && j + 1 == count;
-                        // The next piece's start: in this span, or the next span's.
-                        let next = if j + 1 < count {
-                            axis(p1, at(t(j + 2)).0)
-                        } else if k + 1 < n {
-                            let w = bspline_weights(
-                                1.0 / pieces_of(&[c[k + 1], c[k + 2], c[k + 3], c[k + 4]]) as f32,
-                            );
-                            let q = [c[k + 1], c[k + 2], c[k + 3], c[k + 4]]
-                                .iter()
-                                .zip(w)
-                                .fold(Vec3::ZERO, |acc, (&(q, _), w)| acc + w * q);
-                            axis(p1, q)
-                        } else {
-                            Vec3::ZERO
-                        };
                         shapes.push(Shape::Curve {
                             p0,
                             r0,
@@ -179,21 +164,24 @@ pub fn pieces(
                             r1,
                             v0: v_of(segment, t(j)),
                             v1: v_of(segment, t(j + 1)),
-                            next,
+                            next: Vec3::ZERO,
                             caps: if last { 0 } else { END_CAP },
                         });
                     }
                 }
             }
         }
+        // Each piece of the curve learns the direction of the one after it.
+        for i in start + 1..shapes.len() {
+            if let Shape::Curve { p0, p1, .. } = shapes[i]
+                && let Shape::Curve { next, .. } = &mut shapes[i - 1]
+            {
+                *next = (p1 - p0).normalize_or_zero();
+            }
+        }
         first += n;
     }
     shapes
-}
-
-/// The unit direction from a to b (zero where they coincide).
-fn axis(a: Vec3, b: Vec3) -> Vec3 {
-    (b - a).normalize_or_zero()
 }
 
 /// The uniform cubic B-spline's weights of a span's four control points at t in [0, 1].
